@@ -1,0 +1,453 @@
+//! Bounding volume hierarchy: binned SAH build in parallel (rayon), flattened depth-first into
+//! 32-byte nodes, and closure-based traversal so each primitive kind gets its own monomorphised
+//! loop with the intersection test inlined.
+
+use crate::math::{gamma, Aabb, Vec3A};
+
+/// Leaves hold at most this many primitives.
+const MAX_LEAF: usize = 8;
+const BINS: usize = 16;
+/// Below this many primitives a subtree is built on the current thread.
+const PARALLEL_CUTOFF: usize = 4096;
+/// SAH cost of a node traversal relative to one primitive test.
+const TRAVERSAL_COST: f32 = 1.0;
+/// Past this depth splits are by median, so the depth stays below `STACK` whatever the input.
+const MAX_SAH_DEPTH: usize = 64;
+const STACK: usize = MAX_SAH_DEPTH + 64;
+
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct Node {
+    min: [f32; 3],
+    /// Leaf: first primitive; inner: index of the second child (the first follows this node).
+    offset: u32,
+    max: [f32; 3],
+    /// 0 for inner nodes.
+    count: u16,
+    axis: u8,
+    _pad: u8,
+}
+
+/// A BVH over primitives `0..n`. After building, primitive `order[i]` is the i-th in leaf order;
+/// owners reorder their arrays by `order` so leaves address contiguous ranges.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+}
+
+enum BuildNode {
+    Leaf {
+        bounds: Aabb,
+        start: usize,
+        count: usize,
+    },
+    Inner {
+        bounds: Aabb,
+        axis: u8,
+        children: Box<(BuildNode, BuildNode)>,
+    },
+}
+
+struct BuildPrim {
+    bounds: Aabb,
+    centroid: Vec3A,
+    index: u32,
+}
+
+impl Bvh {
+    /// Builds over the given primitive bounds; returns the BVH and the leaf order.
+    pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<u32>) {
+        assert!(
+            bounds.len() < u32::MAX as usize,
+            "too many primitives for one BVH"
+        );
+        if bounds.is_empty() {
+            return (Bvh::default(), Vec::new());
+        }
+        let mut prims: Vec<BuildPrim> = bounds
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BuildPrim {
+                bounds: *b,
+                centroid: b.centroid(),
+                index: i as u32,
+            })
+            .collect();
+        let root = build_node(&mut prims, 0, 0);
+        let mut nodes = Vec::with_capacity(2 * bounds.len() / MAX_LEAF.max(1) + 1);
+        flatten(&root, &mut nodes);
+        let order = prims.iter().map(|p| p.index).collect();
+        (Bvh { nodes }, order)
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        match self.nodes.first() {
+            Some(n) => Aabb::new(n.min.into(), n.max.into()),
+            None => Aabb::EMPTY,
+        }
+    }
+
+    /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
+    /// `t_max` (and records whatever it needs). Returns the final `t_max`.
+    #[inline]
+    pub fn intersect<F: FnMut(u32, f32) -> Option<f32>>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        mut t_max: f32,
+        mut test: F,
+    ) -> f32 {
+        if self.nodes.is_empty() {
+            return t_max;
+        }
+        let inv = dir.recip();
+        let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
+        let mut stack = [0u32; STACK];
+        let mut sp = 0usize;
+        let mut i = 0usize;
+        loop {
+            let node = &self.nodes[i];
+            if slab(node, origin, inv, t_max) {
+                if node.count > 0 {
+                    let start = node.offset;
+                    for p in start..start + node.count as u32 {
+                        if let Some(t) = test(p, t_max) {
+                            t_max = t;
+                        }
+                    }
+                } else {
+                    // Near child first.
+                    let (first, second) = if neg[node.axis as usize] {
+                        (node.offset as usize, i + 1)
+                    } else {
+                        (i + 1, node.offset as usize)
+                    };
+                    stack[sp] = second as u32;
+                    sp += 1;
+                    i = first;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            i = stack[sp] as usize;
+        }
+        t_max
+    }
+
+    /// Any-hit traversal: stops as soon as `test(prim)` returns true.
+    #[inline]
+    pub fn any<F: FnMut(u32) -> bool>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        mut test: F,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let inv = dir.recip();
+        let mut stack = [0u32; STACK];
+        let mut sp = 0usize;
+        let mut i = 0usize;
+        loop {
+            let node = &self.nodes[i];
+            if slab(node, origin, inv, t_max) {
+                if node.count > 0 {
+                    let start = node.offset;
+                    for p in start..start + node.count as u32 {
+                        if test(p) {
+                            return true;
+                        }
+                    }
+                } else {
+                    stack[sp] = node.offset;
+                    sp += 1;
+                    i += 1;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            i = stack[sp] as usize;
+        }
+    }
+}
+
+/// Ray/box slab test; `t_max` is widened by 2·gamma(3) so rounding never culls a box the ray
+/// really touches (Ize 2013). Zero direction components give ±inf reciprocals, which work.
+#[inline(always)]
+fn slab(node: &Node, origin: Vec3A, inv: Vec3A, t_max: f32) -> bool {
+    let t0 = (Vec3A::from(node.min) - origin) * inv;
+    let t1 = (Vec3A::from(node.max) - origin) * inv;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = t0.max(t1).min_element().min(t_max) * (1.0 + 2.0 * gamma(3));
+    near <= far
+}
+
+fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode {
+    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+    let n = prims.len();
+    if n <= 2 {
+        return BuildNode::Leaf {
+            bounds,
+            start,
+            count: n,
+        };
+    }
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let extent = cb.max - cb.min;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    if extent[axis] <= 0.0 || !extent[axis].is_finite() || depth >= MAX_SAH_DEPTH {
+        // All centroids coincide (or the tree is already deep): split by count.
+        return split_middle(prims, start, bounds, axis, n, depth);
+    }
+
+    // Bin centroids along the widest axis and sweep for the cheapest split.
+    let scale = BINS as f32 / extent[axis];
+    let lo = cb.min[axis];
+    let bin_of = |c: f32| (((c - lo) * scale) as usize).min(BINS - 1);
+    let mut bin_bounds = [Aabb::EMPTY; BINS];
+    let mut bin_count = [0usize; BINS];
+    for p in prims.iter() {
+        let b = bin_of(p.centroid[axis]);
+        bin_bounds[b] = bin_bounds[b].union(p.bounds);
+        bin_count[b] += 1;
+    }
+    let mut right_area = [0.0f32; BINS];
+    let mut right_count = [0usize; BINS];
+    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+    for i in (1..BINS).rev() {
+        acc = acc.union(bin_bounds[i]);
+        cnt += bin_count[i];
+        right_area[i] = acc.half_area();
+        right_count[i] = cnt;
+    }
+    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+    let mut best = (f32::INFINITY, 0usize);
+    for i in 1..BINS {
+        acc = acc.union(bin_bounds[i - 1]);
+        cnt += bin_count[i - 1];
+        if cnt == 0 || right_count[i] == 0 {
+            continue;
+        }
+        let cost = acc.half_area() * cnt as f32 + right_area[i] * right_count[i] as f32;
+        if cost < best.0 {
+            best = (cost, i);
+        }
+    }
+    let leaf_cost = n as f32;
+    let split_cost = TRAVERSAL_COST + best.0 / bounds.half_area().max(f32::MIN_POSITIVE);
+    if best.1 == 0 || (n <= MAX_LEAF && leaf_cost <= split_cost) {
+        if n <= MAX_LEAF {
+            return BuildNode::Leaf {
+                bounds,
+                start,
+                count: n,
+            };
+        }
+        return split_middle(prims, start, bounds, axis, n, depth);
+    }
+    let mid = partition(prims, |p| bin_of(p.centroid[axis]) < best.1);
+    if mid == 0 || mid == n {
+        return split_middle(prims, start, bounds, axis, n, depth);
+    }
+    children(prims, start, bounds, axis, mid, depth)
+}
+
+fn split_middle(
+    prims: &mut [BuildPrim],
+    start: usize,
+    bounds: Aabb,
+    axis: usize,
+    n: usize,
+    depth: usize,
+) -> BuildNode {
+    if n <= MAX_LEAF {
+        return BuildNode::Leaf {
+            bounds,
+            start,
+            count: n,
+        };
+    }
+    let mid = n / 2;
+    prims.select_nth_unstable_by(mid, |a, b| {
+        a.centroid[axis]
+            .total_cmp(&b.centroid[axis])
+            .then(a.index.cmp(&b.index))
+    });
+    children(prims, start, bounds, axis, mid, depth)
+}
+
+fn children(
+    prims: &mut [BuildPrim],
+    start: usize,
+    bounds: Aabb,
+    axis: usize,
+    mid: usize,
+    depth: usize,
+) -> BuildNode {
+    let n = prims.len();
+    let (left, right) = prims.split_at_mut(mid);
+    let (l, r) = if n > PARALLEL_CUTOFF {
+        rayon::join(
+            || build_node(left, start, depth + 1),
+            || build_node(right, start + mid, depth + 1),
+        )
+    } else {
+        (
+            build_node(left, start, depth + 1),
+            build_node(right, start + mid, depth + 1),
+        )
+    };
+    BuildNode::Inner {
+        bounds,
+        axis: axis as u8,
+        children: Box::new((l, r)),
+    }
+}
+
+/// Stable-enough in-place partition (order within each side does not matter, but it must be
+/// deterministic, which this is).
+fn partition(prims: &mut [BuildPrim], pred: impl Fn(&BuildPrim) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..prims.len() {
+        if pred(&prims[j]) {
+            prims.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}
+
+fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> usize {
+    let index = out.len();
+    match node {
+        BuildNode::Leaf {
+            bounds,
+            start,
+            count,
+        } => out.push(Node {
+            min: bounds.min.into(),
+            offset: *start as u32,
+            max: bounds.max.into(),
+            count: *count as u16,
+            axis: 0,
+            _pad: 0,
+        }),
+        BuildNode::Inner {
+            bounds,
+            axis,
+            children,
+        } => {
+            out.push(Node {
+                min: bounds.min.into(),
+                offset: 0,
+                max: bounds.max.into(),
+                count: 0,
+                axis: *axis,
+                _pad: 0,
+            });
+            flatten(&children.0, out);
+            let second = flatten(&children.1, out);
+            out[index].offset = second as u32;
+        }
+    }
+    index
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn boxes(n: usize) -> Vec<Aabb> {
+        // Deterministic pseudo-random unit boxes.
+        let mut s = 12345u32;
+        let mut r = || {
+            s = s.wrapping_mul(1664525).wrapping_add(1013904223);
+            (s >> 8) as f32 / (1u32 << 24) as f32 * 100.0
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3A::new(r(), r(), r());
+                Aabb::new(c - 0.5, c + 0.5)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_primitive_is_in_exactly_one_leaf() {
+        let b = boxes(10_000);
+        let (bvh, order) = Bvh::build(&b);
+        let mut seen = order.clone();
+        seen.sort();
+        assert_eq!(seen, (0..10_000).collect::<Vec<u32>>());
+        let leaf_total: usize = bvh.nodes.iter().map(|n| n.count as usize).sum();
+        assert_eq!(leaf_total, 10_000);
+        assert!(bvh.nodes.iter().all(|n| n.count as usize <= MAX_LEAF));
+    }
+
+    #[test]
+    fn closest_hit_matches_brute_force() {
+        let b = boxes(2000);
+        let (bvh, order) = Bvh::build(&b);
+        let hit_box = |bx: &Aabb, o: Vec3A, d: Vec3A| -> Option<f32> {
+            let inv = d.recip();
+            let t0 = (bx.min - o) * inv;
+            let t1 = (bx.max - o) * inv;
+            let near = t0.min(t1).max_element().max(0.0);
+            let far = t0.max(t1).min_element();
+            (near <= far).then_some(near)
+        };
+        for k in 0..200 {
+            let o = Vec3A::new(-10.0, k as f32 * 0.5, 50.0);
+            let d = Vec3A::new(1.0, 0.01 * k as f32, -0.2).normalize();
+            let brute = b
+                .iter()
+                .filter_map(|bx| hit_box(bx, o, d))
+                .fold(f32::INFINITY, f32::min);
+            let got = bvh.intersect(o, d, f32::INFINITY, |p, tmax| {
+                hit_box(&b[order[p as usize] as usize], o, d).filter(|&t| t < tmax)
+            });
+            assert_eq!(got, brute, "ray {k}");
+        }
+    }
+
+    #[test]
+    fn build_is_deterministic_across_thread_counts() {
+        let b = boxes(50_000);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let (_, o1) = one.install(|| Bvh::build(&b));
+        let (_, o2) = two.install(|| Bvh::build(&b));
+        assert_eq!(o1, o2);
+    }
+
+    #[test]
+    fn coincident_centroids_still_make_small_leaves() {
+        let b = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 100];
+        let (bvh, _) = Bvh::build(&b);
+        assert!(bvh.nodes.iter().all(|n| n.count as usize <= MAX_LEAF));
+    }
+}

@@ -1,0 +1,38 @@
+//! The image being rendered: linear RGBA f32, rows top to bottom.
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Framebuffer {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<f32>,
+}
+
+impl Framebuffer {
+    pub fn new(width: u32, height: u32) -> Framebuffer {
+        Framebuffer {
+            width,
+            height,
+            rgba: vec![0.0; width as usize * height as usize * 4],
+        }
+    }
+
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        let i = (y as usize * self.width as usize + x as usize) * 4;
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
+    }
+
+    /// Copies a `w`×`h` block of pixels to (`x0`, `y0`).
+    pub fn put_block(&mut self, x0: u32, y0: u32, w: u32, h: u32, data: &[f32]) {
+        let stride = self.width as usize * 4;
+        for row in 0..h as usize {
+            let dst = (y0 as usize + row) * stride + x0 as usize * 4;
+            let src = row * w as usize * 4;
+            self.rgba[dst..dst + w as usize * 4].copy_from_slice(&data[src..src + w as usize * 4]);
+        }
+    }
+}

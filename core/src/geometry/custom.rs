@@ -1,0 +1,216 @@
+//! Custom geometry from primitive plugins: the plugin's bounds go into a BVH of their own and
+//! its `intersect`/`occluded` are called through its function table (Embree's user geometry).
+//! Rays cross the boundary in f64 world coordinates (the core works re-centred in f32).
+
+use super::{Counters, Hit, Kind, Surface};
+use crate::bvh::Bvh;
+use crate::math::{gamma, Aabb, DVec3, Vec3A};
+use crate::ray::Ray;
+use luxon_plugin::abi;
+use std::ffi::c_void;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+
+/// One object handed over by a plugin; destroyed through the plugin when the scene drops.
+pub struct CustomObject {
+    pub object: *mut c_void,
+    pub vtable: *const abi::CustomVTable,
+    pub plugin: String,
+    pub count: u64,
+}
+
+// SAFETY: the SDK requires `CustomShape: Send + Sync`; the host only calls the table.
+unsafe impl Send for CustomObject {}
+unsafe impl Sync for CustomObject {}
+
+impl Drop for CustomObject {
+    fn drop(&mut self) {
+        // SAFETY: the library stays loaded for the process lifetime; destroy is called once.
+        unsafe { ((*self.vtable).destroy)(self.object) };
+    }
+}
+
+/// Set when plugin code panics during rendering; the render stops and reports it.
+#[derive(Default)]
+pub struct PluginFault {
+    raised: AtomicBool,
+    message: Mutex<Option<String>>,
+}
+
+impl PluginFault {
+    pub fn raise(&self, message: String) {
+        if !self.raised.swap(true, Ordering::SeqCst) {
+            *self.message.lock().unwrap_or_else(|e| e.into_inner()) = Some(message);
+        }
+    }
+
+    pub fn is_raised(&self) -> bool {
+        self.raised.load(Ordering::Relaxed)
+    }
+
+    pub fn message(&self) -> Option<String> {
+        self.message
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }
+}
+
+#[derive(Default)]
+pub struct Customs {
+    pub objects: Vec<CustomObject>,
+    /// (object, index within it) per BVH primitive.
+    pub refs: Vec<(u32, u64)>,
+    pub material: Vec<u32>,
+    /// World position of the re-centred origin.
+    pub world_offset: DVec3,
+    pub fault: PluginFault,
+    bvh: Bvh,
+}
+
+impl Customs {
+    pub fn new(world_offset: DVec3) -> Customs {
+        Customs {
+            world_offset,
+            ..Default::default()
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.refs.is_empty()
+    }
+
+    pub fn len(&self) -> usize {
+        self.refs.len()
+    }
+
+    /// Asks the plugin for every primitive's bounds; an error names the plugin.
+    pub fn build(&mut self) -> Result<(), String> {
+        let mut bounds = Vec::with_capacity(self.refs.len());
+        for &(o, i) in &self.refs {
+            let obj = &self.objects[o as usize];
+            let (mut min, mut max) = ([0.0f64; 3], [0.0f64; 3]);
+            // SAFETY: valid table from a loaded plugin; out-pointers are ours.
+            let status = unsafe { ((*obj.vtable).bounds)(obj.object, i, &mut min, &mut max) };
+            if status != abi::STATUS_OK {
+                return Err(format!(
+                    "plugin `{}` panicked computing bounds of primitive {i}",
+                    obj.plugin
+                ));
+            }
+            if min.iter().chain(&max).any(|v| v.is_nan()) || (0..3).any(|k| min[k] > max[k]) {
+                return Err(format!(
+                    "plugin `{}` gave invalid bounds {min:?}..{max:?} for primitive {i}",
+                    obj.plugin
+                ));
+            }
+            let lo = (DVec3::from(min) - self.world_offset).as_vec3();
+            let hi = (DVec3::from(max) - self.world_offset).as_vec3();
+            // Round outward so f32 bounds still contain the f64 ones.
+            bounds.push(Aabb::new(
+                Vec3A::from(lo) - Vec3A::from(lo).abs() * gamma(2),
+                Vec3A::from(hi) + Vec3A::from(hi).abs() * gamma(2),
+            ));
+        }
+        let (bvh, order) = Bvh::build(&bounds);
+        self.refs = order.iter().map(|&i| self.refs[i as usize]).collect();
+        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        self.bvh = bvh;
+        Ok(())
+    }
+
+    fn world_ray(&self, ray: &Ray, t_max: f32) -> abi::RayF64 {
+        let o = ray.origin.as_dvec3() + self.world_offset;
+        abi::RayF64 {
+            origin: o.into(),
+            direction: ray.dir.as_dvec3().into(),
+            tmin: 0.0,
+            tmax: t_max as f64,
+            time: ray.time as f64,
+        }
+    }
+
+    fn panicked(&self, o: u32) {
+        let name = &self.objects[o as usize].plugin;
+        self.fault
+            .raise(format!("plugin `{name}` panicked while intersecting a ray"));
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+        if self.refs.is_empty() {
+            return;
+        }
+        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
+            c.tests += 1;
+            let (o, idx) = self.refs[i as usize];
+            let obj = &self.objects[o as usize];
+            let wr = self.world_ray(ray, tm);
+            let mut h = abi::HitF64::default();
+            // SAFETY: valid table of a loaded plugin.
+            match unsafe { ((*obj.vtable).intersect)(obj.object, idx, &wr, &mut h) } {
+                1 => {
+                    let t = h.t as f32;
+                    let n = Vec3A::from(DVec3::from(h.normal).normalize_or_zero().as_vec3());
+                    if !(t > 0.0 && t < tm) || n == Vec3A::ZERO {
+                        return None;
+                    }
+                    let mut hh = Hit::new(t, Kind::Custom, i);
+                    hh.n = n;
+                    hh.uv = h.uv;
+                    *hit = Some(hh);
+                    Some(t)
+                }
+                abi::HIT_PANIC => {
+                    self.panicked(o);
+                    None
+                }
+                _ => None,
+            }
+        });
+    }
+
+    #[inline]
+    pub fn any(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut Counters,
+        mut on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        if self.refs.is_empty() {
+            return false;
+        }
+        let wr = self.world_ray(ray, t_max);
+        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
+            c.tests += 1;
+            let (o, idx) = self.refs[i as usize];
+            let obj = &self.objects[o as usize];
+            // SAFETY: valid table of a loaded plugin.
+            match unsafe { ((*obj.vtable).occluded)(obj.object, idx, &wr) } {
+                1 => on_hit(self.material[i as usize], 1),
+                abi::HIT_PANIC => {
+                    self.panicked(o);
+                    false
+                }
+                _ => false,
+            }
+        })
+    }
+
+    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        let p = ray.at(hit.t);
+        // The plugin's root is as good as f64 allows; rounding to f32 and its unknown method
+        // get a generous relative bound.
+        let p_error = gamma(64) * (p.abs() + ray.origin.abs());
+        Surface {
+            p,
+            p_error,
+            ng: hit.n,
+            ns: hit.n,
+            uv: hit.uv,
+            material: self.material[hit.index as usize],
+            color: None,
+        }
+    }
+}

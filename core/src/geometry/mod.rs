@@ -1,0 +1,88 @@
+//! Native geometry (intersected inline) and custom plugin geometry (called through its table),
+//! each kind in its own BVH, so every traversal loop is monomorphic.
+
+pub mod custom;
+pub mod plane;
+pub mod sphere;
+pub mod triangle;
+
+use crate::math::Vec3A;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Sphere,
+    Triangle,
+    Plane,
+    Custom,
+}
+
+/// The closest hit found so far. Kind-specific extras (`b1`, `b2`: triangle barycentrics;
+/// `n`, `uv`: custom geometry's answer) are filled by the kind that found it.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f32,
+    pub kind: Kind,
+    pub index: u32,
+    pub b1: f32,
+    pub b2: f32,
+    pub n: Vec3A,
+    pub uv: [f32; 2],
+}
+
+impl Hit {
+    pub fn new(t: f32, kind: Kind, index: u32) -> Hit {
+        Hit {
+            t,
+            kind,
+            index,
+            b1: 0.0,
+            b2: 0.0,
+            n: Vec3A::ZERO,
+            uv: [0.0; 2],
+        }
+    }
+}
+
+/// Everything shading needs about a hit point.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    pub p: Vec3A,
+    /// Bound on the rounding error of `p`, per component (for spawning rays off the surface).
+    pub p_error: Vec3A,
+    /// Unit geometric normal as the geometry orients it (outward for closed shapes).
+    pub ng: Vec3A,
+    /// Unit shading normal, in the same hemisphere as `ng`.
+    pub ns: Vec3A,
+    pub uv: [f32; 2],
+    pub material: u32,
+    /// Per-vertex colour, when the mesh has one.
+    pub color: Option<Vec3A>,
+}
+
+/// Per-thread counters of work done (summed after the render; deterministic).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    pub primary: u64,
+    pub shadow: u64,
+    pub reflection: u64,
+    pub refraction: u64,
+    /// Ray/primitive intersection tests (all kinds).
+    pub tests: u64,
+    /// Pixels whose value was NaN or infinite (clamped to 0).
+    pub nan_pixels: u64,
+}
+
+impl Counters {
+    pub fn add(&mut self, o: &Counters) {
+        self.primary += o.primary;
+        self.shadow += o.shadow;
+        self.reflection += o.reflection;
+        self.refraction += o.refraction;
+        self.tests += o.tests;
+        self.nan_pixels += o.nan_pixels;
+    }
+
+    pub fn rays(&self) -> u64 {
+        self.primary + self.shadow + self.reflection + self.refraction
+    }
+}

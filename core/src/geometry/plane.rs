@@ -1,0 +1,97 @@
+//! Infinite planes: unbounded, so they stay outside the BVHs and are tested one by one.
+
+use super::{Counters, Hit, Kind, Surface};
+use crate::math::{gamma, Vec3A};
+use crate::ray::Ray;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Plane {
+    pub point: Vec3A,
+    /// Unit normal.
+    pub normal: Vec3A,
+    pub material: u32,
+}
+
+#[inline(always)]
+fn plane_t(p: &Plane, ray: &Ray, t_max: f32) -> Option<f32> {
+    let denom = p.normal.dot(ray.dir);
+    // Parallel (or nearly): no hit rather than a division by zero.
+    if denom.abs() < 1e-12 {
+        return None;
+    }
+    let t = p.normal.dot(p.point - ray.origin) / denom;
+    (t > 0.0 && t < t_max).then_some(t)
+}
+
+#[derive(Default)]
+pub struct Planes {
+    pub planes: Vec<Plane>,
+}
+
+impl Planes {
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+        for (i, p) in self.planes.iter().enumerate() {
+            c.tests += 1;
+            if let Some(t) = plane_t(p, ray, *t_max) {
+                *t_max = t;
+                *hit = Some(Hit::new(t, Kind::Plane, i as u32));
+            }
+        }
+    }
+
+    #[inline]
+    pub fn any(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut Counters,
+        mut on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        self.planes.iter().any(|p| {
+            c.tests += 1;
+            plane_t(p, ray, t_max).is_some() && on_hit(p.material, 1)
+        })
+    }
+
+    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        let pl = &self.planes[hit.index as usize];
+        // Project the parametric point back onto the plane.
+        let p0 = ray.at(hit.t);
+        let p = p0 - pl.normal.dot(p0 - pl.point) * pl.normal;
+        let p_error = gamma(5) * (p.abs() + pl.point.abs());
+        let t = crate::math::orthogonal(pl.normal);
+        let b = pl.normal.cross(t);
+        Surface {
+            p,
+            p_error,
+            ng: pl.normal,
+            ns: pl.normal,
+            uv: [(p - pl.point).dot(t), (p - pl.point).dot(b)],
+            material: pl.material,
+            color: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parallel_and_behind() {
+        let p = Plane {
+            point: Vec3A::ZERO,
+            normal: Vec3A::Y,
+            material: 0,
+        };
+        let along = Ray::new(Vec3A::new(0.0, 1.0, 0.0), Vec3A::X, 0.0);
+        assert_eq!(plane_t(&p, &along, f32::INFINITY), None);
+        let inside = Ray::new(Vec3A::ZERO, Vec3A::X, 0.0);
+        assert_eq!(plane_t(&p, &inside, f32::INFINITY), None);
+        let down = Ray::new(Vec3A::new(0.0, 2.0, 0.0), -Vec3A::Y, 0.0);
+        assert_eq!(plane_t(&p, &down, f32::INFINITY), Some(2.0));
+        let up = Ray::new(Vec3A::new(0.0, 2.0, 0.0), Vec3A::Y, 0.0);
+        assert_eq!(plane_t(&p, &up, f32::INFINITY), None);
+    }
+}

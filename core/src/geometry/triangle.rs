@@ -1,0 +1,281 @@
+//! Triangles: three vertices each (intersection needs nothing else), optional per-vertex
+//! attributes kept apart and read only when shading.
+
+use super::{Counters, Hit, Kind, Surface};
+use crate::bvh::Bvh;
+use crate::math::{gamma, Aabb, Vec3A};
+use crate::ray::Ray;
+use glam::{DVec3, Vec3};
+
+/// Shading attributes of one vertex.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VertexAttr {
+    /// Unit normal, or zero when the mesh has none.
+    pub n: Vec3,
+    /// Colour, or negative when the mesh has none.
+    pub c: Vec3,
+    pub uv: [f32; 2],
+}
+
+pub const NO_ATTR: u32 = u32::MAX;
+
+#[derive(Default)]
+pub struct Triangles {
+    pub verts: Vec<[Vec3; 3]>,
+    pub material: Vec<u32>,
+    /// Index into `attrs` or `NO_ATTR`.
+    pub attr: Vec<u32>,
+    pub attrs: Vec<[VertexAttr; 3]>,
+    bvh: Bvh,
+}
+
+/// What a ray precomputes once for the watertight test (Woop, Benthin & Wald 2013): the axis
+/// along which it travels most and the shear that maps it onto +z.
+#[derive(Clone, Copy)]
+pub struct TriRay {
+    o: Vec3A,
+    k: [usize; 3],
+    s: [f32; 3],
+}
+
+impl TriRay {
+    pub fn new(ray: &Ray) -> TriRay {
+        let d = ray.dir;
+        let a = d.abs();
+        let kz = if a.x > a.y && a.x > a.z {
+            0
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding so the sign test below means the same for every ray.
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        TriRay {
+            o: ray.origin,
+            k: [kx, ky, kz],
+            s: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
+        }
+    }
+}
+
+/// Watertight ray/triangle test: rays through shared edges and vertices hit exactly one of the
+/// triangles that meet there. Returns (t, b1, b2) with t in (0, t_max).
+#[inline(always)]
+pub fn intersect_triangle(v: &[Vec3; 3], r: &TriRay, t_max: f32) -> Option<(f32, f32, f32)> {
+    let [kx, ky, kz] = r.k;
+    let [sx, sy, sz] = r.s;
+    let a = Vec3A::from(v[0]) - r.o;
+    let b = Vec3A::from(v[1]) - r.o;
+    let c = Vec3A::from(v[2]) - r.o;
+    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+    let mut u = cx * by - cy * bx;
+    let mut vv = ax * cy - ay * cx;
+    let mut w = bx * ay - by * ax;
+    if u == 0.0 || vv == 0.0 || w == 0.0 {
+        // On an edge in f32: decide in f64 so neighbours agree.
+        let (ax, ay, bx, by, cx, cy) = (
+            ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
+        );
+        u = (cx * by - cy * bx) as f32;
+        vv = (ax * cy - ay * cx) as f32;
+        w = (bx * ay - by * ax) as f32;
+    }
+    if (u < 0.0 || vv < 0.0 || w < 0.0) && (u > 0.0 || vv > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + vv + w;
+    if det == 0.0 {
+        return None;
+    }
+    let t_scaled = u * (sz * a[kz]) + vv * (sz * b[kz]) + w * (sz * c[kz]);
+    if det > 0.0 {
+        if t_scaled <= 0.0 || t_scaled >= t_max * det {
+            return None;
+        }
+    } else if t_scaled >= 0.0 || t_scaled <= t_max * det {
+        return None;
+    }
+    let inv = 1.0 / det;
+    Some((t_scaled * inv, vv * inv, w * inv))
+}
+
+impl Triangles {
+    pub fn len(&self) -> usize {
+        self.verts.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.verts.is_empty()
+    }
+
+    pub fn bounds(&self) -> Vec<Aabb> {
+        self.verts
+            .iter()
+            .map(|v| {
+                let a = Vec3A::from(v[0]);
+                Aabb::new(a, a).grow(v[1].into()).grow(v[2].into())
+            })
+            .collect()
+    }
+
+    pub fn build(&mut self) {
+        let (bvh, order) = Bvh::build(&self.bounds());
+        self.verts = order.iter().map(|&i| self.verts[i as usize]).collect();
+        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        self.attr = order.iter().map(|&i| self.attr[i as usize]).collect();
+        self.bvh = bvh;
+    }
+
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+        if self.verts.is_empty() {
+            return;
+        }
+        let tr = TriRay::new(ray);
+        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
+            c.tests += 1;
+            let (t, b1, b2) = intersect_triangle(&self.verts[i as usize], &tr, tm)?;
+            let mut h = Hit::new(t, Kind::Triangle, i);
+            h.b1 = b1;
+            h.b2 = b2;
+            *hit = Some(h);
+            Some(t)
+        });
+    }
+
+    #[inline]
+    pub fn any(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut Counters,
+        mut on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        if self.verts.is_empty() {
+            return false;
+        }
+        let tr = TriRay::new(ray);
+        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
+            c.tests += 1;
+            intersect_triangle(&self.verts[i as usize], &tr, t_max).is_some()
+                && on_hit(self.material[i as usize], 1)
+        })
+    }
+
+    pub fn surface(&self, hit: &Hit) -> Surface {
+        let i = hit.index as usize;
+        let v = self.verts[i];
+        let (b1, b2) = (hit.b1, hit.b2);
+        let b0 = 1.0 - b1 - b2;
+        let (p0, p1, p2) = (Vec3A::from(v[0]), Vec3A::from(v[1]), Vec3A::from(v[2]));
+        let p = b0 * p0 + b1 * p1 + b2 * p2;
+        let p_error = gamma(7) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
+        // Normal in f64: thin triangles lose the direction of the cross product in f32.
+        let e1 = DVec3::from(v[1]) - DVec3::from(v[0]);
+        let e2 = DVec3::from(v[2]) - DVec3::from(v[0]);
+        let ng = Vec3A::from(e1.cross(e2).normalize_or_zero().as_vec3());
+        let mut s = Surface {
+            p,
+            p_error,
+            ng,
+            ns: ng,
+            uv: [b1, b2],
+            material: self.material[i],
+            color: None,
+        };
+        let a = self.attr[i];
+        if a != NO_ATTR {
+            let va = &self.attrs[a as usize];
+            if va[0].n != Vec3::ZERO {
+                let n = b0 * Vec3A::from(va[0].n)
+                    + b1 * Vec3A::from(va[1].n)
+                    + b2 * Vec3A::from(va[2].n);
+                let n = n.normalize_or_zero();
+                if n != Vec3A::ZERO {
+                    s.ns = if n.dot(ng) < 0.0 { -n } else { n };
+                }
+            }
+            if va[0].c.x >= 0.0 {
+                s.color = Some(
+                    b0 * Vec3A::from(va[0].c)
+                        + b1 * Vec3A::from(va[1].c)
+                        + b2 * Vec3A::from(va[2].c),
+                );
+            }
+            let uv = |k: usize| b0 * va[0].uv[k] + b1 * va[1].uv[k] + b2 * va[2].uv[k];
+            s.uv = [uv(0), uv(1)];
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
+        Ray::new(Vec3A::from(o), Vec3A::from(d).normalize(), 0.0)
+    }
+
+    #[test]
+    fn hit_and_barycentrics() {
+        let v = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        let r = ray([0.25, 0.25, 0.0], [0.0, 0.0, 1.0]);
+        let (t, b1, b2) = intersect_triangle(&v, &TriRay::new(&r), f32::INFINITY).unwrap();
+        assert!((t - 1.0).abs() < 1e-6 && (b1 - 0.25).abs() < 1e-6 && (b2 - 0.25).abs() < 1e-6);
+        // Both windings hit; behind the origin does not.
+        let v2 = [v[0], v[2], v[1]];
+        assert!(intersect_triangle(&v2, &TriRay::new(&r), f32::INFINITY).is_some());
+        let back = ray([0.25, 0.25, 2.0], [0.0, 0.0, 1.0]);
+        assert!(intersect_triangle(&v, &TriRay::new(&back), f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn shared_edge_is_watertight() {
+        // Two triangles sharing the diagonal of a square; rays exactly on the diagonal.
+        let a = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+        ];
+        let b = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        for k in 1..1000 {
+            let x = k as f32 / 1000.0;
+            let r = ray([x, x, 0.0], [0.0, 0.0, 1.0]);
+            let tr = TriRay::new(&r);
+            let hits = intersect_triangle(&a, &tr, f32::INFINITY).is_some() as u32
+                + intersect_triangle(&b, &tr, f32::INFINITY).is_some() as u32;
+            assert!(hits >= 1, "ray through the shared edge at {x} leaked");
+        }
+    }
+
+    #[test]
+    fn parallel_ray_misses() {
+        let v = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        let r = ray([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+        assert!(intersect_triangle(&v, &TriRay::new(&r), f32::INFINITY).is_none());
+    }
+}

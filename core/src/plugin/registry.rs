@@ -1,0 +1,395 @@
+//! Finding plugin libraries, the handshake, and looking entries up by the names scenes use.
+//!
+//! Libraries are never unloaded: objects created by a plugin may live anywhere in the process,
+//! and unloading libraries that have thread-local destructors crashes.
+
+use luxon_plugin::abi;
+use std::collections::HashMap;
+use std::ffi::c_void;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PluginKind {
+    Primitive,
+    Texture,
+    VolumeReader,
+    Writer,
+}
+
+impl PluginKind {
+    fn from_abi(k: u32) -> Option<PluginKind> {
+        match k {
+            abi::KIND_PRIMITIVE => Some(PluginKind::Primitive),
+            abi::KIND_TEXTURE => Some(PluginKind::Texture),
+            abi::KIND_VOLUME_READER => Some(PluginKind::VolumeReader),
+            abi::KIND_WRITER => Some(PluginKind::Writer),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for PluginKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            PluginKind::Primitive => "primitive",
+            PluginKind::Texture => "texture",
+            PluginKind::VolumeReader => "volume reader",
+            PluginKind::Writer => "writer",
+        })
+    }
+}
+
+/// A loaded library.
+#[derive(Clone, Debug)]
+pub struct Library {
+    pub path: PathBuf,
+    /// The name the library gives itself.
+    pub name: String,
+    pub sdk_version: String,
+    pub abi_version: u32,
+}
+
+/// One named thing a library provides.
+#[derive(Clone, Debug)]
+pub struct Entry {
+    pub kind: PluginKind,
+    pub name: String,
+    pub description: String,
+    pub params_doc: String,
+    /// Writers: file extensions (lower case, no dot).
+    pub extensions: Vec<String>,
+    /// Index into `Registry::libraries`.
+    pub library: usize,
+    pub(crate) vtable: *const c_void,
+    /// Set when an earlier library in the search order already provides this name.
+    pub shadowed: bool,
+}
+
+// SAFETY: vtables are immutable statics in libraries that are never unloaded.
+unsafe impl Send for Entry {}
+unsafe impl Sync for Entry {}
+
+/// A file that looked like a plugin but could not be used.
+#[derive(Clone, Debug)]
+pub struct Problem {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.path.display(), self.message)
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum LookupError {
+    #[error("{}", not_found_message(.name, .kind, .suggestion, .searched, .problems))]
+    NotFound {
+        name: String,
+        kind: PluginKind,
+        suggestion: Option<String>,
+        searched: Vec<PathBuf>,
+        problems: Vec<Problem>,
+    },
+    #[error("plugin `{name}` is a {found} (in {}), but a {expected} is expected here", .library.display())]
+    WrongKind {
+        name: String,
+        found: PluginKind,
+        expected: PluginKind,
+        library: PathBuf,
+    },
+}
+
+fn not_found_message(
+    name: &str,
+    kind: &PluginKind,
+    suggestion: &Option<String>,
+    searched: &[PathBuf],
+    problems: &[Problem],
+) -> String {
+    let mut m = format!("no {kind} plugin named `{name}`");
+    if let Some(s) = suggestion {
+        m.push_str(&format!(", did you mean `{s}`?"));
+    }
+    let dirs: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
+    m.push_str(&format!(
+        "; searched: {} (add directories with the scene's `plugin_path` or $LUXON_PLUGIN_PATH)",
+        if dirs.is_empty() {
+            "nothing".to_string()
+        } else {
+            dirs.join(", ")
+        }
+    ));
+    if !problems.is_empty() {
+        let p: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+        m.push_str(&format!("; could not use: {}", p.join("; ")));
+    }
+    m
+}
+
+#[derive(Default)]
+pub struct Registry {
+    pub libraries: Vec<Library>,
+    pub entries: Vec<Entry>,
+    /// Every directory (or file) searched, in order.
+    pub searched: Vec<PathBuf>,
+    pub problems: Vec<Problem>,
+    by_name: HashMap<String, usize>,
+}
+
+extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
+    // SAFETY: the plugin passes strings valid for the call.
+    let plugin = unsafe { plugin.as_str() }.unwrap_or("?");
+    let message = unsafe { message.as_str() }.unwrap_or("(invalid UTF-8)");
+    let level = match level {
+        0 => "error",
+        1 => "warning",
+        2 => "info",
+        _ => "debug",
+    };
+    if level != "debug" || std::env::var_os("LUXON_DEBUG").is_some() {
+        eprintln!("luxon: {level}: {plugin}: {message}");
+    }
+}
+
+static HOST: abi::HostTable = abi::HostTable {
+    abi_version: abi::ABI_VERSION,
+    log: host_log,
+};
+
+/// File names scanned in directories: `libluxon_*.so` (`luxon_*.dll` on Windows, `.dylib` on
+/// macOS). Files named explicitly in a plugin path are loaded whatever their name.
+pub fn is_plugin_file_name(name: &str) -> bool {
+    let prefix = format!("{}luxon_", std::env::consts::DLL_PREFIX);
+    name.starts_with(&prefix) && name.ends_with(std::env::consts::DLL_SUFFIX)
+}
+
+/// The default search path after `extra`: `$LUXON_PLUGIN_PATH`, then the executable's directory
+/// (and its parent when that is cargo's `deps`, so test binaries find the workspace's plugins).
+pub fn search_path(extra: &[PathBuf]) -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> = extra.to_vec();
+    if let Some(env) = std::env::var_os("LUXON_PLUGIN_PATH") {
+        dirs.extend(std::env::split_paths(&env).filter(|p| !p.as_os_str().is_empty()));
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        if let Some(dir) = exe.parent() {
+            dirs.push(dir.to_path_buf());
+            if dir.file_name().is_some_and(|n| n == "deps") {
+                if let Some(up) = dir.parent() {
+                    dirs.push(up.to_path_buf());
+                }
+            }
+        }
+    }
+    dirs
+}
+
+impl Registry {
+    /// Loads every plugin found on `search_path(extra)`.
+    pub fn discover(extra: &[PathBuf]) -> Registry {
+        let mut r = Registry::default();
+        for dir in search_path(extra) {
+            r.add_path(&dir);
+        }
+        r
+    }
+
+    /// Adds a directory (scanned for plugin file names) or a library file.
+    pub fn add_path(&mut self, path: &Path) {
+        if self.searched.iter().any(|p| p == path) {
+            return;
+        }
+        self.searched.push(path.to_path_buf());
+        if path.is_file() {
+            self.load(path);
+            return;
+        }
+        let Ok(read) = std::fs::read_dir(path) else {
+            return;
+        };
+        let mut files: Vec<PathBuf> = read
+            .filter_map(|e| e.ok())
+            .map(|e| e.path())
+            .filter(|p| {
+                p.is_file()
+                    && p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(is_plugin_file_name)
+            })
+            .collect();
+        files.sort();
+        for f in files {
+            self.load(&f);
+        }
+    }
+
+    fn problem(&mut self, path: &Path, message: String) {
+        self.problems.push(Problem {
+            path: path.to_path_buf(),
+            message,
+        });
+    }
+
+    fn load(&mut self, path: &Path) {
+        let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        if self.libraries.iter().any(|l| l.path == canonical) {
+            return;
+        }
+        // SAFETY: loading runs the library's initialisers; plugin files are trusted code by
+        // design (the user put them on the search path).
+        let lib = match unsafe { libloading::Library::new(&canonical) } {
+            Ok(l) => l,
+            Err(e) => return self.problem(path, format!("cannot be loaded: {e}")),
+        };
+        let declare: libloading::Symbol<abi::DeclareFn> =
+            match unsafe { lib.get(abi::DECLARE_SYMBOL) } {
+                Ok(s) => s,
+                Err(_) => {
+                    return self.problem(
+                        path,
+                        "not a Luxon plugin (it does not export `luxon_plugin_declare`)".into(),
+                    )
+                }
+            };
+        // SAFETY: the symbol has the declared signature by the ABI contract; every pointer read
+        // below is checked for null and the header's leading fields are fixed across versions.
+        let header = unsafe { declare(&HOST) };
+        let Some(header) = (unsafe { header.as_ref() }) else {
+            return self.problem(path, "not a Luxon plugin (its declaration is null)".into());
+        };
+        if header.magic != abi::MAGIC {
+            return self.problem(
+                path,
+                "not a Luxon plugin (bad magic in its declaration)".into(),
+            );
+        }
+        let sdk = unsafe { header.sdk_version.as_str() }
+            .unwrap_or("?")
+            .to_string();
+        if header.abi_version != abi::ABI_VERSION {
+            return self.problem(
+                path,
+                format!(
+                    "built for plugin ABI {} (luxon-plugin {sdk}), but this Luxon uses ABI {} \
+                     (luxon-plugin {}); rebuild it against luxon-plugin {}",
+                    header.abi_version,
+                    abi::ABI_VERSION,
+                    luxon_plugin::SDK_VERSION,
+                    luxon_plugin::SDK_VERSION
+                ),
+            );
+        }
+        let Some(decl) = (unsafe { header.declaration.as_ref() }) else {
+            return self.problem(path, "plugin declares nothing (null declaration)".into());
+        };
+        let name = unsafe { decl.library.as_str() }.unwrap_or("?").to_string();
+        let raw: &[abi::Entry] = if decl.entry_count == 0 || decl.entries.is_null() {
+            &[]
+        } else {
+            unsafe { std::slice::from_raw_parts(decl.entries, decl.entry_count) }
+        };
+        let index = self.libraries.len();
+        let mut entries = Vec::new();
+        for e in raw {
+            let text = |s: &abi::Str| unsafe { s.as_str() }.unwrap_or("").to_string();
+            let Some(kind) = PluginKind::from_abi(e.kind) else {
+                return self.problem(path, format!("declares an unknown plugin kind {}", e.kind));
+            };
+            if e.vtable.is_null() {
+                return self.problem(
+                    path,
+                    format!("entry `{}` has no function table", text(&e.name)),
+                );
+            }
+            entries.push(Entry {
+                kind,
+                name: text(&e.name),
+                description: text(&e.description),
+                params_doc: text(&e.params_doc),
+                extensions: text(&e.extensions)
+                    .split(',')
+                    .map(|s| s.trim().to_ascii_lowercase())
+                    .filter(|s| !s.is_empty())
+                    .collect(),
+                library: index,
+                vtable: e.vtable,
+                shadowed: false,
+            });
+        }
+        self.libraries.push(Library {
+            path: canonical,
+            name,
+            sdk_version: sdk,
+            abi_version: header.abi_version,
+        });
+        for mut e in entries {
+            if self.by_name.contains_key(&e.name) {
+                e.shadowed = true;
+            } else {
+                self.by_name.insert(e.name.clone(), self.entries.len());
+            }
+            self.entries.push(e);
+        }
+        // Never unload (see the module comment).
+        std::mem::forget(lib);
+    }
+
+    /// The entry a scene means by `name`, which must be of `kind`.
+    pub fn get(&self, name: &str, kind: PluginKind) -> Result<&Entry, LookupError> {
+        match self.by_name.get(name) {
+            Some(&i) => {
+                let e = &self.entries[i];
+                if e.kind != kind {
+                    return Err(LookupError::WrongKind {
+                        name: name.to_string(),
+                        found: e.kind,
+                        expected: kind,
+                        library: self.libraries[e.library].path.clone(),
+                    });
+                }
+                Ok(e)
+            }
+            None => {
+                let candidates = self
+                    .entries
+                    .iter()
+                    .filter(|e| e.kind == kind && !e.shadowed)
+                    .map(|e| e.name.as_str());
+                Err(LookupError::NotFound {
+                    name: name.to_string(),
+                    kind,
+                    suggestion: luxon_plugin::suggest(name, candidates).map(str::to_string),
+                    searched: self.searched.clone(),
+                    problems: self.problems.clone(),
+                })
+            }
+        }
+    }
+
+    /// The writer claiming a file extension (first in search order).
+    pub fn writer_for_extension(&self, ext: &str) -> Option<&Entry> {
+        let ext = ext.to_ascii_lowercase();
+        self.entries
+            .iter()
+            .find(|e| e.kind == PluginKind::Writer && e.extensions.contains(&ext))
+    }
+
+    /// Every extension some writer claims.
+    pub fn writer_extensions(&self) -> Vec<String> {
+        let mut v: Vec<String> = self
+            .entries
+            .iter()
+            .filter(|e| e.kind == PluginKind::Writer)
+            .flat_map(|e| e.extensions.iter().cloned())
+            .collect();
+        v.sort();
+        v.dedup();
+        v
+    }
+
+    pub fn library_of(&self, e: &Entry) -> &Library {
+        &self.libraries[e.library]
+    }
+}

@@ -1,0 +1,404 @@
+//! `Scene`: a `SceneDesc` with plugins resolved and called, geometry stored natively and
+//! re-centred, BVHs built, and the set of effects the scene calls for.
+
+use crate::camera::Camera;
+use crate::error::Error;
+use crate::geometry::custom::Customs;
+use crate::geometry::plane::Planes;
+use crate::geometry::sphere::Spheres;
+use crate::geometry::triangle::Triangles;
+use crate::geometry::{Counters, Hit, Kind, Surface};
+use crate::math::{DVec3, Vec3A};
+use crate::plugin::calls::{create_primitive, create_texture, GeometryBuilder, TextureInstance};
+use crate::plugin::{PluginKind, Registry};
+use crate::ray::Ray;
+use luxon_formats::{Highlight, LightDesc, OutputDesc, SceneDesc};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub color: Vec3A,
+    pub texture: Option<u32>,
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub shininess: f32,
+    pub blinn: bool,
+    pub reflect: f32,
+    pub transmit: f32,
+    pub ior: f32,
+}
+
+impl Material {
+    /// What a shadow ray keeps after crossing this surface once.
+    #[inline]
+    pub fn shadow_filter(&self) -> Vec3A {
+        self.transmit * self.color
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum Light {
+    Point {
+        position: Vec3A,
+        color: Vec3A,
+        shadows: bool,
+    },
+    /// `to_light` is the unit direction toward the light.
+    Directional {
+        to_light: Vec3A,
+        color: Vec3A,
+        shadows: bool,
+    },
+}
+
+impl Light {
+    pub fn casts_shadows(&self) -> bool {
+        match self {
+            Light::Point { shadows, .. } | Light::Directional { shadows, .. } => *shadows,
+        }
+    }
+}
+
+/// The effects a scene calls for; the integrator skips the rest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Features {
+    pub shadows: bool,
+    pub reflection: bool,
+    /// Any used material lets light through (refraction or plain transparency).
+    pub transmission: bool,
+    pub textures: bool,
+    pub antialiasing: bool,
+}
+
+impl std::fmt::Display for Features {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut v = Vec::new();
+        for (on, name) in [
+            (self.shadows, "shadows"),
+            (self.reflection, "reflection"),
+            (self.transmission, "refraction/transparency"),
+            (self.textures, "textures"),
+            (self.antialiasing, "antialiasing"),
+        ] {
+            if on {
+                v.push(name);
+            }
+        }
+        if v.is_empty() {
+            f.write_str("none (direct lighting only)")
+        } else {
+            f.write_str(&v.join(", "))
+        }
+    }
+}
+
+/// Render settings after command-line overrides.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub max_depth: u32,
+    pub min_weight: f32,
+    pub frame: u32,
+    pub time: f32,
+    pub threads: Option<u32>,
+    pub tile_size: u32,
+}
+
+pub struct Scene {
+    pub source: PathBuf,
+    pub camera: Camera,
+    pub background: Vec3A,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    pub textures: Vec<TextureInstance>,
+    pub texture_names: Vec<String>,
+    pub spheres: Spheres,
+    pub triangles: Triangles,
+    pub planes: Planes,
+    pub customs: Customs,
+    /// World position of render space's origin (the camera): coordinates are stored relative
+    /// to it in f32, so a scene far from the world origin keeps its precision.
+    pub world_offset: DVec3,
+    pub settings: Settings,
+    pub outputs: Vec<OutputDesc>,
+    pub features: Features,
+    /// Objects per plugin name, in first-use order.
+    pub object_counts: Vec<(String, usize)>,
+    pub degenerate_triangles: u64,
+    pub bvh_time: Duration,
+    pub plugin_time: Duration,
+}
+
+fn v3(a: [f64; 3]) -> Vec3A {
+    Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
+}
+
+impl Scene {
+    /// Resolves plugins, instantiates every object and builds the BVHs.
+    pub fn build(desc: &SceneDesc, registry: &Registry) -> Result<Scene, Error> {
+        let scene_dir = desc
+            .source
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let world_offset = DVec3::from(desc.camera.value.position);
+        let r = &desc.render;
+
+        let mut texture_names = Vec::new();
+        let mut textures = Vec::new();
+        let t0 = Instant::now();
+        for (name, call) in &desc.textures {
+            let entry = registry
+                .get(&call.value.plugin.value, PluginKind::Texture)
+                .map_err(|e| Error::at(&call.value.plugin.at, e.to_string()))?;
+            let tex = create_texture(
+                registry,
+                entry,
+                &call.value.params,
+                &call.value.params_at,
+                &scene_dir,
+                name,
+            )
+            .map_err(|(at, m)| Error::at(&at, m))?;
+            texture_names.push(name.clone());
+            textures.push(tex);
+        }
+
+        let mut material_names = vec!["default".to_string()];
+        let mut materials = vec![material(&Default::default(), None)];
+        for (name, m) in &desc.materials {
+            let tex = match &m.value.texture {
+                Some(t) => Some(
+                    texture_names
+                        .iter()
+                        .position(|n| n == &t.value)
+                        .ok_or_else(|| {
+                            Error::at(&t.at, format!("no texture named `{}`", t.value))
+                        })? as u32,
+                ),
+                None => None,
+            };
+            let mat = material(&m.value, tex);
+            if let Some(i) = material_names.iter().position(|n| n == name) {
+                materials[i] = mat;
+            } else {
+                material_names.push(name.clone());
+                materials.push(mat);
+            }
+        }
+
+        let mut spheres = Spheres::default();
+        let mut triangles = Triangles::default();
+        let mut planes = Planes::default();
+        let mut customs = Customs::new(world_offset);
+        let mut object_counts: Vec<(String, usize)> = Vec::new();
+        let mut dropped = 0;
+        let mut used = vec![false; materials.len()];
+        for (i, obj) in desc.objects.iter().enumerate() {
+            let call = &obj.value.call;
+            let entry = registry
+                .get(&call.plugin.value, PluginKind::Primitive)
+                .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
+            let material = match &obj.value.material {
+                Some(m) => material_names
+                    .iter()
+                    .position(|n| n == &m.value)
+                    .ok_or_else(|| Error::at(&m.at, format!("no material named `{}`", m.value)))?,
+                None => 0,
+            };
+            used[material] = true;
+            let mut b = GeometryBuilder {
+                spheres: &mut spheres,
+                triangles: &mut triangles,
+                planes: &mut planes,
+                customs: &mut customs,
+                material: material as u32,
+                world_offset,
+                plugin: entry.name.clone(),
+                dropped: 0,
+            };
+            create_primitive(
+                registry,
+                entry,
+                &call.params,
+                &call.params_at,
+                &scene_dir,
+                &format!("object {i}"),
+                &mut b,
+            )
+            .map_err(|(at, m)| Error::at(&at, m))?;
+            dropped += b.dropped;
+            match object_counts.iter_mut().find(|(n, _)| n == &entry.name) {
+                Some((_, c)) => *c += 1,
+                None => object_counts.push((entry.name.clone(), 1)),
+            }
+        }
+        let plugin_time = t0.elapsed();
+
+        let t1 = Instant::now();
+        let (_, custom_result) = rayon::join(
+            || rayon::join(|| spheres.build(), || triangles.build()),
+            || customs.build(),
+        );
+        custom_result.map_err(Error::Plugin)?;
+        let bvh_time = t1.elapsed();
+
+        let lights: Vec<Light> = desc
+            .lights
+            .iter()
+            .map(|l| match &l.value {
+                LightDesc::Point {
+                    position,
+                    color,
+                    intensity,
+                    shadows,
+                } => Light::Point {
+                    position: Vec3A::from((DVec3::from(*position) - world_offset).as_vec3()),
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                },
+                LightDesc::Directional {
+                    direction,
+                    color,
+                    intensity,
+                    shadows,
+                } => Light::Directional {
+                    to_light: -Vec3A::from(DVec3::from(*direction).normalize().as_vec3()),
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                },
+            })
+            .collect();
+
+        let used_mats: Vec<&Material> = materials
+            .iter()
+            .zip(&used)
+            .filter(|(_, u)| **u)
+            .map(|(m, _)| m)
+            .collect();
+        let has_geometry = !(spheres.is_empty()
+            && triangles.is_empty()
+            && planes.planes.is_empty()
+            && customs.is_empty());
+        let features = Features {
+            shadows: has_geometry && lights.iter().any(Light::casts_shadows),
+            reflection: used_mats.iter().any(|m| m.reflect > 0.0),
+            transmission: used_mats.iter().any(|m| m.transmit > 0.0),
+            textures: used_mats.iter().any(|m| m.texture.is_some()),
+            antialiasing: r.samples > 1,
+        };
+
+        let settings = Settings {
+            width: r.width,
+            height: r.height,
+            samples: r.samples,
+            max_depth: r.max_depth,
+            min_weight: r.min_weight as f32,
+            frame: r.frame,
+            time: r.time as f32,
+            threads: r.parallel.threads,
+            tile_size: r.parallel.tile_size,
+        };
+        Ok(Scene {
+            source: desc.source.clone(),
+            camera: Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height),
+            background: v3(desc.background),
+            lights,
+            materials,
+            material_names,
+            textures,
+            texture_names,
+            spheres,
+            triangles,
+            planes,
+            customs,
+            world_offset,
+            settings,
+            outputs: r.outputs.clone(),
+            features,
+            object_counts,
+            degenerate_triangles: dropped,
+            bvh_time,
+            plugin_time,
+        })
+    }
+
+    /// The closest hit along `ray` before `t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
+        let mut hit = None;
+        self.spheres.intersect(ray, &mut t_max, &mut hit, c);
+        self.triangles.intersect(ray, &mut t_max, &mut hit, c);
+        self.planes.intersect(ray, &mut t_max, &mut hit, c);
+        self.customs.intersect(ray, &mut t_max, &mut hit, c);
+        hit
+    }
+
+    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        match hit.kind {
+            Kind::Sphere => self.spheres.surface(hit, ray),
+            Kind::Triangle => self.triangles.surface(hit),
+            Kind::Plane => self.planes.surface(hit, ray),
+            Kind::Custom => self.customs.surface(hit, ray),
+        }
+    }
+
+    /// What reaches the end of a shadow ray: zero when an opaque surface blocks it, otherwise
+    /// the product of the filters of the transparent surfaces it crosses.
+    #[inline]
+    pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
+        if !self.features.transmission {
+            // Opaque world: the first hit anywhere ends the query.
+            let blocked = self.spheres.any(ray, t_max, c, |_, _| true)
+                || self.triangles.any(ray, t_max, c, |_, _| true)
+                || self.planes.any(ray, t_max, c, |_, _| true)
+                || self.customs.any(ray, t_max, c, |_, _| true);
+            return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
+        }
+        let mut filter = Vec3A::ONE;
+        let mut on_hit = |m: u32, crossings: u32| {
+            let mat = &self.materials[m as usize];
+            if mat.transmit <= 0.0 {
+                filter = Vec3A::ZERO;
+                return true;
+            }
+            let f = mat.shadow_filter();
+            for _ in 0..crossings {
+                filter *= f;
+            }
+            filter.max_element() < min_weight
+        };
+        if self.spheres.any(ray, t_max, c, &mut on_hit)
+            || self.triangles.any(ray, t_max, c, &mut on_hit)
+            || self.planes.any(ray, t_max, c, &mut on_hit)
+            || self.customs.any(ray, t_max, c, &mut on_hit)
+        {
+            return Vec3A::ZERO;
+        }
+        filter
+    }
+
+    pub fn primitive_count(&self) -> usize {
+        self.spheres.len() + self.triangles.len() + self.planes.planes.len() + self.customs.len()
+    }
+}
+
+fn material(m: &luxon_formats::MaterialDesc, texture: Option<u32>) -> Material {
+    Material {
+        color: v3(m.color),
+        texture,
+        ambient: m.ambient as f32,
+        diffuse: m.diffuse as f32,
+        specular: m.specular as f32,
+        shininess: m.shininess as f32,
+        blinn: m.highlight == Highlight::Blinn,
+        reflect: m.reflect as f32,
+        transmit: m.transmit as f32,
+        ior: m.ior as f32,
+    }
+}

@@ -1,0 +1,370 @@
+//! One file's serde values plus its span tree into checked `desc` values with positions.
+
+use std::path::{Path, PathBuf};
+
+use crate::desc::*;
+use crate::raw;
+use crate::spans::Node;
+use crate::validate::Checker;
+
+/// What one file says (without its includes). `None`: the file does not give it.
+#[derive(Default)]
+pub(crate) struct Part {
+    pub camera: Option<Spanned<CameraDesc>>,
+    pub background: Option<[f64; 3]>,
+    pub lights: Vec<Spanned<LightDesc>>,
+    pub textures: Vec<(String, Spanned<PluginCall>)>,
+    pub materials: Vec<(String, Spanned<MaterialDesc>)>,
+    pub objects: Vec<Spanned<ObjectDesc>>,
+    /// Without outputs: those are merged as a list, the rest as a whole.
+    pub render: Option<RenderDesc>,
+    pub outputs: Vec<OutputDesc>,
+    pub plugin_path: Vec<PathBuf>,
+}
+
+type Result<T> = std::result::Result<T, crate::SceneError>;
+
+impl Checker<'_> {
+    /// Converts everything but `include`, which the loader follows.
+    pub fn part(&self, scene: raw::Scene, root: &Node) -> Result<Part> {
+        let dir = self
+            .src
+            .file
+            .parent()
+            .unwrap_or(Path::new(""))
+            .to_path_buf();
+        let field = |name| root.field(name).unwrap_or(root);
+        let mut part = Part {
+            plugin_path: scene.plugin_path.iter().map(|p| dir.join(p)).collect(),
+            ..Part::default()
+        };
+        if let Some(camera) = scene.camera {
+            part.camera = Some(self.camera(camera, field("camera"))?);
+        }
+        if let Some(background) = scene.background {
+            part.background = Some(self.colour(field("background"), "background", background)?);
+        }
+        for (i, light) in scene.lights.into_iter().enumerate() {
+            let node = field("lights").item(i).unwrap_or(root);
+            part.lights.push(self.light(light, node)?);
+        }
+        for (i, (name, texture)) in scene.textures.0.into_iter().enumerate() {
+            let (key, node) = field("textures").entry(i).unwrap_or((root, root));
+            let plugin = self.plugin_name(
+                node.field("plugin").unwrap_or(node),
+                texture.plugin,
+                "checker",
+            )?;
+            let call = self.call(plugin, node);
+            part.textures.push((name, self.spanned(call, key)));
+        }
+        for (i, (name, material)) in scene.materials.0.into_iter().enumerate() {
+            let (key, node) = field("materials").entry(i).unwrap_or((root, root));
+            let material = self.material(material, node)?;
+            part.materials.push((name, self.spanned(material, key)));
+        }
+        for (i, object) in scene.objects.into_iter().enumerate() {
+            let node = field("objects").item(i).unwrap_or(root);
+            let plugin = self.plugin_name(
+                node.field("plugin").unwrap_or(node),
+                object.plugin,
+                "sphere",
+            )?;
+            let material = object
+                .material
+                .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
+            let call = self.call(plugin, node);
+            part.objects
+                .push(self.spanned(ObjectDesc { call, material }, node));
+        }
+        if let Some(render) = scene.render {
+            let (render, outputs) = self.render(render, field("render"), &dir)?;
+            part.render = Some(render);
+            part.outputs = outputs;
+        }
+        Ok(part)
+    }
+
+    /// A plugin name and its `params` text, verbatim; "()" at the entry when absent.
+    fn call(&self, plugin: Spanned<String>, entry: &Node) -> PluginCall {
+        let (params, params_at) = self.params(entry);
+        PluginCall {
+            plugin,
+            params,
+            params_at,
+        }
+    }
+
+    fn params(&self, entry: &Node) -> (String, Origin) {
+        match entry.raw_field("params") {
+            Some(node) => (self.src.slice(node).to_string(), self.origin(node)),
+            None => ("()".to_string(), self.origin(entry)),
+        }
+    }
+
+    fn camera(&self, c: raw::Camera, node: &Node) -> Result<Spanned<CameraDesc>> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let projection = match (c.fov, c.zoom) {
+            (Some(_), Some(_)) => {
+                return Err(self.error(
+                    field("zoom"),
+                    "the camera gives both `fov` and `zoom`; expected only one of them",
+                ))
+            }
+            (_, Some(zoom)) => Projection::PerspectiveZoom {
+                zoom: self.positive(field("zoom"), "zoom", zoom)?,
+            },
+            (fov, None) => {
+                let fov_deg = fov.unwrap_or(45.0);
+                if !(fov_deg > 0.0 && fov_deg < 180.0) {
+                    return Err(self.error(
+                        field("fov"),
+                        format!("`fov` is {fov_deg}; expected degrees between 0 and 180 (both excluded)"),
+                    ));
+                }
+                Projection::Perspective { fov_deg }
+            }
+        };
+        let aspect = match c.aspect {
+            Some(a) => Some(self.positive(field("aspect"), "aspect", a)?),
+            None => None,
+        };
+        let up = c.up.unwrap_or([0.0, 1.0, 0.0]);
+        let view = sub(c.look_at, c.position);
+        if length(view) == 0.0 {
+            return Err(self.error(
+                field("look_at"),
+                "the camera's `look_at` equals its `position`; expected a point away from the camera",
+            ));
+        }
+        if length(up) == 0.0 {
+            return Err(self.error(
+                field("up"),
+                "the camera's `up` has zero length; expected a direction such as (0, 1, 0)",
+            ));
+        }
+        // Parallel when the sine of the angle between them is (almost) zero.
+        if length(cross(view, up)) <= 1e-9 * length(view) * length(up) {
+            let given = if c.up.is_some() { "" } else { " (the default)" };
+            return Err(self.error(
+                field("up"),
+                format!(
+                    "the camera's `up` ({}, {}, {}){given} is parallel to its view direction \
+                     (from `position` to `look_at`); expected an `up` at an angle to it",
+                    up[0], up[1], up[2]
+                ),
+            ));
+        }
+        let camera = CameraDesc {
+            position: c.position,
+            look_at: c.look_at,
+            up,
+            projection,
+            aspect,
+        };
+        Ok(self.spanned(camera, node))
+    }
+
+    fn light(&self, light: raw::Light, node: &Node) -> Result<Spanned<LightDesc>> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let common = |color: Option<[f64; 3]>, intensity: Option<f64>| -> Result<_> {
+            let color = self.colour(field("color"), "color", color.unwrap_or([1.0; 3]))?;
+            let intensity = self.range(
+                field("intensity"),
+                "intensity",
+                intensity.unwrap_or(1.0),
+                0.0,
+                f64::INFINITY,
+            )?;
+            Ok((color, intensity))
+        };
+        let light = match light {
+            raw::Light::Point {
+                position,
+                color,
+                intensity,
+                shadows,
+            } => {
+                let (color, intensity) = common(color, intensity)?;
+                LightDesc::Point {
+                    position,
+                    color,
+                    intensity,
+                    shadows: shadows.unwrap_or(true),
+                }
+            }
+            raw::Light::Directional {
+                direction,
+                color,
+                intensity,
+                shadows,
+            } => {
+                if length(direction) == 0.0 {
+                    return Err(self.error(
+                        field("direction"),
+                        "the light's `direction` has zero length; expected a non-zero vector",
+                    ));
+                }
+                let (color, intensity) = common(color, intensity)?;
+                LightDesc::Directional {
+                    direction,
+                    color,
+                    intensity,
+                    shadows: shadows.unwrap_or(true),
+                }
+            }
+        };
+        Ok(self.spanned(light, node))
+    }
+
+    fn material(&self, m: raw::Material, node: &Node) -> Result<MaterialDesc> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let d = MaterialDesc::default();
+        let coefficient = |name, value: Option<f64>, default, max| match value {
+            Some(v) => self.range(field(name), name, v, 0.0, max),
+            None => Ok(default),
+        };
+        let inf = f64::INFINITY;
+        let positive = |name, value: Option<f64>, default| match value {
+            Some(v) => self.positive(field(name), name, v),
+            None => Ok(default),
+        };
+        Ok(MaterialDesc {
+            color: match m.color {
+                Some(c) => self.colour(field("color"), "color", c)?,
+                None => d.color,
+            },
+            texture: m.texture.map(|t| self.spanned(t, field("texture"))),
+            ambient: coefficient("ambient", m.ambient, d.ambient, inf)?,
+            diffuse: coefficient("diffuse", m.diffuse, d.diffuse, inf)?,
+            specular: coefficient("specular", m.specular, d.specular, inf)?,
+            shininess: positive("shininess", m.shininess, d.shininess)?,
+            highlight: match m.highlight {
+                Some(raw::Highlight::Phong) => Highlight::Phong,
+                Some(raw::Highlight::Blinn) => Highlight::Blinn,
+                None => d.highlight,
+            },
+            reflect: coefficient("reflect", m.reflect, d.reflect, 1.0)?,
+            transmit: coefficient("transmit", m.transmit, d.transmit, 1.0)?,
+            ior: positive("ior", m.ior, d.ior)?,
+        })
+    }
+
+    fn render(
+        &self,
+        r: raw::Render,
+        node: &Node,
+        dir: &Path,
+    ) -> Result<(RenderDesc, Vec<OutputDesc>)> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let d = RenderDesc::default();
+        let whole = |name, value: Option<f64>, default, min, max| match value {
+            Some(v) => self.whole(field(name), name, v, min, max),
+            None => Ok(default),
+        };
+        let width = whole("width", r.width, d.width, 1, 65536)?;
+        let height = whole("height", r.height, d.height, 1, 65536)?;
+        let pixels = u64::from(width) * u64::from(height);
+        if pixels > 268_435_456 {
+            return Err(self.error(
+                field("width"),
+                format!(
+                    "the image is absurdly large: {width} x {height} = {pixels} pixels; \
+                     expected at most 268435456 pixels"
+                ),
+            ));
+        }
+        let min_weight = r.min_weight.unwrap_or(d.min_weight);
+        if !(0.0..1.0).contains(&min_weight) {
+            return Err(self.error(
+                field("min_weight"),
+                format!("`min_weight` is {min_weight}; expected at least 0 and less than 1"),
+            ));
+        }
+        let mut outputs = Vec::new();
+        for (i, output) in r.outputs.into_iter().enumerate() {
+            let entry = field("outputs").item(i).unwrap_or(node);
+            outputs.push(self.output(output, entry, dir)?);
+        }
+        let render = RenderDesc {
+            width,
+            height,
+            samples: whole("samples", r.samples, d.samples, 1, 65536)?,
+            max_depth: whole("max_depth", r.max_depth, d.max_depth, 0, 1024)?,
+            min_weight,
+            outputs: Vec::new(),
+            parallel: match r.parallel {
+                Some(p) => self.parallel(p, field("parallel"))?,
+                None => d.parallel,
+            },
+            frame: whole("frame", r.frame, d.frame, 0, u32::MAX)?,
+            time: r.time.unwrap_or(d.time),
+        };
+        Ok((render, outputs))
+    }
+
+    fn output(&self, o: raw::Output, entry: &Node, dir: &Path) -> Result<OutputDesc> {
+        let field = |name| entry.field(name).unwrap_or(entry);
+        if o.path.trim().is_empty() {
+            return Err(self.error(
+                field("path"),
+                "the output path is empty; expected a file name such as \"out.png\"",
+            ));
+        }
+        let plugin = match o.plugin {
+            Some(name) => Some(self.plugin_name(field("plugin"), name, "png")?),
+            None => None,
+        };
+        let (params, params_at) = self.params(entry);
+        Ok(OutputDesc {
+            path: dir.join(&o.path),
+            plugin,
+            params,
+            params_at,
+        })
+    }
+
+    fn parallel(&self, p: raw::Parallel, node: &Node) -> Result<ParallelDesc> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let d = ParallelDesc::default();
+        Ok(ParallelDesc {
+            mode: match p.mode {
+                Some(raw::Mode::Threads) => ParallelMode::Threads,
+                Some(raw::Mode::Mpi) => ParallelMode::Mpi,
+                Some(raw::Mode::Hybrid) => ParallelMode::Hybrid,
+                None => d.mode,
+            },
+            threads: match p.threads {
+                Some(t) => Some(self.whole(field("threads"), "threads", t, 1, 4096)?),
+                None => None,
+            },
+            decomposition: match p.decomposition {
+                Some(raw::Decomposition::PixelCyclic) => Decomposition::PixelCyclic,
+                Some(raw::Decomposition::ScanlineCyclic) => Decomposition::ScanlineCyclic,
+                Some(raw::Decomposition::BlockCyclic) => Decomposition::BlockCyclic,
+                Some(raw::Decomposition::Dynamic) => Decomposition::Dynamic,
+                None => d.decomposition,
+            },
+            tile_size: match p.tile_size {
+                Some(t) => self.whole(field("tile_size"), "tile_size", t, 1, 4096)?,
+                None => d.tile_size,
+            },
+        })
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn length(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}

@@ -1,0 +1,229 @@
+//! `SceneDesc`: what a scene file says, as plain data with source positions. It knows nothing of
+//! plugins; the core resolves plugin names and instantiates objects from it.
+//!
+//! Coordinates stay `f64` here: the core re-centres the world before storing `f32`.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A position in a source file (1-based line and column, in characters).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Origin {
+    pub file: Arc<PathBuf>,
+    pub line: u32,
+    pub col: u32,
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}:{}", self.file.display(), self.line, self.col)
+    }
+}
+
+/// A value and where it was written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spanned<T> {
+    pub value: T,
+    pub at: Origin,
+}
+
+/// A plugin named in a scene and the RON text of its `params` subtree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PluginCall {
+    /// The plugin name as written, with its position.
+    pub plugin: Spanned<String>,
+    /// RON text of `params: (...)`, exactly as in the file ("()" when absent).
+    pub params: String,
+    /// Where `params` text starts (line/col of its first character): the core adds a plugin's
+    /// in-params error positions to this to report scene positions.
+    pub params_at: Origin,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneDesc {
+    /// The file the scene was loaded from (the first of `include`s).
+    pub source: PathBuf,
+    pub camera: Spanned<CameraDesc>,
+    /// Linear RGB.
+    pub background: [f64; 3],
+    pub lights: Vec<Spanned<LightDesc>>,
+    /// Named textures, in file order (later definitions of a name replace earlier ones).
+    pub textures: Vec<(String, Spanned<PluginCall>)>,
+    /// Named materials, in file order (later definitions of a name replace earlier ones).
+    pub materials: Vec<(String, Spanned<MaterialDesc>)>,
+    pub objects: Vec<Spanned<ObjectDesc>>,
+    pub render: RenderDesc,
+    /// Extra plugin directories (or files), already resolved against the scene file's directory.
+    pub plugin_path: Vec<PathBuf>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraDesc {
+    pub position: [f64; 3],
+    pub look_at: [f64; 3],
+    pub up: [f64; 3],
+    pub projection: Projection,
+    /// Width / height of the image plane; `None`: the image's width / height.
+    pub aspect: Option<f64>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Projection {
+    /// Full vertical field of view in degrees, in (0, 180).
+    Perspective { fov_deg: f64 },
+    /// Tachyon's zoom: the image plane's half-height at unit distance is `1 / zoom`.
+    PerspectiveZoom { zoom: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightDesc {
+    Point {
+        position: [f64; 3],
+        color: [f64; 3],
+        intensity: f64,
+        shadows: bool,
+    },
+    /// Light arriving along `direction` (pointing from the light into the scene).
+    Directional {
+        direction: [f64; 3],
+        color: [f64; 3],
+        intensity: f64,
+        shadows: bool,
+    },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Highlight {
+    Phong,
+    Blinn,
+}
+
+/// The thesis's shading model. Coefficients are in [0, 1] except `shininess` and `ior`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDesc {
+    /// Linear RGB base colour.
+    pub color: [f64; 3],
+    /// Name of a texture that replaces `color`.
+    pub texture: Option<Spanned<String>>,
+    pub ambient: f64,
+    pub diffuse: f64,
+    pub specular: f64,
+    /// Highlight exponent (> 0).
+    pub shininess: f64,
+    pub highlight: Highlight,
+    /// Mirror reflection coefficient.
+    pub reflect: f64,
+    /// Fraction of light passing through (0 = opaque).
+    pub transmit: f64,
+    /// Index of refraction (1 = no bending).
+    pub ior: f64,
+}
+
+impl Default for MaterialDesc {
+    fn default() -> Self {
+        MaterialDesc {
+            color: [0.8, 0.8, 0.8],
+            texture: None,
+            ambient: 0.1,
+            diffuse: 0.9,
+            specular: 0.0,
+            shininess: 32.0,
+            highlight: Highlight::Phong,
+            reflect: 0.0,
+            transmit: 0.0,
+            ior: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectDesc {
+    pub call: PluginCall,
+    /// Material name; `None`: the built-in default material.
+    pub material: Option<Spanned<String>>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputDesc {
+    /// Output file, resolved against the scene file's directory.
+    pub path: PathBuf,
+    /// Writer plugin name; `None`: chosen by the file extension.
+    pub plugin: Option<Spanned<String>>,
+    /// RON text of the writer's params ("()" when absent).
+    pub params: String,
+    pub params_at: Origin,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderDesc {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel (1 = one ray through each pixel centre).
+    pub samples: u32,
+    /// Maximum ray depth: 0 = primary rays only... a ray at depth `max_depth` is not traced
+    /// further and sees the background colour.
+    pub max_depth: u32,
+    /// A ray whose contribution to its pixel falls below this is not traced.
+    pub min_weight: f64,
+    pub outputs: Vec<OutputDesc>,
+    pub parallel: ParallelDesc,
+    /// Animation frame number (seeds the sampler).
+    pub frame: u32,
+    /// Shutter time of the frame (rays carry it).
+    pub time: f64,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        RenderDesc {
+            width: 512,
+            height: 512,
+            samples: 1,
+            max_depth: 8,
+            min_weight: 1.0 / 512.0,
+            outputs: Vec::new(),
+            parallel: ParallelDesc::default(),
+            frame: 0,
+            time: 0.0,
+        }
+    }
+}
+
+/// How the work is spread. Threads only in this version; the scheduler issue adds MPI and hybrid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParallelDesc {
+    pub mode: ParallelMode,
+    /// Threads per process; `None`: every CPU the process may use.
+    pub threads: Option<u32>,
+    pub decomposition: Decomposition,
+    /// Tile or block edge in pixels.
+    pub tile_size: u32,
+}
+
+impl Default for ParallelDesc {
+    fn default() -> Self {
+        ParallelDesc {
+            mode: ParallelMode::Threads,
+            threads: None,
+            decomposition: Decomposition::Dynamic,
+            tile_size: 16,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ParallelMode {
+    #[default]
+    Threads,
+    Mpi,
+    Hybrid,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Decomposition {
+    PixelCyclic,
+    ScanlineCyclic,
+    BlockCyclic,
+    #[default]
+    Dynamic,
+}

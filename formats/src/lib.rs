@@ -1,0 +1,45 @@
+//! # luxon-formats: scene files into `SceneDesc`
+//!
+//! Reads Luxon's RON scene format (and, later, importers such as NFF and OBJ) into a
+//! [`SceneDesc`]: plain data with the source position of everything, so that every error names
+//! `file:line:col` and what was expected. Depends on no renderer code and knows no plugins.
+
+mod convert;
+pub mod desc;
+mod error;
+mod raw;
+mod ron_error;
+mod ron_scene;
+mod scanner;
+mod spans;
+mod validate;
+
+use std::path::Path;
+
+pub use desc::*;
+pub use error::{suggest, SceneError};
+pub use ron_scene::load_ron_str;
+
+/// Loads a scene file, choosing the format by its extension (`.ron`).
+pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !extension.eq_ignore_ascii_case("ron") {
+        let found = match extension {
+            "" => "a scene file name without an extension".to_string(),
+            e => format!("unsupported scene file extension `.{e}`"),
+        };
+        let message = format!(
+            "{found}; expected one of {}",
+            ron_scene::supported_extensions()
+        );
+        return Err(SceneError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::Unsupported, message),
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    load_ron_str(&text, path)
+}

@@ -1,0 +1,196 @@
+//! What serde reads: the scene grammar as private structs. Positions come from `spans`.
+//! Whole numbers are read as `f64` so that `width: 1.5` or `-1` gets our own message.
+
+use std::fmt;
+use std::marker::PhantomData;
+
+use serde::de::{IgnoredAny, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer};
+
+pub(crate) type Vec3 = [f64; 3];
+
+#[derive(Deserialize)]
+#[serde(rename = "Scene", deny_unknown_fields)]
+pub(crate) struct Scene {
+    #[serde(default)]
+    pub include: Vec<String>,
+    #[serde(default)]
+    pub plugin_path: Vec<String>,
+    #[serde(default)]
+    pub camera: Option<Camera>,
+    #[serde(default)]
+    pub background: Option<Vec3>,
+    #[serde(default)]
+    pub lights: Vec<Light>,
+    #[serde(default)]
+    pub textures: Named<Texture>,
+    #[serde(default)]
+    pub materials: Named<Material>,
+    #[serde(default)]
+    pub objects: Vec<Object>,
+    #[serde(default)]
+    pub render: Option<Render>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Camera", deny_unknown_fields)]
+pub(crate) struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    #[serde(default)]
+    pub up: Option<Vec3>,
+    #[serde(default)]
+    pub fov: Option<f64>,
+    #[serde(default)]
+    pub zoom: Option<f64>,
+    #[serde(default)]
+    pub aspect: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Light", deny_unknown_fields)]
+pub(crate) enum Light {
+    Point {
+        position: Vec3,
+        #[serde(default)]
+        color: Option<Vec3>,
+        #[serde(default)]
+        intensity: Option<f64>,
+        #[serde(default)]
+        shadows: Option<bool>,
+    },
+    Directional {
+        direction: Vec3,
+        #[serde(default)]
+        color: Option<Vec3>,
+        #[serde(default)]
+        intensity: Option<f64>,
+        #[serde(default)]
+        shadows: Option<bool>,
+    },
+}
+
+/// `params` is only skipped here; its text is taken verbatim from the source.
+#[derive(Deserialize)]
+#[serde(rename = "Texture", deny_unknown_fields)]
+pub(crate) struct Texture {
+    pub plugin: String,
+    #[serde(default, rename = "params")]
+    pub _params: IgnoredAny,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Material", deny_unknown_fields)]
+pub(crate) struct Material {
+    pub color: Option<Vec3>,
+    pub texture: Option<String>,
+    pub ambient: Option<f64>,
+    pub diffuse: Option<f64>,
+    pub specular: Option<f64>,
+    pub shininess: Option<f64>,
+    pub highlight: Option<Highlight>,
+    pub reflect: Option<f64>,
+    pub transmit: Option<f64>,
+    pub ior: Option<f64>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "Highlight")]
+pub(crate) enum Highlight {
+    Phong,
+    Blinn,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Object", deny_unknown_fields)]
+pub(crate) struct Object {
+    pub plugin: String,
+    #[serde(default, rename = "params")]
+    pub _params: IgnoredAny,
+    #[serde(default)]
+    pub material: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Render", deny_unknown_fields)]
+pub(crate) struct Render {
+    pub width: Option<f64>,
+    pub height: Option<f64>,
+    pub samples: Option<f64>,
+    pub max_depth: Option<f64>,
+    pub min_weight: Option<f64>,
+    pub frame: Option<f64>,
+    pub time: Option<f64>,
+    #[serde(default)]
+    pub outputs: Vec<Output>,
+    pub parallel: Option<Parallel>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Output", deny_unknown_fields)]
+pub(crate) struct Output {
+    pub path: String,
+    #[serde(default)]
+    pub plugin: Option<String>,
+    #[serde(default, rename = "params")]
+    pub _params: IgnoredAny,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Parallel", deny_unknown_fields)]
+pub(crate) struct Parallel {
+    pub mode: Option<Mode>,
+    pub threads: Option<f64>,
+    pub decomposition: Option<Decomposition>,
+    pub tile_size: Option<f64>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "ParallelMode")]
+pub(crate) enum Mode {
+    Threads,
+    Mpi,
+    Hybrid,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "Decomposition")]
+pub(crate) enum Decomposition {
+    PixelCyclic,
+    ScanlineCyclic,
+    BlockCyclic,
+    Dynamic,
+}
+
+/// A `{ "name": value }` map in file order, duplicates kept (the merge decides who wins).
+pub(crate) struct Named<T>(pub Vec<(String, T)>);
+
+impl<T> Default for Named<T> {
+    fn default() -> Self {
+        Named(Vec::new())
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Named<T> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct NamedVisitor<T>(PhantomData<T>);
+
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for NamedVisitor<T> {
+            type Value = Named<T>;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a map `{ \"name\": (...), ... }`")
+            }
+
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+                let mut entries = Vec::new();
+                while let Some(entry) = map.next_entry()? {
+                    entries.push(entry);
+                }
+                Ok(Named(entries))
+            }
+        }
+
+        deserializer.deserialize_map(NamedVisitor(PhantomData))
+    }
+}

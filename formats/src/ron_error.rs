@@ -1,0 +1,102 @@
+//! ron's errors as `SceneError`s: positioned on the culprit, reworded to say what was expected.
+
+use ron::error::SpannedError;
+
+use crate::error::{suggest, unknown_name, SceneError};
+use crate::spans::{scan, SourceMap};
+
+/// ron's error, with "did you mean" for names.
+pub(crate) fn ron_error(e: &SpannedError, src: &SourceMap) -> SceneError {
+    // ron's span may start on the blank before the culprit; point at the culprit.
+    let start = src.byte(e.span.start.line, e.span.start.col);
+    let end = src.byte(e.span.end.line, e.span.end.col);
+    let mut at = src.skip_blank(start, end.max(start));
+    // These are reported at the closing bracket; the value's start reads better.
+    if matches!(
+        e.code,
+        ron::Error::MissingStructField { .. } | ron::Error::ExpectedDifferentLength { .. }
+    ) {
+        if let Some(node) = scan(&src.text)
+            .ok()
+            .as_ref()
+            .and_then(|root| root.closed_at(at))
+        {
+            at = node.start;
+        }
+    }
+    let mut message = ron_message(&e.code);
+    if at >= src.text.len() && !message.starts_with("unexpected end") {
+        message = format!("unexpected end of file; {message}");
+    }
+    SceneError::at(src.origin(at), message)
+}
+
+/// What ron found wrong, saying what was expected.
+fn ron_message(code: &ron::Error) -> String {
+    let within = |outer: &Option<String>| match outer {
+        Some(o) => format!(" in `{o}`"),
+        None => String::new(),
+    };
+    use ron::Error as E;
+    match code {
+        E::NoSuchStructField {
+            expected,
+            found,
+            outer,
+        } => unknown_name("field", found, &within(outer), expected.iter().copied()),
+        E::NoSuchEnumVariant {
+            expected,
+            found,
+            outer,
+        } => unknown_name("variant", found, &within(outer), expected.iter().copied()),
+        E::MissingStructField { field, outer } => {
+            format!(
+                "missing field `{field}`{}; expected `{field}: ...`",
+                within(outer)
+            )
+        }
+        E::DuplicateStructField { field, outer } => {
+            format!(
+                "field `{field}` is given twice{}; expected it once",
+                within(outer)
+            )
+        }
+        E::ExpectedDifferentStructName { expected, found } => {
+            let mut message = format!("found `{found}(`; expected `{expected}(` or just `(`");
+            if let Some(close) = suggest(found, [*expected]) {
+                message.push_str(&format!(" (did you mean `{close}`?)"));
+            }
+            message
+        }
+        E::ExpectedDifferentLength { expected, found } if expected.contains("length 3") => {
+            format!("found {found} numbers; expected 3, as in `(x, y, z)`")
+        }
+        E::InvalidValueForType { expected, found } => format!("found {found}; expected {expected}"),
+        E::ExpectedFloat | E::ExpectedInteger => "expected a number".to_string(),
+        E::ExpectedString => "expected a string in double quotes".to_string(),
+        E::ExpectedBoolean => "expected `true` or `false`".to_string(),
+        E::ExpectedStructLike => "expected `(`".to_string(),
+        E::ExpectedStructLikeEnd => "expected `,` or `)`".to_string(),
+        E::ExpectedArray => "expected a list `[...]`".to_string(),
+        E::ExpectedArrayEnd => "expected `,` or `]`".to_string(),
+        E::ExpectedMap => "expected a map `{ \"name\": (...), ... }`".to_string(),
+        E::ExpectedMapEnd => "expected `,` or `}`".to_string(),
+        E::ExpectedMapColon => "expected `:` after the map key".to_string(),
+        E::ExpectedComma => "expected `,` between values (or a closing bracket)".to_string(),
+        E::Eof => "unexpected end of file; expected more of the scene".to_string(),
+        E::ExpectedStringEnd => "unclosed string; expected a closing `\"`".to_string(),
+        E::ExpectedIdentifier => "expected a name (a field name or an identifier)".to_string(),
+        E::TrailingCharacters => {
+            "unexpected text after the end of the scene; expected nothing".to_string()
+        }
+        other => lower_first(&other.to_string()),
+    }
+}
+
+fn lower_first(s: &str) -> String {
+    let mut chars = s.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => String::new(),
+    }
+}

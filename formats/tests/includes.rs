@@ -1,0 +1,319 @@
+//! `include`: merge order, nesting, relative paths, cycles, missing files, error positions.
+
+use std::path::{Path, PathBuf};
+
+use luxon_formats::*;
+
+/// A fresh directory under the system temp dir, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_nanos();
+        let dir = std::env::temp_dir().join(format!(
+            "luxon-formats-{name}-{}-{nanos}",
+            std::process::id()
+        ));
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+
+    fn write(&self, name: &str, text: &str) -> PathBuf {
+        let path = self.0.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn intensities(scene: &SceneDesc) -> Vec<f64> {
+    scene
+        .lights
+        .iter()
+        .map(|l| match l.value {
+            LightDesc::Point { intensity, .. } | LightDesc::Directional { intensity, .. } => {
+                intensity
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn includes_merge_in_order() {
+    let dir = TempDir::new("merge");
+    dir.write(
+        "a.ron",
+        r#"Scene(
+    plugin_path: ["plugins-a"],
+    camera: (position: (0, 0, -1), look_at: (0, 0, 0)),
+    background: (1, 0, 0),
+    lights: [Point(position: (0, 0, 0), intensity: 1)],
+    materials: { "m": (ior: 1.1), "n": (ior: 1.2) },
+    textures: { "t": (plugin: "from-a") },
+    objects: [(plugin: "a")],
+    render: (width: 10, outputs: [(path: "a.png")]),
+)"#,
+    );
+    dir.write(
+        "b.ron",
+        r#"(
+    include: ["sub/c.ron"],
+    lights: [Point(position: (0, 0, 0), intensity: 2)],
+    materials: { "m": (ior: 1.3) },
+    render: (width: 20, outputs: [(path: "b.png")]),
+)"#,
+    );
+    dir.write(
+        "sub/c.ron",
+        r#"(
+    plugin_path: ["plugins-c"],
+    lights: [Point(position: (0, 0, 0), intensity: 3)],
+    materials: { "c": () },
+    objects: [(plugin: "c")],
+    render: (outputs: [(path: "c.png")]),
+)"#,
+    );
+    let main = dir.write(
+        "main.ron",
+        r#"Scene(
+    include: ["a.ron", "b.ron"],
+    plugin_path: ["plugins-main"],
+    lights: [Point(position: (0, 0, 0), intensity: 4)],
+    materials: { "n": (ior: 1.4), "z": () },
+    textures: { "t": (plugin: "from-main") },
+    objects: [(plugin: "main", material: "c")],
+)"#,
+    );
+    let scene = load(&main).unwrap();
+    let d = &dir.0;
+
+    // Lists: included files first (depth first, in include order), then this file.
+    assert_eq!(intensities(&scene), [1.0, 3.0, 2.0, 4.0]);
+    let plugins: Vec<&str> = scene
+        .objects
+        .iter()
+        .map(|o| o.value.call.plugin.value.as_str())
+        .collect();
+    assert_eq!(plugins, ["a", "c", "main"]);
+    assert_eq!(
+        scene.plugin_path,
+        [
+            d.join("plugins-a"),
+            d.join("sub").join("plugins-c"),
+            d.join("plugins-main")
+        ]
+    );
+    let outputs: Vec<&Path> = scene
+        .render
+        .outputs
+        .iter()
+        .map(|o| o.path.as_path())
+        .collect();
+    assert_eq!(
+        outputs,
+        [
+            d.join("a.png"),
+            d.join("sub").join("c.png"),
+            d.join("b.png")
+        ]
+    );
+
+    // Maps: later definitions win, in the place of the first definition.
+    let materials: Vec<(&str, f64)> = scene
+        .materials
+        .iter()
+        .map(|(n, m)| (n.as_str(), m.value.ior))
+        .collect();
+    assert_eq!(materials, [("m", 1.3), ("n", 1.4), ("c", 1.0), ("z", 1.0)]);
+    assert_eq!(*scene.materials[0].1.at.file, d.join("b.ron"));
+    assert_eq!(scene.textures.len(), 1);
+    assert_eq!(scene.textures[0].1.value.plugin.value, "from-main");
+
+    // Singles: from the including file when it gives them, else from the last include that does.
+    assert_eq!(*scene.camera.at.file, d.join("a.ron"));
+    assert_eq!(scene.background, [1.0, 0.0, 0.0]);
+    assert_eq!(scene.render.width, 20);
+    assert_eq!(scene.source, main);
+}
+
+#[test]
+fn positions_in_included_content_name_that_file() {
+    let dir = TempDir::new("positions");
+    dir.write(
+        "common.ron",
+        "(\n    objects: [\n        (plugin: \"sphere\", params: (radius: 2)),\n    ],\n)",
+    );
+    let main = dir.write(
+        "main.ron",
+        "(\n    include: [\"common.ron\"],\n    camera: (position: (0, 0, -1), look_at: (0, 0, 0)),\n)",
+    );
+    let scene = load(&main).unwrap();
+    let sphere = &scene.objects[0];
+    assert_eq!(*sphere.at.file, dir.0.join("common.ron"));
+    assert_eq!((sphere.at.line, sphere.at.col), (3, 9));
+    assert_eq!(sphere.value.call.params, "(radius: 2)");
+    assert_eq!(
+        (
+            sphere.value.call.params_at.line,
+            sphere.value.call.params_at.col
+        ),
+        (3, 36)
+    );
+    assert_eq!(*scene.camera.at.file, main);
+
+    // An error inside an included file names it.
+    dir.write(
+        "common.ron",
+        "(\n    objects: [\n        (plugin: \"sphere\", params: (radius: NaN)),\n    ],\n)",
+    );
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!(*at.file, dir.0.join("common.ron"));
+    assert_eq!((at.line, at.col), (3, 45));
+    let prefix = format!(
+        "{}:3:45: NaN is not allowed",
+        dir.0.join("common.ron").display()
+    );
+    assert!(error.to_string().starts_with(&prefix), "{error}");
+
+    // ron's own errors too.
+    dir.write(
+        "common.ron",
+        "(\n    lights: [Pont(position: (0, 0, 0))],\n)",
+    );
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!(
+        (&**at.file, at.line, at.col),
+        (dir.0.join("common.ron").as_path(), 2, 14)
+    );
+    assert!(
+        error.to_string().contains("did you mean `Point`?"),
+        "{error}"
+    );
+}
+
+#[test]
+fn names_defined_in_the_including_file_resolve_in_included_content() {
+    let dir = TempDir::new("names");
+    dir.write(
+        "objects.ron",
+        "(objects: [(plugin: \"sphere\", material: \"gold\")])",
+    );
+    let main = dir.write(
+        "main.ron",
+        "(include: [\"objects.ron\"], camera: (position: (0, 0, -1), look_at: (0, 0, 0)), \
+         materials: {\"gold\": ()})",
+    );
+    assert_eq!(load(&main).unwrap().objects.len(), 1);
+
+    dir.write(
+        "objects.ron",
+        "(objects: [(plugin: \"sphere\", material: \"gould\")])",
+    );
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!(
+        (&**at.file, at.line, at.col),
+        (dir.0.join("objects.ron").as_path(), 1, 41)
+    );
+    assert!(
+        error.to_string().contains("did you mean `gold`?"),
+        "{error}"
+    );
+}
+
+#[test]
+fn include_cycle_is_an_error_naming_the_chain() {
+    let dir = TempDir::new("cycle");
+    let main = dir.write(
+        "main.ron",
+        "(\n    include: [\"a.ron\"],\n    camera: (position: (0, 0, -1), look_at: (0, 0, 0)),\n)",
+    );
+    dir.write("a.ron", "(include: [\"b.ron\"])");
+    dir.write("b.ron", "(\n  include: [\n    \"main.ron\",\n  ],\n)");
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!(
+        (&**at.file, at.line, at.col),
+        (dir.0.join("b.ron").as_path(), 3, 5)
+    );
+    let message = error.to_string();
+    assert!(message.contains("include cycle"), "{message}");
+    let chain = format!(
+        "{} -> {} -> {} -> {}",
+        main.display(),
+        dir.0.join("a.ron").display(),
+        dir.0.join("b.ron").display(),
+        dir.0.join("main.ron").display()
+    );
+    assert!(message.contains(&chain), "{message}");
+
+    // A file including itself.
+    dir.write("a.ron", "(include: [\"./a.ron\"])");
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!(
+        (&**at.file, at.line, at.col),
+        (dir.0.join("a.ron").as_path(), 1, 12)
+    );
+    assert!(error.to_string().contains("include cycle"), "{error}");
+}
+
+#[test]
+fn the_same_file_may_be_included_twice_without_a_cycle() {
+    let dir = TempDir::new("diamond");
+    dir.write("l.ron", "(lights: [Point(position: (0, 0, 0))])");
+    dir.write("a.ron", "(include: [\"l.ron\"])");
+    let main = dir.write(
+        "main.ron",
+        "(include: [\"a.ron\", \"l.ron\"], camera: (position: (0, 0, -1), look_at: (0, 0, 0)))",
+    );
+    assert_eq!(load(&main).unwrap().lights.len(), 2);
+}
+
+#[test]
+fn missing_include_is_reported_at_its_string() {
+    let dir = TempDir::new("missing");
+    let main = dir.write(
+        "main.ron",
+        "(\n    include: [\"common.ron\", \"nope.ron\"],\n    camera: (position: (0, 0, -1), look_at: (0, 0, 0)),\n)",
+    );
+    dir.write("common.ron", "()");
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!((&**at.file, at.line, at.col), (main.as_path(), 2, 29));
+    let message = error.to_string();
+    assert!(message.contains("cannot read included file"), "{message}");
+    assert!(message.contains("nope.ron"), "{message}");
+}
+
+#[test]
+fn missing_camera_after_merging_is_reported_at_the_main_file() {
+    let dir = TempDir::new("nocamera");
+    dir.write("a.ron", "(lights: [])");
+    let main = dir.write("main.ron", "\n\n(include: [\"a.ron\"])");
+    let error = load(&main).unwrap_err();
+    let at = error.origin().unwrap();
+    assert_eq!((&**at.file, at.line, at.col), (main.as_path(), 1, 1));
+    assert!(
+        error.to_string().contains("the scene has no camera"),
+        "{error}"
+    );
+
+    // A camera from an include is enough.
+    dir.write(
+        "a.ron",
+        "(camera: (position: (0, 0, -1), look_at: (0, 0, 0)))",
+    );
+    assert!(load(&main).is_ok());
+}

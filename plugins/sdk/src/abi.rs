@@ -1,0 +1,368 @@
+//! THE plugin ABI, all of it, in this one file.
+//!
+//! Only `#[repr(C)]` plain data and `extern "C"` function pointers cross the boundary. Strings and
+//! slices are borrowed pointer + length pairs that live for the duration of the call; memory is
+//! freed by the side that allocated it. Enumerations travel as `u32` so that a bad value from the
+//! other side is an error, not undefined behaviour.
+//!
+//! Handshake: the library exports [`DECLARE_SYMBOL`], an `extern "C" fn(*const HostTable) ->
+//! *const PluginHeader`. The host reads `magic` and `abi_version` first and stops there when they
+//! do not match; everything after them may change between ABI versions.
+//!
+//! Any change to a type or a function signature in this file must bump [`ABI_VERSION`].
+
+use std::ffi::c_void;
+
+/// Bumped on every incompatible change to this file.
+pub const ABI_VERSION: u32 = 1;
+/// First eight bytes of every [`PluginHeader`].
+pub const MAGIC: [u8; 8] = *b"LUXONPLG";
+/// The one symbol a plugin library exports (NUL-terminated for `dlsym`).
+pub const DECLARE_SYMBOL: &[u8] = b"luxon_plugin_declare\0";
+
+/// The signature of [`DECLARE_SYMBOL`].
+pub type DeclareFn = unsafe extern "C" fn(host: *const HostTable) -> *const PluginHeader;
+
+/// Borrowed UTF-8 text.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct Str {
+    pub ptr: *const u8,
+    pub len: usize,
+}
+
+impl Str {
+    pub const EMPTY: Str = Str {
+        ptr: std::ptr::null(),
+        len: 0,
+    };
+
+    pub const fn new(s: &str) -> Str {
+        Str {
+            ptr: s.as_ptr(),
+            len: s.len(),
+        }
+    }
+
+    /// # Safety
+    /// `ptr`/`len` must describe valid memory for the lifetime `'a`.
+    pub unsafe fn as_str<'a>(&self) -> Result<&'a str, std::str::Utf8Error> {
+        if self.ptr.is_null() || self.len == 0 {
+            return Ok("");
+        }
+        std::str::from_utf8(std::slice::from_raw_parts(self.ptr, self.len))
+    }
+}
+
+/// Result of every call across the boundary.
+pub type Status = u32;
+pub const STATUS_OK: Status = 0;
+/// The callee reported an error through the [`ErrorSink`].
+pub const STATUS_ERROR: Status = 1;
+/// The callee panicked; the panic was caught on its side and its message sent to the sink.
+pub const STATUS_PANIC: Status = 2;
+
+/// Plugin kinds (`Entry::kind`).
+pub const KIND_PRIMITIVE: u32 = 1;
+pub const KIND_TEXTURE: u32 = 2;
+pub const KIND_VOLUME_READER: u32 = 3;
+pub const KIND_WRITER: u32 = 4;
+
+/// What the host offers every plugin (given in the handshake, valid for the process lifetime).
+/// A cdylib has its own statics, so logging goes through here rather than a `log` facade.
+#[repr(C)]
+pub struct HostTable {
+    pub abi_version: u32,
+    /// level: 0 error, 1 warning, 2 info, 3 debug.
+    pub log: extern "C" fn(level: u32, plugin: Str, message: Str),
+}
+
+/// Returned by the handshake; lives for the process lifetime (a static in the plugin).
+#[repr(C)]
+pub struct PluginHeader {
+    pub magic: [u8; 8],
+    pub abi_version: u32,
+    /// Version of the `luxon-plugin` crate the plugin was built with, e.g. "0.1.0".
+    pub sdk_version: Str,
+    /// Only read when `magic` and `abi_version` match.
+    pub declaration: *const Declaration,
+}
+
+#[repr(C)]
+pub struct Declaration {
+    /// The library's own name, e.g. "luxon-shapes"; used in messages.
+    pub library: Str,
+    pub entries: *const Entry,
+    pub entry_count: usize,
+}
+
+/// One named thing a library provides.
+#[repr(C)]
+pub struct Entry {
+    pub kind: u32,
+    /// The name a scene uses: `(plugin: "sphere", ...)`.
+    pub name: Str,
+    pub description: Str,
+    /// The parameter table, one `name: type = default  description` per line.
+    pub params_doc: Str,
+    /// Writers: comma-separated file extensions without dots ("ppm,pnm"); empty otherwise.
+    pub extensions: Str,
+    /// Points to the table for `kind`: [`PrimitiveVTable`], [`TextureVTable`],
+    /// [`VolumeReaderVTable`] or [`WriterVTable`].
+    pub vtable: *const c_void,
+}
+
+/// Where a plugin reports an error. `line`/`col` are 1-based positions inside the params text it
+/// was given (0 when the error has no position); the host maps them to the scene file.
+#[repr(C)]
+pub struct ErrorSink {
+    pub ctx: *mut c_void,
+    pub set: extern "C" fn(ctx: *mut c_void, message: Str, line: u32, col: u32),
+}
+
+/// What every create/read/write call receives besides its params.
+#[repr(C)]
+pub struct CallContext {
+    /// Directory of the scene file that named the plugin: relative paths resolve against it.
+    pub scene_dir: Str,
+    /// The scene's name for this instance (the object's index or the texture's name), for messages.
+    pub instance: Str,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Primitives: a plugin turns its parameters into native geometry (spheres, planes, triangle
+// meshes) that the core stores compactly and intersects inline, and/or custom geometry that the
+// core calls through `CustomVTable` from inside the same BVH.
+// ---------------------------------------------------------------------------------------------
+
+#[repr(C)]
+pub struct PrimitiveVTable {
+    pub create: extern "C" fn(
+        params: Str,
+        ctx: *const CallContext,
+        sink: *const GeometrySink,
+        err: *const ErrorSink,
+    ) -> Status,
+}
+
+/// A triangle mesh handed to the host. All pointers are borrowed for the call; optional arrays
+/// are null when absent, otherwise they have one entry per vertex.
+#[repr(C)]
+pub struct MeshData {
+    /// x, y, z per vertex.
+    pub positions: *const f64,
+    pub vertex_count: u64,
+    /// Three vertex indices per triangle.
+    pub indices: *const u64,
+    pub triangle_count: u64,
+    /// x, y, z per vertex, or null.
+    pub normals: *const f64,
+    /// r, g, b per vertex, or null.
+    pub colors: *const f32,
+    /// u, v per vertex, or null.
+    pub uvs: *const f32,
+}
+
+/// A ray in world space, double precision.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct RayF64 {
+    pub origin: [f64; 3],
+    pub direction: [f64; 3],
+    pub tmin: f64,
+    pub tmax: f64,
+    pub time: f64,
+}
+
+/// A custom primitive's answer to `intersect`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct HitF64 {
+    pub t: f64,
+    /// Geometric normal in world space, any length, any orientation.
+    pub normal: [f64; 3],
+    pub uv: [f32; 2],
+}
+
+/// Custom geometry: `count` primitives the host puts in its BVH.
+/// `intersect`/`occluded` return 1 for a hit, 0 for none, and [`STATUS_PANIC`] + 1 (= 3) when the
+/// plugin panicked (the host then stops the render with an error naming the plugin).
+#[repr(C)]
+pub struct CustomVTable {
+    pub bounds: extern "C" fn(
+        object: *const c_void,
+        index: u64,
+        min: *mut [f64; 3],
+        max: *mut [f64; 3],
+    ) -> Status,
+    pub intersect: extern "C" fn(
+        object: *const c_void,
+        index: u64,
+        ray: *const RayF64,
+        hit: *mut HitF64,
+    ) -> u32,
+    pub occluded: extern "C" fn(object: *const c_void, index: u64, ray: *const RayF64) -> u32,
+    /// Called once by the host when it no longer needs the object.
+    pub destroy: extern "C" fn(object: *mut c_void),
+}
+
+/// Return value of `intersect`/`occluded` when the plugin panicked.
+pub const HIT_PANIC: u32 = 3;
+
+#[repr(C)]
+pub struct CustomGeometry {
+    pub object: *mut c_void,
+    pub count: u64,
+    pub vtable: *const CustomVTable,
+}
+
+/// The host's geometry builder. Each call copies what it is given; it returns [`STATUS_ERROR`] and
+/// fills `err` when the data is unusable (NaN, bad index...).
+#[repr(C)]
+pub struct GeometrySink {
+    pub ctx: *mut c_void,
+    /// `count` spheres as x, y, z, radius.
+    pub add_spheres: extern "C" fn(
+        ctx: *mut c_void,
+        data: *const f64,
+        count: u64,
+        err: *const ErrorSink,
+    ) -> Status,
+    /// `count` infinite planes as point x, y, z then normal x, y, z.
+    pub add_planes: extern "C" fn(
+        ctx: *mut c_void,
+        data: *const f64,
+        count: u64,
+        err: *const ErrorSink,
+    ) -> Status,
+    pub add_mesh:
+        extern "C" fn(ctx: *mut c_void, mesh: *const MeshData, err: *const ErrorSink) -> Status,
+    /// Ownership of `geometry.object` passes to the host, which calls `destroy` when done.
+    pub add_custom: extern "C" fn(
+        ctx: *mut c_void,
+        geometry: *const CustomGeometry,
+        err: *const ErrorSink,
+    ) -> Status,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Textures: an instance evaluated per shading point.
+// ---------------------------------------------------------------------------------------------
+
+#[repr(C)]
+pub struct TextureVTable {
+    pub create: extern "C" fn(
+        params: Str,
+        ctx: *const CallContext,
+        out: *mut TextureObject,
+        err: *const ErrorSink,
+    ) -> Status,
+}
+
+#[repr(C)]
+pub struct TextureObject {
+    pub object: *mut c_void,
+    pub vtable: *const TextureInstanceVTable,
+}
+
+/// Where and how a texture is looked up.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TexQuery {
+    /// Hit point in world space.
+    pub p: [f64; 3],
+    /// Shading normal (unit).
+    pub n: [f32; 3],
+    pub uv: [f32; 2],
+    /// Approximate world-space width of the ray's footprint at `p` (for filtering).
+    pub footprint: f32,
+    pub time: f32,
+}
+
+#[repr(C)]
+pub struct TextureInstanceVTable {
+    /// Writes linear RGBA into `out`; returns [`STATUS_PANIC`] when the plugin panicked.
+    pub eval:
+        extern "C" fn(object: *const c_void, query: *const TexQuery, out: *mut [f32; 4]) -> Status,
+    pub destroy: extern "C" fn(object: *mut c_void),
+}
+
+// ---------------------------------------------------------------------------------------------
+// Volume readers: a reader streams a scalar grid into the host as dense blocks and constant
+// tiles (sparse formats such as OpenVDB hand over their leaves and tiles as they are).
+// ---------------------------------------------------------------------------------------------
+
+#[repr(C)]
+pub struct VolumeReaderVTable {
+    pub read: extern "C" fn(
+        params: Str,
+        ctx: *const CallContext,
+        sink: *const VolumeSink,
+        err: *const ErrorSink,
+    ) -> Status,
+}
+
+#[repr(C)]
+pub struct VolumeDesc {
+    /// Row-major 3x4 affine map from voxel index space to world space.
+    pub world_from_index: [f64; 12],
+    /// Value outside every block and tile.
+    pub background: f32,
+    /// Inclusive index-space bounds of the data.
+    pub index_min: [i64; 3],
+    pub index_max: [i64; 3],
+    pub grid_name: Str,
+}
+
+#[repr(C)]
+pub struct VolumeSink {
+    pub ctx: *mut c_void,
+    /// Called once, before any block or tile.
+    pub begin:
+        extern "C" fn(ctx: *mut c_void, desc: *const VolumeDesc, err: *const ErrorSink) -> Status,
+    /// A dense block of `dims[0]*dims[1]*dims[2]` values, x fastest, starting at index `origin`.
+    pub add_dense: extern "C" fn(
+        ctx: *mut c_void,
+        origin: *const [i64; 3],
+        dims: *const [u64; 3],
+        values: *const f32,
+        err: *const ErrorSink,
+    ) -> Status,
+    /// A constant box of `dims` voxels starting at `origin`.
+    pub add_tile: extern "C" fn(
+        ctx: *mut c_void,
+        origin: *const [i64; 3],
+        dims: *const [u64; 3],
+        value: f32,
+        err: *const ErrorSink,
+    ) -> Status,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writers: encode a finished image into bytes; the host writes them atomically.
+// ---------------------------------------------------------------------------------------------
+
+#[repr(C)]
+pub struct WriterVTable {
+    pub write: extern "C" fn(
+        params: Str,
+        ctx: *const CallContext,
+        image: *const ImageView,
+        out: *const ByteSink,
+        err: *const ErrorSink,
+    ) -> Status,
+}
+
+/// A finished image: linear (not gamma-encoded) RGBA f32, rows top to bottom.
+#[repr(C)]
+pub struct ImageView {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: *const f32,
+}
+
+#[repr(C)]
+pub struct ByteSink {
+    pub ctx: *mut c_void,
+    pub write: extern "C" fn(ctx: *mut c_void, data: *const u8, len: usize) -> Status,
+}

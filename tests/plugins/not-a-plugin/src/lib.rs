@@ -1,0 +1,7 @@
+//! Test library: a valid shared object without the Luxon handshake symbol. The host must
+//! report it as "not a Luxon plugin" rather than crash.
+
+#[no_mangle]
+pub extern "C" fn not_luxon() -> i32 {
+    42
+}

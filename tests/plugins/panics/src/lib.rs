@@ -1,0 +1,102 @@
+//! Test plugin: entry points that panic, so the host can check that each panic becomes an error
+//! naming the plugin instead of unwinding into it or aborting.
+//!
+//! - `panic_create` (primitive): panics in `create`.
+//! - `panic_intersect` (primitive): custom geometry filling the box [-1, 1]³ whose `intersect`
+//!   and `occluded` panic (`bounds` works, so the host gets as far as tracing rays).
+//! - `panic_texture` (texture): created fine, panics in `eval`.
+
+use luxon_plugin::abi::TexQuery;
+use luxon_plugin::{
+    Aabb, Context, CustomShape, Describe, Error, Geometry, Hit, Primitive, Ray, Texture,
+};
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoParams {}
+
+pub struct PanicCreate;
+
+impl Describe for PanicCreate {
+    const NAME: &'static str = "panic_create";
+    const DESCRIPTION: &'static str = "Test plugin: panics in create.";
+    const PARAMS: &'static str = "";
+}
+
+impl Primitive for PanicCreate {
+    type Params = NoParams;
+    fn create(_: NoParams, _: &Context, _: &mut Geometry) -> Result<(), Error> {
+        panic!("deliberate panic in create")
+    }
+}
+
+pub struct PanicIntersect;
+
+impl Describe for PanicIntersect {
+    const NAME: &'static str = "panic_intersect";
+    const DESCRIPTION: &'static str =
+        "Test plugin: custom geometry in [-1, 1]^3 that panics in intersect and occluded.";
+    const PARAMS: &'static str = "";
+}
+
+impl Primitive for PanicIntersect {
+    type Params = NoParams;
+    fn create(_: NoParams, _: &Context, out: &mut Geometry) -> Result<(), Error> {
+        out.custom(PanicBox)
+    }
+}
+
+pub struct PanicBox;
+
+impl CustomShape for PanicBox {
+    fn count(&self) -> u64 {
+        1
+    }
+    fn bounds(&self, _: u64) -> Aabb {
+        Aabb {
+            min: [-1.0; 3],
+            max: [1.0; 3],
+        }
+    }
+    fn intersect(&self, _: u64, _: &Ray) -> Option<Hit> {
+        panic!("deliberate panic in intersect")
+    }
+    fn occluded(&self, _: u64, _: &Ray) -> bool {
+        panic!("deliberate panic in occluded")
+    }
+}
+
+pub struct PanicTexture;
+
+impl Describe for PanicTexture {
+    const NAME: &'static str = "panic_texture";
+    const DESCRIPTION: &'static str = "Test plugin: a texture that panics in eval.";
+    const PARAMS: &'static str = "";
+}
+
+impl Texture for PanicTexture {
+    type Params = NoParams;
+    fn create(_: NoParams, _: &Context) -> Result<Self, Error> {
+        Ok(PanicTexture)
+    }
+    fn eval(&self, _: &TexQuery) -> [f32; 4] {
+        panic!("deliberate panic in texture eval")
+    }
+}
+
+luxon_plugin::export!(
+    library: "luxon-test-panics",
+    primitives: [PanicCreate, PanicIntersect],
+    textures: [PanicTexture],
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_params_parse() {
+        assert!(luxon_plugin::parse_params::<NoParams>("()").is_ok());
+        assert!(luxon_plugin::parse_params::<NoParams>("").is_ok());
+    }
+}
