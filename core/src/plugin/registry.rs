@@ -114,8 +114,9 @@ fn not_found_message(
         m.push_str(&format!(", did you mean `{s}`?"));
     }
     let dirs: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
+    let sep = if suggestion.is_some() { " S" } else { "; s" };
     m.push_str(&format!(
-        "; searched: {} (add directories with the scene's `plugin_path` or $LUXON_PLUGIN_PATH)",
+        "{sep}earched: {} (add directories with the scene's `plugin_path` or $LUXON_PLUGIN_PATH)",
         if dirs.is_empty() {
             "nothing".to_string()
         } else {

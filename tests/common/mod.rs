@@ -1,0 +1,97 @@
+//! Shared by the integration tests: building the plugins, rendering scenes through the library,
+//! running the `luxon` binary, and temporary directories.
+#![allow(dead_code)]
+
+use luxon::plugin::Registry;
+use luxon::{Framebuffer, Scene};
+use luxon_formats::SceneDesc;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `cargo test` does not build the plugin cdylibs (nothing links them), so the tests build them
+/// once, with the same profile, before anything needs them. Plain `cargo test` is then complete
+/// and never runs against stale plugins.
+pub fn ensure_plugins() {
+    static BUILT: OnceLock<()> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        let exe = std::env::current_exe().unwrap();
+        let profile_dir = exe.parent().unwrap().parent().unwrap();
+        let mut cmd = Command::new(env!("CARGO"));
+        cmd.args(["build", "--workspace", "--lib", "--quiet"]).current_dir(root());
+        if profile_dir.file_name().is_some_and(|n| n == "release") {
+            cmd.arg("--release");
+        }
+        let status = cmd.status().expect("cannot run cargo to build the plugins");
+        assert!(status.success(), "building the plugins failed");
+    });
+}
+
+pub fn registry(desc: &SceneDesc) -> Registry {
+    ensure_plugins();
+    Registry::discover(&desc.plugin_path)
+}
+
+/// Loads a scene file, lets `edit` change its description, builds and renders it.
+pub fn render_with(path: &Path, edit: impl FnOnce(&mut SceneDesc)) -> Framebuffer {
+    let mut desc = luxon_formats::load(path).unwrap_or_else(|e| panic!("{e}"));
+    edit(&mut desc);
+    let reg = registry(&desc);
+    let scene = Scene::build(&desc, &reg).unwrap_or_else(|e| panic!("{e}"));
+    luxon::render::render(&scene, &|_, _| {}).unwrap_or_else(|e| panic!("{e}")).0
+}
+
+/// Renders RON text (written to a temporary scene file in `dir`).
+pub fn render_text(dir: &Path, ron: &str, edit: impl FnOnce(&mut SceneDesc)) -> Framebuffer {
+    let p = dir.join("scene.ron");
+    std::fs::write(&p, ron).unwrap();
+    render_with(&p, edit)
+}
+
+pub fn luxon() -> Command {
+    ensure_plugins();
+    Command::new(env!("CARGO_BIN_EXE_luxon"))
+}
+
+pub fn run(args: &[&str]) -> Output {
+    luxon().args(args).output().expect("cannot run luxon")
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// A fresh, empty directory for one test.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("luxon-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// 8-bit sRGB RGB, as the PNG writer stores it.
+pub fn to_srgb8(fb: &Framebuffer) -> Vec<u8> {
+    fb.rgba
+        .chunks_exact(4)
+        .flat_map(|p| {
+            [0, 1, 2].map(|k| (luxon_plugin::linear_to_srgb(p[k]) * 255.0 + 0.5) as u8)
+        })
+        .collect()
+}
+
+/// Mean and maximum of |a - b| over 8-bit channels.
+pub fn diff(a: &[u8], b: &[u8]) -> (f64, u8) {
+    assert_eq!(a.len(), b.len());
+    let mut sum = 0u64;
+    let mut max = 0u8;
+    for (x, y) in a.iter().zip(b) {
+        let d = x.abs_diff(*y);
+        sum += d as u64;
+        max = max.max(d);
+    }
+    (sum as f64 / a.len() as f64, max)
+}

@@ -1,0 +1,70 @@
+//! Golden images: every shipped scene, rendered small, against a committed reference picture.
+//! After an intended change of the pictures, regenerate them with
+//! `LUXON_BLESS=1 cargo test --test golden` and look at every one before committing.
+
+mod common;
+
+use common::*;
+
+const WIDTH: u32 = 192;
+
+fn check(name: &str) {
+    let path = root().join("scenes").join(format!("{name}.ron"));
+    let fb = render_with(&path, |d| {
+        let aspect = d.render.height as f64 / d.render.width as f64;
+        d.render.width = WIDTH;
+        d.render.height = (WIDTH as f64 * aspect).round() as u32;
+    });
+    let got = to_srgb8(&fb);
+    let golden = root().join("tests/golden").join(format!("{name}.png"));
+    if std::env::var_os("LUXON_BLESS").is_some() {
+        image::save_buffer(&golden, &got, fb.width, fb.height, image::ColorType::Rgb8).unwrap();
+        return;
+    }
+    let want = image::open(&golden)
+        .unwrap_or_else(|e| panic!("{}: {e} (bless with LUXON_BLESS=1)", golden.display()))
+        .to_rgb8();
+    assert_eq!((want.width(), want.height()), (fb.width, fb.height), "{name}: size");
+    // A reference that is one flat colour would let a broken renderer pass.
+    let px = want.as_raw();
+    let distinct = {
+        let mut v: Vec<[u8; 3]> = px.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        v.sort();
+        v.dedup();
+        v.len()
+    };
+    assert!(distinct > 50, "{name}: golden image has only {distinct} colours");
+    let (mean, max) = diff(&got, px);
+    // Same machine: identical. Elsewhere, libm's last bits may differ a little at edges.
+    assert!(mean < 0.5 && max < 64, "{name}: mean diff {mean:.3}, max {max} (see LUXON_BLESS in this file)");
+}
+
+#[test]
+fn spheres() {
+    check("spheres");
+}
+
+#[test]
+fn glass() {
+    check("glass");
+}
+
+#[test]
+fn mirrors() {
+    check("mirrors");
+}
+
+#[test]
+fn shadows_through_glass() {
+    check("shadows-glass");
+}
+
+#[test]
+fn antialiasing() {
+    check("antialiasing");
+}
+
+#[test]
+fn torus_custom_primitive() {
+    check("torus");
+}

@@ -1,0 +1,160 @@
+//! Plugin failures give precise errors: missing, not a plugin, wrong ABI, wrong kind, bad
+//! parameters, panics (at creation and while rendering).
+
+mod common;
+
+use common::*;
+use luxon::Scene;
+use std::path::{Path, PathBuf};
+
+/// Copies a test plugin into `dir` under a name the scanner picks up.
+fn install(dir: &Path, lib: &str, as_name: &str) -> PathBuf {
+    ensure_plugins();
+    let exe = std::env::current_exe().unwrap();
+    let profile_dir = exe.parent().unwrap().parent().unwrap();
+    let file = |n: &str| format!("{}{n}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
+    let dst = dir.join(file(as_name));
+    std::fs::copy(profile_dir.join(file(lib)), &dst).unwrap();
+    dst
+}
+
+/// Builds a scene with one object line; returns the error message.
+fn build_error(dir: &Path, object: &str) -> String {
+    let text = format!(
+        "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    objects: [\n        {object},\n    ],\n)\n",
+        dir.display()
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    let desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    match Scene::build(&desc, &registry(&desc)) {
+        Ok(_) => panic!("scene built, but an error was expected"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn unknown_plugin_suggests_and_lists_the_search_path() {
+    let dir = temp_dir("unknown");
+    let e = build_error(&dir, r#"(plugin: "sphre", params: (center: (0, 0, 0), radius: 1))"#);
+    assert!(e.contains("scene.ron:5:18: no primitive plugin named `sphre`, did you mean `sphere`?"), "{e}");
+    assert!(e.contains("searched:") && e.contains(&dir.display().to_string()), "{e}");
+}
+
+#[test]
+fn wrong_kind_names_both_kinds() {
+    let dir = temp_dir("kind");
+    let e = build_error(&dir, r#"(plugin: "checker")"#);
+    assert!(e.contains("scene.ron:5:18: plugin `checker` is a texture"), "{e}");
+    assert!(e.contains("but a primitive is expected"), "{e}");
+}
+
+#[test]
+fn bad_parameter_is_reported_at_its_scene_position() {
+    let dir = temp_dir("params");
+    let e = build_error(&dir, r#"(plugin: "sphere", params: (center: (0, 0, 0), radus: 1))"#);
+    assert!(e.contains("scene.ron:5:56:"), "{e}");
+    assert!(e.contains("plugin `sphere`") && e.contains("did you mean `radius`"), "{e}");
+    let e = build_error(&dir, r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: -1))"#);
+    assert!(e.contains("scene.ron:5:") && e.contains("radius"), "{e}");
+}
+
+#[test]
+fn wrong_abi_version_names_both_versions() {
+    let dir = temp_dir("abi");
+    install(&dir, "testplug_bad_abi", "luxon_old");
+    let e = build_error(&dir, r#"(plugin: "old_thing")"#);
+    assert!(e.contains("no primitive plugin named `old_thing`"), "{e}");
+    assert!(e.contains("libluxon_old") && e.contains("built for plugin ABI 9999"), "{e}");
+    assert!(e.contains(&format!("this Luxon uses ABI {}", luxon_plugin::ABI_VERSION)), "{e}");
+}
+
+#[test]
+fn a_library_that_is_not_a_plugin_is_named() {
+    let dir = temp_dir("notplugin");
+    install(&dir, "testplug_not_a_plugin", "luxon_imposter");
+    let e = build_error(&dir, r#"(plugin: "imposter")"#);
+    assert!(e.contains("libluxon_imposter") && e.contains("not a Luxon plugin"), "{e}");
+}
+
+#[test]
+fn panic_in_create_becomes_an_error_naming_the_plugin() {
+    let dir = temp_dir("panic-create");
+    install(&dir, "testplug_panics", "luxon_panics");
+    let e = build_error(&dir, r#"(plugin: "panic_create")"#);
+    assert!(e.contains("scene.ron:5:") && e.contains("plugin `panic_create`"), "{e}");
+    assert!(e.contains("panicked") && e.contains("deliberate panic in create"), "{e}");
+}
+
+fn render_error(dir: &Path, objects: &str, extra: &str) -> String {
+    let text = format!(
+        "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    lights: [Point(position: (0, 5, -5))],\n    {extra}\n    objects: [{objects}],\n    render: (width: 16, height: 16),\n)\n",
+        dir.display()
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    let desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let scene = Scene::build(&desc, &registry(&desc)).unwrap_or_else(|e| panic!("{e}"));
+    match luxon::render::render(&scene, &|_, _| {}) {
+        Ok(_) => panic!("render succeeded, but an error was expected"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn panic_while_intersecting_stops_the_render_with_an_error() {
+    let dir = temp_dir("panic-intersect");
+    install(&dir, "testplug_panics", "luxon_panics");
+    let e = render_error(&dir, r#"(plugin: "panic_intersect")"#, "");
+    assert!(e.contains("plugin `panic_intersect` panicked while intersecting"), "{e}");
+}
+
+#[test]
+fn panic_in_a_texture_stops_the_render_with_an_error() {
+    let dir = temp_dir("panic-texture");
+    install(&dir, "testplug_panics", "luxon_panics");
+    let e = render_error(
+        &dir,
+        r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")"#,
+        r#"textures: { "t": (plugin: "panic_texture") }, materials: { "m": (texture: "t") },"#,
+    );
+    assert!(e.contains("plugin `panic_texture` panicked"), "{e}");
+}
+
+#[test]
+fn a_plugin_file_named_in_plugin_path_is_loaded_whatever_its_name() {
+    let dir = temp_dir("explicit");
+    let file = install(&dir, "testplug_panics", "whatever_name");
+    let text = format!(
+        "Scene(plugin_path: [\"{}\"], camera: (position: (0, 0, -5), look_at: (0, 0, 0)), objects: [(plugin: \"panic_create\")])",
+        file.display()
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    let desc = luxon_formats::load(&path).unwrap();
+    let e = Scene::build(&desc, &registry(&desc)).err().expect("expected the plugin's panic").to_string();
+    assert!(e.contains("deliberate panic in create"), "{e}");
+}
+
+#[test]
+fn plugins_command_lists_every_plugin_and_its_parameters() {
+    let dir = temp_dir("list");
+    install(&dir, "testplug_bad_abi", "luxon_old");
+    let out = run(&["plugins", "--plugin-path", dir.to_str().unwrap()]);
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    for want in [
+        "primitive `sphere`",
+        "primitive `mesh`",
+        "primitive `torus`",
+        "texture `checker`",
+        "writer `png` [.png]",
+        "writer `exr` [.exr]",
+        "plugin ABI 1",
+        "radius",
+        "skipped",
+        "built for plugin ABI 9999",
+    ] {
+        assert!(s.contains(want), "missing `{want}` in:\n{s}");
+    }
+}

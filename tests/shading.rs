@@ -1,0 +1,171 @@
+//! The shading model against values worked out by hand: one pixel through the image centre.
+
+mod common;
+
+use common::*;
+
+/// Renders a 1x1 image (its single ray goes through the image centre) and returns its RGB.
+fn centre(name: &str, scene: &str) -> [f32; 3] {
+    let dir = temp_dir(name);
+    let fb = render_text(&dir, scene, |d| {
+        d.render.width = 1;
+        d.render.height = 1;
+    });
+    let p = fb.pixel(0, 0);
+    [p[0], p[1], p[2]]
+}
+
+fn close(a: [f32; 3], b: [f32; 3]) -> bool {
+    a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-4)
+}
+
+const HEAD_ON: &str = r#"Scene(
+    camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 30),
+    background: (0.2, 0.3, 0.4),
+    lights: [Directional(direction: (0, 0, 1), intensity: 1.0, shadows: false)],
+    materials: { "m": (color: (1, 0.5, 0.25), ambient: 0.1, diffuse: 0.6, specular: SPEC, shininess: 10) },
+    objects: [(plugin: "sphere", params: (center: (0, 0, 5), radius: 1), material: "m")],
+)"#;
+
+#[test]
+fn ambient_plus_lambert() {
+    let c = centre("lambert", &HEAD_ON.replace("SPEC", "0.0"));
+    assert!(close(c, [0.7, 0.35, 0.175]), "{c:?}");
+}
+
+#[test]
+fn phong_highlight_adds_white() {
+    let c = centre("phong", &HEAD_ON.replace("SPEC", "0.5"));
+    assert!(close(c, [1.2, 0.85, 0.675]), "{c:?}");
+}
+
+#[test]
+fn blinn_highlight_adds_white() {
+    let scene = HEAD_ON.replace("SPEC", "0.5").replace("shininess: 10", "shininess: 10, highlight: Blinn");
+    let c = centre("blinn", &scene);
+    assert!(close(c, [1.2, 0.85, 0.675]), "{c:?}");
+}
+
+#[test]
+fn miss_shows_the_background() {
+    let scene = HEAD_ON.replace("SPEC", "0.0").replace("center: (0, 0, 5)", "center: (0, 5, 5)");
+    assert!(close(centre("miss", &scene), [0.2, 0.3, 0.4]));
+}
+
+/// Two parallel mirrors with the camera between them: each bounce adds the ambient term and
+/// halves the rest; at the depth limit a ray sees the background.
+fn mirrors(depth: u32, background: f32) -> [f32; 3] {
+    let scene = format!(
+        r#"Scene(
+        camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 30),
+        background: ({background}, {background}, {background}),
+        materials: {{ "mirror": (color: (1, 1, 1), ambient: 0.1, diffuse: 0, reflect: 0.5) }},
+        objects: [
+            (plugin: "plane", params: (point: (0, 0, 5), normal: (0, 0, -1)), material: "mirror"),
+            (plugin: "plane", params: (point: (0, 0, -5), normal: (0, 0, 1)), material: "mirror"),
+        ],
+        render: (max_depth: {depth}, min_weight: 0),
+    )"#
+    );
+    centre(&format!("mirrors-{depth}-{background}"), &scene)
+}
+
+#[test]
+fn depth_limit_ends_in_the_background() {
+    for depth in [0u32, 1, 3, 7] {
+        for bg in [0.0f32, 1.0] {
+            let expect: f32 = (0..=depth).map(|k| 0.1 * 0.5f32.powi(k as i32)).sum::<f32>()
+                + 0.5f32.powi(depth as i32 + 1) * bg;
+            let c = mirrors(depth, bg);
+            assert!(close(c, [expect; 3]), "depth {depth} bg {bg}: {c:?} vs {expect}");
+        }
+    }
+}
+
+#[test]
+fn deep_mirrors_finish() {
+    // Deep recursion between mirrors must end (depth limit) without overflowing the stack.
+    let c = mirrors(200, 0.0);
+    assert!(close(c, [0.2; 3]), "{c:?}");
+}
+
+/// Camera between a floor and a light, looking down through nothing at the floor; a blocker
+/// above the camera sits between the floor point and the light.
+fn under(name: &str, blocker: &str, material: &str) -> [f32; 3] {
+    let scene = format!(
+        r#"Scene(
+        camera: (position: (0, 1, 0), look_at: (0, 0, 0), up: (0, 0, 1), fov: 10),
+        lights: [Directional(direction: (0, -1, 0), intensity: 1.0)],
+        materials: {{
+            "floor": (color: (1, 1, 1), ambient: 0, diffuse: 1),
+            "blocker": {material},
+        }},
+        objects: [
+            (plugin: "plane", params: (normal: (0, 1, 0)), material: "floor"),
+            {blocker}
+        ],
+    )"#
+    );
+    centre(name, &scene)
+}
+
+const PANE: &str = r#"(plugin: "triangle", params: (vertices: ((-5, 2, -5), (5, 2, -5), (0, 2, 5))), material: "blocker"),"#;
+const BALL: &str = r#"(plugin: "sphere", params: (center: (0, 3, 0), radius: 0.5), material: "blocker"),"#;
+const TINTED: &str = r#"(color: (1, 0.5, 0.25), diffuse: 0, ambient: 0, transmit: 0.8, ior: 1.0)"#;
+
+#[test]
+fn shadow_through_a_pane_is_filtered_once() {
+    let c = under("pane", PANE, TINTED);
+    assert!(close(c, [0.8, 0.4, 0.2]), "{c:?}");
+}
+
+#[test]
+fn shadow_through_a_ball_is_filtered_twice() {
+    let c = under("ball", BALL, TINTED);
+    assert!(close(c, [0.64, 0.16, 0.04]), "{c:?}");
+}
+
+#[test]
+fn opaque_blocker_casts_a_black_shadow() {
+    let c = under("opaque", BALL, "(color: (1, 1, 1))");
+    assert!(close(c, [0.0; 3]), "{c:?}");
+    let lit = under("nothing", "", "(color: (1, 1, 1))");
+    assert!(close(lit, [1.0; 3]), "{lit:?}");
+}
+
+#[test]
+fn clear_object_with_unit_ior_is_invisible() {
+    let scene = r#"Scene(
+        camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 30),
+        background: (0.2, 0.3, 0.4),
+        materials: { "clear": (color: (1, 1, 1), ambient: 0, diffuse: 0, transmit: 1, ior: 1) },
+        objects: [(plugin: "sphere", params: (center: (0, 0, 5), radius: 1), material: "clear")],
+    )"#;
+    assert!(close(centre("clear", scene), [0.2, 0.3, 0.4]));
+}
+
+#[test]
+fn glass_ball_lens_inverts_what_is_behind_it() {
+    // A glass ball acts as a lens: a red object seen above the axis through it shows up below.
+    let scene = r#"Scene(
+        camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 12),
+        background: (0, 0, 0),
+        materials: {
+            "glass": (color: (1, 1, 1), ambient: 0, diffuse: 0, transmit: 1, ior: 1.5),
+            "red": (color: (1, 0, 0), ambient: 1, diffuse: 0),
+        },
+        objects: [
+            (plugin: "sphere", params: (center: (0, 0, 10), radius: 1), material: "glass"),
+            (plugin: "sphere", params: (center: (0, 2, 20), radius: 1.2), material: "red"),
+        ],
+    )"#;
+    let dir = temp_dir("lens");
+    let fb = render_text(&dir, scene, |d| {
+        d.render.width = 41;
+        d.render.height = 41;
+    });
+    let red_rows: Vec<u32> = (0..41).filter(|&y| (0..41).any(|x| fb.pixel(x, y)[0] > 0.5)).collect();
+    assert!(!red_rows.is_empty(), "the red ball is not visible at all");
+    // Without the lens it would be in the top half (rows < 20); through it, in the bottom half.
+    assert!(red_rows.iter().any(|&y| y > 20), "rows {red_rows:?}");
+}
