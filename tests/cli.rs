@@ -15,14 +15,21 @@ fn render_writes_every_format_by_extension() {
         .iter()
         .map(|e| dir.join(format!("out.{e}")).display().to_string())
         .collect();
-    let mut args = vec!["render", &*Box::leak(scene("spheres.ron").into_boxed_str()), "--res", "64x40"];
+    let mut args = vec![
+        "render",
+        &*Box::leak(scene("spheres.ron").into_boxed_str()),
+        "--res",
+        "64x40",
+    ];
     for o in &outs {
         args.extend(["-o", o.as_str()]);
     }
     let out = run(&args);
     assert!(out.status.success(), "{}", stderr(&out));
     for o in &outs[..4] {
-        let img = image::open(o).unwrap_or_else(|e| panic!("{o}: {e}")).to_rgb8();
+        let img = image::open(o)
+            .unwrap_or_else(|e| panic!("{o}: {e}"))
+            .to_rgb8();
         assert_eq!((img.width(), img.height()), (64, 40));
         let first = img.get_pixel(0, 0);
         assert!(img.pixels().any(|p| p != first), "{o} is one flat colour");
@@ -35,18 +42,38 @@ fn render_writes_every_format_by_extension() {
 fn stats_print_rays_per_kind() {
     let dir = temp_dir("stats");
     let o = dir.join("g.png");
-    let out = run(&["render", &scene("glass.ron"), "-o", o.to_str().unwrap(), "--res", "48x32", "--stats", "--threads", "2"]);
+    let out = run(&[
+        "render",
+        &scene("glass.ron"),
+        "-o",
+        o.to_str().unwrap(),
+        "--res",
+        "48x32",
+        "--stats",
+        "--threads",
+        "2",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let e = stderr(&out);
     let count = |label: &str| -> u64 {
-        let line = e.lines().find(|l| l.trim_start().starts_with(label)).unwrap_or_else(|| panic!("no `{label}` in {e}"));
-        line.split_whitespace().nth(if label == "intersection" { 2 } else { 1 }).unwrap().parse().unwrap()
+        let line = e
+            .lines()
+            .find(|l| l.trim_start().starts_with(label))
+            .unwrap_or_else(|| panic!("no `{label}` in {e}"));
+        line.split_whitespace()
+            .nth(if label == "intersection" { 2 } else { 1 })
+            .unwrap()
+            .parse()
+            .unwrap()
     };
     assert_eq!(count("primary"), 48 * 32 * 4);
     assert!(count("shadow") > 0 && count("reflection") > 0 && count("refraction") > 0);
     assert!(count("intersection") > count("primary"));
     assert!(e.contains("threads          2"), "{e}");
-    assert!(e.contains("BVH build") && e.contains("NaN pixels       0"), "{e}");
+    assert!(
+        e.contains("BVH build") && e.contains("NaN pixels       0"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -54,10 +81,21 @@ fn unused_effects_cast_no_rays() {
     // The antialiasing scene has no shadows (its light casts none), no mirrors and no glass.
     let dir = temp_dir("effects");
     let o = dir.join("a.png");
-    let out = run(&["render", &scene("antialiasing.ron"), "-o", o.to_str().unwrap(), "--res", "32x24", "--stats"]);
+    let out = run(&[
+        "render",
+        &scene("antialiasing.ron"),
+        "-o",
+        o.to_str().unwrap(),
+        "--res",
+        "32x24",
+        "--stats",
+    ]);
     let e = stderr(&out);
     for kind in ["shadow", "reflection", "refraction"] {
-        let line = e.lines().find(|l| l.trim_start().starts_with(kind)).unwrap();
+        let line = e
+            .lines()
+            .find(|l| l.trim_start().starts_with(kind))
+            .unwrap();
         assert!(line.trim_end().ends_with(" 0"), "{line}");
     }
 }
@@ -67,7 +105,12 @@ fn check_describes_the_scene_without_rendering() {
     let out = run(&["check", &scene("torus.ron")]);
     assert!(out.status.success(), "{}", stderr(&out));
     let s = String::from_utf8_lossy(&out.stdout);
-    assert!(s.contains("2 torus") && s.contains("2 custom") && s.contains("effects    shadows, reflection, textures, antialiasing"), "{s}");
+    assert!(
+        s.contains("2 torus")
+            && s.contains("2 custom")
+            && s.contains("effects    shadows, reflection, textures, antialiasing"),
+        "{s}"
+    );
     assert!(!root().join("out/torus-should-not-exist.png").exists());
 }
 
@@ -76,21 +119,37 @@ fn scene_errors_are_one_line_with_file_line_col() {
     let dir = temp_dir("syntax");
     let p = dir.join("bad.ron");
     std::fs::write(&p, "Scene(\n  camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n  objects: [(plugin: \"sphere\", params: (center: (0, 0, 0), radius: 1), materal: \"x\")],\n)\n").unwrap();
-    let out = run(&["render", p.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
+    let out = run(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        dir.join("x.png").to_str().unwrap(),
+    ]);
     assert_eq!(out.status.code(), Some(1));
     let e = stderr(&out);
     assert_eq!(e.lines().count(), 1, "{e}");
-    assert!(e.starts_with(&format!("luxon: error: {}:3:", p.display())), "{e}");
+    assert!(
+        e.starts_with(&format!("luxon: error: {}:3:", p.display())),
+        "{e}"
+    );
     assert!(e.contains("did you mean `material`"), "{e}");
 }
 
 #[test]
 fn unknown_output_extension_lists_the_known_ones() {
     let dir = temp_dir("ext");
-    let out = run(&["render", &scene("spheres.ron"), "-o", dir.join("x.xyz").to_str().unwrap()]);
+    let out = run(&[
+        "render",
+        &scene("spheres.ron"),
+        "-o",
+        dir.join("x.xyz").to_str().unwrap(),
+    ]);
     assert_eq!(out.status.code(), Some(1));
     let e = stderr(&out);
-    assert!(e.contains("no writer for") && e.contains(".png") && e.contains(".exr"), "{e}");
+    assert!(
+        e.contains("no writer for") && e.contains(".png") && e.contains(".exr"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -108,16 +167,28 @@ fn a_failed_write_leaves_the_existing_file_untouched() {
     .unwrap();
     let out = run(&["render", p.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("expected 8 or 16"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("expected 8 or 16"),
+        "{}",
+        stderr(&out)
+    );
     assert_eq!(std::fs::read(&target).unwrap(), b"precious");
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2, "a temporary file was left behind");
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        2,
+        "a temporary file was left behind"
+    );
 }
 
 #[test]
 fn missing_scene_and_bad_arguments() {
     let out = run(&["render", "/nonexistent/scene.ron", "-o", "x.png"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("/nonexistent/scene.ron"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("/nonexistent/scene.ron"),
+        "{}",
+        stderr(&out)
+    );
     let out = run(&["render", &scene("spheres.ron"), "--res", "0x10"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("out of range"), "{}", stderr(&out));
@@ -127,9 +198,20 @@ fn missing_scene_and_bad_arguments() {
 fn empty_scene_renders_the_background() {
     let dir = temp_dir("empty");
     let p = dir.join("empty.ron");
-    std::fs::write(&p, "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), background: (0.2, 0.4, 0.6))").unwrap();
+    std::fs::write(
+        &p,
+        "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), background: (0.2, 0.4, 0.6))",
+    )
+    .unwrap();
     let o = dir.join("e.png");
-    let out = run(&["render", p.to_str().unwrap(), "-o", o.to_str().unwrap(), "--res", "8x8"]);
+    let out = run(&[
+        "render",
+        p.to_str().unwrap(),
+        "-o",
+        o.to_str().unwrap(),
+        "--res",
+        "8x8",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let img = image::open(&o).unwrap().to_rgb8();
     let px = img.get_pixel(3, 3).0;

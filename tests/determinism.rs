@@ -23,6 +23,9 @@ fn one_and_two_threads_and_any_tile_size_agree_bitwise() {
         assert!(one.iter().any(|&v| v > 0.05), "{name}: image is black");
         let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
         assert!(same(&one, &two), "{name}: 1 vs 2 threads differ");
-        assert!(same(&one, &odd_tiles), "{name}: tile size changes the image");
+        assert!(
+            same(&one, &odd_tiles),
+            "{name}: tile size changes the image"
+        );
     }
 }

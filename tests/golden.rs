@@ -24,7 +24,11 @@ fn check(name: &str) {
     let want = image::open(&golden)
         .unwrap_or_else(|e| panic!("{}: {e} (bless with LUXON_BLESS=1)", golden.display()))
         .to_rgb8();
-    assert_eq!((want.width(), want.height()), (fb.width, fb.height), "{name}: size");
+    assert_eq!(
+        (want.width(), want.height()),
+        (fb.width, fb.height),
+        "{name}: size"
+    );
     // A reference that is one flat colour would let a broken renderer pass.
     let px = want.as_raw();
     let distinct = {
@@ -33,10 +37,16 @@ fn check(name: &str) {
         v.dedup();
         v.len()
     };
-    assert!(distinct > 50, "{name}: golden image has only {distinct} colours");
+    assert!(
+        distinct > 50,
+        "{name}: golden image has only {distinct} colours"
+    );
     let (mean, max) = diff(&got, px);
     // Same machine: identical. Elsewhere, libm's last bits may differ a little at edges.
-    assert!(mean < 0.5 && max < 64, "{name}: mean diff {mean:.3}, max {max} (see LUXON_BLESS in this file)");
+    assert!(
+        mean < 0.5 && max < 64,
+        "{name}: mean diff {mean:.3}, max {max} (see LUXON_BLESS in this file)"
+    );
 }
 
 #[test]

@@ -12,7 +12,13 @@ fn install(dir: &Path, lib: &str, as_name: &str) -> PathBuf {
     ensure_plugins();
     let exe = std::env::current_exe().unwrap();
     let profile_dir = exe.parent().unwrap().parent().unwrap();
-    let file = |n: &str| format!("{}{n}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX);
+    let file = |n: &str| {
+        format!(
+            "{}{n}{}",
+            std::env::consts::DLL_PREFIX,
+            std::env::consts::DLL_SUFFIX
+        )
+    };
     let dst = dir.join(file(as_name));
     std::fs::copy(profile_dir.join(file(lib)), &dst).unwrap();
     dst
@@ -36,26 +42,47 @@ fn build_error(dir: &Path, object: &str) -> String {
 #[test]
 fn unknown_plugin_suggests_and_lists_the_search_path() {
     let dir = temp_dir("unknown");
-    let e = build_error(&dir, r#"(plugin: "sphre", params: (center: (0, 0, 0), radius: 1))"#);
-    assert!(e.contains("scene.ron:5:18: no primitive plugin named `sphre`, did you mean `sphere`?"), "{e}");
-    assert!(e.contains("searched:") && e.contains(&dir.display().to_string()), "{e}");
+    let e = build_error(
+        &dir,
+        r#"(plugin: "sphre", params: (center: (0, 0, 0), radius: 1))"#,
+    );
+    assert!(
+        e.contains("scene.ron:5:18: no primitive plugin named `sphre`, did you mean `sphere`?"),
+        "{e}"
+    );
+    assert!(
+        e.contains("did you mean `sphere`? Searched:") && e.contains(&dir.display().to_string()),
+        "{e}"
+    );
 }
 
 #[test]
 fn wrong_kind_names_both_kinds() {
     let dir = temp_dir("kind");
     let e = build_error(&dir, r#"(plugin: "checker")"#);
-    assert!(e.contains("scene.ron:5:18: plugin `checker` is a texture"), "{e}");
+    assert!(
+        e.contains("scene.ron:5:18: plugin `checker` is a texture"),
+        "{e}"
+    );
     assert!(e.contains("but a primitive is expected"), "{e}");
 }
 
 #[test]
 fn bad_parameter_is_reported_at_its_scene_position() {
     let dir = temp_dir("params");
-    let e = build_error(&dir, r#"(plugin: "sphere", params: (center: (0, 0, 0), radus: 1))"#);
+    let e = build_error(
+        &dir,
+        r#"(plugin: "sphere", params: (center: (0, 0, 0), radus: 1))"#,
+    );
     assert!(e.contains("scene.ron:5:56:"), "{e}");
-    assert!(e.contains("plugin `sphere`") && e.contains("did you mean `radius`"), "{e}");
-    let e = build_error(&dir, r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: -1))"#);
+    assert!(
+        e.contains("plugin `sphere`") && e.contains("did you mean `radius`"),
+        "{e}"
+    );
+    let e = build_error(
+        &dir,
+        r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: -1))"#,
+    );
     assert!(e.contains("scene.ron:5:") && e.contains("radius"), "{e}");
 }
 
@@ -65,8 +92,17 @@ fn wrong_abi_version_names_both_versions() {
     install(&dir, "testplug_bad_abi", "luxon_old");
     let e = build_error(&dir, r#"(plugin: "old_thing")"#);
     assert!(e.contains("no primitive plugin named `old_thing`"), "{e}");
-    assert!(e.contains("libluxon_old") && e.contains("built for plugin ABI 9999"), "{e}");
-    assert!(e.contains(&format!("this Luxon uses ABI {}", luxon_plugin::ABI_VERSION)), "{e}");
+    assert!(
+        e.contains("libluxon_old") && e.contains("built for plugin ABI 9999"),
+        "{e}"
+    );
+    assert!(
+        e.contains(&format!(
+            "this Luxon uses ABI {}",
+            luxon_plugin::ABI_VERSION
+        )),
+        "{e}"
+    );
 }
 
 #[test]
@@ -74,7 +110,10 @@ fn a_library_that_is_not_a_plugin_is_named() {
     let dir = temp_dir("notplugin");
     install(&dir, "testplug_not_a_plugin", "luxon_imposter");
     let e = build_error(&dir, r#"(plugin: "imposter")"#);
-    assert!(e.contains("libluxon_imposter") && e.contains("not a Luxon plugin"), "{e}");
+    assert!(
+        e.contains("libluxon_imposter") && e.contains("not a Luxon plugin"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -82,8 +121,14 @@ fn panic_in_create_becomes_an_error_naming_the_plugin() {
     let dir = temp_dir("panic-create");
     install(&dir, "testplug_panics", "luxon_panics");
     let e = build_error(&dir, r#"(plugin: "panic_create")"#);
-    assert!(e.contains("scene.ron:5:") && e.contains("plugin `panic_create`"), "{e}");
-    assert!(e.contains("panicked") && e.contains("deliberate panic in create"), "{e}");
+    assert!(
+        e.contains("scene.ron:5:") && e.contains("plugin `panic_create`"),
+        "{e}"
+    );
+    assert!(
+        e.contains("panicked") && e.contains("deliberate panic in create"),
+        "{e}"
+    );
 }
 
 fn render_error(dir: &Path, objects: &str, extra: &str) -> String {
@@ -106,7 +151,10 @@ fn panic_while_intersecting_stops_the_render_with_an_error() {
     let dir = temp_dir("panic-intersect");
     install(&dir, "testplug_panics", "luxon_panics");
     let e = render_error(&dir, r#"(plugin: "panic_intersect")"#, "");
-    assert!(e.contains("plugin `panic_intersect` panicked while intersecting"), "{e}");
+    assert!(
+        e.contains("plugin `panic_intersect` panicked while intersecting"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -132,7 +180,10 @@ fn a_plugin_file_named_in_plugin_path_is_loaded_whatever_its_name() {
     let path = dir.join("scene.ron");
     std::fs::write(&path, text).unwrap();
     let desc = luxon_formats::load(&path).unwrap();
-    let e = Scene::build(&desc, &registry(&desc)).err().expect("expected the plugin's panic").to_string();
+    let e = Scene::build(&desc, &registry(&desc))
+        .err()
+        .expect("expected the plugin's panic")
+        .to_string();
     assert!(e.contains("deliberate panic in create"), "{e}");
 }
 

@@ -41,14 +41,18 @@ fn phong_highlight_adds_white() {
 
 #[test]
 fn blinn_highlight_adds_white() {
-    let scene = HEAD_ON.replace("SPEC", "0.5").replace("shininess: 10", "shininess: 10, highlight: Blinn");
+    let scene = HEAD_ON
+        .replace("SPEC", "0.5")
+        .replace("shininess: 10", "shininess: 10, highlight: Blinn");
     let c = centre("blinn", &scene);
     assert!(close(c, [1.2, 0.85, 0.675]), "{c:?}");
 }
 
 #[test]
 fn miss_shows_the_background() {
-    let scene = HEAD_ON.replace("SPEC", "0.0").replace("center: (0, 0, 5)", "center: (0, 5, 5)");
+    let scene = HEAD_ON
+        .replace("SPEC", "0.0")
+        .replace("center: (0, 0, 5)", "center: (0, 5, 5)");
     assert!(close(centre("miss", &scene), [0.2, 0.3, 0.4]));
 }
 
@@ -74,10 +78,15 @@ fn mirrors(depth: u32, background: f32) -> [f32; 3] {
 fn depth_limit_ends_in_the_background() {
     for depth in [0u32, 1, 3, 7] {
         for bg in [0.0f32, 1.0] {
-            let expect: f32 = (0..=depth).map(|k| 0.1 * 0.5f32.powi(k as i32)).sum::<f32>()
+            let expect: f32 = (0..=depth)
+                .map(|k| 0.1 * 0.5f32.powi(k as i32))
+                .sum::<f32>()
                 + 0.5f32.powi(depth as i32 + 1) * bg;
             let c = mirrors(depth, bg);
-            assert!(close(c, [expect; 3]), "depth {depth} bg {bg}: {c:?} vs {expect}");
+            assert!(
+                close(c, [expect; 3]),
+                "depth {depth} bg {bg}: {c:?} vs {expect}"
+            );
         }
     }
 }
@@ -110,7 +119,8 @@ fn under(name: &str, blocker: &str, material: &str) -> [f32; 3] {
 }
 
 const PANE: &str = r#"(plugin: "triangle", params: (vertices: ((-5, 2, -5), (5, 2, -5), (0, 2, 5))), material: "blocker"),"#;
-const BALL: &str = r#"(plugin: "sphere", params: (center: (0, 3, 0), radius: 0.5), material: "blocker"),"#;
+const BALL: &str =
+    r#"(plugin: "sphere", params: (center: (0, 3, 0), radius: 0.5), material: "blocker"),"#;
 const TINTED: &str = r#"(color: (1, 0.5, 0.25), diffuse: 0, ambient: 0, transmit: 0.8, ior: 1.0)"#;
 
 #[test]
@@ -164,7 +174,9 @@ fn glass_ball_lens_inverts_what_is_behind_it() {
         d.render.width = 41;
         d.render.height = 41;
     });
-    let red_rows: Vec<u32> = (0..41).filter(|&y| (0..41).any(|x| fb.pixel(x, y)[0] > 0.5)).collect();
+    let red_rows: Vec<u32> = (0..41)
+        .filter(|&y| (0..41).any(|x| fb.pixel(x, y)[0] > 0.5))
+        .collect();
     assert!(!red_rows.is_empty(), "the red ball is not visible at all");
     // Without the lens it would be in the top half (rows < 20); through it, in the bottom half.
     assert!(red_rows.iter().any(|&y| y > 20), "rows {red_rows:?}");

@@ -115,21 +115,17 @@ impl Whitted<'_> {
         let view = -ray.dir;
         let mut color = mat.ambient * opacity * base;
         for light in &scene.lights {
-            let (to_light, dist, light_color, shadows) = match light {
+            let (to_light, light_color, shadows) = match light {
                 Light::Point {
                     position,
                     color,
                     shadows,
-                } => {
-                    let d = *position - s.p;
-                    let len = d.length();
-                    (d / len, len, *color, *shadows)
-                }
+                } => ((*position - s.p).normalize(), *color, *shadows),
                 Light::Directional {
                     to_light,
                     color,
                     shadows,
-                } => (*to_light, f32::INFINITY, *color, *shadows),
+                } => (*to_light, *color, *shadows),
             };
             let ndotl = n.dot(to_light);
             if ndotl <= 0.0 {
@@ -146,7 +142,6 @@ impl Whitted<'_> {
                         (spawn(s.p, s.p_error, ng, to_light, ray.time), f32::INFINITY)
                     }
                 };
-                let _ = dist;
                 arriving *= scene.transmittance(&sray, t_max, settings.min_weight, c);
                 if arriving == Vec3A::ZERO {
                     continue;

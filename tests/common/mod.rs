@@ -22,7 +22,8 @@ pub fn ensure_plugins() {
         let exe = std::env::current_exe().unwrap();
         let profile_dir = exe.parent().unwrap().parent().unwrap();
         let mut cmd = Command::new(env!("CARGO"));
-        cmd.args(["build", "--workspace", "--lib", "--quiet"]).current_dir(root());
+        cmd.args(["build", "--workspace", "--lib", "--quiet"])
+            .current_dir(root());
         if profile_dir.file_name().is_some_and(|n| n == "release") {
             cmd.arg("--release");
         }
@@ -42,7 +43,9 @@ pub fn render_with(path: &Path, edit: impl FnOnce(&mut SceneDesc)) -> Framebuffe
     edit(&mut desc);
     let reg = registry(&desc);
     let scene = Scene::build(&desc, &reg).unwrap_or_else(|e| panic!("{e}"));
-    luxon::render::render(&scene, &|_, _| {}).unwrap_or_else(|e| panic!("{e}")).0
+    luxon::render::render(&scene, &|_, _| {})
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0
 }
 
 /// Renders RON text (written to a temporary scene file in `dir`).
@@ -77,9 +80,7 @@ pub fn temp_dir(name: &str) -> PathBuf {
 pub fn to_srgb8(fb: &Framebuffer) -> Vec<u8> {
     fb.rgba
         .chunks_exact(4)
-        .flat_map(|p| {
-            [0, 1, 2].map(|k| (luxon_plugin::linear_to_srgb(p[k]) * 255.0 + 0.5) as u8)
-        })
+        .flat_map(|p| [0, 1, 2].map(|k| (luxon_plugin::linear_to_srgb(p[k]) * 255.0 + 0.5) as u8))
         .collect()
 }
 
