@@ -1,0 +1,74 @@
+//! `luxon check`: validate a scene and describe it.
+
+use luxon::plugin::Registry;
+use luxon::{Error, Scene};
+use luxon_formats::SceneDesc;
+use std::path::Path;
+
+pub fn run(path: &Path) -> Result<(), Error> {
+    let desc = luxon_formats::load(path)?;
+    let registry = Registry::discover(&desc.plugin_path);
+    let scene = Scene::build(&desc, &registry)?;
+    let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
+    describe(&desc, &scene, &outputs);
+    Ok(())
+}
+
+fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) {
+    let s = &scene.settings;
+    println!("scene      {}", desc.source.display());
+    let cam = &desc.camera.value;
+    println!(
+        "camera     at {:?} looking at {:?}, up {:?}, {:?}",
+        cam.position, cam.look_at, cam.up, cam.projection
+    );
+    println!(
+        "image      {}x{}, {} sample(s) per pixel, max depth {}",
+        s.width, s.height, s.samples, s.max_depth
+    );
+    let objects: Vec<String> = scene
+        .object_counts
+        .iter()
+        .map(|(n, c)| format!("{c} {n}"))
+        .collect();
+    println!(
+        "objects    {} ({})",
+        desc.objects.len(),
+        if objects.is_empty() {
+            "none".into()
+        } else {
+            objects.join(", ")
+        }
+    );
+    println!(
+        "primitives {} spheres, {} triangles, {} planes, {} custom",
+        scene.spheres.len(),
+        scene.triangles.len(),
+        scene.planes.planes.len(),
+        scene.customs.len()
+    );
+    if scene.degenerate_triangles > 0 {
+        println!(
+            "           ({} zero-area triangles dropped)",
+            scene.degenerate_triangles
+        );
+    }
+    println!("lights     {}", scene.lights.len());
+    println!("materials  {}", scene.material_names.join(", "));
+    println!(
+        "textures   {}",
+        if scene.texture_names.is_empty() {
+            "none".into()
+        } else {
+            scene.texture_names.join(", ")
+        }
+    );
+    println!("effects    {}", scene.features);
+    for o in outputs {
+        println!(
+            "output     {} (writer `{}`)",
+            o.desc.path.display(),
+            o.writer.name
+        );
+    }
+}

@@ -1,0 +1,6 @@
+//! The subcommands of `luxon`, one module each.
+
+pub mod check;
+pub mod plugins;
+pub mod progress;
+pub mod render;

@@ -1,0 +1,45 @@
+//! `luxon plugins`: every plugin found and what it takes.
+
+use luxon::plugin::{PluginKind, Registry};
+use std::path::PathBuf;
+
+pub fn run(extra: &[PathBuf]) {
+    let registry = Registry::discover(extra);
+    for (i, lib) in registry.libraries.iter().enumerate() {
+        println!(
+            "{} (library `{}`, plugin ABI {}, luxon-plugin {})",
+            lib.path.display(),
+            lib.name,
+            lib.abi_version,
+            lib.sdk_version
+        );
+        for e in registry.entries.iter().filter(|e| e.library == i) {
+            let ext = if e.kind == PluginKind::Writer {
+                format!(" [.{}]", e.extensions.join(", ."))
+            } else {
+                String::new()
+            };
+            let shadow = if e.shadowed {
+                " (shadowed by an earlier library)"
+            } else {
+                ""
+            };
+            println!("  {} `{}`{ext}{shadow}: {}", e.kind, e.name, e.description);
+            for line in e.params_doc.lines() {
+                println!("      {line}");
+            }
+        }
+    }
+    if registry.libraries.is_empty() {
+        println!("no plugins found");
+    }
+    for p in &registry.problems {
+        println!("skipped {p}");
+    }
+    let dirs: Vec<String> = registry
+        .searched
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    println!("searched: {}", dirs.join(", "));
+}
