@@ -1,31 +1,56 @@
-//! Images are bitwise identical whatever the thread count and tile size.
+//! Images are bitwise identical whatever the thread count, tile size and decomposition.
 
 mod common;
 
 use common::*;
+use luxon_formats::Decomposition;
 
-fn render(name: &str, threads: u32, tile: u32) -> Vec<f32> {
+fn render(name: &str, threads: u32, tile: u32, how: Decomposition) -> Vec<f32> {
     render_with(&root().join("scenes").join(format!("{name}.ron")), |d| {
         d.render.width = 97;
         d.render.height = 61;
         d.render.parallel.threads = Some(threads);
         d.render.parallel.tile_size = tile;
+        d.render.parallel.decomposition = how;
     })
     .rgba
+}
+
+fn same(a: &[f32], b: &[f32]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 #[test]
 fn one_and_two_threads_and_any_tile_size_agree_bitwise() {
     for name in ["glass", "torus", "antialiasing"] {
-        let one = render(name, 1, 16);
-        let two = render(name, 2, 16);
-        let odd_tiles = render(name, 3, 7);
+        let one = render(name, 1, 16, Decomposition::Dynamic);
+        let two = render(name, 2, 16, Decomposition::Dynamic);
+        let odd_tiles = render(name, 3, 7, Decomposition::Dynamic);
         assert!(one.iter().any(|&v| v > 0.05), "{name}: image is black");
-        let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
         assert!(same(&one, &two), "{name}: 1 vs 2 threads differ");
         assert!(
             same(&one, &odd_tiles),
             "{name}: tile size changes the image"
         );
+    }
+}
+
+#[test]
+fn every_decomposition_agrees_bitwise() {
+    for name in ["glass", "torus"] {
+        let reference = render(name, 1, 16, Decomposition::Dynamic);
+        for how in [
+            Decomposition::PixelCyclic,
+            Decomposition::ScanlineCyclic,
+            Decomposition::BlockCyclic,
+        ] {
+            for (threads, block) in [(1, 16), (2, 5), (3, 16)] {
+                let img = render(name, threads, block, how);
+                assert!(
+                    same(&reference, &img),
+                    "{name}: {how:?} on {threads} threads (block {block}) differs"
+                );
+            }
+        }
     }
 }

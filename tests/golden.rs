@@ -78,3 +78,8 @@ fn antialiasing() {
 fn torus_custom_primitive() {
     check("torus");
 }
+
+#[test]
+fn molecule_cylinders_cones_rings() {
+    check("molecule");
+}

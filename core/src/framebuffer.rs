@@ -35,4 +35,18 @@ impl Framebuffer {
             self.rgba[dst..dst + w as usize * 4].copy_from_slice(&data[src..src + w as usize * 4]);
         }
     }
+
+    /// Copies rendered pixels to where their spans say.
+    pub fn put_chunk(&mut self, c: &crate::schedule::Chunk) {
+        let mut src = c.rgba.chunks_exact(4);
+        for s in &c.spans {
+            let row = s.y as usize * self.width as usize;
+            for x in s.xs() {
+                let i = (row + x as usize) * 4;
+                if let Some(px) = src.next() {
+                    self.rgba[i..i + 4].copy_from_slice(px);
+                }
+            }
+        }
+    }
 }

@@ -27,8 +27,10 @@ pub mod output;
 pub mod plugin;
 pub mod ray;
 pub mod render;
+pub mod schedule;
 pub mod sampler;
 pub mod scene;
+pub mod volume;
 
 pub use error::Error;
 pub use framebuffer::Framebuffer;

@@ -31,12 +31,25 @@ enum Command {
         /// Samples per pixel.
         #[arg(long)]
         samples: Option<u32>,
-        /// Render threads (default: every CPU).
+        /// Render threads per process (default: every CPU; with MPI, the rank's share of them).
         #[arg(long)]
         threads: Option<u32>,
-        /// Print rays cast per kind, intersection tests and timings.
+        /// Print rays cast per kind, intersection tests, timings and the work of every rank and
+        /// thread.
         #[arg(long)]
         stats: bool,
+        /// Parallel mode: threads in one process, MPI ranks (one thread each), or both.
+        #[arg(long, value_parser = ["threads", "mpi", "hybrid"])]
+        parallel: Option<String>,
+        /// How pixels are dealt to threads and ranks.
+        #[arg(long, value_parser = ["pixel-cyclic", "scanline-cyclic", "block-cyclic", "dynamic"])]
+        decomposition: Option<String>,
+        /// Edge in pixels of dynamic tiles and block-cyclic blocks.
+        #[arg(long = "block-size", alias = "tile-size")]
+        block_size: Option<u32>,
+        /// Output: written while rendering, after it, or by every MPI rank (8-bit PPM).
+        #[arg(long, value_parser = ["async", "sync", "mpi-io"])]
+        io: Option<String>,
     },
     /// Validate a scene and print what it contains; renders nothing.
     Check { scene: PathBuf },
@@ -78,6 +91,10 @@ fn main() -> ExitCode {
             samples,
             threads,
             stats,
+            parallel,
+            decomposition,
+            block_size,
+            io,
         } => cli::render::run(
             &scene,
             &cli::render::Overrides {
@@ -86,6 +103,10 @@ fn main() -> ExitCode {
                 samples,
                 threads,
                 stats,
+                parallel,
+                decomposition,
+                block_size,
+                io,
             },
         ),
         Command::Check { scene } => cli::check::run(&scene),

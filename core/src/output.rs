@@ -9,7 +9,10 @@ use luxon_formats::OutputDesc;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+pub mod stream;
+
 /// An output with its writer resolved.
+#[derive(Clone)]
 pub struct Output<'r> {
     pub desc: OutputDesc,
     pub writer: &'r Entry,
@@ -54,22 +57,31 @@ pub fn resolve<'r>(
         .collect()
 }
 
+/// The temporary file `path` is written to before it is renamed over `path` (same directory,
+/// named after the process `pid`); creates missing directories.
+pub fn temp_path(path: &Path, pid: u32) -> Result<PathBuf, Error> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    Ok(dir.join(format!(".{name}.{pid}.tmp")))
+}
+
 /// Writes `bytes` to `path` atomically (temporary file + rename), creating missing directories.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir).map_err(io)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let tmp = temp_path(path, std::process::id())?;
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;

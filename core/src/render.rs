@@ -1,6 +1,6 @@
-//! Rendering a scene into a framebuffer: the image is cut into tiles that rayon's work stealing
-//! spreads over the threads. Every pixel's samples come from its own deterministic sequence, so
-//! the result does not depend on which thread renders which tile.
+//! Rendering pixels, and a whole scene into a framebuffer in this process. Which thread renders
+//! which pixels is [`crate::schedule`]'s business; every pixel's samples come from its own
+//! deterministic sequence, so the result does not depend on it.
 
 use crate::error::Error;
 use crate::framebuffer::Framebuffer;
@@ -9,8 +9,9 @@ use crate::integrator::{IorStack, Whitted};
 use crate::math::Vec3A;
 use crate::sampler::pixel_sample;
 use crate::scene::Scene;
-use rayon::prelude::*;
+use crate::schedule::{render_local, threads_for, Chunk, RankStats, Span};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// What a render did.
@@ -18,46 +19,45 @@ use std::time::{Duration, Instant};
 pub struct RenderStats {
     pub counters: Counters,
     pub render_time: Duration,
+    /// Render threads of each process.
     pub threads: usize,
+    /// Units of work (tiles, blocks or rows) rendered.
     pub tiles: usize,
+    /// The work of every process (one entry without MPI), per thread.
+    pub ranks: Vec<RankStats>,
 }
 
-/// Called after each finished tile with (tiles done, tiles in all); may be called from any thread.
-pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
-
-#[derive(Clone, Copy, Debug)]
-struct Tile {
-    x0: u32,
-    y0: u32,
-    w: u32,
-    h: u32,
-}
-
-fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
-    let size = size.max(1);
-    let mut v = Vec::new();
-    for y0 in (0..height).step_by(size as usize) {
-        for x0 in (0..width).step_by(size as usize) {
-            v.push(Tile {
-                x0,
-                y0,
-                w: size.min(width - x0),
-                h: size.min(height - y0),
-            });
+impl RenderStats {
+    pub fn of(ranks: Vec<RankStats>, render_time: Duration) -> RenderStats {
+        let mut total = crate::schedule::WorkerStats::default();
+        for r in &ranks {
+            total.add(&r.total());
+        }
+        RenderStats {
+            counters: total.counters,
+            render_time,
+            threads: ranks.first().map_or(0, |r| r.threads.len()),
+            tiles: total.units as usize,
+            ranks,
         }
     }
-    v
 }
 
-fn render_tile(scene: &Scene, t: Tile, c: &mut Counters) -> Vec<f32> {
+/// Called with (pixels done, pixels in all); may be called from any thread.
+pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
+
+/// Renders the pixels of `spans`, returning their RGBA values span after span.
+pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
     let s = &scene.settings;
     let integrator = Whitted { scene };
-    let mut out = Vec::with_capacity((t.w * t.h * 4) as usize);
+    let count: usize = spans.iter().map(|s| s.count as usize).sum();
+    let mut out = Vec::with_capacity(count * 4);
     let n = s.samples.max(1);
     let inv_n = 1.0 / n as f32;
     let media = IorStack::default();
-    for y in t.y0..t.y0 + t.h {
-        for x in t.x0..t.x0 + t.w {
+    for span in spans {
+        let y = span.y;
+        for x in span.xs() {
             let mut sum = Vec3A::ZERO;
             for i in 0..n {
                 let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
@@ -79,66 +79,20 @@ fn render_tile(scene: &Scene, t: Tile, c: &mut Counters) -> Vec<f32> {
     out
 }
 
-/// Renders `scene` with its settings. `progress` is told about finished tiles.
+/// Renders `scene` in this process with its settings (threads, decomposition). `progress` is
+/// told about finished pixels.
 pub fn render(scene: &Scene, progress: Progress) -> Result<(Framebuffer, RenderStats), Error> {
     let s = &scene.settings;
-    let threads = match s.threads {
-        Some(n) => n as usize,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .thread_name(|i| format!("luxon-render-{i}"))
-        .build()
-        .map_err(|e| Error::Render(format!("cannot start {threads} render threads: {e}")))?;
-    let list = tiles(s.width, s.height, s.tile_size);
-    let total = list.len() as u64;
+    let fb = Mutex::new(Framebuffer::new(s.width, s.height));
+    let total = s.width as u64 * s.height as u64;
     let done = AtomicU64::new(0);
     let start = Instant::now();
-    let results: Vec<(Vec<f32>, Counters)> = pool.install(|| {
-        list.par_iter()
-            .map(|&t| {
-                let mut c = Counters::default();
-                // After a plugin fault the remaining tiles are skipped.
-                let px = if scene.customs.fault.is_raised() {
-                    vec![0.0; (t.w * t.h * 4) as usize]
-                } else {
-                    render_tile(scene, t, &mut c)
-                };
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-                (px, c)
-            })
-            .collect()
-    });
-    if let Some(m) = scene.customs.fault.message() {
-        return Err(Error::Plugin(m));
-    }
-    let mut fb = Framebuffer::new(s.width, s.height);
-    let mut counters = Counters::default();
-    for (t, (px, c)) in list.iter().zip(&results) {
-        fb.put_block(t.x0, t.y0, t.w, t.h, px);
-        counters.add(c);
-    }
-    Ok((
-        fb,
-        RenderStats {
-            counters,
-            render_time: start.elapsed(),
-            threads,
-            tiles: list.len(),
-        },
-    ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn tiles_cover_the_image_once() {
-        let t = tiles(37, 20, 16);
-        let area: u32 = t.iter().map(|t| t.w * t.h).sum();
-        assert_eq!(area, 37 * 20);
-        assert_eq!(t.len(), 3 * 2);
-    }
+    let sink = |c: Chunk| {
+        let n = c.pixels();
+        fb.lock().unwrap_or_else(|e| e.into_inner()).put_chunk(&c);
+        progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
+    };
+    let rank = render_local(scene, threads_for(scene), &sink)?;
+    let stats = RenderStats::of(vec![rank], start.elapsed());
+    Ok((fb.into_inner().unwrap_or_else(|e| e.into_inner()), stats))
 }

@@ -3,10 +3,12 @@
 
 use crate::camera::Camera;
 use crate::error::Error;
+use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
+use crate::geometry::disc::Discs;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
-use crate::geometry::triangle::Triangles;
+use crate::geometry::triangle::{MeshInput, Triangles};
 use crate::geometry::{Counters, Hit, Kind, Surface};
 use crate::math::{DVec3, Vec3A};
 use crate::plugin::calls::{create_primitive, create_texture, GeometryBuilder, TextureInstance};
@@ -106,6 +108,9 @@ pub struct Settings {
     pub time: f32,
     pub threads: Option<u32>,
     pub tile_size: u32,
+    pub mode: luxon_formats::ParallelMode,
+    pub decomposition: luxon_formats::Decomposition,
+    pub io: luxon_formats::OutputIo,
 }
 
 pub struct Scene {
@@ -120,7 +125,12 @@ pub struct Scene {
     pub spheres: Spheres,
     pub triangles: Triangles,
     pub planes: Planes,
+    pub cones: Cones,
+    pub discs: Discs,
     pub customs: Customs,
+    /// Volumes read by volume-reader plugins, in scene order. (Rendering them comes with the
+    /// volume-rendering work; for now they are read, checked and described.)
+    pub volumes: Vec<crate::volume::Volume>,
     /// World position of render space's origin (the camera): coordinates are stored relative
     /// to it in f32, so a scene far from the world origin keeps its precision.
     pub world_offset: DVec3,
@@ -169,6 +179,28 @@ impl Scene {
             textures.push(tex);
         }
 
+        let mut volumes = Vec::with_capacity(desc.volumes.len());
+        for (i, v) in desc.volumes.iter().enumerate() {
+            let call = &v.value.call;
+            let entry = registry
+                .get(&call.plugin.value, PluginKind::VolumeReader)
+                .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
+            let name = match &v.value.name {
+                Some(n) => n.value.clone(),
+                None => format!("volume {i}"),
+            };
+            let volume = crate::volume::read_volume(
+                registry,
+                entry,
+                &call.params,
+                &call.params_at,
+                &scene_dir,
+                &name,
+            )
+            .map_err(|(at, m)| Error::at(&at, m))?;
+            volumes.push(volume);
+        }
+
         let mut material_names = vec!["default".to_string()];
         let mut materials = vec![material(&Default::default(), None)];
         for (name, m) in &desc.materials {
@@ -195,6 +227,8 @@ impl Scene {
         let mut spheres = Spheres::default();
         let mut triangles = Triangles::default();
         let mut planes = Planes::default();
+        let mut cones = Cones::default();
+        let mut discs = Discs::default();
         let mut customs = Customs::new(world_offset);
         let mut object_counts: Vec<(String, usize)> = Vec::new();
         let mut dropped = 0;
@@ -216,6 +250,8 @@ impl Scene {
                 spheres: &mut spheres,
                 triangles: &mut triangles,
                 planes: &mut planes,
+                cones: &mut cones,
+                discs: &mut discs,
                 customs: &mut customs,
                 material: material as u32,
                 world_offset,
@@ -238,11 +274,51 @@ impl Scene {
                 None => object_counts.push((entry.name.clone(), 1)),
             }
         }
+        for (k, g) in desc.inline.iter().enumerate() {
+            let at = || g.at.clone().unwrap_or_else(|| desc.camera.at.clone());
+            let material = match &g.material {
+                Some(m) => material_names
+                    .iter()
+                    .position(|n| n == &m.value)
+                    .ok_or_else(|| Error::at(&m.at, format!("no material named `{}`", m.value)))?,
+                None => 0,
+            };
+            used[material] = true;
+            let m = material as u32;
+            let fail = |e: String| Error::at(&at(), format!("imported geometry group {k}: {e}"));
+            for (i, s) in g.spheres.iter().enumerate() {
+                spheres.push_world(i, *s, world_offset, m).map_err(fail)?;
+            }
+            for (i, c) in g.cones.iter().enumerate() {
+                cones.push(i, *c, world_offset, m).map_err(fail)?;
+            }
+            for (i, d) in g.discs.iter().enumerate() {
+                discs.push(i, *d, world_offset, m).map_err(fail)?;
+            }
+            for (i, p) in g.planes.iter().enumerate() {
+                planes.push_world(i, *p, world_offset, m).map_err(fail)?;
+            }
+            if !g.mesh.indices.is_empty() {
+                let input = MeshInput {
+                    positions: g.mesh.positions.as_flattened(),
+                    indices: g.mesh.indices.as_flattened(),
+                    normals: g.mesh.normals.as_flattened(),
+                    colors: &[],
+                    uvs: &[],
+                };
+                dropped += triangles.push_mesh(&input, world_offset, m).map_err(fail)?;
+            }
+        }
         let plugin_time = t0.elapsed();
 
         let t1 = Instant::now();
         let (_, custom_result) = rayon::join(
-            || rayon::join(|| spheres.build(), || triangles.build()),
+            || {
+                rayon::join(
+                    || rayon::join(|| spheres.build(), || triangles.build()),
+                    || rayon::join(|| cones.build(), || discs.build()),
+                )
+            },
             || customs.build(),
         );
         custom_result.map_err(Error::Plugin)?;
@@ -303,6 +379,9 @@ impl Scene {
             time: r.time as f32,
             threads: r.parallel.threads,
             tile_size: r.parallel.tile_size,
+            mode: r.parallel.mode,
+            decomposition: r.parallel.decomposition,
+            io: r.parallel.io,
         };
         Ok(Scene {
             source: desc.source.clone(),
@@ -316,7 +395,10 @@ impl Scene {
             spheres,
             triangles,
             planes,
+            cones,
+            discs,
             customs,
+            volumes,
             world_offset,
             settings,
             outputs: r.outputs.clone(),
@@ -335,6 +417,8 @@ impl Scene {
         self.spheres.intersect(ray, &mut t_max, &mut hit, c);
         self.triangles.intersect(ray, &mut t_max, &mut hit, c);
         self.planes.intersect(ray, &mut t_max, &mut hit, c);
+        self.cones.intersect(ray, &mut t_max, &mut hit, c);
+        self.discs.intersect(ray, &mut t_max, &mut hit, c);
         self.customs.intersect(ray, &mut t_max, &mut hit, c);
         hit
     }
@@ -344,6 +428,8 @@ impl Scene {
             Kind::Sphere => self.spheres.surface(hit, ray),
             Kind::Triangle => self.triangles.surface(hit),
             Kind::Plane => self.planes.surface(hit, ray),
+            Kind::Cone => self.cones.surface(hit, ray),
+            Kind::Disc => self.discs.surface(hit, ray),
             Kind::Custom => self.customs.surface(hit, ray),
         }
     }
@@ -357,6 +443,8 @@ impl Scene {
             let blocked = self.spheres.any(ray, t_max, c, |_, _| true)
                 || self.triangles.any(ray, t_max, c, |_, _| true)
                 || self.planes.any(ray, t_max, c, |_, _| true)
+                || self.cones.any(ray, t_max, c, |_, _| true)
+                || self.discs.any(ray, t_max, c, |_, _| true)
                 || self.customs.any(ray, t_max, c, |_, _| true);
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
@@ -376,6 +464,8 @@ impl Scene {
         if self.spheres.any(ray, t_max, c, &mut on_hit)
             || self.triangles.any(ray, t_max, c, &mut on_hit)
             || self.planes.any(ray, t_max, c, &mut on_hit)
+            || self.cones.any(ray, t_max, c, &mut on_hit)
+            || self.discs.any(ray, t_max, c, &mut on_hit)
             || self.customs.any(ray, t_max, c, &mut on_hit)
         {
             return Vec3A::ZERO;
@@ -384,7 +474,12 @@ impl Scene {
     }
 
     pub fn primitive_count(&self) -> usize {
-        self.spheres.len() + self.triangles.len() + self.planes.planes.len() + self.customs.len()
+        self.spheres.len()
+            + self.triangles.len()
+            + self.planes.planes.len()
+            + self.cones.len()
+            + self.discs.len()
+            + self.customs.len()
     }
 }
 

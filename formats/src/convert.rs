@@ -16,6 +16,7 @@ pub(crate) struct Part {
     pub textures: Vec<(String, Spanned<PluginCall>)>,
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
+    pub volumes: Vec<Spanned<VolumeDescEntry>>,
     /// Without outputs: those are merged as a list, the rest as a whole.
     pub render: Option<RenderDesc>,
     pub outputs: Vec<OutputDesc>,
@@ -77,6 +78,10 @@ impl Checker<'_> {
             part.objects
                 .push(self.spanned(ObjectDesc { call, material }, node));
         }
+        for (i, volume) in scene.volumes.into_iter().enumerate() {
+            let node = field("volumes").item(i).unwrap_or(root);
+            part.volumes.push(self.volume(volume, node)?);
+        }
         if let Some(render) = scene.render {
             let (render, outputs) = self.render(render, field("render"), &dir)?;
             part.render = Some(render);
@@ -100,6 +105,23 @@ impl Checker<'_> {
             Some(node) => (self.src.slice(node).to_string(), self.origin(node)),
             None => ("()".to_string(), self.origin(entry)),
         }
+    }
+
+    fn volume(&self, v: raw::Volume, node: &Node) -> Result<Spanned<VolumeDescEntry>> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let plugin = self.plugin_name(field("plugin"), v.plugin, "raw")?;
+        let name = match v.name {
+            Some(name) if name.trim().is_empty() => {
+                return Err(self.error(
+                    field("name"),
+                    "the volume name is empty; expected a name such as \"head\" (or no `name`)",
+                ))
+            }
+            Some(name) => Some(self.spanned(name, field("name"))),
+            None => None,
+        };
+        let call = self.call(plugin, node);
+        Ok(self.spanned(VolumeDescEntry { call, name }, node))
     }
 
     fn camera(&self, c: raw::Camera, node: &Node) -> Result<Spanned<CameraDesc>> {
@@ -348,6 +370,12 @@ impl Checker<'_> {
             tile_size: match p.tile_size {
                 Some(t) => self.whole(field("tile_size"), "tile_size", t, 1, 4096)?,
                 None => d.tile_size,
+            },
+            io: match p.io {
+                Some(raw::Io::Async) => OutputIo::Async,
+                Some(raw::Io::Sync) => OutputIo::Sync,
+                Some(raw::Io::MpiIo) => OutputIo::MpiIo,
+                None => d.io,
             },
         })
     }

@@ -52,6 +52,10 @@ pub struct SceneDesc {
     /// Named materials, in file order (later definitions of a name replace earlier ones).
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
+    /// Native geometry from importers (NFF, OBJ...), stored by the core without plugins.
+    pub inline: Vec<crate::geometry::InlineGeometry>,
+    /// Volumes read by volume-reader plugins, in file order (includes first).
+    pub volumes: Vec<Spanned<VolumeDescEntry>>,
     pub render: RenderDesc,
     /// Extra plugin directories (or files), already resolved against the scene file's directory.
     pub plugin_path: Vec<PathBuf>,
@@ -143,6 +147,19 @@ pub struct ObjectDesc {
     pub material: Option<Spanned<String>>,
 }
 
+/// A volume: a volume-reader plugin call and the scene's name for the grid it reads.
+///
+/// ```ron
+/// volumes: [ (plugin: "raw", params: (file: "head.raw", dims: (256, 256, 109)), name: "head") ],
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeDescEntry {
+    pub call: PluginCall,
+    /// The scene's name for the volume (unique among the scene's volumes, not empty); `None`:
+    /// unnamed (the core calls it by its index).
+    pub name: Option<Spanned<String>>,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputDesc {
     /// Output file, resolved against the scene file's directory.
@@ -198,6 +215,8 @@ pub struct ParallelDesc {
     pub decomposition: Decomposition,
     /// Tile or block edge in pixels.
     pub tile_size: u32,
+    /// How finished pixels reach the output files.
+    pub io: OutputIo,
 }
 
 impl Default for ParallelDesc {
@@ -207,6 +226,7 @@ impl Default for ParallelDesc {
             threads: None,
             decomposition: Decomposition::Dynamic,
             tile_size: 16,
+            io: OutputIo::Async,
         }
     }
 }
@@ -226,4 +246,17 @@ pub enum Decomposition {
     BlockCyclic,
     #[default]
     Dynamic,
+}
+
+/// How finished pixels reach the output files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum OutputIo {
+    /// Rank 0 hands finished rows to a writer thread while rendering goes on.
+    #[default]
+    Async,
+    /// Rank 0 writes every output after the whole image is rendered.
+    Sync,
+    /// Every MPI rank writes its own pixels of 8-bit PPM outputs (`MPI_File_write_at_all`);
+    /// other outputs, and runs without MPI, as `Async`.
+    MpiIo,
 }

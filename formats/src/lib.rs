@@ -6,7 +6,9 @@
 
 mod convert;
 pub mod desc;
+pub mod geometry;
 mod error;
+pub mod nff;
 mod raw;
 mod ron_error;
 mod ron_scene;
@@ -17,11 +19,16 @@ mod validate;
 use std::path::Path;
 
 pub use desc::*;
+pub use geometry::{InlineGeometry, InlineMesh};
 pub use error::{suggest, SceneError};
 pub use ron_scene::load_ron_str;
 
-/// Loads a scene file, choosing the format by its extension (`.ron`).
+/// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
+/// through the [`nff`] importer; any case).
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
+    if nff::is_nff_path(path) {
+        return nff::load(path);
+    }
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !extension.eq_ignore_ascii_case("ron") {
         let found = match extension {
@@ -29,7 +36,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             e => format!("unsupported scene file extension `.{e}`"),
         };
         let message = format!(
-            "{found}; expected one of {}",
+            "{found}; expected one of {}, `.nff`, `.nff.gz`",
             ron_scene::supported_extensions()
         );
         return Err(SceneError::Io {

@@ -29,6 +29,8 @@ pub(crate) struct Scene {
     #[serde(default)]
     pub objects: Vec<Object>,
     #[serde(default)]
+    pub volumes: Vec<Volume>,
+    #[serde(default)]
     pub render: Option<Render>,
 }
 
@@ -112,6 +114,16 @@ pub(crate) struct Object {
 }
 
 #[derive(Deserialize)]
+#[serde(rename = "Volume", deny_unknown_fields)]
+pub(crate) struct Volume {
+    pub plugin: String,
+    #[serde(default, rename = "params")]
+    pub _params: IgnoredAny,
+    #[serde(default)]
+    pub name: Option<String>,
+}
+
+#[derive(Deserialize)]
 #[serde(rename = "Render", deny_unknown_fields)]
 pub(crate) struct Render {
     pub width: Option<f64>,
@@ -143,6 +155,15 @@ pub(crate) struct Parallel {
     pub threads: Option<f64>,
     pub decomposition: Option<Decomposition>,
     pub tile_size: Option<f64>,
+    pub io: Option<Io>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "OutputIo")]
+pub(crate) enum Io {
+    Async,
+    Sync,
+    MpiIo,
 }
 
 #[derive(Deserialize, Clone, Copy)]

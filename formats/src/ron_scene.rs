@@ -36,6 +36,8 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         textures: part.textures,
         materials: part.materials,
         objects: part.objects,
+        inline: Vec::new(),
+        volumes: part.volumes,
         render,
         plugin_path: part.plugin_path,
     };
@@ -126,6 +128,7 @@ impl Part {
         }
         self.lights.extend(later.lights);
         self.objects.extend(later.objects);
+        self.volumes.extend(later.volumes);
         self.outputs.extend(later.outputs);
         self.plugin_path.extend(later.plugin_path);
         upsert(&mut self.textures, later.textures);

@@ -148,7 +148,8 @@ fn literal_is_finite(text: &str) -> bool {
     text.parse::<f64>().map_or(true, f64::is_finite)
 }
 
-/// Names used before they are known: material textures and object materials, after merging.
+/// Names used before they are known (material textures, object materials) and volume names
+/// given twice, after merging.
 pub(crate) fn references(scene: &SceneDesc) -> Result<(), SceneError> {
     let textures: Vec<&str> = scene.textures.iter().map(|(n, _)| n.as_str()).collect();
     for (_, material) in &scene.materials {
@@ -167,6 +168,22 @@ pub(crate) fn references(scene: &SceneDesc) -> Result<(), SceneError> {
                     unknown_name("material", &material.value, "", materials.iter().copied());
                 return Err(SceneError::at(material.at.clone(), message));
             }
+        }
+    }
+    let names: Vec<&Spanned<String>> = scene
+        .volumes
+        .iter()
+        .filter_map(|v| v.value.name.as_ref())
+        .collect();
+    for (i, name) in names.iter().enumerate() {
+        if let Some(first) = names[..i].iter().find(|n| n.value == name.value) {
+            return Err(SceneError::at(
+                name.at.clone(),
+                format!(
+                    "the volume name `{}` is already used at {}; expected each volume name once",
+                    name.value, first.at
+                ),
+            ));
         }
     }
     Ok(())

@@ -34,7 +34,7 @@ Scene(
     render: (
         width: 640, height: 480, samples: 4, max_depth: 8, min_weight: 0.002, frame: 3, time: 0.5,
         outputs: [ (path: "out.png"), (path: "/tmp/out.exr", plugin: "exr", params: (half: true)) ],
-        parallel: (mode: Threads, threads: 2, decomposition: BlockCyclic, tile_size: 32),
+        parallel: (mode: Threads, threads: 2, decomposition: BlockCyclic, tile_size: 32, io: Sync),
     ),
 )
 "#;
@@ -143,6 +143,7 @@ fn render_outputs_and_paths() {
             threads: Some(2),
             decomposition: Decomposition::BlockCyclic,
             tile_size: 32,
+            io: OutputIo::Sync,
         }
     );
     assert_eq!(r.outputs.len(), 2);

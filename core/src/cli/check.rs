@@ -41,16 +41,28 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
         }
     );
     println!(
-        "primitives {} spheres, {} triangles, {} planes, {} custom",
+        "primitives {} spheres, {} triangles, {} planes, {} cones, {} discs, {} custom",
         scene.spheres.len(),
         scene.triangles.len(),
         scene.planes.planes.len(),
+        scene.cones.len(),
+        scene.discs.len(),
         scene.customs.len()
     );
     if scene.degenerate_triangles > 0 {
         println!(
             "           ({} zero-area triangles dropped)",
             scene.degenerate_triangles
+        );
+    }
+    for v in &scene.volumes {
+        let (lo, hi) = v.min_max();
+        println!(
+            "volume     `{}` ({}): {} voxels, values {lo}..{hi}, {:.1} MiB",
+            v.name,
+            v.plugin,
+            v.voxel_count(),
+            v.memory_bytes() as f64 / (1024.0 * 1024.0)
         );
     }
     println!("lights     {}", scene.lights.len());

@@ -1,6 +1,7 @@
 //! The subcommands of `luxon`, one module each.
 
 pub mod check;
+pub mod job;
 pub mod plugins;
 pub mod progress;
 pub mod render;

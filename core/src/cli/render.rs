@@ -1,12 +1,18 @@
-//! `luxon render`: load, override from the command line, build, render, write.
+//! `luxon render`: load, override from the command line, build, render (in this process or as
+//! one rank of an MPI job), write.
 
+use super::job::Job;
 use super::progress::Progress;
+use luxon::output::stream::{is_ppm8, AsyncOutput};
+use luxon::output::Output;
 use luxon::plugin::Registry;
 use luxon::render::RenderStats;
-use luxon::{Error, Scene};
-use luxon_formats::{Origin, OutputDesc};
+use luxon::schedule::Chunk;
+use luxon::{Error, Framebuffer, Scene};
+use luxon_formats::{Decomposition, Origin, OutputDesc, OutputIo, ParallelMode, SceneDesc};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// What the command line can change in a scene's render settings.
@@ -17,6 +23,13 @@ pub struct Overrides {
     pub samples: Option<u32>,
     pub threads: Option<u32>,
     pub stats: bool,
+    /// `threads`, `mpi` or `hybrid`.
+    pub parallel: Option<String>,
+    /// `pixel-cyclic`, `scanline-cyclic`, `block-cyclic` or `dynamic`.
+    pub decomposition: Option<String>,
+    pub block_size: Option<u32>,
+    /// `async`, `sync` or `mpi-io`.
+    pub io: Option<String>,
 }
 
 pub fn cli_origin(what: &str) -> Origin {
@@ -27,29 +40,54 @@ pub fn cli_origin(what: &str) -> Origin {
     }
 }
 
-pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
-    let (output, res, samples, threads, show_stats) =
-        (&o.output, o.res, o.samples, o.threads, o.stats);
-    let t0 = Instant::now();
+fn load(path: &Path, o: &Overrides) -> Result<SceneDesc, Error> {
     let mut desc = luxon_formats::load(path)?;
-    if let Some((w, h)) = res {
-        desc.render.width = w;
-        desc.render.height = h;
+    let r = &mut desc.render;
+    if let Some((w, h)) = o.res {
+        r.width = w;
+        r.height = h;
     }
-    if let Some(n) = samples {
+    if let Some(n) = o.samples {
         if n == 0 || n > 65536 {
             return Err(Error::Usage(format!("--samples {n}: expected 1..=65536")));
         }
-        desc.render.samples = n;
+        r.samples = n;
     }
-    if let Some(n) = threads {
+    if let Some(n) = o.threads {
         if n == 0 || n > 4096 {
             return Err(Error::Usage(format!("--threads {n}: expected 1..=4096")));
         }
-        desc.render.parallel.threads = Some(n);
+        r.parallel.threads = Some(n);
     }
-    if !output.is_empty() {
-        desc.render.outputs = output
+    if let Some(n) = o.block_size {
+        if n == 0 || n > 4096 {
+            return Err(Error::Usage(format!("--block-size {n}: expected 1..=4096")));
+        }
+        r.parallel.tile_size = n;
+    }
+    // clap has checked the names.
+    match o.parallel.as_deref() {
+        Some("threads") => r.parallel.mode = ParallelMode::Threads,
+        Some("mpi") => r.parallel.mode = ParallelMode::Mpi,
+        Some("hybrid") => r.parallel.mode = ParallelMode::Hybrid,
+        _ => {}
+    }
+    match o.decomposition.as_deref() {
+        Some("pixel-cyclic") => r.parallel.decomposition = Decomposition::PixelCyclic,
+        Some("scanline-cyclic") => r.parallel.decomposition = Decomposition::ScanlineCyclic,
+        Some("block-cyclic") => r.parallel.decomposition = Decomposition::BlockCyclic,
+        Some("dynamic") => r.parallel.decomposition = Decomposition::Dynamic,
+        _ => {}
+    }
+    match o.io.as_deref() {
+        Some("async") => r.parallel.io = OutputIo::Async,
+        Some("sync") => r.parallel.io = OutputIo::Sync,
+        Some("mpi-io") => r.parallel.io = OutputIo::MpiIo,
+        _ => {}
+    }
+    if !o.output.is_empty() {
+        r.outputs = o
+            .output
             .iter()
             .map(|p| OutputDesc {
                 path: p.clone(),
@@ -59,26 +97,136 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
             })
             .collect();
     }
-    if desc.render.outputs.is_empty() {
+    if r.outputs.is_empty() {
         return Err(Error::Usage(format!(
             "{} has no outputs; give one with -o FILE.png or add `outputs: [(path: \"out.png\")]` to its render settings",
             path.display()
         )));
     }
-    let registry = Registry::discover(&desc.plugin_path);
+    Ok(desc)
+}
+
+/// How rank 0 writes: outputs split between its writer (async or after the render) and MPI-IO.
+struct Plan<'r> {
+    written_by_root: Vec<Output<'r>>,
+    concurrent: Vec<Output<'r>>,
+    /// Created before rendering, so an unwritable path fails at once.
+    streams: Option<AsyncOutput<'r>>,
+}
+
+fn plan<'r>(scene: &Scene, outputs: Vec<Output<'r>>, job: &Job) -> Result<Plan<'r>, Error> {
+    let s = &scene.settings;
+    let mpi_io = s.io == OutputIo::MpiIo && matches!(job, Job::Mpi(_));
+    let (concurrent, written_by_root): (Vec<_>, Vec<_>) =
+        outputs.into_iter().partition(|o| mpi_io && is_ppm8(o));
+    let streams = match (job.rank(), s.io) {
+        (0, OutputIo::Async | OutputIo::MpiIo) if !written_by_root.is_empty() => {
+            Some(AsyncOutput::new(&written_by_root, s.width, s.height)?)
+        }
+        _ => None,
+    };
+    Ok(Plan {
+        written_by_root,
+        concurrent,
+        streams,
+    })
+}
+
+pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
+    let t0 = Instant::now();
+    let job = Job::from_launcher()?;
+    let desc = load(path, o);
+    let job = match &desc {
+        Ok(d) => job.for_mode(d.render.parallel.mode)?,
+        Err(_) => job,
+    };
+    let empty = Vec::new();
+    let registry = Registry::discover(desc.as_ref().map_or(&empty, |d| &d.plugin_path));
     let load_time = t0.elapsed();
-    let scene = Scene::build(&desc, &registry)?;
-    let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
+    let ready = desc.and_then(|desc| {
+        let scene = Scene::build(&desc, &registry)?;
+        let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
+        let plan = plan(&scene, outputs, &job)?;
+        Ok((desc, scene, plan))
+    });
+    let (ready, status) = match ready {
+        Ok(r) => {
+            let threads = job.threads(&r.1);
+            (Some(r), Ok(threads))
+        }
+        Err(e) => (None, Err(e)),
+    };
+    let threads = match job.agree(status) {
+        Ok(t) => t,
+        Err(Some(e)) => return Err(e),
+        Err(None) => {
+            // Another rank failed and rank 0 reports it: end quietly (dropping the job
+            // finalises MPI).
+            drop(job);
+            std::process::exit(1);
+        }
+    };
+    let Some((desc, scene, plan)) = ready else {
+        return Err(Error::Render("not ready to render".into()));
+    };
+    let s = &scene.settings;
+    let scene_dir = desc.source.parent().unwrap_or(Path::new("."));
 
     let bar = Progress::new();
-    let (fb, stats) = luxon::render::render(&scene, &|done, total| bar.tick(done, total))?;
+    let total = s.width as u64 * s.height as u64;
+    let done = AtomicU64::new(0);
+    let sync = s.io == OutputIo::Sync && job.rank() == 0;
+    let sync_fb = Mutex::new(Framebuffer::new(0, 0));
+    if sync {
+        *sync_fb.lock().unwrap_or_else(|e| e.into_inner()) = Framebuffer::new(s.width, s.height);
+    }
+    let gather = !plan.written_by_root.is_empty();
+    let keep = !plan.concurrent.is_empty();
+    let (tx, rx) = mpsc::channel::<Chunk>();
+    let start = Instant::now();
+    let (rendered, streamed, tail) = std::thread::scope(|sc| {
+        let writer = plan
+            .streams
+            .map(|streams| sc.spawn(|| streams.run(rx, &registry, scene_dir)));
+        let streaming = writer.is_some();
+        let sink = |c: Chunk| {
+            let n = c.pixels();
+            if streaming {
+                let _ = tx.send(c);
+            } else if sync {
+                sync_fb.lock().unwrap_or_else(|e| e.into_inner()).put_chunk(&c);
+            }
+            bar.tick(done.fetch_add(n, Ordering::Relaxed) + n, total);
+        };
+        let rendered = job.render(&scene, &threads, gather, keep, &sink);
+        let render_end = Instant::now();
+        drop(tx);
+        let streamed = writer.map(|w| {
+            w.join()
+                .unwrap_or_else(|_| Err(Error::Render("the writer thread panicked".into())))
+        });
+        (rendered, streamed, render_end.elapsed())
+    });
+    let render_time = start.elapsed() - tail;
     bar.finish();
-    let scene_dir = desc.source.parent().unwrap_or(Path::new("."));
+    let (ranks, kept) = rendered?;
     let t_write = Instant::now();
-    let written = luxon::output::write_all(&outputs, &fb, &registry, scene_dir)?;
-    let write_time = t_write.elapsed();
-    if show_stats {
-        print_stats(&scene, &stats, load_time, write_time, t0.elapsed());
+    let mut written = streamed.transpose()?.unwrap_or_default();
+    for out in &plan.concurrent {
+        job.write_concurrent(&out.desc.path, s.width, s.height, &kept)?;
+        written.push(out.desc.path.clone());
+    }
+    if job.rank() != 0 {
+        return Ok(());
+    }
+    if sync {
+        let fb = sync_fb.into_inner().unwrap_or_else(|e| e.into_inner());
+        written.extend(luxon::output::write_all(&plan.written_by_root, &fb, &registry, scene_dir)?);
+    }
+    let write_time = tail + t_write.elapsed();
+    let stats = RenderStats::of(ranks, render_time);
+    if o.stats {
+        print_stats(&scene, &job, &stats, load_time, write_time, t0.elapsed());
     }
     for w in written {
         eprintln!("luxon: wrote {}", w.display());
@@ -92,16 +240,21 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     Ok(())
 }
 
-fn print_stats(scene: &Scene, s: &RenderStats, load: Duration, write: Duration, total: Duration) {
+fn print_stats(
+    scene: &Scene,
+    job: &Job,
+    s: &RenderStats,
+    load: Duration,
+    write: Duration,
+    total: Duration,
+) {
     let c = &s.counters;
+    let set = &scene.settings;
     let secs = s.render_time.as_secs_f64();
     eprintln!("luxon: statistics");
     eprintln!(
         "  image            {}x{}, {} sample(s) per pixel, max depth {}",
-        scene.settings.width,
-        scene.settings.height,
-        scene.settings.samples,
-        scene.settings.max_depth
+        set.width, set.height, set.samples, set.max_depth
     );
     eprintln!(
         "  primitives       {} ({} spheres, {} triangles, {} planes, {} custom)",
@@ -112,7 +265,51 @@ fn print_stats(scene: &Scene, s: &RenderStats, load: Duration, write: Duration, 
         scene.customs.len()
     );
     eprintln!("  effects          {}", scene.features);
-    eprintln!("  threads          {} ({} tiles)", s.threads, s.tiles);
+    let mode = match (job, set.mode) {
+        (Job::Local, ParallelMode::Threads) => "threads",
+        (Job::Local, _) => "threads (this luxon was built without MPI)",
+        (Job::Mpi(_), ParallelMode::Mpi) => "mpi",
+        (Job::Mpi(_), _) => "hybrid",
+    };
+    let (how, unit) = match set.decomposition {
+        Decomposition::PixelCyclic => ("pixel-cyclic", "rows"),
+        Decomposition::ScanlineCyclic => ("scanline-cyclic", "rows"),
+        Decomposition::BlockCyclic => ("block-cyclic", "blocks"),
+        Decomposition::Dynamic => ("dynamic", "tiles"),
+    };
+    let io = match set.io {
+        OutputIo::Async => "asynchronous",
+        OutputIo::Sync => "synchronous",
+        OutputIo::MpiIo => "MPI-IO",
+    };
+    eprintln!(
+        "  parallel         {mode}, {how} ({} px), {io} output",
+        set.tile_size
+    );
+    eprintln!("  ranks            {}", job.size());
+    eprintln!("  threads          {} per rank ({} {unit})", s.threads, s.tiles);
+    for r in &s.ranks {
+        let t = r.total();
+        eprintln!(
+            "    rank {:<3}       {} thread(s), {} {unit}, {} pixels, {} rays, busy {:.3} s of {:.3} s",
+            r.rank,
+            r.threads.len(),
+            t.units,
+            t.pixels,
+            t.counters.rays(),
+            t.busy.as_secs_f64(),
+            r.time.as_secs_f64()
+        );
+        for (i, w) in r.threads.iter().enumerate() {
+            eprintln!(
+                "      thread {i:<3}   {} {unit}, {} pixels, {} rays, busy {:.3} s",
+                w.units,
+                w.pixels,
+                w.counters.rays(),
+                w.busy.as_secs_f64()
+            );
+        }
+    }
     eprintln!(
         "  rays             {} ({:.2} M/s)",
         c.rays(),

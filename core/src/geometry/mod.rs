@@ -1,7 +1,9 @@
 //! Native geometry (intersected inline) and custom plugin geometry (called through its table),
 //! each kind in its own BVH, so every traversal loop is monomorphic.
 
+pub mod cone;
 pub mod custom;
+pub mod disc;
 pub mod plane;
 pub mod sphere;
 pub mod triangle;
@@ -13,6 +15,8 @@ pub enum Kind {
     Sphere,
     Triangle,
     Plane,
+    Cone,
+    Disc,
     Custom,
 }
 

@@ -1,7 +1,7 @@
 //! Infinite planes: unbounded, so they stay outside the BVHs and are tested one by one.
 
 use super::{Counters, Hit, Kind, Surface};
-use crate::math::{gamma, Vec3A};
+use crate::math::{gamma, DVec3, Vec3A};
 use crate::ray::Ray;
 
 #[derive(Clone, Copy, Debug)]
@@ -29,6 +29,30 @@ pub struct Planes {
 }
 
 impl Planes {
+    /// Validates and stores plane `i` (point, normal) given in world coordinates.
+    pub fn push_world(
+        &mut self,
+        i: usize,
+        p: [f64; 6],
+        offset: DVec3,
+        material: u32,
+    ) -> Result<(), String> {
+        if p.iter().any(|x| !x.is_finite()) {
+            return Err(format!("plane {i} has a non-finite value {p:?}"));
+        }
+        let n = DVec3::new(p[3], p[4], p[5]);
+        if n.length() == 0.0 {
+            return Err(format!("plane {i} has a zero-length normal"));
+        }
+        let point = (DVec3::new(p[0], p[1], p[2]) - offset).as_vec3();
+        self.planes.push(Plane {
+            point: point.into(),
+            normal: Vec3A::from(n.normalize().as_vec3()),
+            material,
+        });
+        Ok(())
+    }
+
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
         for (i, p) in self.planes.iter().enumerate() {

@@ -2,7 +2,7 @@
 
 use super::{Counters, Hit, Kind, Surface};
 use crate::bvh::Bvh;
-use crate::math::{gamma, Aabb, Vec3A};
+use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
 
 #[derive(Default)]
@@ -70,6 +70,28 @@ impl Spheres {
     pub fn push(&mut self, s: [f32; 4], material: u32) {
         self.data.push(s);
         self.material.push(material);
+    }
+
+    /// Validates and stores sphere `i` of a batch given in world coordinates.
+    pub fn push_world(
+        &mut self,
+        i: usize,
+        s: [f64; 4],
+        offset: DVec3,
+        material: u32,
+    ) -> Result<(), String> {
+        if s.iter().any(|x| !x.is_finite()) {
+            return Err(format!("sphere {i} has a non-finite value {s:?}"));
+        }
+        if s[3] <= 0.0 {
+            return Err(format!(
+                "sphere {i} has radius {}; expected a radius > 0",
+                s[3]
+            ));
+        }
+        let c = (DVec3::new(s[0], s[1], s[2]) - offset).as_vec3();
+        self.push([c.x, c.y, c.z, s[3] as f32], material);
+        Ok(())
     }
 
     pub fn bounds(&self) -> Vec<Aabb> {

@@ -106,7 +106,109 @@ pub fn intersect_triangle(v: &[Vec3; 3], r: &TriRay, t_max: f32) -> Option<(f32,
     Some((t_scaled * inv, vv * inv, w * inv))
 }
 
+/// A mesh as plugins and importers give it: flat f64/f32 arrays, optional ones empty.
+pub struct MeshInput<'a> {
+    /// x, y, z per vertex.
+    pub positions: &'a [f64],
+    /// Three vertex indices per triangle.
+    pub indices: &'a [u64],
+    /// x, y, z per vertex, or empty.
+    pub normals: &'a [f64],
+    /// r, g, b per vertex, or empty.
+    pub colors: &'a [f32],
+    /// u, v per vertex, or empty.
+    pub uvs: &'a [f32],
+}
+
 impl Triangles {
+    /// Validates and stores a mesh given in world coordinates; returns how many zero-area
+    /// triangles were dropped (they can never be hit and have no normal).
+    pub fn push_mesh(
+        &mut self,
+        m: &MeshInput,
+        offset: DVec3,
+        material: u32,
+    ) -> Result<u64, String> {
+        let nv = m.positions.len() / 3;
+        if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
+            return Err("mesh arrays are not whole vertices or triangles".into());
+        }
+        for (what, len, per) in [
+            ("normals", m.normals.len(), 3),
+            ("colors", m.colors.len(), 3),
+            ("uvs", m.uvs.len(), 2),
+        ] {
+            if len != 0 && len != nv * per {
+                return Err(format!("mesh has {nv} vertices but {} {what}", len / per));
+            }
+        }
+        if let Some(i) = m.positions.iter().position(|x| !x.is_finite()) {
+            return Err(format!("vertex {} has a non-finite coordinate", i / 3));
+        }
+        if m.normals.iter().any(|x| !x.is_finite())
+            || m.colors.iter().any(|x| !x.is_finite())
+            || m.uvs.iter().any(|x| !x.is_finite())
+        {
+            return Err("mesh has a non-finite normal, colour or uv".into());
+        }
+        let verts: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|p| (DVec3::new(p[0], p[1], p[2]) - offset).as_vec3())
+            .collect();
+        let has_attr = !m.normals.is_empty() || !m.colors.is_empty() || !m.uvs.is_empty();
+        let attr_of = |v: usize| VertexAttr {
+            n: if m.normals.is_empty() {
+                Vec3::ZERO
+            } else {
+                DVec3::new(m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2])
+                    .normalize_or_zero()
+                    .as_vec3()
+            },
+            c: if m.colors.is_empty() {
+                Vec3::splat(-1.0)
+            } else {
+                Vec3::new(m.colors[3 * v], m.colors[3 * v + 1], m.colors[3 * v + 2])
+            },
+            uv: if m.uvs.is_empty() {
+                [0.0; 2]
+            } else {
+                [m.uvs[2 * v], m.uvs[2 * v + 1]]
+            },
+        };
+        let mut dropped = 0;
+        self.verts.reserve(m.indices.len() / 3);
+        for (t, tri) in m.indices.chunks_exact(3).enumerate() {
+            let mut v = [Vec3::ZERO; 3];
+            for k in 0..3 {
+                let i = tri[k];
+                if i >= nv as u64 {
+                    return Err(format!(
+                        "triangle {t} uses vertex {i}, but the mesh has {nv} vertices"
+                    ));
+                }
+                v[k] = verts[i as usize];
+            }
+            if (v[1] - v[0]).cross(v[2] - v[0]) == Vec3::ZERO {
+                dropped += 1;
+                continue;
+            }
+            self.verts.push(v);
+            self.material.push(material);
+            if has_attr {
+                self.attr.push(self.attrs.len() as u32);
+                self.attrs.push([
+                    attr_of(tri[0] as usize),
+                    attr_of(tri[1] as usize),
+                    attr_of(tri[2] as usize),
+                ]);
+            } else {
+                self.attr.push(NO_ATTR);
+            }
+        }
+        Ok(dropped)
+    }
+
     pub fn len(&self) -> usize {
         self.verts.len()
     }

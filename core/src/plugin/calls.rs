@@ -1,12 +1,13 @@
 //! Calling into plugins: the host side of the sinks, and errors mapped back to the scene file.
 
-use super::registry::{Entry, Registry};
+use super::registry::{Entry, PluginKind, Registry};
+use crate::geometry::cone::Cones;
 use crate::geometry::custom::CustomObject;
-use crate::geometry::plane::Plane;
-use crate::geometry::triangle::{VertexAttr, NO_ATTR};
+use crate::geometry::disc::Discs;
+use crate::geometry::triangle::MeshInput;
 use crate::geometry::{custom::Customs, plane::Planes, sphere::Spheres, triangle::Triangles};
-use crate::math::{DVec3, Vec3A};
-use glam::Vec3;
+use crate::math::DVec3;
+use crate::volume::VolumeBuilder;
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
@@ -94,6 +95,8 @@ pub fn call_context<'a>(scene_dir: &'a str, instance: &'a str) -> abi::CallConte
     abi::CallContext {
         scene_dir: abi::Str::new(scene_dir),
         instance: abi::Str::new(instance),
+        texture_cache_bytes: 0,
+        threads: rayon::current_num_threads() as u32,
     }
 }
 
@@ -103,6 +106,8 @@ pub struct GeometryBuilder<'a> {
     pub spheres: &'a mut Spheres,
     pub triangles: &'a mut Triangles,
     pub planes: &'a mut Planes,
+    pub cones: &'a mut Cones,
+    pub discs: &'a mut Discs,
     pub customs: &'a mut Customs,
     pub material: u32,
     pub world_offset: DVec3,
@@ -157,17 +162,8 @@ extern "C" fn add_spheres(
         let b = builder(ctx);
         let v = unsafe { slice(data, checked_len(count, 4, "sphere")?) };
         for (i, s) in v.chunks_exact(4).enumerate() {
-            if s.iter().any(|x| !x.is_finite()) {
-                return Err(format!("sphere {i} has a non-finite value {s:?}"));
-            }
-            if s[3] <= 0.0 {
-                return Err(format!(
-                    "sphere {i} has radius {}; expected a radius > 0",
-                    s[3]
-                ));
-            }
-            let c = (DVec3::new(s[0], s[1], s[2]) - b.world_offset).as_vec3();
-            b.spheres.push([c.x, c.y, c.z, s[3] as f32], b.material);
+            let s = s.try_into().expect("chunk of 4");
+            b.spheres.push_world(i, s, b.world_offset, b.material)?;
         }
         Ok(())
     })
@@ -183,19 +179,50 @@ extern "C" fn add_planes(
         let b = builder(ctx);
         let v = unsafe { slice(data, checked_len(count, 6, "plane")?) };
         for (i, p) in v.chunks_exact(6).enumerate() {
-            if p.iter().any(|x| !x.is_finite()) {
-                return Err(format!("plane {i} has a non-finite value {p:?}"));
-            }
-            let n = DVec3::new(p[3], p[4], p[5]);
-            if n.length() == 0.0 {
-                return Err(format!("plane {i} has a zero-length normal"));
-            }
-            let point = (DVec3::new(p[0], p[1], p[2]) - b.world_offset).as_vec3();
-            b.planes.planes.push(Plane {
-                point: point.into(),
-                normal: Vec3A::from(n.normalize().as_vec3()),
-                material: b.material,
-            });
+            let p = p.try_into().expect("chunk of 6");
+            b.planes.push_world(i, p, b.world_offset, b.material)?;
+        }
+        Ok(())
+    })
+}
+
+extern "C" fn add_cones(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    guard(err, || {
+        let b = builder(ctx);
+        let v = unsafe { slice(data, checked_len(count, 8, "cone")?) };
+        for (i, c) in v.chunks_exact(8).enumerate() {
+            b.cones.push(
+                i,
+                c.try_into().expect("chunk of 8"),
+                b.world_offset,
+                b.material,
+            )?;
+        }
+        Ok(())
+    })
+}
+
+extern "C" fn add_discs(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    guard(err, || {
+        let b = builder(ctx);
+        let v = unsafe { slice(data, checked_len(count, 8, "disc")?) };
+        for (i, d) in v.chunks_exact(8).enumerate() {
+            b.discs.push(
+                i,
+                d.try_into().expect("chunk of 8"),
+                b.world_offset,
+                b.material,
+            )?;
         }
         Ok(())
     })
@@ -210,73 +237,18 @@ extern "C" fn add_mesh(
         let b = builder(ctx);
         let m = unsafe { mesh.as_ref() }.ok_or("no mesh data")?;
         let nv = checked_len(m.vertex_count, 1, "vertex")?;
-        let pos = unsafe { slice(m.positions, checked_len(m.vertex_count, 3, "vertex")?) };
-        let idx = unsafe { slice(m.indices, checked_len(m.triangle_count, 3, "triangle")?) };
-        let normals = unsafe { slice(m.normals, if m.normals.is_null() { 0 } else { nv * 3 }) };
-        let colors = unsafe { slice(m.colors, if m.colors.is_null() { 0 } else { nv * 3 }) };
-        let uvs = unsafe { slice(m.uvs, if m.uvs.is_null() { 0 } else { nv * 2 }) };
-        if let Some(i) = pos.iter().position(|x| !x.is_finite()) {
-            return Err(format!("vertex {} has a non-finite coordinate", i / 3));
-        }
-        if normals.iter().any(|x| !x.is_finite())
-            || colors.iter().any(|x| !x.is_finite())
-            || uvs.iter().any(|x| !x.is_finite())
-        {
-            return Err("mesh has a non-finite normal, colour or uv".into());
-        }
-        let verts: Vec<Vec3> = pos
-            .chunks_exact(3)
-            .map(|p| (DVec3::new(p[0], p[1], p[2]) - b.world_offset).as_vec3())
-            .collect();
-        let has_attr = !normals.is_empty() || !colors.is_empty() || !uvs.is_empty();
-        let attr_of = |v: usize| VertexAttr {
-            n: if normals.is_empty() {
-                Vec3::ZERO
-            } else {
-                DVec3::new(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2])
-                    .normalize_or_zero()
-                    .as_vec3()
-            },
-            c: if colors.is_empty() {
-                Vec3::splat(-1.0)
-            } else {
-                Vec3::new(colors[3 * v], colors[3 * v + 1], colors[3 * v + 2])
-            },
-            uv: if uvs.is_empty() {
-                [0.0; 2]
-            } else {
-                [uvs[2 * v], uvs[2 * v + 1]]
-            },
+        let optional = |p: bool, per: usize| if p { 0 } else { nv * per };
+        // SAFETY: the plugin guarantees the arrays' lengths (ABI contract of MeshData).
+        let input = unsafe {
+            MeshInput {
+                positions: slice(m.positions, checked_len(m.vertex_count, 3, "vertex")?),
+                indices: slice(m.indices, checked_len(m.triangle_count, 3, "triangle")?),
+                normals: slice(m.normals, optional(m.normals.is_null(), 3)),
+                colors: slice(m.colors, optional(m.colors.is_null(), 3)),
+                uvs: slice(m.uvs, optional(m.uvs.is_null(), 2)),
+            }
         };
-        for (t, tri) in idx.chunks_exact(3).enumerate() {
-            let mut v = [Vec3::ZERO; 3];
-            for k in 0..3 {
-                let i = tri[k];
-                if i >= nv as u64 {
-                    return Err(format!(
-                        "triangle {t} uses vertex {i}, but the mesh has {nv} vertices"
-                    ));
-                }
-                v[k] = verts[i as usize];
-            }
-            // Zero-area triangles (after rounding) can never be hit and have no normal.
-            if (v[1] - v[0]).cross(v[2] - v[0]) == Vec3::ZERO {
-                b.dropped += 1;
-                continue;
-            }
-            b.triangles.verts.push(v);
-            b.triangles.material.push(b.material);
-            if has_attr {
-                b.triangles.attr.push(b.triangles.attrs.len() as u32);
-                b.triangles.attrs.push([
-                    attr_of(tri[0] as usize),
-                    attr_of(tri[1] as usize),
-                    attr_of(tri[2] as usize),
-                ]);
-            } else {
-                b.triangles.attr.push(NO_ATTR);
-            }
-        }
+        b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
         Ok(())
     })
 }
@@ -329,6 +301,8 @@ pub fn create_primitive(
         ctx: builder as *mut GeometryBuilder as *mut c_void,
         add_spheres,
         add_planes,
+        add_cones,
+        add_discs,
         add_mesh,
         add_custom,
     };
@@ -443,4 +417,165 @@ pub fn encode_image(
         (vt.write)(abi::Str::new(params), &ctx, &image, &sink, err)
     })?;
     Ok(bytes)
+}
+
+// ------------------------------------------------------------------------------------------------
+// Volume readers: the host side of `VolumeSink`. Storage and checks live in `crate::volume`.
+// ------------------------------------------------------------------------------------------------
+
+/// "plugin `name` (library file)", as messages name a plugin.
+pub fn plugin_label(registry: &Registry, entry: &Entry) -> String {
+    let file = registry
+        .library_of(entry)
+        .path
+        .file_name()
+        .map(|f| f.to_string_lossy().to_string())
+        .unwrap_or_default();
+    format!("plugin `{}` ({file})", entry.name)
+}
+
+/// Runs one volume sink callback: never unwinds, and any failure (a panic included) stops the
+/// volume so the read fails even if the plugin ignores the error.
+fn volume_call(
+    ctx: *mut c_void,
+    err: *const abi::ErrorSink,
+    f: impl FnOnce(&mut VolumeBuilder) -> Result<(), String>,
+) -> abi::Status {
+    if ctx.is_null() {
+        return fail(err, "the volume sink has no context");
+    }
+    // SAFETY: ctx is the builder passed in `VolumeSink::ctx` for the duration of read().
+    let b = unsafe { &mut *(ctx as *mut VolumeBuilder) };
+    let message = match catch_unwind(AssertUnwindSafe(|| f(&mut *b))) {
+        Ok(Ok(())) => return abi::STATUS_OK,
+        Ok(Err(m)) => m,
+        Err(_) => {
+            let m = "internal error in the host while storing volume data";
+            let _ = catch_unwind(AssertUnwindSafe(|| b.fail(m)));
+            m.to_string()
+        }
+    };
+    fail(err, &message)
+}
+
+extern "C" fn volume_begin(
+    ctx: *mut c_void,
+    desc: *const abi::VolumeDesc,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    volume_call(ctx, err, |b| {
+        let Some(d) = (unsafe { desc.as_ref() }) else {
+            let m = "`begin` was given no grid description";
+            b.fail(m);
+            return Err(m.into());
+        };
+        let Ok(name) = (unsafe { d.grid_name.as_str() }) else {
+            let m = "the grid name is not valid UTF-8";
+            b.fail(m);
+            return Err(m.into());
+        };
+        b.begin(
+            d.world_from_index,
+            d.background,
+            d.index_min,
+            d.index_max,
+            name,
+        )
+    })
+}
+
+extern "C" fn volume_add_dense(
+    ctx: *mut c_void,
+    origin: *const [i64; 3],
+    dims: *const [u64; 3],
+    values: *const f32,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    volume_call(ctx, err, |b| {
+        let (Some(&origin), Some(&dims)) = (unsafe { origin.as_ref() }, unsafe { dims.as_ref() })
+        else {
+            let m = "`add_dense` was given a null origin or size";
+            b.fail(m);
+            return Err(m.into());
+        };
+        // The builder checks the size against the grid; here it only has to be addressable.
+        let n = dims
+            .iter()
+            .try_fold(1u64, |a, &d| a.checked_mul(d))
+            .and_then(|n| usize::try_from(n).ok())
+            .filter(|&n| n <= usize::MAX / std::mem::size_of::<f32>());
+        let Some(n) = n else {
+            let m = format!(
+                "dense block at {origin:?} of {}x{}x{} voxels has too many voxels (the count \
+                 overflows)",
+                dims[0], dims[1], dims[2]
+            );
+            b.fail(&m);
+            return Err(m);
+        };
+        if values.is_null() && n > 0 {
+            let m = format!("dense block at {origin:?} was given no values (a null pointer)");
+            b.fail(&m);
+            return Err(m);
+        }
+        // Borrowed for the call (ABI contract); `n` values, x fastest.
+        let values = unsafe { slice(values, n) };
+        b.add_dense(origin, dims, values)
+    })
+}
+
+extern "C" fn volume_add_tile(
+    ctx: *mut c_void,
+    origin: *const [i64; 3],
+    dims: *const [u64; 3],
+    value: f32,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    volume_call(ctx, err, |b| {
+        let (Some(&origin), Some(&dims)) = (unsafe { origin.as_ref() }, unsafe { dims.as_ref() })
+        else {
+            let m = "`add_tile` was given a null origin or size";
+            b.fail(m);
+            return Err(m.into());
+        };
+        b.add_tile(origin, dims, value)
+    })
+}
+
+/// Runs a volume-reader plugin's `read` into `builder` (which must be fresh). `entry` must be a
+/// volume reader.
+#[allow(clippy::too_many_arguments)]
+pub fn read_volume_into(
+    registry: &Registry,
+    entry: &Entry,
+    params: &str,
+    params_at: &Origin,
+    scene_dir: &Path,
+    instance: &str,
+    builder: &mut VolumeBuilder,
+) -> Result<(), (Origin, String)> {
+    if entry.kind != PluginKind::VolumeReader {
+        return Err((
+            params_at.clone(),
+            format!(
+                "{} is a {}, but a volume reader is expected here",
+                plugin_label(registry, entry),
+                entry.kind
+            ),
+        ));
+    }
+    let sink = abi::VolumeSink {
+        ctx: builder as *mut VolumeBuilder as *mut c_void,
+        begin: volume_begin,
+        add_dense: volume_add_dense,
+        add_tile: volume_add_tile,
+    };
+    let dir = scene_dir.to_string_lossy();
+    let ctx = call_context(&dir, instance);
+    // SAFETY: the entry is a volume reader (checked above), so its vtable is a
+    // VolumeReaderVTable.
+    let vt = unsafe { &*(entry.vtable as *const abi::VolumeReaderVTable) };
+    call_plugin(registry, entry, params_at, |err| {
+        (vt.read)(abi::Str::new(params), &ctx, &sink, err)
+    })
 }

@@ -127,6 +127,10 @@ pub struct CallContext {
     pub scene_dir: Str,
     /// The scene's name for this instance (the object's index or the texture's name), for messages.
     pub instance: Str,
+    /// Memory budget for cached texture data, bytes (render settings; 0 = the plugin's default).
+    pub texture_cache_bytes: u64,
+    /// Threads that will call the instance concurrently.
+    pub threads: u32,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -230,6 +234,21 @@ pub struct GeometrySink {
     ) -> Status,
     /// `count` infinite planes as point x, y, z then normal x, y, z.
     pub add_planes: extern "C" fn(
+        ctx: *mut c_void,
+        data: *const f64,
+        count: u64,
+        err: *const ErrorSink,
+    ) -> Status,
+    /// `count` open cones as base x, y, z, base radius, apex x, y, z, apex radius (equal radii:
+    /// a cylinder; one radius may be 0: a pointed cone). No caps: add discs for them.
+    pub add_cones: extern "C" fn(
+        ctx: *mut c_void,
+        data: *const f64,
+        count: u64,
+        err: *const ErrorSink,
+    ) -> Status,
+    /// `count` discs (rings) as centre x, y, z, normal x, y, z, inner radius, outer radius.
+    pub add_discs: extern "C" fn(
         ctx: *mut c_void,
         data: *const f64,
         count: u64,

@@ -105,6 +105,22 @@ pub struct Context {
     pub scene_dir: PathBuf,
     /// How the scene refers to this instance, for messages.
     pub instance: String,
+    /// Memory budget for cached texture data in bytes (0: choose a default).
+    pub texture_cache_bytes: u64,
+    /// Threads that will call the instance concurrently.
+    pub threads: u32,
+}
+
+impl Default for Context {
+    /// A context outside any scene (tests, tools): relative paths resolve against ".".
+    fn default() -> Context {
+        Context {
+            scene_dir: PathBuf::from("."),
+            instance: String::new(),
+            texture_cache_bytes: 0,
+            threads: 1,
+        }
+    }
 }
 
 impl Context {
@@ -278,6 +294,31 @@ impl Geometry<'_> {
                 self.sink.ctx,
                 planes.as_ptr() as *const f64,
                 planes.len() as u64,
+                err,
+            )
+        })
+    }
+
+    /// Open cones as `[bx, by, bz, base_radius, ax, ay, az, apex_radius]`; equal radii make a
+    /// cylinder. Caps are not included: add discs.
+    pub fn cones(&mut self, cones: &[[f64; 8]]) -> Result<(), Error> {
+        call_sink(|err| {
+            (self.sink.add_cones)(
+                self.sink.ctx,
+                cones.as_ptr() as *const f64,
+                cones.len() as u64,
+                err,
+            )
+        })
+    }
+
+    /// Discs or rings as `[cx, cy, cz, nx, ny, nz, inner_radius, outer_radius]`.
+    pub fn discs(&mut self, discs: &[[f64; 8]]) -> Result<(), Error> {
+        call_sink(|err| {
+            (self.sink.add_discs)(
+                self.sink.ctx,
+                discs.as_ptr() as *const f64,
+                discs.len() as u64,
                 err,
             )
         })
@@ -577,11 +618,10 @@ pub mod shim {
             Some(c) => Context {
                 scene_dir: PathBuf::from(unsafe { c.scene_dir.as_str() }.unwrap_or(".")),
                 instance: unsafe { c.instance.as_str() }.unwrap_or("").to_string(),
+                texture_cache_bytes: c.texture_cache_bytes,
+                threads: c.threads,
             },
-            None => Context {
-                scene_dir: PathBuf::from("."),
-                instance: String::new(),
-            },
+            None => Context::default(),
         }
     }
 

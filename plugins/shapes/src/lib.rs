@@ -10,6 +10,10 @@
 //! | `plane`    | one infinite plane                             |
 //! | `triangle` | one triangle                                   |
 //! | `mesh`     | an inline triangle mesh                        |
+//! | `cylinder` | a finite cylinder, capped or open              |
+//! | `cone`     | a cone or truncated cone (NFF's `c`)           |
+//! | `ring`     | a flat ring or disc                            |
+//! | `polycylinder` | cylinders with sphere joints (bonds, tubes) |
 //!
 //! Vectors are RON tuples: `(x, y, z)`. Every number must be finite. Indices in error messages
 //! (triangle numbers, `normals[4]`, ...) start at 0, like the `indices` of a mesh.
@@ -51,6 +55,37 @@
 //! Triangles of zero area (repeated or collinear corners) are dropped with a warning; a mesh
 //! left with no triangle is an error.
 //!
+//! ## `cylinder`
+//! ```text
+//! base: (x, y, z)  centre of one end
+//! apex: (x, y, z)  centre of the other end
+//! radius: f64 > 0  radius
+//! caps: bool = true  close both ends with discs
+//! ```
+//!
+//! ## `cone`
+//! ```text
+//! base: (x, y, z)  centre of the base
+//! base_radius: f64 >= 0  radius at the base
+//! apex: (x, y, z)  centre of the apex end
+//! apex_radius: f64 >= 0 = 0  radius at the apex (0: pointed)
+//! caps: bool = true  close the ends that have a radius with discs
+//! ```
+//!
+//! ## `ring`
+//! ```text
+//! center: (x, y, z)  centre
+//! normal: (x, y, z)  normal, any non-zero length
+//! inner: f64 >= 0 = 0  radius of the hole
+//! outer: f64 > inner  outer radius
+//! ```
+//!
+//! ## `polycylinder`
+//! ```text
+//! points: [(x, y, z), ...]  at least two points along the chain
+//! radius: f64 > 0  radius of the tube
+//! ```
+//!
 //! ## Scene snippet
 //! ```text
 //! objects: [
@@ -66,7 +101,7 @@
 //! ]
 //! ```
 
-use luxon_plugin::{finite, invalid, Context, Describe, Error, Geometry, Mesh, Primitive};
+pub(crate) use luxon_plugin::{finite, invalid, Context, Describe, Error, Geometry, Mesh, Primitive};
 use serde::Deserialize;
 
 const LIBRARY: &str = "luxon-shapes";
@@ -85,7 +120,7 @@ where
 // Vector helpers
 // ------------------------------------------------------------------------------------------------
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
@@ -97,11 +132,11 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-fn length(a: [f64; 3]) -> f64 {
+pub(crate) fn length(a: [f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 
@@ -132,7 +167,7 @@ fn zero_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
     length(cross(e1, e2)) <= 1e-12 * length(e1) * length(e2)
 }
 
-fn positive(name: &str, x: f64) -> Result<f64, Error> {
+pub(crate) fn positive(name: &str, x: f64) -> Result<f64, Error> {
     let [x] = finite(name, [x])?;
     if x > 0.0 {
         Ok(x)
@@ -516,9 +551,12 @@ impl Primitive for MeshEntry {
     }
 }
 
+mod cones;
+pub use cones::{Cone, Cylinder, Polycylinder, Ring};
+
 luxon_plugin::export!(
     library: "luxon-shapes",
-    primitives: [Sphere, Spheres, Plane, Triangle, MeshEntry],
+    primitives: [Sphere, Spheres, Plane, Triangle, MeshEntry, Cylinder, Cone, Ring, Polycylinder],
 );
 
 #[cfg(test)]
@@ -815,6 +853,10 @@ mod tests {
             (Plane::NAME, Plane::PARAMS),
             (Triangle::NAME, Triangle::PARAMS),
             (MeshEntry::NAME, MeshEntry::PARAMS),
+            (Cylinder::NAME, Cylinder::PARAMS),
+            (Cone::NAME, Cone::PARAMS),
+            (Ring::NAME, Ring::PARAMS),
+            (Polycylinder::NAME, Polycylinder::PARAMS),
         ] {
             let section = format!("## `{name}`\n```text\n{table}\n```");
             assert!(

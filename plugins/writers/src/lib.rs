@@ -499,6 +499,7 @@ mod tests {
         Context {
             scene_dir: ".".into(),
             instance: "test".into(),
+            ..Default::default()
         }
     }
 

@@ -1,0 +1,162 @@
+//! The processes of one `luxon render`: this process alone, or the ranks of an MPI job (with
+//! the `mpi` feature). Hides the feature from the rest of the command.
+
+#[cfg(feature = "mpi")]
+use luxon::output::temp_path;
+use luxon::schedule::{launched_ranks, render_local, threads_for, Chunk, RankStats, Sink};
+use luxon::{Error, Scene};
+use luxon_formats::ParallelMode;
+use std::path::Path;
+
+#[cfg(feature = "mpi")]
+pub use luxon::schedule::cluster::Cluster;
+
+/// Uninhabited without the `mpi` feature.
+#[cfg(not(feature = "mpi"))]
+pub enum Cluster {}
+
+pub enum Job {
+    Local,
+    Mpi(Cluster),
+}
+
+impl Job {
+    /// Joins the MPI job when an MPI launcher started this process (before anything can fail,
+    /// so that failures are agreed on collectively).
+    pub fn from_launcher() -> Result<Job, Error> {
+        match launched_ranks() {
+            None => Ok(Job::Local),
+            Some(n) => Self::mpi(n),
+        }
+    }
+
+    /// Starts a one-rank MPI job for a scene that asks for MPI or hybrid mode without a
+    /// launcher (without the `mpi` feature: renders in this process).
+    pub fn for_mode(self, mode: ParallelMode) -> Result<Job, Error> {
+        match (self, mode) {
+            (Job::Local, ParallelMode::Mpi | ParallelMode::Hybrid) if cfg!(feature = "mpi") => {
+                Self::mpi(1)
+            }
+            (job, _) => Ok(job),
+        }
+    }
+
+    #[cfg(feature = "mpi")]
+    fn mpi(_ranks: usize) -> Result<Job, Error> {
+        Ok(Job::Mpi(Cluster::init()?))
+    }
+
+    #[cfg(not(feature = "mpi"))]
+    fn mpi(ranks: usize) -> Result<Job, Error> {
+        if ranks > 1 {
+            return Err(Error::Usage(format!(
+                "started as {ranks} MPI processes, but this luxon was built without MPI; rebuild with `cargo build --release --features mpi`"
+            )));
+        }
+        Ok(Job::Local)
+    }
+
+    pub fn rank(&self) -> usize {
+        match self {
+            Job::Local => 0,
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => c.rank(),
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+
+    pub fn size(&self) -> usize {
+        match self {
+            Job::Local => 1,
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => c.size(),
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+}
+
+impl Job {
+    /// Render threads of this process.
+    pub fn threads(&self, scene: &Scene) -> usize {
+        match self {
+            Job::Local => threads_for(scene),
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => c.threads(scene),
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+
+    /// Whether every process is ready to render: then the threads of every rank; otherwise the
+    /// error to report (on rank 0; `None` on ranks that should exit quietly).
+    pub fn agree(&self, ready: Result<usize, Error>) -> Result<Vec<usize>, Option<Error>> {
+        match self {
+            Job::Local => ready.map(|t| vec![t]).map_err(Some),
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => c.agree(ready),
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+
+    /// Renders this process's share: rank 0's `sink` gets its own chunks and, when `gather`,
+    /// every rank's. Returns every rank's statistics (on rank 0) and, with `keep`, the chunks
+    /// this rank rendered.
+    pub fn render(
+        &self,
+        scene: &Scene,
+        threads: &[usize],
+        gather: bool,
+        keep: bool,
+        sink: Sink,
+    ) -> Result<(Vec<RankStats>, Vec<Chunk>), Error> {
+        match self {
+            Job::Local => {
+                let _ = (gather, keep);
+                render_local(scene, threads[0], sink).map(|r| (vec![r], Vec::new()))
+            }
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => {
+                let r = c.render(scene, threads, gather, keep, sink);
+                Ok((r.ranks, r.kept))
+            }
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+
+    /// Every rank writes its `chunks` of the 8-bit PPM `path` with MPI-IO; rank 0 then renames
+    /// the file into place.
+    pub fn write_concurrent(
+        &self,
+        path: &Path,
+        width: u32,
+        height: u32,
+        chunks: &[Chunk],
+    ) -> Result<(), Error> {
+        match self {
+            Job::Local => {
+                let _ = (path, width, height, chunks);
+                Err(Error::Render("MPI-IO needs an MPI job".into()))
+            }
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => {
+                let tmp = temp_path(path, c.root_pid())?;
+                c.barrier();
+                c.write_ppm(&tmp, width, height, chunks);
+                c.barrier();
+                if c.rank() == 0 {
+                    std::fs::rename(&tmp, path).map_err(|source| Error::Io {
+                        path: path.to_path_buf(),
+                        source,
+                    })?;
+                }
+                Ok(())
+            }
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+}

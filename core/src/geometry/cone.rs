@@ -1,0 +1,274 @@
+//! Open cones and cylinders between two end discs (base centre + radius, apex centre + radius):
+//! 32 bytes each, in their own BVH. Molecular bonds and the SPD's `c` primitives are these.
+
+use super::{Counters, Hit, Kind, Surface};
+use crate::bvh::Bvh;
+use crate::math::{gamma, Aabb, DVec3, Vec3A};
+use crate::ray::Ray;
+
+#[derive(Default)]
+pub struct Cones {
+    /// Base x, y, z, base radius, apex x, y, z, apex radius (re-centred world space).
+    pub data: Vec<[f32; 8]>,
+    pub material: Vec<u32>,
+    bvh: Bvh,
+}
+
+/// Bounds of a disc of radius `r` around `c` with unit normal `w`: per axis r·√(1 − wᵢ²).
+pub fn disc_bounds(c: Vec3A, w: Vec3A, r: f32) -> Aabb {
+    let q = (Vec3A::ONE - w * w).max(Vec3A::ZERO);
+    let e = r * Vec3A::new(q.x.sqrt(), q.y.sqrt(), q.z.sqrt());
+    Aabb::new(c - e, c + e)
+}
+
+/// The roots of the cone's quadric along the ray that lie on the finite, correct-nappe part of
+/// the surface within (0, t_max), nearest first; solved in f64.
+#[inline(always)]
+fn cone_roots(c: &[f32; 8], o: Vec3A, d: Vec3A, t_max: f32) -> ([f64; 2], usize) {
+    let b = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+    let a = DVec3::new(c[4] as f64, c[5] as f64, c[6] as f64);
+    let (rb, ra) = (c[3] as f64, c[7] as f64);
+    let ba = a - b;
+    let h = ba.length();
+    let w = ba / h;
+    let k = (ra - rb) / h;
+    let oc = o.as_dvec3() - b;
+    let d = d.as_dvec3();
+    let so = oc.dot(w);
+    let sd = d.dot(w);
+    let ro = oc - so * w;
+    let rd = d - sd * w;
+    let m = rb + k * so;
+    let n = k * sd;
+    let qa = rd.dot(rd) - n * n;
+    let qb = ro.dot(rd) - m * n;
+    let qc = ro.dot(ro) - m * m;
+    let mut roots = [0.0f64; 2];
+    let mut count = 0;
+    let mut consider = |t: f64| {
+        if t > 0.0 && t < t_max as f64 {
+            let s = so + t * sd;
+            if (0.0..=h).contains(&s) && m + n * t >= 0.0 {
+                roots[count] = t;
+                count += 1;
+            }
+        }
+    };
+    if qa.abs() < 1e-12 * (rd.dot(rd) + n * n).max(1e-300) {
+        // Ray parallel to a line of the cone: one root.
+        if qb != 0.0 {
+            consider(-qc / (2.0 * qb));
+        }
+    } else {
+        let disc = qb * qb - qa * qc;
+        if disc < 0.0 {
+            return (roots, 0);
+        }
+        let q = -(qb + disc.sqrt().copysign(qb));
+        let (mut t0, mut t1) = (q / qa, if q != 0.0 { qc / q } else { q / qa });
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        consider(t0);
+        if t1 != t0 {
+            consider(t1);
+        }
+    }
+    (roots, count)
+}
+
+impl Cones {
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// Validates and stores cone `i` of a plugin's batch (world coordinates).
+    pub fn push(
+        &mut self,
+        i: usize,
+        c: [f64; 8],
+        offset: DVec3,
+        material: u32,
+    ) -> Result<(), String> {
+        if c.iter().any(|v| !v.is_finite()) {
+            return Err(format!("cone {i} has a non-finite value {c:?}"));
+        }
+        if c[3] < 0.0 || c[7] < 0.0 || (c[3] == 0.0 && c[7] == 0.0) {
+            return Err(format!(
+                "cone {i} has radii {} and {}; expected radii >= 0, not both 0",
+                c[3], c[7]
+            ));
+        }
+        let b = (DVec3::new(c[0], c[1], c[2]) - offset).as_vec3();
+        let a = (DVec3::new(c[4], c[5], c[6]) - offset).as_vec3();
+        if a == b {
+            return Err(format!(
+                "cone {i} has the same base and apex centre; expected a length > 0"
+            ));
+        }
+        self.data
+            .push([b.x, b.y, b.z, c[3] as f32, a.x, a.y, a.z, c[7] as f32]);
+        self.material.push(material);
+        Ok(())
+    }
+
+    pub fn bounds(&self) -> Vec<Aabb> {
+        self.data
+            .iter()
+            .map(|c| {
+                let b = Vec3A::new(c[0], c[1], c[2]);
+                let a = Vec3A::new(c[4], c[5], c[6]);
+                let w = (a - b).normalize();
+                disc_bounds(b, w, c[3]).union(disc_bounds(a, w, c[7]))
+            })
+            .collect()
+    }
+
+    pub fn build(&mut self) {
+        let (bvh, order) = Bvh::build(&self.bounds());
+        self.data = order.iter().map(|&i| self.data[i as usize]).collect();
+        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        self.bvh = bvh;
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+        if self.data.is_empty() {
+            return;
+        }
+        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
+            c.tests += 1;
+            let (r, n) = cone_roots(&self.data[i as usize], ray.origin, ray.dir, tm);
+            if n == 0 {
+                return None;
+            }
+            let t = r[0] as f32;
+            if !(t > 0.0 && t < tm) {
+                return None;
+            }
+            *hit = Some(Hit::new(t, Kind::Cone, i));
+            Some(t)
+        });
+    }
+
+    #[inline]
+    pub fn any(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut Counters,
+        mut on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        if self.data.is_empty() {
+            return false;
+        }
+        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
+            c.tests += 1;
+            let (_, n) = cone_roots(&self.data[i as usize], ray.origin, ray.dir, t_max);
+            n > 0 && on_hit(self.material[i as usize], n as u32)
+        })
+    }
+
+    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        let c = &self.data[hit.index as usize];
+        let b = Vec3A::new(c[0], c[1], c[2]);
+        let a = Vec3A::new(c[4], c[5], c[6]);
+        let h = (a - b).length();
+        let w = (a - b) / h;
+        let k = (c[7] - c[3]) / h;
+        let p = ray.at(hit.t);
+        let s = (p - b).dot(w);
+        let radial = (p - b) - s * w;
+        let q = radial.normalize_or_zero();
+        let q = if q == Vec3A::ZERO {
+            crate::math::orthogonal(w)
+        } else {
+            q
+        };
+        let n = (q - k * w).normalize();
+        let p_error = gamma(16) * (p.abs() + b.abs().max(a.abs()) + Vec3A::splat(c[3].max(c[7])));
+        let u = 0.5
+            + q.dot(crate::math::orthogonal(w))
+                .atan2(q.dot(w.cross(crate::math::orthogonal(w))))
+                / std::f32::consts::TAU;
+        Surface {
+            p,
+            p_error,
+            ng: n,
+            ns: n,
+            uv: [u, (s / h).clamp(0.0, 1.0)],
+            material: self.material[hit.index as usize],
+            color: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CYL: [f32; 8] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 4.0, 1.0];
+
+    #[test]
+    fn cylinder_hit_from_outside_inside_and_along_the_axis() {
+        let (r, n) = cone_roots(&CYL, Vec3A::new(-5.0, 0.0, 2.0), Vec3A::X, f32::INFINITY);
+        assert_eq!(n, 2);
+        assert!((r[0] - 4.0).abs() < 1e-9 && (r[1] - 6.0).abs() < 1e-9);
+        let (r, n) = cone_roots(&CYL, Vec3A::new(0.0, 0.0, 2.0), Vec3A::X, f32::INFINITY);
+        assert_eq!((n, r[0]), (1, 1.0));
+        // Along the axis through the open ends: no hit.
+        let (_, n) = cone_roots(&CYL, Vec3A::new(0.0, 0.0, -1.0), Vec3A::Z, f32::INFINITY);
+        assert_eq!(n, 0);
+        // Beyond the ends: no hit.
+        let (_, n) = cone_roots(&CYL, Vec3A::new(-5.0, 0.0, 5.0), Vec3A::X, f32::INFINITY);
+        assert_eq!(n, 0);
+    }
+
+    #[test]
+    fn cone_hits_only_its_own_nappe() {
+        // Pointed cone: radius 1 at z=0, 0 at z=1.
+        let cone = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0];
+        let (r, n) = cone_roots(&cone, Vec3A::new(-5.0, 0.0, 0.5), Vec3A::X, f32::INFINITY);
+        assert_eq!(n, 2);
+        assert!((r[0] - 4.5).abs() < 1e-6, "{r:?}");
+        // Through the mirrored nappe above the apex: nothing.
+        let (_, n) = cone_roots(&cone, Vec3A::new(-5.0, 0.0, 1.5), Vec3A::X, f32::INFINITY);
+        assert_eq!(n, 0);
+    }
+
+    #[test]
+    fn normals_point_outward() {
+        let mut cones = Cones::default();
+        cones
+            .push(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0], DVec3::ZERO, 0)
+            .unwrap();
+        let ray = Ray::new(Vec3A::new(-5.0, 0.0, 0.5), Vec3A::X, 0.0);
+        let s = cones.surface(&Hit::new(4.5, Kind::Cone, 0), &ray);
+        let want = Vec3A::new(-1.0, 0.0, 1.0).normalize();
+        assert!((s.ng - want).length() < 1e-5, "{:?}", s.ng);
+    }
+
+    #[test]
+    fn bad_cones_are_rejected() {
+        let mut c = Cones::default();
+        assert!(c.push(0, [0.0; 8], DVec3::ZERO, 0).is_err());
+        assert!(c
+            .push(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], DVec3::ZERO, 0)
+            .is_err());
+        assert!(c
+            .push(0, [0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 1.0], DVec3::ZERO, 0)
+            .is_err());
+        assert!(c
+            .push(
+                0,
+                [f64::NAN, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0],
+                DVec3::ZERO,
+                0
+            )
+            .is_err());
+    }
+}

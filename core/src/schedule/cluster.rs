@@ -1,0 +1,512 @@
+//! Rendering across MPI ranks (feature `mpi`). Every rank builds the whole scene and renders its
+//! share on its own thread pool; only rank 0 writes outputs (unless MPI-IO).
+//!
+//! - Static decompositions: workers are numbered across ranks (rank r's threads follow rank
+//!   r-1's), so pixel-, scanline- and block-cyclic deal units over every thread of the job.
+//! - Dynamic: rank 0 hands out tiles from a counter its own threads also take from; each other
+//!   rank keeps `threads + 1` tiles requested (one ahead) and asks for one more per finished tile.
+//!
+//! All MPI calls are made by each rank's main thread, which polls (and sleeps briefly: OpenMPI's
+//! blocking calls spin and would steal a core from the render threads), except on failure: an
+//! error or panic anywhere ends the whole job through [`fail`] (`MPI_Abort`), after rank 0 has
+//! printed the cause.
+
+use super::{decompose, run_share, wire, Chunk, RankStats, Share, Sink};
+use crate::error::Error;
+use crate::scene::Scene;
+use luxon_formats::{Decomposition, ParallelMode};
+use mpi::ffi;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use std::collections::VecDeque;
+use std::os::raw::{c_int, c_void};
+use std::sync::atomic::{AtomicBool, AtomicI32, AtomicUsize, Ordering};
+use std::sync::{mpsc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+const TAG_REQUEST: i32 = 1;
+const TAG_TILE: i32 = 2;
+const TAG_DONE: i32 = 3;
+const TAG_CHUNK: i32 = 4;
+const TAG_FINISHED: i32 = 5;
+const TAG_ERROR: i32 = 6;
+
+/// How long the main thread sleeps between polls.
+const POLL: Duration = Duration::from_micros(500);
+
+/// This process's rank once MPI is up (-1 before): read by [`fail`] from any thread.
+static RANK: AtomicI32 = AtomicI32::new(-1);
+
+pub struct Cluster {
+    world: SimpleCommunicator,
+    rank: usize,
+    size: usize,
+    /// Ranks on this node that share this rank's CPUs (including it).
+    sharing: usize,
+    // Dropped last: finalises MPI.
+    _universe: mpi::environment::Universe,
+}
+
+/// What [`Cluster::render`] leaves: every rank's statistics (rank 0; others: their own) and the
+/// chunks this rank rendered, when asked to keep them.
+pub struct Rendered {
+    pub ranks: Vec<RankStats>,
+    pub kept: Vec<Chunk>,
+}
+
+impl Cluster {
+    /// Initialises MPI (once per process) and makes a panic anywhere end the whole job.
+    pub fn init() -> Result<Cluster, Error> {
+        let (universe, _) = mpi::initialize_with_threading(mpi::Threading::Multiple)
+            .ok_or_else(|| Error::Render("MPI was already initialised in this process".into()))?;
+        let world = universe.world();
+        let (rank, size) = (world.rank() as usize, world.size() as usize);
+        RANK.store(rank as i32, Ordering::SeqCst);
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            previous(info);
+            let p = info.payload();
+            let what = p
+                .downcast_ref::<&str>()
+                .copied()
+                .or_else(|| p.downcast_ref::<String>().map(String::as_str))
+                .unwrap_or("(no message)");
+            let at = info.location().map(|l| format!(" at {l}")).unwrap_or_default();
+            fail(&format!("panic{at}: {what}"));
+        }));
+        // Ranks bound to the same CPUs share them; ranks bound to other CPUs do not.
+        let node = world.split_shared(0);
+        let mine = cpu_set_fingerprint();
+        let mut all = vec![0u64; node.size() as usize];
+        node.all_gather_into(&mine, &mut all[..]);
+        let sharing = all.iter().filter(|&&f| f == mine).count().max(1);
+        Ok(Cluster {
+            world,
+            rank,
+            size,
+            sharing,
+            _universe: universe,
+        })
+    }
+
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// Render threads for this rank: the settings' count, else one in pure MPI mode, else this
+    /// rank's share of the CPUs it may run on.
+    pub fn threads(&self, scene: &Scene) -> usize {
+        match (scene.settings.threads, scene.settings.mode) {
+            (Some(n), _) => n as usize,
+            (None, ParallelMode::Mpi) => 1,
+            (None, _) => (super::available_cpus() / self.sharing).max(1),
+        }
+    }
+
+    /// Collective, before rendering: every rank says whether it is ready (with its thread
+    /// count). All ready: every rank's thread count. Otherwise rank 0 gets the first failing
+    /// rank's error and the other ranks `None` (they should exit quietly).
+    pub fn agree(&self, ready: Result<usize, Error>) -> Result<Vec<usize>, Option<Error>> {
+        let mine: [u64; 2] = match &ready {
+            Ok(t) => [0, *t as u64],
+            Err(_) => [1, 0],
+        };
+        let mut all = vec![0u64; 2 * self.size];
+        self.world.all_gather_into(&mine[..], &mut all[..]);
+        let Some(bad) = (0..self.size).find(|&r| all[2 * r] == 1) else {
+            return Ok((0..self.size).map(|r| all[2 * r + 1] as usize).collect());
+        };
+        match (self.rank, ready) {
+            (0, Err(e)) => Err(Some(e)),
+            (0, Ok(_)) => {
+                let (bytes, _) = self
+                    .world
+                    .process_at_rank(bad as i32)
+                    .receive_vec_with_tag::<u8>(TAG_ERROR);
+                let m = String::from_utf8_lossy(&bytes).to_string();
+                Err(Some(Error::Render(format!("rank {bad}: {m}"))))
+            }
+            (r, Err(e)) if r == bad => {
+                let m = e.to_string();
+                self.world
+                    .process_at_rank(0)
+                    .send_with_tag(m.as_bytes(), TAG_ERROR);
+                Err(None)
+            }
+            _ => Err(None),
+        }
+    }
+
+    /// Renders this rank's share with `threads[rank]` threads. On rank 0, `sink` gets rank 0's
+    /// chunks, and every other rank's when `gather`. With `keep`, each rank also returns the
+    /// chunks it rendered (for MPI-IO). Any failure ends the job.
+    pub fn render(
+        &self,
+        scene: &Scene,
+        threads: &[usize],
+        gather: bool,
+        keep: bool,
+        sink: Sink,
+    ) -> Rendered {
+        let pool = super::thread_pool(threads[self.rank]).unwrap_or_else(|e| fail(&e.to_string()));
+        let s = &scene.settings;
+        let tiles = decompose::tiles(s.width, s.height, s.tile_size);
+        let kept = Mutex::new(Vec::new());
+        let injected = Injected::from_env(self.rank);
+        let local_sink = |c: Chunk| {
+            injected.on_chunk();
+            if keep {
+                kept.lock().unwrap_or_else(|e| e.into_inner()).push(c.clone());
+            }
+            sink(c);
+        };
+        let ranks = if self.rank == 0 {
+            self.lead(scene, &pool, &tiles, threads, gather, &local_sink, &injected)
+        } else {
+            let (tx, rx) = mpsc::channel();
+            let injected = &injected;
+            let to_main = move |c: Chunk| {
+                injected.on_chunk();
+                let _ = tx.send(c);
+            };
+            let (mine, chunks) =
+                self.follow(scene, &pool, &tiles, threads, gather, &to_main, rx, injected);
+            if keep {
+                kept.lock().unwrap_or_else(|e| e.into_inner()).extend(chunks);
+            }
+            vec![mine]
+        };
+        Rendered {
+            ranks,
+            kept: kept.into_inner().unwrap_or_else(|e| e.into_inner()),
+        }
+    }
+
+    fn share<'a>(
+        &self,
+        scene: &Scene,
+        threads: &[usize],
+        tiles: &'a [decompose::Rect],
+        next: &'a (dyn Fn() -> Option<usize> + Sync),
+    ) -> Share<'a> {
+        match scene.settings.decomposition {
+            Decomposition::Dynamic => Share::Queue { tiles, next },
+            how => Share::Static {
+                how,
+                first: threads[..self.rank].iter().sum(),
+                workers: threads.iter().sum(),
+            },
+        }
+    }
+
+    /// Rank 0: renders, hands out tiles, takes chunks and statistics from the other ranks.
+    #[allow(clippy::too_many_arguments)]
+    fn lead(
+        &self,
+        scene: &Scene,
+        pool: &rayon::ThreadPool,
+        tiles: &[decompose::Rect],
+        threads: &[usize],
+        gather: bool,
+        sink: Sink,
+        injected: &Injected,
+    ) -> Vec<RankStats> {
+        let counter = AtomicUsize::new(0);
+        let take = || {
+            let i = counter.fetch_add(1, Ordering::Relaxed);
+            (i < tiles.len()).then_some(i)
+        };
+        let share = self.share(scene, threads, tiles, &take);
+        let mut stats: Vec<Option<RankStats>> = vec![None; self.size];
+        let mut done_sent = vec![false; self.size];
+        let mut finished = 0;
+        std::thread::scope(|sc| {
+            let local = sc.spawn(|| run_share(scene, pool, share, sink));
+            loop {
+                while let Some((msg, status)) = self.world.any_process().immediate_matched_probe() {
+                    let (from, tag) = (status.source_rank(), status.tag());
+                    let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
+                    let to = self.world.process_at_rank(from);
+                    match tag {
+                        TAG_REQUEST => {
+                            for _ in 0..word(&bytes) {
+                                match take() {
+                                    Some(i) => to.send_with_tag(&bytes_of(i as u64)[..], TAG_TILE),
+                                    None if !done_sent[from as usize] => {
+                                        done_sent[from as usize] = true;
+                                        to.send_with_tag(&bytes_of(0)[..], TAG_DONE);
+                                    }
+                                    None => {}
+                                }
+                            }
+                        }
+                        TAG_CHUNK if gather => match wire::decode_chunk(&bytes) {
+                            Some(c) => sink(c),
+                            None => fail(&format!("rank {from} sent a corrupt chunk")),
+                        },
+                        TAG_FINISHED => {
+                            let s = wire::decode_stats(&bytes).unwrap_or_else(|| {
+                                fail(&format!("rank {from} sent corrupt statistics"))
+                            });
+                            stats[from as usize] = Some(s);
+                            finished += 1;
+                        }
+                        TAG_ERROR => {
+                            let m = String::from_utf8_lossy(&bytes);
+                            eprintln!("luxon: error: rank {from}: {m}");
+                            abort_job();
+                        }
+                        _ => {}
+                    }
+                }
+                check(scene, injected);
+                if finished == self.size - 1 && local.is_finished() {
+                    break;
+                }
+                std::thread::sleep(POLL);
+            }
+            let mine = local.join().unwrap_or_else(|_| fail("a render thread panicked"));
+            check(scene, injected);
+            stats[0] = Some(mine);
+        });
+        stats
+            .into_iter()
+            .enumerate()
+            .map(|(rank, s)| RankStats {
+                rank,
+                ..s.unwrap_or_default()
+            })
+            .collect()
+    }
+
+    /// Ranks above 0: render, send chunks (when gathering) and statistics to rank 0; for the
+    /// dynamic decomposition, keep `threads + 1` tiles requested. Returns this rank's
+    /// statistics and its chunks.
+    #[allow(clippy::too_many_arguments)]
+    fn follow(
+        &self,
+        scene: &Scene,
+        pool: &rayon::ThreadPool,
+        tiles: &[decompose::Rect],
+        threads: &[usize],
+        gather: bool,
+        sink: Sink,
+        chunks: mpsc::Receiver<Chunk>,
+        injected: &Injected,
+    ) -> (RankStats, Vec<Chunk>) {
+        let queue = TileQueue::default();
+        let next = || queue.pop();
+        let share = self.share(scene, threads, tiles, &next);
+        let dynamic = matches!(share, Share::Queue { .. });
+        let root = self.world.process_at_rank(0);
+        let mut mine = Vec::new();
+        let mut no_more_tiles = !dynamic;
+        if dynamic {
+            root.send_with_tag(&bytes_of(threads[self.rank] as u64 + 1)[..], TAG_REQUEST);
+        }
+        let mut stats = std::thread::scope(|sc| {
+            let local = sc.spawn(|| run_share(scene, pool, share, sink));
+            loop {
+                let finished = local.is_finished();
+                match chunks.recv_timeout(POLL) {
+                    Ok(c) => {
+                        if gather {
+                            root.send_with_tag(&wire::encode_chunk(&c)[..], TAG_CHUNK);
+                        }
+                        if !no_more_tiles {
+                            root.send_with_tag(&bytes_of(1)[..], TAG_REQUEST);
+                        }
+                        mine.push(c);
+                    }
+                    // Every chunk is sent before the render threads finish.
+                    Err(_) if finished => break,
+                    Err(_) => {}
+                }
+                while let Some((msg, status)) = root.immediate_matched_probe() {
+                    let tag = status.tag();
+                    let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
+                    match tag {
+                        TAG_TILE => queue.push(word(&bytes) as usize),
+                        TAG_DONE => {
+                            no_more_tiles = true;
+                            queue.close();
+                        }
+                        _ => {}
+                    }
+                }
+                check(scene, injected);
+            }
+            local.join().unwrap_or_else(|_| fail("a render thread panicked"))
+        });
+        check(scene, injected);
+        stats.rank = self.rank;
+        root.send_with_tag(&wire::encode_stats(&stats)[..], TAG_FINISHED);
+        (stats, mine)
+    }
+
+    /// Collective: rank 0's process id, so every rank names the same temporary file.
+    pub fn root_pid(&self) -> u32 {
+        let mut pid = std::process::id();
+        self.world.process_at_rank(0).broadcast_into(&mut pid);
+        pid
+    }
+
+    pub fn barrier(&self) {
+        self.world.barrier();
+    }
+
+    /// Collective: writes this rank's pixels of an 8-bit PPM into `tmp` with MPI-IO (rank 0 adds
+    /// the header).
+    pub fn write_ppm(&self, tmp: &std::path::Path, width: u32, height: u32, mine: &[Chunk]) {
+        let header = if self.rank == 0 {
+            crate::output::stream::ppm_header(width, height)
+        } else {
+            Vec::new()
+        };
+        if let Err(e) = super::mpi_io::write_ppm(self.world.as_raw(), tmp, &header, width, height, mine) {
+            fail(&format!("{}: MPI-IO: {e}", tmp.display()));
+        }
+    }
+}
+
+/// Every message is bytes (MPI matches datatypes); numbers are native-endian u64.
+fn bytes_of(v: u64) -> [u8; 8] {
+    v.to_ne_bytes()
+}
+
+fn word(bytes: &[u8]) -> u64 {
+    bytes
+        .get(..8)
+        .and_then(|b| b.try_into().ok())
+        .map_or(0, u64::from_ne_bytes)
+}
+
+/// Ends the job if a plugin faulted or a test asked for a failure.
+fn check(scene: &Scene, injected: &Injected) {
+    if let Some(m) = scene.customs.fault.message() {
+        fail(&m);
+    }
+    if injected.raised.load(Ordering::Relaxed) {
+        fail("injected failure (LUXON_TEST_FAIL_RANK)");
+    }
+}
+
+/// Tiles a follower has been given and not yet started; `pop` waits for one.
+#[derive(Default)]
+struct TileQueue {
+    state: Mutex<(VecDeque<usize>, bool)>,
+    ready: Condvar,
+}
+
+impl TileQueue {
+    fn push(&self, i: usize) {
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).0.push_back(i);
+        self.ready.notify_one();
+    }
+    fn close(&self) {
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).1 = true;
+        self.ready.notify_all();
+    }
+    fn pop(&self) -> Option<usize> {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        loop {
+            if let Some(i) = s.0.pop_front() {
+                return Some(i);
+            }
+            if s.1 {
+                return None;
+            }
+            s = self.ready.wait(s).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+}
+
+/// A failure injected by tests on one rank: `LUXON_TEST_FAIL_RANK=k` with
+/// `LUXON_TEST_FAIL=error` (default) or `panic`, raised when rank k finishes its first unit.
+struct Injected {
+    panic: bool,
+    armed: bool,
+    raised: AtomicBool,
+}
+
+impl Injected {
+    fn from_env(rank: usize) -> Injected {
+        let armed = std::env::var("LUXON_TEST_FAIL_RANK").is_ok_and(|r| r.trim() == rank.to_string());
+        Injected {
+            panic: std::env::var("LUXON_TEST_FAIL").is_ok_and(|m| m == "panic"),
+            armed,
+            raised: AtomicBool::new(false),
+        }
+    }
+    fn on_chunk(&self) {
+        if self.armed {
+            if self.panic {
+                panic!("injected panic (LUXON_TEST_FAIL_RANK)");
+            }
+            self.raised.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// A fingerprint of the CPUs this process may run on (Linux; elsewhere every rank's is equal).
+fn cpu_set_fingerprint() -> u64 {
+    use std::hash::{Hash, Hasher};
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let line = status
+        .lines()
+        .find(|l| l.starts_with("Cpus_allowed_list:"))
+        .unwrap_or("");
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    line.hash(&mut h);
+    h.finish()
+}
+
+/// Ends the whole job: prints `message` (rank 0 prints other ranks' causes for them), then
+/// `MPI_Abort`. Callable from any thread, including a panic hook.
+pub fn fail(message: &str) -> ! {
+    let rank = RANK.load(Ordering::SeqCst);
+    if rank > 0 {
+        // Rank 0 normally prints the cause and aborts within milliseconds; if it is not
+        // listening (busy in a collective), this rank prints it and aborts itself.
+        let bytes = message.as_bytes();
+        // SAFETY: MPI is initialised with MPI_THREAD_MULTIPLE; `bytes` outlives the request
+        // because this function never returns.
+        unsafe {
+            let mut req = ffi::RSMPI_REQUEST_NULL;
+            ffi::MPI_Isend(
+                bytes.as_ptr() as *const c_void,
+                bytes.len() as c_int,
+                ffi::RSMPI_UINT8_T,
+                0,
+                TAG_ERROR,
+                ffi::RSMPI_COMM_WORLD,
+                &mut req,
+            );
+            let deadline = Instant::now() + Duration::from_secs(3);
+            let mut flag: c_int = 0;
+            while Instant::now() < deadline {
+                if flag == 0 {
+                    ffi::MPI_Test(&mut req, &mut flag, ffi::RSMPI_STATUS_IGNORE);
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            }
+        }
+        eprintln!("luxon: error: rank {rank}: {message}");
+    } else {
+        eprintln!("luxon: error: {message}");
+    }
+    abort_job()
+}
+
+fn abort_job() -> ! {
+    crate::output::stream::discard_temp_files();
+    // SAFETY: plain FFI call on the world communicator.
+    unsafe {
+        ffi::MPI_Abort(ffi::RSMPI_COMM_WORLD, 1);
+    }
+    std::process::exit(1)
+}

@@ -1,0 +1,212 @@
+//! Parallel scheduling: which worker renders which pixels, in one process ([`render_local`]) or
+//! across MPI ranks (`cluster`, with the `mpi` feature). Whatever the decomposition, each pixel's
+//! samples come from its own deterministic sequence, so the image never depends on it.
+
+pub mod decompose;
+pub mod wire;
+
+#[cfg(feature = "mpi")]
+pub mod cluster;
+#[cfg(feature = "mpi")]
+mod mpi_io;
+
+use crate::error::Error;
+use crate::geometry::Counters;
+use crate::render::render_spans;
+use crate::scene::Scene;
+pub use decompose::{Rect, Span};
+use luxon_formats::Decomposition;
+use rayon::prelude::*;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// Rendered pixels: spans and their linear RGBA values, span after span.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chunk {
+    pub spans: Vec<Span>,
+    pub rgba: Vec<f32>,
+}
+
+impl Chunk {
+    pub fn pixels(&self) -> u64 {
+        self.spans.iter().map(|s| s.count as u64).sum()
+    }
+}
+
+/// Where finished chunks go; called from the render threads.
+pub type Sink<'a> = &'a (dyn Fn(Chunk) + Sync);
+
+/// The work one render thread did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WorkerStats {
+    /// Units of work: tiles, blocks or rows.
+    pub units: u64,
+    pub pixels: u64,
+    pub counters: Counters,
+    /// Time spent rendering (not waiting).
+    pub busy: Duration,
+}
+
+impl WorkerStats {
+    pub fn add(&mut self, o: &WorkerStats) {
+        self.units += o.units;
+        self.pixels += o.pixels;
+        self.counters.add(&o.counters);
+        self.busy += o.busy;
+    }
+}
+
+/// The work one process (MPI rank) did, per thread.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RankStats {
+    pub rank: usize,
+    pub threads: Vec<WorkerStats>,
+    /// Wall time of the rank's render phase.
+    pub time: Duration,
+}
+
+impl RankStats {
+    pub fn total(&self) -> WorkerStats {
+        let mut t = WorkerStats::default();
+        for w in &self.threads {
+            t.add(w);
+        }
+        t
+    }
+}
+
+/// What the render threads of one process take on.
+pub enum Share<'a> {
+    /// A static decomposition: this process's threads are workers `first..first + threads` of
+    /// `workers` numbered across every rank.
+    Static {
+        how: Decomposition,
+        first: usize,
+        workers: usize,
+    },
+    /// Rayon work stealing over these tiles.
+    Steal(&'a [Rect]),
+    /// Tiles (indices into `tiles`) taken from `next` until it says there are no more; `next`
+    /// may block waiting for one.
+    Queue {
+        tiles: &'a [Rect],
+        next: &'a (dyn Fn() -> Option<usize> + Sync),
+    },
+}
+
+/// Every CPU this process may run on (affinity respected).
+pub fn available_cpus() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, Error> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("luxon-render-{i}"))
+        .build()
+        .map_err(|e| Error::Render(format!("cannot start {threads} render threads: {e}")))
+}
+
+/// Runs `share` on `pool`, handing each finished unit to `sink`. Stops early (leaving pixels
+/// out) once a plugin has faulted; the caller reports the fault.
+pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Sink) -> RankStats {
+    let start = Instant::now();
+    let stats: Vec<Mutex<WorkerStats>> = (0..pool.current_num_threads())
+        .map(|_| Mutex::default())
+        .collect();
+    let one = |thread: usize, spans: Vec<Span>| {
+        let t0 = Instant::now();
+        let mut w = WorkerStats {
+            units: 1,
+            ..Default::default()
+        };
+        let rgba = render_spans(scene, &spans, &mut w.counters);
+        let chunk = Chunk { spans, rgba };
+        w.pixels = chunk.pixels();
+        w.busy = t0.elapsed();
+        sink(chunk);
+        stats[thread].lock().unwrap_or_else(|e| e.into_inner()).add(&w);
+    };
+    let faulted = || scene.customs.fault.is_raised();
+    let s = &scene.settings;
+    match share {
+        Share::Static {
+            how,
+            first,
+            workers,
+        } => {
+            pool.broadcast(|ctx| {
+                let units =
+                    decompose::static_units(s.width, s.height, how, s.tile_size, first + ctx.index(), workers);
+                for unit in units {
+                    if faulted() {
+                        break;
+                    }
+                    one(ctx.index(), unit);
+                }
+            });
+        }
+        Share::Steal(tiles) => pool.install(|| {
+            tiles.par_iter().for_each(|t| {
+                if !faulted() {
+                    one(rayon::current_thread_index().unwrap_or(0), t.spans());
+                }
+            })
+        }),
+        Share::Queue { tiles, next } => {
+            pool.broadcast(|ctx| {
+                while let Some(i) = next() {
+                    if faulted() {
+                        break;
+                    }
+                    one(ctx.index(), tiles[i].spans());
+                }
+            });
+        }
+    }
+    RankStats {
+        rank: 0,
+        threads: stats
+            .into_iter()
+            .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
+            .collect(),
+        time: start.elapsed(),
+    }
+}
+
+/// Renders the whole image in this process on `threads` threads with the scene's decomposition
+/// (dynamic: work stealing over tiles), handing finished chunks to `sink`.
+pub fn render_local(scene: &Scene, threads: usize, sink: Sink) -> Result<RankStats, Error> {
+    let pool = thread_pool(threads)?;
+    let s = &scene.settings;
+    let tiles = decompose::tiles(s.width, s.height, s.tile_size);
+    let share = match s.decomposition {
+        Decomposition::Dynamic => Share::Steal(&tiles),
+        how => Share::Static {
+            how,
+            first: 0,
+            workers: threads,
+        },
+    };
+    let stats = run_share(scene, &pool, share, sink);
+    match scene.customs.fault.message() {
+        Some(m) => Err(Error::Plugin(m)),
+        None => Ok(stats),
+    }
+}
+
+/// Threads per process: the scene's (or command line's) count, else every CPU.
+pub fn threads_for(scene: &Scene) -> usize {
+    scene
+        .settings
+        .threads
+        .map_or_else(available_cpus, |n| n as usize)
+}
+
+/// The number of processes an MPI launcher (mpirun, mpiexec) started this job with, read from
+/// the environment before (or without) initialising MPI; `None` when not launched by one.
+pub fn launched_ranks() -> Option<usize> {
+    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.trim().parse().ok())
+}

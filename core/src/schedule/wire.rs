@@ -1,0 +1,165 @@
+//! Chunks and statistics as bytes, for messages between ranks (all ranks run the same binary on
+//! machines of one byte order, so native-endian words are enough).
+
+use super::{Chunk, RankStats, Span, WorkerStats};
+use crate::geometry::Counters;
+use std::time::Duration;
+
+fn put32(b: &mut Vec<u8>, v: u32) {
+    b.extend_from_slice(&v.to_ne_bytes());
+}
+
+fn put64(b: &mut Vec<u8>, v: u64) {
+    b.extend_from_slice(&v.to_ne_bytes());
+}
+
+struct Reader<'a>(&'a [u8]);
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> Option<[u8; N]> {
+        let (head, rest) = self.0.split_at_checked(N)?;
+        self.0 = rest;
+        head.try_into().ok()
+    }
+    fn u32(&mut self) -> Option<u32> {
+        self.take().map(u32::from_ne_bytes)
+    }
+    fn u64(&mut self) -> Option<u64> {
+        self.take().map(u64::from_ne_bytes)
+    }
+}
+
+/// `[spans][y x0 step count]*[rgba f32]*`
+pub fn encode_chunk(c: &Chunk) -> Vec<u8> {
+    let mut b = Vec::with_capacity(4 + c.spans.len() * 16 + c.rgba.len() * 4);
+    put32(&mut b, c.spans.len() as u32);
+    for s in &c.spans {
+        for v in [s.y, s.x0, s.step, s.count] {
+            put32(&mut b, v);
+        }
+    }
+    for v in &c.rgba {
+        put32(&mut b, v.to_bits());
+    }
+    b
+}
+
+pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
+    let mut r = Reader(bytes);
+    let n = r.u32()? as usize;
+    let mut spans = Vec::with_capacity(n.min(bytes.len() / 16));
+    for _ in 0..n {
+        spans.push(Span {
+            y: r.u32()?,
+            x0: r.u32()?,
+            step: r.u32()?,
+            count: r.u32()?,
+        });
+    }
+    let pixels: usize = spans.iter().map(|s| s.count as usize).sum();
+    let mut rgba = Vec::with_capacity(pixels * 4);
+    for _ in 0..pixels * 4 {
+        rgba.push(f32::from_bits(r.u32()?));
+    }
+    r.0.is_empty().then_some(Chunk { spans, rgba })
+}
+
+/// `[rank][time ns][threads][units pixels primary shadow reflection refraction tests nan busy]*`
+pub fn encode_stats(s: &RankStats) -> Vec<u8> {
+    let mut b = Vec::new();
+    put64(&mut b, s.rank as u64);
+    put64(&mut b, s.time.as_nanos() as u64);
+    put64(&mut b, s.threads.len() as u64);
+    for w in &s.threads {
+        let c = &w.counters;
+        for v in [
+            w.units,
+            w.pixels,
+            c.primary,
+            c.shadow,
+            c.reflection,
+            c.refraction,
+            c.tests,
+            c.nan_pixels,
+            w.busy.as_nanos() as u64,
+        ] {
+            put64(&mut b, v);
+        }
+    }
+    b
+}
+
+pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
+    let mut r = Reader(bytes);
+    let rank = r.u64()? as usize;
+    let time = Duration::from_nanos(r.u64()?);
+    let n = r.u64()? as usize;
+    let mut threads = Vec::with_capacity(n.min(bytes.len() / 72));
+    for _ in 0..n {
+        threads.push(WorkerStats {
+            units: r.u64()?,
+            pixels: r.u64()?,
+            counters: Counters {
+                primary: r.u64()?,
+                shadow: r.u64()?,
+                reflection: r.u64()?,
+                refraction: r.u64()?,
+                tests: r.u64()?,
+                nan_pixels: r.u64()?,
+            },
+            busy: Duration::from_nanos(r.u64()?),
+        });
+    }
+    r.0.is_empty().then_some(RankStats {
+        rank,
+        threads,
+        time,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_and_stats_round_trip() {
+        let c = Chunk {
+            spans: vec![
+                Span {
+                    y: 3,
+                    x0: 1,
+                    step: 2,
+                    count: 2,
+                },
+                Span {
+                    y: 4,
+                    x0: 0,
+                    step: 1,
+                    count: 1,
+                },
+            ],
+            rgba: (0..12).map(|i| i as f32 * 0.37 - 1.0).collect(),
+        };
+        let b = encode_chunk(&c);
+        assert_eq!(decode_chunk(&b), Some(c));
+        assert_eq!(decode_chunk(&b[..b.len() - 1]), None);
+        let s = RankStats {
+            rank: 2,
+            time: Duration::from_millis(1234),
+            threads: vec![WorkerStats {
+                units: 5,
+                pixels: 80,
+                counters: Counters {
+                    primary: 80,
+                    shadow: 7,
+                    reflection: 6,
+                    refraction: 5,
+                    tests: 4,
+                    nan_pixels: 1,
+                },
+                busy: Duration::from_micros(99),
+            }],
+        };
+        assert_eq!(decode_stats(&encode_stats(&s)), Some(s));
+    }
+}

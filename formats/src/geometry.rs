@@ -1,0 +1,50 @@
+//! Inline native geometry: what importers of fixed formats (NFF, OBJ, Tachyon) hand the core
+//! directly. A million triangles must not round-trip through RON text to reach a plugin, so an
+//! importer fills these arrays and the core stores them as it stores a primitive plugin's output
+//! (same validation, same native types). World coordinates, f64.
+
+use crate::desc::{Origin, Spanned};
+
+/// A run of primitives sharing one material.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InlineGeometry {
+    /// Material name; `None`: the built-in default material.
+    pub material: Option<Spanned<String>>,
+    /// Where the geometry came from (first primitive), for messages.
+    pub at: Option<Origin>,
+    /// x, y, z, radius.
+    pub spheres: Vec<[f64; 4]>,
+    /// Open cones: base x, y, z, base radius, apex x, y, z, apex radius (equal radii: cylinder).
+    pub cones: Vec<[f64; 8]>,
+    /// Discs/rings: centre x, y, z, normal x, y, z, inner radius, outer radius.
+    pub discs: Vec<[f64; 8]>,
+    /// Infinite planes: point x, y, z, normal x, y, z.
+    pub planes: Vec<[f64; 6]>,
+    pub mesh: InlineMesh,
+}
+
+/// Triangles indexing shared vertices; `normals` is empty or has one entry per position.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InlineMesh {
+    pub positions: Vec<[f64; 3]>,
+    pub normals: Vec<[f64; 3]>,
+    pub indices: Vec<[u64; 3]>,
+}
+
+impl InlineGeometry {
+    pub fn is_empty(&self) -> bool {
+        self.spheres.is_empty()
+            && self.cones.is_empty()
+            && self.discs.is_empty()
+            && self.planes.is_empty()
+            && self.mesh.indices.is_empty()
+    }
+
+    pub fn primitive_count(&self) -> usize {
+        self.spheres.len()
+            + self.cones.len()
+            + self.discs.len()
+            + self.planes.len()
+            + self.mesh.indices.len()
+    }
+}

@@ -1,0 +1,196 @@
+//! MPI runs of the `luxon` binary under `mpirun` (feature `mpi`; OpenMPI): bitwise-identical
+//! images from any ranks × threads and decomposition, MPI-IO output equal to gathered output,
+//! and a failing rank ending the whole job quickly. Every mpirun has a deadline.
+
+mod common;
+
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn mpi_tests_skipped_without_the_mpi_feature() {
+    eprintln!(
+        "skipped: the MPI tests need the `mpi` feature: cargo test --workspace --features mpi"
+    );
+}
+
+#[cfg(feature = "mpi")]
+mod with_mpi {
+    use super::common::*;
+    use std::path::{Path, PathBuf};
+    use std::process::{Command, Output, Stdio};
+    use std::time::{Duration, Instant};
+
+    const DEADLINE: Duration = Duration::from_secs(60);
+
+    fn scene() -> String {
+        root().join("scenes/glass.ron").display().to_string()
+    }
+
+    /// Runs `mpirun -np ranks luxon args...`, killed after the deadline (mpirun's own
+    /// `--timeout` too, so a hung job cannot outlive the test).
+    fn mpirun(ranks: usize, args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
+        ensure_plugins();
+        let mut cmd = Command::new("mpirun");
+        cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .args(["--oversubscribe", "--bind-to", "none", "--timeout"])
+            .arg(DEADLINE.as_secs().to_string());
+        for (k, v) in env {
+            cmd.env(k, v).args(["-x", k]);
+        }
+        cmd.arg("-np")
+            .arg(ranks.to_string())
+            .arg(env!("CARGO_BIN_EXE_luxon"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        let start = Instant::now();
+        let mut child = cmd.spawn().expect("cannot run mpirun (install OpenMPI)");
+        while child.try_wait().expect("mpirun").is_none() {
+            if start.elapsed() > DEADLINE + Duration::from_secs(15) {
+                let _ = child.kill();
+                panic!("mpirun -np {ranks} {args:?} hung");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let out = child.wait_with_output().expect("mpirun output");
+        (out, start.elapsed())
+    }
+
+    fn render_mpi(ranks: usize, dir: &Path, tag: &str, extra: &[&str]) -> (Vec<u8>, Vec<u8>) {
+        let (exr, ppm) = (dir.join(format!("{tag}.exr")), dir.join(format!("{tag}.ppm")));
+        let s = scene();
+        let mut args = vec!["render", &s, "--res", "97x61", "-o"];
+        args.extend([exr.to_str().unwrap(), "-o", ppm.to_str().unwrap()]);
+        args.extend(extra);
+        let (o, _) = mpirun(ranks, &args, &[]);
+        assert!(o.status.success(), "-np {ranks} {extra:?}: {}", stderr(&o));
+        (std::fs::read(exr).unwrap(), std::fs::read(ppm).unwrap())
+    }
+
+    /// One thread in one process, no MPI: the reference (float EXR for bitwise comparison).
+    fn reference(dir: &Path) -> (Vec<u8>, Vec<u8>) {
+        let (exr, ppm): (PathBuf, PathBuf) = (dir.join("ref.exr"), dir.join("ref.ppm"));
+        let s = scene();
+        let o = run(&[
+            "render",
+            &s,
+            "--res",
+            "97x61",
+            "--threads",
+            "1",
+            "-o",
+            exr.to_str().unwrap(),
+            "-o",
+            ppm.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (std::fs::read(exr).unwrap(), std::fs::read(ppm).unwrap())
+    }
+
+    #[test]
+    fn ranks_threads_and_decompositions_agree_bitwise() {
+        let dir = temp_dir("mpi-bitwise");
+        let want = reference(&dir);
+        let runs: &[(usize, &[&str])] = &[
+            (1, &["--parallel", "mpi"]),
+            (2, &[]),
+            (3, &["--parallel", "hybrid", "--threads", "2"]),
+            (2, &["--parallel", "mpi", "--decomposition", "pixel-cyclic"]),
+            (2, &["--parallel", "mpi", "--decomposition", "scanline-cyclic"]),
+            (3, &["--decomposition", "block-cyclic", "--block-size", "7"]),
+            (3, &["--parallel", "hybrid", "--threads", "2", "--block-size", "5"]),
+            (2, &["--io", "sync"]),
+        ];
+        for (i, (ranks, extra)) in runs.iter().enumerate() {
+            let got = render_mpi(*ranks, &dir, &format!("run{i}"), extra);
+            assert!(got.0 == want.0, "-np {ranks} {extra:?}: EXR differs");
+            assert!(got.1 == want.1, "-np {ranks} {extra:?}: PPM differs");
+        }
+    }
+
+    #[test]
+    fn mpi_io_output_equals_gathered_output() {
+        let dir = temp_dir("mpi-io");
+        let (_, gathered) = render_mpi(2, &dir, "gathered", &[]);
+        for (ranks, how) in [(2, "dynamic"), (3, "pixel-cyclic"), (3, "scanline-cyclic")] {
+            let ppm = dir.join(format!("io-{ranks}-{how}.ppm"));
+            let s = scene();
+            let args = [
+                "render",
+                &s,
+                "--res",
+                "97x61",
+                "--io",
+                "mpi-io",
+                "--decomposition",
+                how,
+                "-o",
+                ppm.to_str().unwrap(),
+            ];
+            let (o, _) = mpirun(ranks, &args, &[]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            let written = std::fs::read(&ppm).unwrap();
+            assert!(written == gathered, "MPI-IO -np {ranks} {how}: PPM differs");
+        }
+        let temps: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+            .collect();
+        assert!(temps.is_empty(), "{temps:?}");
+    }
+
+    #[test]
+    fn a_failing_rank_ends_the_job_with_its_cause() {
+        let dir = temp_dir("mpi-fail");
+        let out = dir.join("never.ppm");
+        let s = scene();
+        let args = [
+            "render",
+            &s,
+            "--res",
+            "97x61",
+            "--block-size",
+            "8",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        for (rank, how, says) in [
+            ("1", "error", "luxon: error: rank 1: injected failure"),
+            ("2", "panic", "luxon: error: rank 2: panic at"),
+            ("0", "error", "luxon: error: injected failure"),
+        ] {
+            let env = [("LUXON_TEST_FAIL_RANK", rank), ("LUXON_TEST_FAIL", how)];
+            let (o, took) = mpirun(3, &args, &env);
+            let e = stderr(&o);
+            assert!(!o.status.success(), "rank {rank} {how}: the job succeeded");
+            assert!(e.contains(says), "rank {rank} {how}: {e}");
+            assert!(took < Duration::from_secs(10), "rank {rank} {how}: took {took:?}");
+            assert!(!out.exists());
+        }
+        let temps = std::fs::read_dir(&dir).unwrap().count();
+        assert_eq!(temps, 0, "files left after failed jobs");
+    }
+
+    #[test]
+    fn more_ranks_than_tiles_or_rows() {
+        let dir = temp_dir("mpi-tiny");
+        let s = scene();
+        for (extra, tag) in [
+            (&["--block-size", "64"][..], "one-tile"),
+            (&["--decomposition", "scanline-cyclic"][..], "rows"),
+        ] {
+            let (a, b) = (dir.join(format!("{tag}-1.ppm")), dir.join(format!("{tag}-4.ppm")));
+            let mut args = vec!["render", &s, "--res", "9x3", "-o", a.to_str().unwrap()];
+            let o = run(&args);
+            assert!(o.status.success(), "{}", stderr(&o));
+            args[5] = b.to_str().unwrap();
+            args.extend(extra);
+            args.push("--stats");
+            let (o, _) = mpirun(4, &args, &[]);
+            assert!(o.status.success(), "{tag}: {}", stderr(&o));
+            assert!(stderr(&o).contains("ranks            4"), "{}", stderr(&o));
+            assert_eq!(std::fs::read(a).unwrap(), std::fs::read(b).unwrap(), "{tag}");
+        }
+    }
+}
