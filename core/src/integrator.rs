@@ -97,6 +97,7 @@ impl Whitted<'_> {
                 n: n.into(),
                 uv: s.uv,
                 footprint: 0.0,
+                uv_footprint: 0.0,
                 time: ray.time,
             };
             match scene.textures[t as usize].eval(&q) {

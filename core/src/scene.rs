@@ -290,10 +290,10 @@ impl Scene {
                 spheres.push_world(i, *s, world_offset, m).map_err(fail)?;
             }
             for (i, c) in g.cones.iter().enumerate() {
-                cones.push(i, *c, world_offset, m).map_err(fail)?;
+                cones.push_world(i, *c, world_offset, m).map_err(fail)?;
             }
             for (i, d) in g.discs.iter().enumerate() {
-                discs.push(i, *d, world_offset, m).map_err(fail)?;
+                discs.push_world(i, *d, world_offset, m).map_err(fail)?;
             }
             for (i, p) in g.planes.iter().enumerate() {
                 planes.push_world(i, *p, world_offset, m).map_err(fail)?;
@@ -315,7 +315,7 @@ impl Scene {
         let (_, custom_result) = rayon::join(
             || {
                 rayon::join(
-                    || rayon::join(|| spheres.build(), || triangles.build()),
+                    || rayon::join(|| spheres.build(), || triangles.set.build()),
                     || rayon::join(|| cones.build(), || discs.build()),
                 )
             },
@@ -415,7 +415,7 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
         let mut hit = None;
         self.spheres.intersect(ray, &mut t_max, &mut hit, c);
-        self.triangles.intersect(ray, &mut t_max, &mut hit, c);
+        self.triangles.set.intersect(ray, &mut t_max, &mut hit, c);
         self.planes.intersect(ray, &mut t_max, &mut hit, c);
         self.cones.intersect(ray, &mut t_max, &mut hit, c);
         self.discs.intersect(ray, &mut t_max, &mut hit, c);
@@ -441,7 +441,7 @@ impl Scene {
         if !self.features.transmission {
             // Opaque world: the first hit anywhere ends the query.
             let blocked = self.spheres.any(ray, t_max, c, |_, _| true)
-                || self.triangles.any(ray, t_max, c, |_, _| true)
+                || self.triangles.set.any(ray, t_max, c, |_, _| true)
                 || self.planes.any(ray, t_max, c, |_, _| true)
                 || self.cones.any(ray, t_max, c, |_, _| true)
                 || self.discs.any(ray, t_max, c, |_, _| true)
@@ -462,7 +462,7 @@ impl Scene {
             filter.max_element() < min_weight
         };
         if self.spheres.any(ray, t_max, c, &mut on_hit)
-            || self.triangles.any(ray, t_max, c, &mut on_hit)
+            || self.triangles.set.any(ray, t_max, c, &mut on_hit)
             || self.planes.any(ray, t_max, c, &mut on_hit)
             || self.cones.any(ray, t_max, c, &mut on_hit)
             || self.discs.any(ray, t_max, c, &mut on_hit)

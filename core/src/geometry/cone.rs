@@ -1,18 +1,23 @@
 //! Open cones and cylinders between two end discs (base centre + radius, apex centre + radius):
 //! 32 bytes each, in their own BVH. Molecular bonds and the SPD's `c` primitives are these.
 
-use super::{Counters, Hit, Kind, Surface};
-use crate::bvh::Bvh;
+use super::set::{Set, Shape};
+use super::{Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
+use glam::Vec3;
 
-#[derive(Default)]
-pub struct Cones {
-    /// Base x, y, z, base radius, apex x, y, z, apex radius (re-centred world space).
-    pub data: Vec<[f32; 8]>,
-    pub material: Vec<u32>,
-    bvh: Bvh,
+/// An open cone or cylinder: base centre and radius, apex centre and radius (32 bytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Cone {
+    pub base: Vec3,
+    pub base_radius: f32,
+    pub apex: Vec3,
+    pub apex_radius: f32,
 }
+
+pub type Cones = Set<Cone>;
 
 /// Bounds of a disc of radius `r` around `c` with unit normal `w`: per axis r·√(1 − wᵢ²).
 pub fn disc_bounds(c: Vec3A, w: Vec3A, r: f32) -> Aabb {
@@ -24,10 +29,10 @@ pub fn disc_bounds(c: Vec3A, w: Vec3A, r: f32) -> Aabb {
 /// The roots of the cone's quadric along the ray that lie on the finite, correct-nappe part of
 /// the surface within (0, t_max), nearest first; solved in f64.
 #[inline(always)]
-fn cone_roots(c: &[f32; 8], o: Vec3A, d: Vec3A, t_max: f32) -> ([f64; 2], usize) {
-    let b = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-    let a = DVec3::new(c[4] as f64, c[5] as f64, c[6] as f64);
-    let (rb, ra) = (c[3] as f64, c[7] as f64);
+fn cone_roots(c: &Cone, o: Vec3A, d: Vec3A, t_max: f32) -> ([f64; 2], usize) {
+    let b = c.base.as_dvec3();
+    let a = c.apex.as_dvec3();
+    let (rb, ra) = (c.base_radius as f64, c.apex_radius as f64);
     let ba = a - b;
     let h = ba.length();
     let w = ba / h;
@@ -77,17 +82,33 @@ fn cone_roots(c: &[f32; 8], o: Vec3A, d: Vec3A, t_max: f32) -> ([f64; 2], usize)
     (roots, count)
 }
 
-impl Cones {
-    pub fn len(&self) -> usize {
-        self.data.len()
+impl Shape for Cone {
+    const KIND: Kind = Kind::Cone;
+    type Prep = ();
+    fn prep(_: &Ray) {}
+
+    fn bounds(&self) -> Aabb {
+        let (b, a) = (Vec3A::from(self.base), Vec3A::from(self.apex));
+        let w = (a - b).normalize();
+        disc_bounds(b, w, self.base_radius).union(disc_bounds(a, w, self.apex_radius))
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.data.is_empty()
+    #[inline(always)]
+    fn hit(&self, ray: &Ray, _: &(), t_max: f32) -> Option<(f32, f32, f32)> {
+        let (r, n) = cone_roots(self, ray.origin, ray.dir, t_max);
+        let t = r[0] as f32;
+        (n > 0 && t > 0.0 && t < t_max).then_some((t, 0.0, 0.0))
     }
 
-    /// Validates and stores cone `i` of a plugin's batch (world coordinates).
-    pub fn push(
+    #[inline(always)]
+    fn crossings(&self, ray: &Ray, _: &(), t_max: f32) -> u32 {
+        cone_roots(self, ray.origin, ray.dir, t_max).1 as u32
+    }
+}
+
+impl Set<Cone> {
+    /// Validates and stores cone `i` of a batch given in world coordinates.
+    pub fn push_world(
         &mut self,
         i: usize,
         c: [f64; 8],
@@ -103,98 +124,40 @@ impl Cones {
                 c[3], c[7]
             ));
         }
-        let b = (DVec3::new(c[0], c[1], c[2]) - offset).as_vec3();
-        let a = (DVec3::new(c[4], c[5], c[6]) - offset).as_vec3();
-        if a == b {
+        let base = (DVec3::new(c[0], c[1], c[2]) - offset).as_vec3();
+        let apex = (DVec3::new(c[4], c[5], c[6]) - offset).as_vec3();
+        if base == apex {
             return Err(format!(
                 "cone {i} has the same base and apex centre; expected a length > 0"
             ));
         }
-        self.data
-            .push([b.x, b.y, b.z, c[3] as f32, a.x, a.y, a.z, c[7] as f32]);
-        self.material.push(material);
+        self.push(
+            Cone {
+                base,
+                base_radius: c[3] as f32,
+                apex,
+                apex_radius: c[7] as f32,
+            },
+            material,
+        );
         Ok(())
-    }
-
-    pub fn bounds(&self) -> Vec<Aabb> {
-        self.data
-            .iter()
-            .map(|c| {
-                let b = Vec3A::new(c[0], c[1], c[2]);
-                let a = Vec3A::new(c[4], c[5], c[6]);
-                let w = (a - b).normalize();
-                disc_bounds(b, w, c[3]).union(disc_bounds(a, w, c[7]))
-            })
-            .collect()
-    }
-
-    pub fn build(&mut self) {
-        let (bvh, order) = Bvh::build(&self.bounds());
-        self.data = order.iter().map(|&i| self.data[i as usize]).collect();
-        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
-        self.bvh = bvh;
-    }
-
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
-        if self.data.is_empty() {
-            return;
-        }
-        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
-            c.tests += 1;
-            let (r, n) = cone_roots(&self.data[i as usize], ray.origin, ray.dir, tm);
-            if n == 0 {
-                return None;
-            }
-            let t = r[0] as f32;
-            if !(t > 0.0 && t < tm) {
-                return None;
-            }
-            *hit = Some(Hit::new(t, Kind::Cone, i));
-            Some(t)
-        });
-    }
-
-    #[inline]
-    pub fn any(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        c: &mut Counters,
-        mut on_hit: impl FnMut(u32, u32) -> bool,
-    ) -> bool {
-        if self.data.is_empty() {
-            return false;
-        }
-        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
-            c.tests += 1;
-            let (_, n) = cone_roots(&self.data[i as usize], ray.origin, ray.dir, t_max);
-            n > 0 && on_hit(self.material[i as usize], n as u32)
-        })
     }
 
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         let c = &self.data[hit.index as usize];
-        let b = Vec3A::new(c[0], c[1], c[2]);
-        let a = Vec3A::new(c[4], c[5], c[6]);
+        let (b, a) = (Vec3A::from(c.base), Vec3A::from(c.apex));
         let h = (a - b).length();
         let w = (a - b) / h;
-        let k = (c[7] - c[3]) / h;
+        let k = (c.apex_radius - c.base_radius) / h;
         let p = ray.at(hit.t);
         let s = (p - b).dot(w);
-        let radial = (p - b) - s * w;
-        let q = radial.normalize_or_zero();
-        let q = if q == Vec3A::ZERO {
-            crate::math::orthogonal(w)
-        } else {
-            q
-        };
+        let ortho = crate::math::orthogonal(w);
+        let q = ((p - b) - s * w).normalize_or_zero();
+        let q = if q == Vec3A::ZERO { ortho } else { q };
         let n = (q - k * w).normalize();
-        let p_error = gamma(16) * (p.abs() + b.abs().max(a.abs()) + Vec3A::splat(c[3].max(c[7])));
-        let u = 0.5
-            + q.dot(crate::math::orthogonal(w))
-                .atan2(q.dot(w.cross(crate::math::orthogonal(w))))
-                / std::f32::consts::TAU;
+        let r_max = c.base_radius.max(c.apex_radius);
+        let p_error = gamma(16) * (p.abs() + b.abs().max(a.abs()) + Vec3A::splat(r_max));
+        let u = 0.5 + q.dot(w.cross(ortho)).atan2(q.dot(ortho)) / std::f32::consts::TAU;
         Surface {
             p,
             p_error,
@@ -211,7 +174,12 @@ impl Cones {
 mod tests {
     use super::*;
 
-    const CYL: [f32; 8] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 4.0, 1.0];
+    const CYL: Cone = Cone {
+        base: Vec3::ZERO,
+        base_radius: 1.0,
+        apex: Vec3::new(0.0, 0.0, 4.0),
+        apex_radius: 1.0,
+    };
 
     #[test]
     fn cylinder_hit_from_outside_inside_and_along_the_axis() {
@@ -231,7 +199,12 @@ mod tests {
     #[test]
     fn cone_hits_only_its_own_nappe() {
         // Pointed cone: radius 1 at z=0, 0 at z=1.
-        let cone = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0];
+        let cone = Cone {
+            base: Vec3::ZERO,
+            base_radius: 1.0,
+            apex: Vec3::Z,
+            apex_radius: 0.0,
+        };
         let (r, n) = cone_roots(&cone, Vec3A::new(-5.0, 0.0, 0.5), Vec3A::X, f32::INFINITY);
         assert_eq!(n, 2);
         assert!((r[0] - 4.5).abs() < 1e-6, "{r:?}");
@@ -244,7 +217,7 @@ mod tests {
     fn normals_point_outward() {
         let mut cones = Cones::default();
         cones
-            .push(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0], DVec3::ZERO, 0)
+            .push_world(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0], DVec3::ZERO, 0)
             .unwrap();
         let ray = Ray::new(Vec3A::new(-5.0, 0.0, 0.5), Vec3A::X, 0.0);
         let s = cones.surface(&Hit::new(4.5, Kind::Cone, 0), &ray);
@@ -255,15 +228,15 @@ mod tests {
     #[test]
     fn bad_cones_are_rejected() {
         let mut c = Cones::default();
-        assert!(c.push(0, [0.0; 8], DVec3::ZERO, 0).is_err());
+        assert!(c.push_world(0, [0.0; 8], DVec3::ZERO, 0).is_err());
         assert!(c
-            .push(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], DVec3::ZERO, 0)
+            .push_world(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], DVec3::ZERO, 0)
             .is_err());
         assert!(c
-            .push(0, [0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 1.0], DVec3::ZERO, 0)
+            .push_world(0, [0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 1.0], DVec3::ZERO, 0)
             .is_err());
         assert!(c
-            .push(
+            .push_world(
                 0,
                 [f64::NAN, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0],
                 DVec3::ZERO,

@@ -5,6 +5,7 @@ pub mod cone;
 pub mod custom;
 pub mod disc;
 pub mod plane;
+pub mod set;
 pub mod sphere;
 pub mod triangle;
 

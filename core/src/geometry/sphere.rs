@@ -1,17 +1,20 @@
 //! Spheres: 16 bytes each (centre + radius) plus a material index, in their own BVH.
 
-use super::{Counters, Hit, Kind, Surface};
-use crate::bvh::Bvh;
+use super::set::{Set, Shape};
+use super::{Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
+use glam::Vec3;
 
-#[derive(Default)]
-pub struct Spheres {
-    /// x, y, z, radius (world space, re-centred).
-    pub data: Vec<[f32; 4]>,
-    pub material: Vec<u32>,
-    bvh: Bvh,
+/// A sphere: 16 bytes (the molecular case stores millions).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
 }
+
+pub type Spheres = Set<Sphere>;
 
 /// The nearest root of a unit-direction ray against a sphere in (0, t_max), and how many roots
 /// lie in (0, t_max). Solved in sphere-centred coordinates with the cancellation-free form of the
@@ -19,9 +22,9 @@ pub struct Spheres {
 /// are solved in f64 so that a huge sphere seen from close by (an Earth-sized ground) keeps its
 /// precision: in f32, |f|² − r² loses every digit when |f| ≈ r ≈ 1e6.
 #[inline(always)]
-pub fn intersect_sphere(s: [f32; 4], o: Vec3A, d: Vec3A, t_max: f32) -> (Option<f32>, u32) {
-    let c = Vec3A::new(s[0], s[1], s[2]);
-    let r = s[3];
+pub fn intersect_sphere(s: &Sphere, o: Vec3A, d: Vec3A, t_max: f32) -> (Option<f32>, u32) {
+    let c = Vec3A::from(s.center);
+    let r = s.radius;
     let f = o - c;
     let l = f - f.dot(d) * d;
     let r2 = r * r;
@@ -58,20 +61,30 @@ pub fn intersect_sphere(s: [f32; 4], o: Vec3A, d: Vec3A, t_max: f32) -> (Option<
     }
 }
 
-impl Spheres {
-    pub fn len(&self) -> usize {
-        self.data.len()
+impl Shape for Sphere {
+    const KIND: Kind = Kind::Sphere;
+    type Prep = ();
+    fn prep(_: &Ray) {}
+
+    fn bounds(&self) -> Aabb {
+        let c = Vec3A::from(self.center);
+        Aabb::new(c - self.radius, c + self.radius)
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.data.is_empty()
+    #[inline(always)]
+    fn hit(&self, ray: &Ray, _: &(), t_max: f32) -> Option<(f32, f32, f32)> {
+        intersect_sphere(self, ray.origin, ray.dir, t_max)
+            .0
+            .map(|t| (t, 0.0, 0.0))
     }
 
-    pub fn push(&mut self, s: [f32; 4], material: u32) {
-        self.data.push(s);
-        self.material.push(material);
+    #[inline(always)]
+    fn crossings(&self, ray: &Ray, _: &(), t_max: f32) -> u32 {
+        intersect_sphere(self, ray.origin, ray.dir, t_max).1
     }
+}
 
+impl Set<Sphere> {
     /// Validates and stores sphere `i` of a batch given in world coordinates.
     pub fn push_world(
         &mut self,
@@ -89,69 +102,26 @@ impl Spheres {
                 s[3]
             ));
         }
-        let c = (DVec3::new(s[0], s[1], s[2]) - offset).as_vec3();
-        self.push([c.x, c.y, c.z, s[3] as f32], material);
+        let center = (DVec3::new(s[0], s[1], s[2]) - offset).as_vec3();
+        self.push(
+            Sphere {
+                center,
+                radius: s[3] as f32,
+            },
+            material,
+        );
         Ok(())
-    }
-
-    pub fn bounds(&self) -> Vec<Aabb> {
-        self.data
-            .iter()
-            .map(|s| {
-                let c = Vec3A::new(s[0], s[1], s[2]);
-                Aabb::new(c - s[3], c + s[3])
-            })
-            .collect()
-    }
-
-    /// Builds the BVH and reorders the spheres into leaf order.
-    pub fn build(&mut self) {
-        let (bvh, order) = Bvh::build(&self.bounds());
-        self.data = order.iter().map(|&i| self.data[i as usize]).collect();
-        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
-        self.bvh = bvh;
-    }
-
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
-    }
-
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
-        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
-            c.tests += 1;
-            let (t, _) = intersect_sphere(self.data[i as usize], ray.origin, ray.dir, tm);
-            let t = t?;
-            *hit = Some(Hit::new(t, Kind::Sphere, i));
-            Some(t)
-        });
-    }
-
-    /// Calls `on_hit(material, crossings)` for spheres crossing (0, t_max) until it returns true.
-    #[inline]
-    pub fn any(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        c: &mut Counters,
-        mut on_hit: impl FnMut(u32, u32) -> bool,
-    ) -> bool {
-        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
-            c.tests += 1;
-            let (_, n) = intersect_sphere(self.data[i as usize], ray.origin, ray.dir, t_max);
-            n > 0 && on_hit(self.material[i as usize], n)
-        })
     }
 
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         let s = self.data[hit.index as usize];
-        let c = Vec3A::new(s[0], s[1], s[2]);
+        let c = Vec3A::from(s.center);
         // Re-project onto the sphere: the error is then a few ulps of the coordinates.
         let mut pr = ray.at(hit.t) - c;
-        pr *= s[3] / pr.length();
+        pr *= s.radius / pr.length();
         let p = c + pr;
         let p_error = gamma(6) * (pr.abs() + c.abs());
-        let n = pr / s[3];
+        let n = pr / s.radius;
         let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
         let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
         Surface {
@@ -172,7 +142,10 @@ mod tests {
 
     #[test]
     fn hits_from_outside_and_inside() {
-        let s = [0.0, 0.0, 5.0, 1.0];
+        let s = &Sphere {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+        };
         let (t, n) = intersect_sphere(s, Vec3A::ZERO, Vec3A::Z, f32::INFINITY);
         assert_eq!((t, n), (Some(4.0), 2));
         let (t, n) = intersect_sphere(s, Vec3A::new(0.0, 0.0, 5.0), Vec3A::Z, f32::INFINITY);
@@ -187,7 +160,10 @@ mod tests {
     fn huge_far_sphere_has_no_cancellation() {
         // Earth-sized sphere, camera 1 unit above its surface looking straight down.
         let r = 6.4e6f32;
-        let s = [0.0, -r, 0.0, r];
+        let s = &Sphere {
+            center: Vec3::new(0.0, -r, 0.0),
+            radius: r,
+        };
         let (t, _) = intersect_sphere(s, Vec3A::new(0.0, 1.0, 0.0), -Vec3A::Y, f32::INFINITY);
         let t = t.unwrap();
         assert!((t - 1.0).abs() < 1e-6, "t = {t}");

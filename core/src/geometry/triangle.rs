@@ -1,8 +1,8 @@
 //! Triangles: three vertices each (intersection needs nothing else), optional per-vertex
 //! attributes kept apart and read only when shading.
 
-use super::{Counters, Hit, Kind, Surface};
-use crate::bvh::Bvh;
+use super::set::{Set, Shape};
+use super::{Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, Vec3A};
 use crate::ray::Ray;
 use glam::{DVec3, Vec3};
@@ -19,14 +19,18 @@ pub struct VertexAttr {
 
 pub const NO_ATTR: u32 = u32::MAX;
 
+/// A triangle: its three vertices (all the intersection test reads) and the index of its
+/// per-vertex shading attributes, or `NO_ATTR`.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangle {
+    pub v: [Vec3; 3],
+    pub attr: u32,
+}
+
 #[derive(Default)]
 pub struct Triangles {
-    pub verts: Vec<[Vec3; 3]>,
-    pub material: Vec<u32>,
-    /// Index into `attrs` or `NO_ATTR`.
-    pub attr: Vec<u32>,
+    pub set: Set<Triangle>,
     pub attrs: Vec<[VertexAttr; 3]>,
-    bvh: Bvh,
 }
 
 /// What a ray precomputes once for the watertight test (Woop, Benthin & Wald 2013): the axis
@@ -120,7 +124,36 @@ pub struct MeshInput<'a> {
     pub uvs: &'a [f32],
 }
 
+impl Shape for Triangle {
+    const KIND: Kind = Kind::Triangle;
+    type Prep = TriRay;
+
+    fn prep(ray: &Ray) -> TriRay {
+        TriRay::new(ray)
+    }
+
+    fn bounds(&self) -> Aabb {
+        let a = Vec3A::from(self.v[0]);
+        Aabb::new(a, a)
+            .grow(self.v[1].into())
+            .grow(self.v[2].into())
+    }
+
+    #[inline(always)]
+    fn hit(&self, _: &Ray, prep: &TriRay, t_max: f32) -> Option<(f32, f32, f32)> {
+        intersect_triangle(&self.v, prep, t_max)
+    }
+}
+
 impl Triangles {
+    pub fn len(&self) -> usize {
+        self.set.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.set.is_empty()
+    }
+
     /// Validates and stores a mesh given in world coordinates; returns how many zero-area
     /// triangles were dropped (they can never be hit and have no normal).
     pub fn push_mesh(
@@ -177,7 +210,7 @@ impl Triangles {
             },
         };
         let mut dropped = 0;
-        self.verts.reserve(m.indices.len() / 3);
+        self.set.data.reserve(m.indices.len() / 3);
         for (t, tri) in m.indices.chunks_exact(3).enumerate() {
             let mut v = [Vec3::ZERO; 3];
             for k in 0..3 {
@@ -193,91 +226,24 @@ impl Triangles {
                 dropped += 1;
                 continue;
             }
-            self.verts.push(v);
-            self.material.push(material);
-            if has_attr {
-                self.attr.push(self.attrs.len() as u32);
+            let attr = if has_attr {
                 self.attrs.push([
                     attr_of(tri[0] as usize),
                     attr_of(tri[1] as usize),
                     attr_of(tri[2] as usize),
                 ]);
+                self.attrs.len() as u32 - 1
             } else {
-                self.attr.push(NO_ATTR);
-            }
+                NO_ATTR
+            };
+            self.set.push(Triangle { v, attr }, material);
         }
         Ok(dropped)
     }
 
-    pub fn len(&self) -> usize {
-        self.verts.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.verts.is_empty()
-    }
-
-    pub fn bounds(&self) -> Vec<Aabb> {
-        self.verts
-            .iter()
-            .map(|v| {
-                let a = Vec3A::from(v[0]);
-                Aabb::new(a, a).grow(v[1].into()).grow(v[2].into())
-            })
-            .collect()
-    }
-
-    pub fn build(&mut self) {
-        let (bvh, order) = Bvh::build(&self.bounds());
-        self.verts = order.iter().map(|&i| self.verts[i as usize]).collect();
-        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
-        self.attr = order.iter().map(|&i| self.attr[i as usize]).collect();
-        self.bvh = bvh;
-    }
-
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
-    }
-
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
-        if self.verts.is_empty() {
-            return;
-        }
-        let tr = TriRay::new(ray);
-        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
-            c.tests += 1;
-            let (t, b1, b2) = intersect_triangle(&self.verts[i as usize], &tr, tm)?;
-            let mut h = Hit::new(t, Kind::Triangle, i);
-            h.b1 = b1;
-            h.b2 = b2;
-            *hit = Some(h);
-            Some(t)
-        });
-    }
-
-    #[inline]
-    pub fn any(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        c: &mut Counters,
-        mut on_hit: impl FnMut(u32, u32) -> bool,
-    ) -> bool {
-        if self.verts.is_empty() {
-            return false;
-        }
-        let tr = TriRay::new(ray);
-        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
-            c.tests += 1;
-            intersect_triangle(&self.verts[i as usize], &tr, t_max).is_some()
-                && on_hit(self.material[i as usize], 1)
-        })
-    }
-
     pub fn surface(&self, hit: &Hit) -> Surface {
         let i = hit.index as usize;
-        let v = self.verts[i];
+        let Triangle { v, attr: a } = self.set.data[i];
         let (b1, b2) = (hit.b1, hit.b2);
         let b0 = 1.0 - b1 - b2;
         let (p0, p1, p2) = (Vec3A::from(v[0]), Vec3A::from(v[1]), Vec3A::from(v[2]));
@@ -293,10 +259,9 @@ impl Triangles {
             ng,
             ns: ng,
             uv: [b1, b2],
-            material: self.material[i],
+            material: self.set.material[i],
             color: None,
         };
-        let a = self.attr[i];
         if a != NO_ATTR {
             let va = &self.attrs[a as usize];
             if va[0].n != Vec3::ZERO {

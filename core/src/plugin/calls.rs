@@ -196,7 +196,7 @@ extern "C" fn add_cones(
         let b = builder(ctx);
         let v = unsafe { slice(data, checked_len(count, 8, "cone")?) };
         for (i, c) in v.chunks_exact(8).enumerate() {
-            b.cones.push(
+            b.cones.push_world(
                 i,
                 c.try_into().expect("chunk of 8"),
                 b.world_offset,
@@ -217,7 +217,7 @@ extern "C" fn add_discs(
         let b = builder(ctx);
         let v = unsafe { slice(data, checked_len(count, 8, "disc")?) };
         for (i, d) in v.chunks_exact(8).enumerate() {
-            b.discs.push(
+            b.discs.push_world(
                 i,
                 d.try_into().expect("chunk of 8"),
                 b.world_offset,

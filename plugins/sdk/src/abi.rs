@@ -295,6 +295,9 @@ pub struct TexQuery {
     pub uv: [f32; 2],
     /// Approximate world-space width of the ray's footprint at `p` (for filtering).
     pub footprint: f32,
+    /// The same footprint measured in `uv` units (0 when the surface has no uv parametrisation
+    /// the host can measure); image textures under UV mapping choose their MIP level from it.
+    pub uv_footprint: f32,
     pub time: f32,
 }
 
