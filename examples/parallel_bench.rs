@@ -5,7 +5,7 @@
 //!
 //! ```sh
 //! cargo build --release --features mpi
-//! cargo run --release --features mpi --example parallel_bench -- [--runs 5] [--size 4] [--res 512x512]
+//! cargo run --release --features mpi --example parallel_bench -- [--runs 5] [--size 4] [--res 512x512] [--samples 4]
 //! ```
 //! `--no-mpi` skips the MPI rows (for a build without the `mpi` feature); `--scene-only FILE`
 //! just writes the scene. Times are the render phase as `luxon render --stats` reports it (the
@@ -20,6 +20,7 @@ struct Args {
     runs: usize,
     size: u32,
     res: String,
+    samples: u32,
     mpi: bool,
     scene_only: Option<PathBuf>,
 }
@@ -29,6 +30,7 @@ fn args() -> Args {
         runs: 5,
         size: 4,
         res: "512x512".into(),
+        samples: 4,
         mpi: true,
         scene_only: None,
     };
@@ -39,6 +41,7 @@ fn args() -> Args {
             "--runs" => a.runs = val().parse().expect("--runs N"),
             "--size" => a.size = val().parse().expect("--size N"),
             "--res" => a.res = val(),
+            "--samples" => a.samples = val().parse().expect("--samples N"),
             "--no-mpi" => a.mpi = false,
             "--scene-only" => a.scene_only = Some(val().into()),
             _ => panic!("unknown argument {k}; see the comment at the top of parallel_bench.rs"),
@@ -49,7 +52,11 @@ fn args() -> Args {
 
 /// Unit vectors of an orthonormal frame around `d`.
 fn frame(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let a = if d[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let a = if d[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
     let u = norm(cross(d, a));
     (u, cross(d, u))
 }
@@ -144,6 +151,7 @@ fn luxon_binary() -> PathBuf {
 }
 
 /// One configuration: how to launch, and the `luxon render` flags.
+#[derive(Clone)]
 struct Config {
     label: String,
     ranks: usize,
@@ -161,7 +169,7 @@ fn config(label: &str, ranks: usize, threads: usize, args: &str) -> Config {
 }
 
 /// (render seconds, wall seconds) of one run.
-fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, res: &str) -> (f64, f64) {
+fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, a: &Args) -> (f64, f64) {
     let mut cmd = if c.ranks > 0 {
         let mut m = Command::new("mpirun");
         m.args(["--oversubscribe", "--bind-to", "none", "-np"])
@@ -175,7 +183,14 @@ fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, res: &str) -> (f64
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .arg("render")
         .arg(scene)
-        .args(["--stats", "--res", res, "-o"])
+        .args([
+            "--stats",
+            "--res",
+            &a.res,
+            "--samples",
+            &a.samples.to_string(),
+            "-o",
+        ])
         .arg(out)
         .args(&c.args);
     let t = Instant::now();
@@ -185,7 +200,14 @@ fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, res: &str) -> (f64
     assert!(o.status.success(), "{}: {err}", c.label);
     let render = err
         .lines()
-        .find_map(|l| l.trim().strip_prefix("render")?.trim().strip_suffix(" s")?.parse().ok())
+        .find_map(|l| {
+            l.trim()
+                .strip_prefix("render")?
+                .trim()
+                .strip_suffix(" s")?
+                .parse()
+                .ok()
+        })
         .unwrap_or_else(|| panic!("no render time in {err}"));
     (render, wall)
 }
@@ -252,40 +274,58 @@ fn main() {
     let mut io = Vec::new();
     for (name, _) in outputs {
         for mode in ["async", "sync"] {
-            io.push(config(&format!("{name}, {mode}"), 0, 2, &format!("--threads 2 --io {mode}")));
+            io.push(config(
+                &format!("{name}, {mode}"),
+                0,
+                2,
+                &format!("--threads 2 --io {mode}"),
+            ));
         }
     }
     groups.push(("Output, 2 threads", io));
 
     println!(
-        "sphereflake size {} ({} spheres), {}, {} run(s) per row, medians; luxon: {}\n",
-        a.size, balls, a.res,
+        "sphereflake size {} ({} spheres), {}, {} sample(s) per pixel, {} run(s) per row, medians; luxon: {}\n",
+        a.size, balls, a.res, a.samples,
         a.runs,
         bin.display()
     );
+    // Rounds visit every configuration once, so a change in the machine's load hits them all.
+    let all: Vec<&Config> = groups.iter().flat_map(|g| &g.1).collect();
+    let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); all.len()];
+    for round in 0..a.runs {
+        eprintln!("round {} of {}", round + 1, a.runs);
+        for (c, t) in all.iter().zip(&mut times) {
+            let ext = if c.label.starts_with("PNG") {
+                "png"
+            } else {
+                "ppm"
+            };
+            let (r, w) = run_once(&bin, &scene, &dir.join(format!("out.{ext}")), c, &a);
+            t.0.push(r);
+            t.1.push(w);
+        }
+    }
+    let mut times = times.into_iter();
     let mut base = None;
-    for (title, configs) in groups {
+    for (title, configs) in &groups {
         println!("### {title}\n");
-        println!("| configuration | render s | speedup | efficiency | time / first row | wall s |");
-        println!("|---|---:|---:|---:|---:|---:|");
+        println!("| configuration | render s (median) | min | speedup | efficiency | efficiency of min | time / first row | wall s |");
+        println!("|---|---:|---:|---:|---:|---:|---:|---:|");
         let mut first_in_group = None;
         for c in configs {
-            let ext = if c.label.starts_with("PNG") { "png" } else { "ppm" };
-            let out = dir.join(format!("out.{ext}"));
-            let (mut r, mut w) = (Vec::new(), Vec::new());
-            for _ in 0..a.runs {
-                let (rt, wt) = run_once(&bin, &scene, &out, &c, &a.res);
-                r.push(rt);
-                w.push(wt);
-            }
+            let (r, w) = times.next().unwrap_or_default();
+            let min = r.iter().copied().fold(f64::INFINITY, f64::min);
             let (r, w) = (median(r), median(w));
-            let t1 = *base.get_or_insert(r);
+            let (t1, t1_min) = *base.get_or_insert((r, min));
             let speedup = t1 / r;
             let first = *first_in_group.get_or_insert(r);
+            let p = c.threads as f64;
             println!(
-                "| {} | {r:.3} | {speedup:.2} | {:.1} % | {:.3} | {w:.3} |",
+                "| {} | {r:.3} | {min:.3} | {speedup:.2} | {:.1} % | {:.1} % | {:.3} | {w:.3} |",
                 c.label,
-                100.0 * speedup / c.threads as f64,
+                100.0 * speedup / p,
+                100.0 * t1_min / min / p,
                 r / first
             );
         }

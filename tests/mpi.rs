@@ -57,7 +57,10 @@ mod with_mpi {
     }
 
     fn render_mpi(ranks: usize, dir: &Path, tag: &str, extra: &[&str]) -> (Vec<u8>, Vec<u8>) {
-        let (exr, ppm) = (dir.join(format!("{tag}.exr")), dir.join(format!("{tag}.ppm")));
+        let (exr, ppm) = (
+            dir.join(format!("{tag}.exr")),
+            dir.join(format!("{tag}.ppm")),
+        );
         let s = scene();
         let mut args = vec!["render", &s, "--res", "97x61", "-o"];
         args.extend([exr.to_str().unwrap(), "-o", ppm.to_str().unwrap()]);
@@ -96,9 +99,22 @@ mod with_mpi {
             (2, &[]),
             (3, &["--parallel", "hybrid", "--threads", "2"]),
             (2, &["--parallel", "mpi", "--decomposition", "pixel-cyclic"]),
-            (2, &["--parallel", "mpi", "--decomposition", "scanline-cyclic"]),
+            (
+                2,
+                &["--parallel", "mpi", "--decomposition", "scanline-cyclic"],
+            ),
             (3, &["--decomposition", "block-cyclic", "--block-size", "7"]),
-            (3, &["--parallel", "hybrid", "--threads", "2", "--block-size", "5"]),
+            (
+                3,
+                &[
+                    "--parallel",
+                    "hybrid",
+                    "--threads",
+                    "2",
+                    "--block-size",
+                    "5",
+                ],
+            ),
             (2, &["--io", "sync"]),
         ];
         for (i, (ranks, extra)) in runs.iter().enumerate() {
@@ -165,7 +181,10 @@ mod with_mpi {
             let e = stderr(&o);
             assert!(!o.status.success(), "rank {rank} {how}: the job succeeded");
             assert!(e.contains(says), "rank {rank} {how}: {e}");
-            assert!(took < Duration::from_secs(10), "rank {rank} {how}: took {took:?}");
+            assert!(
+                took < Duration::from_secs(10),
+                "rank {rank} {how}: took {took:?}"
+            );
             assert!(!out.exists());
         }
         let temps = std::fs::read_dir(&dir).unwrap().count();
@@ -180,7 +199,10 @@ mod with_mpi {
             (&["--block-size", "64"][..], "one-tile"),
             (&["--decomposition", "scanline-cyclic"][..], "rows"),
         ] {
-            let (a, b) = (dir.join(format!("{tag}-1.ppm")), dir.join(format!("{tag}-4.ppm")));
+            let (a, b) = (
+                dir.join(format!("{tag}-1.ppm")),
+                dir.join(format!("{tag}-4.ppm")),
+            );
             let mut args = vec!["render", &s, "--res", "9x3", "-o", a.to_str().unwrap()];
             let o = run(&args);
             assert!(o.status.success(), "{}", stderr(&o));
@@ -190,7 +212,11 @@ mod with_mpi {
             let (o, _) = mpirun(4, &args, &[]);
             assert!(o.status.success(), "{tag}: {}", stderr(&o));
             assert!(stderr(&o).contains("ranks            4"), "{}", stderr(&o));
-            assert_eq!(std::fs::read(a).unwrap(), std::fs::read(b).unwrap(), "{tag}");
+            assert_eq!(
+                std::fs::read(a).unwrap(),
+                std::fs::read(b).unwrap(),
+                "{tag}"
+            );
         }
     }
 }

@@ -62,7 +62,13 @@ fn stats_show_the_work_of_every_thread() {
     let (_, e) = render_to(
         &dir,
         "s.png",
-        &["--threads", "2", "--stats", "--decomposition", "scanline-cyclic"],
+        &[
+            "--threads",
+            "2",
+            "--stats",
+            "--decomposition",
+            "scanline-cyclic",
+        ],
     );
     assert!(e.contains("ranks            1"), "{e}");
     assert!(e.contains("threads          2 per rank"), "{e}");

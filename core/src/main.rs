@@ -59,6 +59,18 @@ enum Command {
         #[arg(long = "plugin-path")]
         plugin_path: Vec<PathBuf>,
     },
+    /// Generate an SPD scene (Eric Haines' Standard Procedural Databases); without a name, list
+    /// them.
+    Spd {
+        /// balls, gears, lattice, mount, rings, teapot, tetra or tree.
+        name: Option<String>,
+        /// The SPD's size factor (recursion depth or resolution); default: the SPD's default.
+        #[arg(short, long)]
+        size: Option<u32>,
+        /// Output file: .nff, .nff.gz or .ron (`-`: NFF on standard output).
+        #[arg(short, long = "output")]
+        output: Option<PathBuf>,
+    },
 }
 
 fn parse_res(s: &str) -> Result<(u32, u32), String> {
@@ -113,6 +125,9 @@ fn main() -> ExitCode {
         Command::Plugins { plugin_path } => {
             cli::plugins::run(&plugin_path);
             Ok(())
+        }
+        Command::Spd { name, size, output } => {
+            cli::spd::run(name.as_deref(), size, output.as_deref())
         }
     };
     match result {

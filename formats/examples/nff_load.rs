@@ -14,7 +14,6 @@ use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.first().map(String::as_str) == Some("--bench") { bench(); return; }
     if args.first().map(String::as_str) == Some("--make-big") {
         let (src, out) = (&args[1], &args[2]);
         let copies = flag(&args, "--copies").unwrap_or(10);
@@ -54,7 +53,6 @@ fn main() {
         println!("run {}: {:.3} s", run + 1, secs);
         times.push(secs);
     }
-    println!("slow {}", slow());
     times.sort_by(f64::total_cmp);
     println!(
         "median {:.3} s over {} runs ({} threads)",
@@ -109,16 +107,4 @@ fn make_big(src: &Path, out: &Path, copies: usize) {
         }
     }
     w.flush().unwrap();
-}
-pub fn slow() -> u64 { luxon_formats::nff::lex::SLOW.load(std::sync::atomic::Ordering::Relaxed) }
-#[allow(dead_code)]
-pub fn bench() {
-    let mut text = String::new();
-    for i in 0..1_000_000 {
-        let x = i as f64 * 0.001234;
-        text.push_str(&format!("{:.5} {:.5} {:.5} {:.5} {:.5} {:.5}\n", x, -x, x * 0.5, 0.12345, -0.5, x));
-    }
-    let t = Instant::now();
-    let (s, c) = luxon_formats::nff::lex::bench_lines(text.as_bytes());
-    println!("bench: {c} lines {s} in {:?}", t.elapsed());
 }

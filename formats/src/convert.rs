@@ -372,9 +372,9 @@ impl Checker<'_> {
                 None => d.tile_size,
             },
             io: match p.io {
-                Some(raw::Io::Async) => OutputIo::Async,
-                Some(raw::Io::Sync) => OutputIo::Sync,
-                Some(raw::Io::MpiIo) => OutputIo::MpiIo,
+                Some(raw::IoMode::Async) => OutputIo::Async,
+                Some(raw::IoMode::Sync) => OutputIo::Sync,
+                Some(raw::IoMode::MpiIo) => OutputIo::MpiIo,
                 None => d.io,
             },
         })

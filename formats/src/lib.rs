@@ -9,6 +9,7 @@ pub mod desc;
 pub mod geometry;
 mod error;
 pub mod nff;
+pub mod spd;
 mod raw;
 mod ron_error;
 mod ron_scene;

@@ -155,12 +155,12 @@ pub(crate) struct Parallel {
     pub threads: Option<f64>,
     pub decomposition: Option<Decomposition>,
     pub tile_size: Option<f64>,
-    pub io: Option<Io>,
+    pub io: Option<IoMode>,
 }
 
 #[derive(Deserialize, Clone, Copy)]
 #[serde(rename = "OutputIo")]
-pub(crate) enum Io {
+pub(crate) enum IoMode {
     Async,
     Sync,
     MpiIo,

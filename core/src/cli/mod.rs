@@ -5,3 +5,4 @@ pub mod job;
 pub mod plugins;
 pub mod progress;
 pub mod render;
+pub mod spd;

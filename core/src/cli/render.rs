@@ -194,7 +194,10 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
             if streaming {
                 let _ = tx.send(c);
             } else if sync {
-                sync_fb.lock().unwrap_or_else(|e| e.into_inner()).put_chunk(&c);
+                sync_fb
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .put_chunk(&c);
             }
             bar.tick(done.fetch_add(n, Ordering::Relaxed) + n, total);
         };
@@ -221,7 +224,12 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     }
     if sync {
         let fb = sync_fb.into_inner().unwrap_or_else(|e| e.into_inner());
-        written.extend(luxon::output::write_all(&plan.written_by_root, &fb, &registry, scene_dir)?);
+        written.extend(luxon::output::write_all(
+            &plan.written_by_root,
+            &fb,
+            &registry,
+            scene_dir,
+        )?);
     }
     let write_time = tail + t_write.elapsed();
     let stats = RenderStats::of(ranks, render_time);
@@ -287,7 +295,10 @@ fn print_stats(
         set.tile_size
     );
     eprintln!("  ranks            {}", job.size());
-    eprintln!("  threads          {} per rank ({} {unit})", s.threads, s.tiles);
+    eprintln!(
+        "  threads          {} per rank ({} {unit})",
+        s.threads, s.tiles
+    );
     for r in &s.ranks {
         let t = r.total();
         eprintln!(

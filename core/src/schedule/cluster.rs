@@ -71,7 +71,10 @@ impl Cluster {
                 .copied()
                 .or_else(|| p.downcast_ref::<String>().map(String::as_str))
                 .unwrap_or("(no message)");
-            let at = info.location().map(|l| format!(" at {l}")).unwrap_or_default();
+            let at = info
+                .location()
+                .map(|l| format!(" at {l}"))
+                .unwrap_or_default();
             fail(&format!("panic{at}: {what}"));
         }));
         // Ranks bound to the same CPUs share them; ranks bound to other CPUs do not.
@@ -160,12 +163,22 @@ impl Cluster {
         let local_sink = |c: Chunk| {
             injected.on_chunk();
             if keep {
-                kept.lock().unwrap_or_else(|e| e.into_inner()).push(c.clone());
+                kept.lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(c.clone());
             }
             sink(c);
         };
         let ranks = if self.rank == 0 {
-            self.lead(scene, &pool, &tiles, threads, gather, &local_sink, &injected)
+            self.lead(
+                scene,
+                &pool,
+                &tiles,
+                threads,
+                gather,
+                &local_sink,
+                &injected,
+            )
         } else {
             let (tx, rx) = mpsc::channel();
             let injected = &injected;
@@ -173,10 +186,13 @@ impl Cluster {
                 injected.on_chunk();
                 let _ = tx.send(c);
             };
-            let (mine, chunks) =
-                self.follow(scene, &pool, &tiles, threads, gather, &to_main, rx, injected);
+            let (mine, chunks) = self.follow(
+                scene, &pool, &tiles, threads, gather, &to_main, rx, injected,
+            );
             if keep {
-                kept.lock().unwrap_or_else(|e| e.into_inner()).extend(chunks);
+                kept.lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .extend(chunks);
             }
             vec![mine]
         };
@@ -269,7 +285,9 @@ impl Cluster {
                 }
                 std::thread::sleep(POLL);
             }
-            let mine = local.join().unwrap_or_else(|_| fail("a render thread panicked"));
+            let mine = local
+                .join()
+                .unwrap_or_else(|_| fail("a render thread panicked"));
             check(scene, injected);
             stats[0] = Some(mine);
         });
@@ -340,7 +358,9 @@ impl Cluster {
                 }
                 check(scene, injected);
             }
-            local.join().unwrap_or_else(|_| fail("a render thread panicked"))
+            local
+                .join()
+                .unwrap_or_else(|_| fail("a render thread panicked"))
         });
         check(scene, injected);
         stats.rank = self.rank;
@@ -367,7 +387,9 @@ impl Cluster {
         } else {
             Vec::new()
         };
-        if let Err(e) = super::mpi_io::write_ppm(self.world.as_raw(), tmp, &header, width, height, mine) {
+        if let Err(e) =
+            super::mpi_io::write_ppm(self.world.as_raw(), tmp, &header, width, height, mine)
+        {
             fail(&format!("{}: MPI-IO: {e}", tmp.display()));
         }
     }
@@ -404,7 +426,11 @@ struct TileQueue {
 
 impl TileQueue {
     fn push(&self, i: usize) {
-        self.state.lock().unwrap_or_else(|e| e.into_inner()).0.push_back(i);
+        self.state
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .0
+            .push_back(i);
         self.ready.notify_one();
     }
     fn close(&self) {
@@ -435,7 +461,8 @@ struct Injected {
 
 impl Injected {
     fn from_env(rank: usize) -> Injected {
-        let armed = std::env::var("LUXON_TEST_FAIL_RANK").is_ok_and(|r| r.trim() == rank.to_string());
+        let armed =
+            std::env::var("LUXON_TEST_FAIL_RANK").is_ok_and(|r| r.trim() == rank.to_string());
         Injected {
             panic: std::env::var("LUXON_TEST_FAIL").is_ok_and(|m| m == "panic"),
             armed,

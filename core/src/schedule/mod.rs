@@ -125,7 +125,10 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
         w.pixels = chunk.pixels();
         w.busy = t0.elapsed();
         sink(chunk);
-        stats[thread].lock().unwrap_or_else(|e| e.into_inner()).add(&w);
+        stats[thread]
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .add(&w);
     };
     let faulted = || scene.customs.fault.is_raised();
     let s = &scene.settings;
@@ -136,8 +139,14 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
             workers,
         } => {
             pool.broadcast(|ctx| {
-                let units =
-                    decompose::static_units(s.width, s.height, how, s.tile_size, first + ctx.index(), workers);
+                let units = decompose::static_units(
+                    s.width,
+                    s.height,
+                    how,
+                    s.tile_size,
+                    first + ctx.index(),
+                    workers,
+                );
                 for unit in units {
                     if faulted() {
                         break;
@@ -206,7 +215,12 @@ pub fn threads_for(scene: &Scene) -> usize {
 /// The number of processes an MPI launcher (mpirun, mpiexec) started this job with, read from
 /// the environment before (or without) initialising MPI; `None` when not launched by one.
 pub fn launched_ranks() -> Option<usize> {
-    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"]
-        .iter()
-        .find_map(|v| std::env::var(v).ok()?.trim().parse().ok())
+    [
+        "OMPI_COMM_WORLD_SIZE",
+        "PMI_SIZE",
+        "PMIX_SIZE",
+        "MPI_LOCALNRANKS",
+    ]
+    .iter()
+    .find_map(|v| std::env::var(v).ok()?.trim().parse().ok())
 }

@@ -87,7 +87,10 @@ pub fn write_ppm(
             "MPI_File_open",
             ffi::MPI_File_open(comm, name.as_ptr(), mode, ffi::RSMPI_INFO_NULL, &mut file),
         )?;
-        let mut result = check("MPI_File_set_size", ffi::MPI_File_set_size(file, total as ffi::MPI_Offset));
+        let mut result = check(
+            "MPI_File_set_size",
+            ffi::MPI_File_set_size(file, total as ffi::MPI_Offset),
+        );
         // A rank with nothing to write still takes part, with a plain byte view.
         let mut view = byte;
         if result.is_ok() && !runs.is_empty() {

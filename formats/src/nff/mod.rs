@@ -54,7 +54,7 @@
 //! exact fast path; primitives go straight into per-material arrays (no allocation per
 //! primitive).
 
-pub mod lex;
+mod lex;
 mod parse;
 mod polygon;
 mod stream;
@@ -183,6 +183,8 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Imported, SceneError> {
 
 /// sRGB-encoded display value to linear.
 fn linear(c: f64) -> f64 {
+    if std::env::var("NFF_EXP").is_ok_and(|v| v == "raw") { return c; }
+    if std::env::var("NFF_EXP").is_ok_and(|v| v == "g22") { return c.powf(2.2); }
     if c <= 0.04045 {
         c / 12.92
     } else {

@@ -218,6 +218,103 @@ pub fn generate_ron(name: &str, size: u32, out: &mut dyn Write) -> Result<(), Sp
     Ok(())
 }
 
+/// The file formats scenes are written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// NFF text, as the SPD programs print it.
+    Nff,
+    /// NFF text, gzip-compressed.
+    NffGz,
+    /// A Luxon RON scene of the same content.
+    Ron,
+}
+
+impl OutputFormat {
+    /// The format a file name asks for: `.nff`, `.nff.gz` or `.ron` (any case).
+    pub fn of_path(path: &std::path::Path) -> Option<OutputFormat> {
+        let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
+        if name.ends_with(".nff.gz") {
+            Some(OutputFormat::NffGz)
+        } else if name.ends_with(".nff") {
+            Some(OutputFormat::Nff)
+        } else if name.ends_with(".ron") {
+            Some(OutputFormat::Ron)
+        } else {
+            None
+        }
+    }
+}
+
+/// Writes scene `name` at `size` to `out` in `format`; returns what it held.
+pub fn generate_as(
+    name: &str,
+    size: u32,
+    format: OutputFormat,
+    out: &mut dyn Write,
+) -> Result<Counts, SpdError> {
+    let (scene, size) = find(name, Some(size))?;
+    let nff = |out: &mut dyn Write| -> Result<Counts, SpdError> {
+        let mut w = NffWriter::new(out);
+        let mut tee = Tee {
+            inner: &mut w,
+            counts: Counts::default(),
+        };
+        scene.generate(size, &mut tee)?;
+        let counts = tee.counts;
+        w.flush()?;
+        Ok(counts)
+    };
+    match format {
+        OutputFormat::Nff => nff(out),
+        OutputFormat::Ron => Ok(ron_out::write(scene, size, out)?),
+        OutputFormat::NffGz => {
+            let mut gz = flate2::write::GzEncoder::new(out, flate2::Compression::fast());
+            let counts = nff(&mut gz)?;
+            gz.finish()?;
+            Ok(counts)
+        }
+    }
+}
+
+/// Passes everything on to `inner` and counts it.
+struct Tee<'a> {
+    inner: &'a mut dyn Sink,
+    counts: Counts,
+}
+
+impl Sink for Tee<'_> {
+    fn background(&mut self, rgb: [f64; 3]) -> io::Result<()> {
+        self.inner.background(rgb)
+    }
+    fn view(&mut self, v: &View) -> io::Result<()> {
+        self.inner.view(v)
+    }
+    fn light(&mut self, p: [f64; 3]) -> io::Result<()> {
+        self.counts.light(p)?;
+        self.inner.light(p)
+    }
+    fn fill(&mut self, f: &Fill) -> io::Result<()> {
+        self.counts.fill(f)?;
+        self.inner.fill(f)
+    }
+    fn sphere(&mut self, c: [f64; 3], r: f64) -> io::Result<()> {
+        self.counts.sphere(c, r)?;
+        self.inner.sphere(c, r)
+    }
+    fn cone(&mut self, b: [f64; 3], br: f64, a: [f64; 3], ar: f64) -> io::Result<()> {
+        self.counts.cone(b, br, a, ar)?;
+        self.inner.cone(b, br, a, ar)
+    }
+    fn polygon(&mut self, v: &[[f64; 3]]) -> io::Result<()> {
+        self.counts.polygon(v)?;
+        self.inner.polygon(v)
+    }
+    fn patch(&mut self, v: &[[f64; 3]], n: &[[f64; 3]]) -> io::Result<()> {
+        self.counts.patch(v, n)?;
+        self.inner.patch(v, n)
+    }
+}
+
 /// What a scene holds, counted without writing it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Counts {

@@ -11,6 +11,67 @@ pub fn push_g(out: &mut Vec<u8>, x: f64) {
         out.extend_from_slice(if x.is_sign_negative() { b"-0" } else { b"0" });
         return;
     }
+    if !fast_g(out, x) {
+        slow_g(out, x);
+    }
+}
+
+/// Powers of ten 10^0 ..= 10^10.
+const POW10: [f64; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
+
+/// `%g` for 1e-4 <= |x| < 999999.5 by scaling to six digits in floating point; declines
+/// (returns false) near a rounding tie, where only exact decimal arithmetic decides.
+fn fast_g(out: &mut Vec<u8>, x: f64) -> bool {
+    let a = x.abs();
+    if !(1e-4..999_999.0).contains(&a) {
+        return false;
+    }
+    // e = floor(log10(a)), in -4..=5.
+    let mut e: i32 = 5;
+    while e > -4 && a < POW10[(e + 4) as usize] * 1e-4 {
+        e -= 1;
+    }
+    let scaled = a * POW10[(5 - e) as usize];
+    let floor = scaled.floor();
+    if (scaled - floor - 0.5).abs() < 1e-6 {
+        return false;
+    }
+    let mut digits = scaled.round() as u64;
+    if digits >= 1_000_000 {
+        digits /= 10;
+        e += 1;
+        if e >= 6 {
+            return false;
+        }
+    }
+    if x < 0.0 {
+        out.push(b'-');
+    }
+    let mut d = [0u8; 6];
+    for k in (0..6).rev() {
+        d[k] = b'0' + (digits % 10) as u8;
+        digits /= 10;
+    }
+    let last = d.iter().rposition(|&c| c != b'0').unwrap_or(0);
+    if e >= 0 {
+        let int = (e + 1) as usize;
+        out.extend_from_slice(&d[..int]);
+        if last >= int {
+            out.push(b'.');
+            out.extend_from_slice(&d[int..=last]);
+        }
+    } else {
+        out.extend_from_slice(b"0.");
+        for _ in 0..(-e - 1) {
+            out.push(b'0');
+        }
+        out.extend_from_slice(&d[..=last]);
+    }
+    true
+}
+
+/// `%g` through Rust's exact decimal formatting.
+fn slow_g(out: &mut Vec<u8>, x: f64) {
     if !x.is_finite() {
         let _ = write!(out, "{x}");
         return;
@@ -166,6 +227,23 @@ mod tests {
         let mut v = Vec::new();
         push_g(&mut v, x);
         String::from_utf8(v).unwrap()
+    }
+
+    #[test]
+    fn fast_path_agrees_with_exact_formatting() {
+        let mut state = 0x1234_5678_9abc_def0u64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let x = (mantissa - 0.5) * 10f64.powi((state % 13) as i32 - 5);
+            let (mut fast, mut slow) = (Vec::new(), Vec::new());
+            if super::fast_g(&mut fast, x) {
+                super::slow_g(&mut slow, x);
+                assert_eq!(fast, slow, "{x:e}");
+            }
+        }
     }
 
     #[test]

@@ -8,8 +8,9 @@
 //! are red, green, blue, cyan, magenta and yellow. Groups are stacked in a square pyramid
 //! receding from the viewer: level `k` (0..size) is a `(k+1) x (k+1)` grid of groups 2 apart
 //! in x and z, at depth `(k+1) d` with `d = 1 / sin(22.5 degrees)`, so size 7 is
-//! 1 + 4 + ... + 49 = 140 groups, 4200 cylinders and 4200 spheres. A white wall closes the
-//! view behind the pyramid.
+//! 1 + 4 + ... + 49 = 140 groups, 4200 cylinders and 4200 spheres. The eye is at depth `-d`,
+//! looking along +y; a white wall one level beyond the pyramid closes the view, 1% wider than
+//! the 45-degree view at its distance.
 //!
 //! A ring is written corner by corner: the cylinder from the corner back to the previous one,
 //! then the sphere at the corner.
@@ -27,9 +28,9 @@ pub fn generate(size: u32, s: &mut dyn Sink) -> io::Result<()> {
     for l in [[3.0, -d, 3.0], [-4.0, -d, 1.0], [2.0, -d, -4.0]] {
         s.light(l)?;
     }
-    // The wall: at the next level's depth, wide enough to fill the view (9.83895 at size 7).
+    // The wall: at the next level's depth, 1% wider than the view there.
     let wall_y = (size as f64 + 1.0) * d;
-    let half = 9.83895 * (size as f64 + 2.0) / 9.0;
+    let half = 1.01 * (wall_y + d) * (std::f64::consts::PI / 8.0).tan();
     s.fill(&fill([1.0; 3], 1.0, 0.0, 0.0, 0.0, 0.0))?;
     s.polygon(&[
         [-1.0 + half, wall_y, 0.5 + half],

@@ -1,13 +1,43 @@
-//! # luxon-textures: procedural texture plugins for Luxon
+//! # luxon-textures: texture plugins for Luxon
 //!
-//! Solid (3D, world-space) textures evaluated at each shading point. Colours are linear RGB,
-//! non-negative (values above 1 are allowed); every texture returns alpha 1.
+//! Procedural solid textures, texture trees and image textures. Colours are linear RGB (values
+//! above 1 are allowed); alpha is 1 except for image textures with an alpha channel. Every
+//! texture is deterministic and safe to evaluate from many threads at once.
 //!
 //! | texture    | what |
 //! |------------|------|
 //! | `constant` | one colour everywhere |
-//! | `checker`  | a 3D checkerboard of cubes |
+//! | `checker`  | a 3D checkerboard of cubes; each cell colour may be another texture |
+//! | `blend`    | two textures or colours mixed by a third |
 //! | `gradient` | a clamped linear blend between two colours along an axis |
+//! | `marble`   | Perlin's marble: stripes bent by turbulence |
+//! | `wood`     | growth rings around an axis, wobbled by noise |
+//! | `noise`    | Perlin's improved gradient noise, fractal ("grit") |
+//! | `image`    | an image file (PNG, JPEG, TGA, PPM, EXR), mapped, tiled, MIP-mapped, cached |
+//!
+//! ## Placement of solid textures
+//!
+//! `constant`, `checker`, `gradient`, `marble`, `wood` and `noise` share three parameters that
+//! place the pattern in the world ([`transform`]):
+//!
+//! | name        | type                   | default     | meaning |
+//! |-------------|------------------------|-------------|---------|
+//! | `scale`     | f64 or `(x, y, z)`, > 0 | `1.0`      | world units per pattern unit (one number: the same on every axis) |
+//! | `rotate`    | `(x, y, z)` degrees    | `(0, 0, 0)` | turns the pattern about x, then y, then z |
+//! | `translate` | `(x, y, z)`            | `(0, 0, 0)` | where the pattern's origin lands |
+//!
+//! The lookup point is `S⁻¹ · Rᵀ · (p - translate)` with `R = Rz · Ry · Rx`. They are accepted
+//! by `constant` too, where they change nothing.
+//!
+//! ## Texture trees
+//!
+//! The inputs of `checker` (`even`, `odd`) and `blend` (`a`, `b`, `mix`) are each a grey level
+//! (`0.5`), a colour (`(r, g, b)`) or another texture of this plugin written inline by its
+//! capitalised name with its own parameters: `Constant(...)`, `Checker(...)`, `Blend(...)`,
+//! `Gradient(...)`, `Marble(...)`, `Wood(...)`, `Noise(...)`, `Image(...)` (`Marble()` takes
+//! every default). Trees nest to any depth. A nested texture is evaluated at the same shading
+//! point as its parent, placed by its own parameters only. Errors name the path to the input:
+//! ``` `odd`: `even`: parameter `turbulence` must not be negative ```.
 //!
 //! ## Parameters
 //!
@@ -17,34 +47,125 @@
 //! |---------|-------------|----------|---------|
 //! | `color` | `(r, g, b)` | required | the colour |
 //!
-//! `checker`
+//! `checker` (and placement)
 //!
-//! | name     | type        | default     | meaning |
-//! |----------|-------------|-------------|---------|
-//! | `scale`  | f64 > 0     | `1.0`       | edge length of a cell, world units |
-//! | `even`   | `(r, g, b)` | `(1, 1, 1)` | colour of cells whose indices sum to an even number (e.g. the cell at the origin) |
-//! | `odd`    | `(r, g, b)` | `(0, 0, 0)` | colour of the other cells |
-//! | `offset` | `(x, y, z)` | `(0, 0, 0)` | a cell corner; the grid is shifted so that it starts here |
+//! | name     | type  | default     | meaning |
+//! |----------|-------|-------------|---------|
+//! | `even`   | input | `(1, 1, 1)` | cells whose indices sum to an even number (e.g. the cell at the origin) |
+//! | `odd`    | input | `(0, 0, 0)` | the other cells |
+//! | `offset` | `(x, y, z)` | `(0, 0, 0)` | older name of `translate` (a cell corner); give one of them |
 //!
-//! The cell of a point `p` has indices `floor((p - offset) / scale)` per axis, so cells are
-//! half-open, `[k, k + 1)` in cell units: a point exactly on a boundary belongs to the cell on
-//! its positive side, for negative coordinates as for positive ones (no mirroring at zero, and
-//! `-0.0` is the same as `0.0`). Points within 1e-4 cell units of a boundary are snapped onto it
-//! first, so that rounding noise in hit points on a surface lying on a boundary (the floor
-//! `y = 0` with the default grid) cannot make the pattern speckle between two cells.
+//! `scale` is the edge length of a cell. The cell of a point has indices `floor(l)` per axis of
+//! its pattern-space point `l`, so cells are half-open, `[k, k + 1)`: a point exactly on a
+//! boundary belongs to the cell on its positive side, for negative coordinates as for positive
+//! ones. Points within 1e-4 cell units of a boundary are snapped onto it first, so that rounding
+//! noise in hit points on a surface lying on a boundary (the floor `y = 0` with the default
+//! grid) cannot make the pattern speckle between two cells.
 //!
-//! `gradient`
+//! `blend`
+//!
+//! | name  | type  | default     | meaning |
+//! |-------|-------|-------------|---------|
+//! | `a`   | input | `(0, 0, 0)` | where `mix` is 0 |
+//! | `b`   | input | `(1, 1, 1)` | where `mix` is 1 |
+//! | `mix` | input | `0.5`       | weight of `b`, per channel, clamped to [0, 1] (alpha: the mean) |
+//!
+//! `gradient` (and placement)
 //!
 //! | name    | type        | default     | meaning |
 //! |---------|-------------|-------------|---------|
 //! | `from`  | `(r, g, b)` | `(0, 0, 0)` | colour at `start` and before it |
 //! | `to`    | `(r, g, b)` | `(1, 1, 1)` | colour at `end` and after it |
-//! | `axis`  | `(x, y, z)` | `(0, 1, 0)` | direction of the blend, normalised (must not be zero) |
-//! | `start` | f64         | `0.0`       | where the blend starts: distance along `axis` from the world origin |
+//! | `axis`  | `(x, y, z)` | `(0, 1, 0)` | direction of the blend in pattern space, normalised (must not be zero) |
+//! | `start` | f64         | `0.0`       | where the blend starts: distance along `axis` from the pattern origin |
 //! | `end`   | f64         | `1.0`       | where it ends (must differ from `start`; may be smaller) |
 //!
-//! The colour at `p` is `from + (to - from) * clamp((dot(p, axis) - start) / (end - start), 0, 1)`,
-//! blended in linear RGB.
+//! The colour at pattern point `l` is `from + (to - from) * clamp((dot(l, axis) - start) /
+//! (end - start), 0, 1)`.
+//!
+//! `marble` (and placement)
+//!
+//! | name         | type        | default              | meaning |
+//! |--------------|-------------|----------------------|---------|
+//! | `base`       | `(r, g, b)` | `(0.8, 0.78, 0.74)`  | the stone |
+//! | `vein`       | `(r, g, b)` | `(0.1, 0.1, 0.12)`   | the veins |
+//! | `turbulence` | f64 ≥ 0     | `1.0`                | how far veins wander, in stripe widths (0: straight) |
+//! | `sharpness`  | f64 > 0     | `3.0`                | exponent of the vein profile (larger: thinner veins) |
+//! | `octaves`    | 1..=16      | `5`                  | octaves of turbulence |
+//! | `seed`       | u64         | `0`                  | noise seed |
+//!
+//! With phase `φ = l.x + turbulence · turb(l)` (Perlin's turbulence, in [0, 1]) the vein
+//! weight is `((1 - cos 2πφ) / 2)^sharpness`: stone at whole `φ`, vein half-way; one stripe per
+//! pattern unit across the pattern's x axis.
+//!
+//! `wood` (and placement)
+//!
+//! | name         | type        | default               | meaning |
+//! |--------------|-------------|-----------------------|---------|
+//! | `light`      | `(r, g, b)` | `(0.73, 0.48, 0.24)`  | early wood, at whole radii |
+//! | `dark`       | `(r, g, b)` | `(0.26, 0.1, 0.025)`  | late wood, half-way between rings |
+//! | `turbulence` | f64 ≥ 0     | `0.15`                | ring wobble, in ring spacings (0: circles) |
+//! | `octaves`    | 1..=16      | `3`                   | octaves of noise |
+//! | `seed`       | u64         | `0`                   | noise seed |
+//!
+//! Rings around the pattern's y axis (turn it with `rotate`), one per pattern unit of radius:
+//! weight `(1 - cos 2πr) / 2` with `r = hypot(l.x, l.z) + turbulence · fbm(l)`.
+//!
+//! `noise` (and placement)
+//!
+//! | name         | type        | default     | meaning |
+//! |--------------|-------------|-------------|---------|
+//! | `from`       | `(r, g, b)` | `(0, 0, 0)` | where the noise is lowest |
+//! | `to`         | `(r, g, b)` | `(1, 1, 1)` | where it is highest |
+//! | `octaves`    | 1..=16      | `4`         | octaves summed |
+//! | `gain`       | f64 > 0     | `0.5`       | amplitude ratio between octaves |
+//! | `lacunarity` | f64 > 0     | `2.0`       | frequency ratio between octaves |
+//! | `turbulent`  | bool        | `false`     | sum absolute values (creased, Perlin's turbulence) |
+//! | `seed`       | u64         | `0`         | noise seed: a permutation table shuffled from it |
+//!
+//! The weight of `to` is `0.5 + 0.5 · fbm(l)` (or `turb(l)`), clamped to [0, 1]; sums are
+//! divided by the total amplitude, so every octave count keeps the range. One octave of noise is
+//! exactly 0 (weight 0.5) at whole pattern coordinates.
+//!
+//! `image`
+//!
+//! | name      | type | default    | meaning |
+//! |-----------|------|------------|---------|
+//! | `file`    | path | required   | PNG, JPEG, TGA, PPM/PGM/PBM/PAM or OpenEXR, relative to the scene file |
+//! | `srgb`    | bool | `true`     | 8- and 16-bit sources are sRGB-encoded (decoded to linear); `false`: already linear. EXR is always linear |
+//! | `mapping` | `uv`, `planar`, `cylindrical`, `spherical` | `uv` | mesh texture coordinates, or a projection |
+//! | `center`  | `(x, y, z)` | `(0, 0, 0)` | origin of the projection (not with `uv`) |
+//! | `axis`    | `(x, y, z)` | `(0, 1, 0)` | plane normal (planar) or pole (cylindrical, spherical); not with `uv` |
+//! | `scale`   | f64 or `(u, v)`, > 0 | `1.0` | size of one copy of the image in mapping units |
+//! | `rotate`  | f64 degrees | `0` | turns the image counter-clockwise |
+//! | `offset`  | `(u, v)` | `(0, 0)` | where the image's corner `(0, 0)` lands |
+//! | `wrap`    | `repeat`, `clamp`, `mirror` | `repeat` | outside [0, 1): tile, extend the edge texels, tile mirrored |
+//! | `filter`  | `nearest`, `bilinear`, `mip` | `mip` | `mip`: trilinear between MIP levels chosen from the ray's footprint |
+//!
+//! Names of `mapping`, `wrap` and `filter` may also be capitalised (`Planar`). Image
+//! coordinates `(s, t)` have `(0, 0)` at the image's bottom-left corner and `(1, 1)` at its
+//! top-right. The mappings are defined in [`mapping`]: `planar` gives `u = d · e1`,
+//! `v = d · e2` for `d = p - center` in a frame `e1` (world x made perpendicular to `axis`),
+//! `e2 = axis × e1` (floor, default axis: `u = x`, `v = -z`; wall with axis `(0, 0, 1)`:
+//! `u = x`, `v = y`); `cylindrical` gives the longitude / 2π and the height along the axis;
+//! `spherical` the longitude / 2π and the latitude mapped to [0, 1]. Then
+//! `(s, t) = R(-rotate) · ((u, v) - offset) / scale`.
+//!
+//! **MIP level.** The footprint is measured in level-0 texels: under `uv` mapping from the
+//! host's `uv_footprint`, under the projections from the world `footprint` through the
+//! mapping's derivatives and `scale` (planar: `footprint / scale` image widths). The level is
+//! `log2(texels)`, clamped to the pyramid (a footprint of 0 or 1 texel is level 0; 4 texels is
+//! level 2), blended linearly between the two levels around it. The pyramid is built once per
+//! decode with an exact area (box) filter that also handles odd sizes ([`mipmap`]).
+//!
+//! **Loading and the cache.** `create` checks that the file exists and reads its header
+//! (errors name the resolved path); the texels are decoded on the first lookup. Every image of
+//! the library lives in one LRU cache bounded by the render settings' texture cache budget
+//! (`texture_cache_bytes`; 0: 1 GiB), counted per MIP level; lookups that hit take no lock.
+//! Least recently used levels are evicted when the budget is exceeded and decoded again when
+//! needed, so scenes with more texture data than the budget still render; a warning says once
+//! when that happens (the cache is thrashing), with the budget and the data size. An image
+//! that cannot be decoded renders magenta, with one error in the log. See [`cache`].
 //!
 //! ## Scene
 //!
@@ -52,420 +173,148 @@
 //! textures: {
 //!     "checks": (plugin: "checker", params: (scale: 0.5)),
 //!     "sky": (plugin: "gradient", params: (from: (1, 1, 1), to: (0.2, 0.4, 0.9), start: 0, end: 10)),
+//!     "stone": (plugin: "marble", params: (scale: 0.4, rotate: (0, 30, 10), seed: 7)),
+//!     "table": (plugin: "wood", params: (scale: 0.05, rotate: (90, 0, 0))),
+//!     "grit": (plugin: "noise", params: (from: (0.3, 0.3, 0.3), to: (0.6, 0.6, 0.6), scale: 0.02)),
+//!     "tiles": (plugin: "checker", params: (
+//!         scale: 1,
+//!         even: Marble(scale: 0.5),
+//!         odd: Blend(a: Wood(scale: 0.1), b: Image(file: "wood.png", mapping: planar), mix: 0.3),
+//!     )),
+//!     "earth": (plugin: "image", params: (file: "earth.jpg", mapping: spherical, center: (0, 1, 0))),
+//!     "label": (plugin: "image", params: (file: "label.exr", wrap: clamp, filter: bilinear)),
 //! },
 //! materials: {
-//!     "floor": (texture: "checks", diffuse: 0.8),
+//!     "floor": (texture: "tiles", diffuse: 0.8),
 //! },
 //! ```
 
-use luxon_plugin::abi::TexQuery;
-use luxon_plugin::{finite, invalid, Context, Describe, Error, Texture};
-use serde::Deserialize;
+mod cache;
+mod decode;
+mod image;
+mod mapping;
+mod mipmap;
+mod noise;
+mod params;
+mod procedural;
+mod transform;
+mod tree;
 
-/// A colour parameter: finite and non-negative.
-fn color(name: &str, c: [f64; 3]) -> Result<[f32; 4], Error> {
-    let c = finite(name, c)?;
-    if c.iter().any(|&x| x < 0.0) {
-        return Err(invalid(format!(
-            "parameter `{name}` must not be negative, got {c:?}"
-        )));
-    }
-    Ok([c[0] as f32, c[1] as f32, c[2] as f32, 1.0])
-}
+#[cfg(test)]
+mod testutil;
 
-// ------------------------------------------------------------------------------------------------
-// constant
-// ------------------------------------------------------------------------------------------------
+pub use crate::image::ImageTexture;
+pub use procedural::{Checker, Constant, Gradient, Marble, Noise, Wood};
+pub use tree::Blend;
 
-pub struct Constant {
-    color: [f32; 4],
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ConstantParams {
-    color: [f64; 3],
-}
-
-impl Describe for Constant {
-    const NAME: &'static str = "constant";
-    const DESCRIPTION: &'static str = "One colour everywhere.";
-    const PARAMS: &'static str = "color: (r, g, b) = required  linear RGB, non-negative";
-}
-
-impl Texture for Constant {
-    type Params = ConstantParams;
-
-    fn create(p: ConstantParams, _ctx: &Context) -> Result<Self, Error> {
-        Ok(Constant {
-            color: color("color", p.color)?,
-        })
-    }
-
-    fn eval(&self, _q: &TexQuery) -> [f32; 4] {
-        self.color
-    }
-}
-
-// ------------------------------------------------------------------------------------------------
-// checker
-// ------------------------------------------------------------------------------------------------
-
-pub struct Checker {
-    scale: f64,
-    offset: [f64; 3],
-    even: [f32; 4],
-    odd: [f32; 4],
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CheckerParams {
-    #[serde(default = "one")]
-    scale: f64,
-    #[serde(default = "white")]
-    even: [f64; 3],
-    #[serde(default)]
-    odd: [f64; 3],
-    #[serde(default)]
-    offset: [f64; 3],
-}
-
-fn one() -> f64 {
-    1.0
-}
-
-fn white() -> [f64; 3] {
-    [1.0; 3]
-}
-
-/// Distance from a boundary, in cell units, within which a coordinate counts as on it.
-const SNAP: f64 = 1e-4;
-
-/// The cell index along one axis: `floor(u)`, with `u` snapped onto a nearby integer first.
-fn cell(u: f64) -> i64 {
-    let r = u.round();
-    let k = if (u - r).abs() <= SNAP { r } else { u.floor() };
-    // `as` saturates (and maps NaN to 0), so far-away or bad points cannot panic.
-    k as i64
-}
-
-impl Describe for Checker {
-    const NAME: &'static str = "checker";
-    const DESCRIPTION: &'static str = "A 3D checkerboard of cubes in world space.";
-    const PARAMS: &'static str = "\
-scale: f64 = 1.0  edge length of a cell (> 0), world units
-even: (r, g, b) = (1, 1, 1)  colour of cells whose indices sum to an even number
-odd: (r, g, b) = (0, 0, 0)  colour of the other cells
-offset: (x, y, z) = (0, 0, 0)  a cell corner: the grid starts here";
-}
-
-impl Texture for Checker {
-    type Params = CheckerParams;
-
-    fn create(p: CheckerParams, _ctx: &Context) -> Result<Self, Error> {
-        let [scale] = finite("scale", [p.scale])?;
-        if scale <= 0.0 {
-            return Err(invalid(format!(
-                "parameter `scale` must be greater than 0, got {scale}"
-            )));
-        }
-        Ok(Checker {
-            scale,
-            offset: finite("offset", p.offset)?,
-            even: color("even", p.even)?,
-            odd: color("odd", p.odd)?,
-        })
-    }
-
-    fn eval(&self, q: &TexQuery) -> [f32; 4] {
-        let sum = (0..3).fold(0i64, |acc, i| {
-            acc.wrapping_add(cell((q.p[i] - self.offset[i]) / self.scale))
-        });
-        if sum & 1 == 0 {
-            self.even
-        } else {
-            self.odd
-        }
-    }
-}
-
-// ------------------------------------------------------------------------------------------------
-// gradient
-// ------------------------------------------------------------------------------------------------
-
-pub struct Gradient {
-    from: [f32; 4],
-    to: [f32; 4],
-    axis: [f64; 3],
-    start: f64,
-    inv_length: f64,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GradientParams {
-    #[serde(default)]
-    from: [f64; 3],
-    #[serde(default = "white")]
-    to: [f64; 3],
-    #[serde(default = "up")]
-    axis: [f64; 3],
-    #[serde(default)]
-    start: f64,
-    #[serde(default = "one")]
-    end: f64,
-}
-
-fn up() -> [f64; 3] {
-    [0.0, 1.0, 0.0]
-}
-
-impl Describe for Gradient {
-    const NAME: &'static str = "gradient";
-    const DESCRIPTION: &'static str =
-        "A linear blend between two colours along an axis, clamped outside [start, end].";
-    const PARAMS: &'static str = "\
-from: (r, g, b) = (0, 0, 0)  colour at `start` and before it
-to: (r, g, b) = (1, 1, 1)  colour at `end` and after it
-axis: (x, y, z) = (0, 1, 0)  direction of the blend (normalised; must not be zero)
-start: f64 = 0.0  where the blend starts, distance along `axis` from the origin
-end: f64 = 1.0  where it ends (must differ from `start`)";
-}
-
-impl Texture for Gradient {
-    type Params = GradientParams;
-
-    fn create(p: GradientParams, _ctx: &Context) -> Result<Self, Error> {
-        let axis = finite("axis", p.axis)?;
-        let len = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
-        if len == 0.0 || !len.is_finite() {
-            return Err(invalid(format!(
-                "parameter `axis` must be a non-zero finite direction, got {axis:?}"
-            )));
-        }
-        let [start] = finite("start", [p.start])?;
-        let [end] = finite("end", [p.end])?;
-        let inv_length = 1.0 / (end - start);
-        if start == end || !inv_length.is_finite() {
-            return Err(invalid(format!(
-                "parameters `start` and `end` must differ, got {start} and {end}"
-            )));
-        }
-        Ok(Gradient {
-            from: color("from", p.from)?,
-            to: color("to", p.to)?,
-            axis: axis.map(|a| a / len),
-            start,
-            inv_length,
-        })
-    }
-
-    fn eval(&self, q: &TexQuery) -> [f32; 4] {
-        let d: f64 = (0..3).map(|i| q.p[i] * self.axis[i]).sum();
-        let t = ((d - self.start) * self.inv_length).clamp(0.0, 1.0);
-        // NaN points (never expected) get `from` rather than a NaN colour.
-        let t = if t.is_nan() { 0.0 } else { t as f32 };
-        std::array::from_fn(|i| self.from[i] + (self.to[i] - self.from[i]) * t)
-    }
-}
-
-luxon_plugin::export!(library: "luxon-textures", textures: [Constant, Checker, Gradient]);
+luxon_plugin::export!(
+    library: "luxon-textures",
+    textures: [Constant, Checker, Blend, Gradient, Marble, Wood, Noise, ImageTexture]
+);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use luxon_plugin::parse_params;
+    use crate::testutil::{ctx_in, make_in, write_png, TempDir};
+    use luxon_plugin::abi::TexQuery;
+    use luxon_plugin::Texture;
 
-    fn ctx() -> Context {
-        Context {
-            scene_dir: ".".into(),
-            instance: "test".into(),
-            ..Default::default()
-        }
+    /// Points and uvs spread over a few cells and image copies.
+    fn queries() -> Vec<TexQuery> {
+        (0..4000)
+            .map(|i| {
+                let t = i as f64;
+                TexQuery {
+                    p: [
+                        (t * 0.618_034).fract() * 6.0 - 3.0,
+                        (t * 0.414_214).fract() * 6.0 - 3.0,
+                        (t * 0.732_051).fract() * 6.0 - 3.0,
+                    ],
+                    uv: [(t * 0.1234).fract() as f32 * 3.0, (t * 0.377).fract() as f32],
+                    footprint: (i % 5) as f32 * 0.01,
+                    uv_footprint: (i % 7) as f32 * 0.02,
+                    ..Default::default()
+                }
+            })
+            .collect()
     }
 
-    fn make<T: Texture>(params: &str) -> Result<T, Error> {
-        T::create(parse_params(params)?, &ctx())
-    }
-
-    fn at<T: Texture>(t: &T, p: [f64; 3]) -> [f32; 4] {
-        t.eval(&TexQuery {
-            p,
-            ..Default::default()
-        })
-    }
-
-    const WHITE: [f32; 4] = [1.0, 1.0, 1.0, 1.0];
-    const BLACK: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
-
-    #[test]
-    fn constant_everywhere() {
-        let t: Constant = make("(color: (0.25, 0.5, 2))").unwrap();
-        for p in [[0.0; 3], [1e9, -3.0, 7.5], [-0.5, 0.5, 0.0]] {
-            assert_eq!(at(&t, p), [0.25, 0.5, 2.0, 1.0]);
-        }
+    fn run<T: Texture>(t: &T, qs: &[TexQuery]) -> Vec<[u32; 4]> {
+        qs.iter().map(|q| t.eval(q).map(f32::to_bits)).collect()
     }
 
     #[test]
-    fn constant_requires_color() {
-        let e = make::<Constant>("()").err().unwrap();
-        assert!(
-            e.message.contains("missing parameter `color`"),
-            "{}",
-            e.message
-        );
-    }
-
-    #[test]
-    fn checker_defaults_known_points() {
-        let t: Checker = make("()").unwrap();
-        assert_eq!(at(&t, [0.5, 0.5, 0.5]), WHITE);
-        assert_eq!(at(&t, [1.5, 0.5, 0.5]), BLACK);
-        assert_eq!(at(&t, [1.5, 1.5, 0.5]), WHITE);
-        assert_eq!(at(&t, [1.5, 1.5, 1.5]), BLACK);
-        assert_eq!(at(&t, [2.5, 0.5, 0.5]), WHITE);
-    }
-
-    #[test]
-    fn checker_negative_coordinates_use_floor() {
-        let t: Checker = make("()").unwrap();
-        // (-0.5) is in cell -1, not 0: no doubled cell around zero.
-        assert_eq!(at(&t, [-0.5, 0.5, 0.5]), BLACK);
-        assert_eq!(at(&t, [-1.5, 0.5, 0.5]), WHITE);
-        assert_eq!(at(&t, [-0.5, -0.5, 0.5]), WHITE);
-        assert_eq!(at(&t, [-0.5, -0.5, -0.5]), BLACK);
-        assert_eq!(at(&t, [-2.5, -7.5, 3.5]), WHITE);
-        assert_eq!(at(&t, [-2.5, -6.5, 3.5]), BLACK);
-    }
-
-    #[test]
-    fn checker_boundaries_belong_to_positive_side() {
-        let t: Checker = make("()").unwrap();
-        // Exactly on a boundary: the cell on the positive side, whatever the sign.
-        assert_eq!(at(&t, [1.0, 0.5, 0.5]), BLACK);
-        assert_eq!(at(&t, [-1.0, 0.5, 0.5]), BLACK);
-        assert_eq!(at(&t, [0.0, 0.5, 0.5]), WHITE);
-        assert_eq!(at(&t, [-0.0, 0.5, 0.5]), WHITE);
-        assert_eq!(at(&t, [2.0, 0.5, 0.5]), WHITE);
-        // Rounding noise on either side of a boundary snaps onto it.
-        for eps in [1e-12, -1e-12, 1e-7, -1e-7, 5e-5, -5e-5] {
-            assert_eq!(at(&t, [0.5, eps, 0.5]), WHITE, "y = {eps}");
-            assert_eq!(at(&t, [0.5, 1.0 + eps, 0.5]), BLACK, "y = 1 + {eps}");
-            assert_eq!(at(&t, [0.5, -1.0 + eps, 0.5]), BLACK, "y = -1 + {eps}");
-        }
-        // Further away, the real neighbour.
-        assert_eq!(at(&t, [0.5, -2e-4, 0.5]), BLACK);
-        assert_eq!(at(&t, [0.5, 1.0 - 2e-4, 0.5]), WHITE);
-        assert_eq!(at(&t, [0.5, 0.999, 0.5]), WHITE);
-        assert_eq!(at(&t, [0.5, -0.001, 0.5]), BLACK);
-    }
-
-    #[test]
-    fn checker_scale_offset_and_colours() {
-        let t: Checker =
-            make("(scale: 0.5, even: (1, 0, 0), odd: (0, 0, 1), offset: (0.25, 0, 0))").unwrap();
-        let red = [1.0, 0.0, 0.0, 1.0];
-        let blue = [0.0, 0.0, 1.0, 1.0];
-        assert_eq!(at(&t, [0.3, 0.1, 0.1]), red);
-        assert_eq!(at(&t, [0.2, 0.1, 0.1]), blue);
-        assert_eq!(at(&t, [0.75, 0.1, 0.1]), blue);
-        assert_eq!(at(&t, [0.74, 0.1, 0.1]), red);
-        assert_eq!(at(&t, [0.3, 0.6, 0.1]), blue);
-        assert_eq!(at(&t, [0.3, -0.1, -0.1]), red);
-        // Small cells: boundaries at multiples of the scale.
-        let t: Checker = make("(scale: 0.1)").unwrap();
-        assert_eq!(at(&t, [0.3, 0.05, 0.05]), BLACK);
-        assert_eq!(at(&t, [0.29, 0.05, 0.05]), WHITE);
-    }
-
-    #[test]
-    fn checker_far_away_points_do_not_panic() {
-        let t: Checker = make("(scale: 1e-300)").unwrap();
-        let _ = at(&t, [1e300, -1e300, f64::NAN]);
-        let t: Checker = make("()").unwrap();
-        let _ = at(&t, [f64::INFINITY, f64::NEG_INFINITY, 0.0]);
-    }
-
-    #[test]
-    fn checker_param_errors() {
-        for (params, name) in [
-            ("(scale: 0)", "`scale`"),
-            ("(scale: -1)", "`scale`"),
-            ("(scale: inf)", "`scale`"),
-            ("(scale: NaN)", "`scale`"),
-            ("(even: (1, -0.1, 0))", "`even`"),
-            ("(odd: (0, 0, inf))", "`odd`"),
-            ("(offset: (0, NaN, 0))", "`offset`"),
-        ] {
-            let e = make::<Checker>(params).err().unwrap();
-            assert!(e.message.contains(name), "{params}: {}", e.message);
-        }
-        let e = make::<Checker>("(scael: 2)").err().unwrap();
-        assert!(e.message.contains("did you mean `scale`"), "{}", e.message);
-    }
-
-    #[test]
-    fn gradient_blends_and_clamps() {
-        let t: Gradient = make("(from: (0, 0, 0), to: (1, 2, 4), start: 1, end: 3)").unwrap();
-        assert_eq!(at(&t, [0.0, 1.0, 0.0]), [0.0, 0.0, 0.0, 1.0]);
-        assert_eq!(at(&t, [0.0, -5.0, 0.0]), [0.0, 0.0, 0.0, 1.0]);
-        assert_eq!(at(&t, [7.0, 2.0, -3.0]), [0.5, 1.0, 2.0, 1.0]);
-        assert_eq!(at(&t, [0.0, 3.0, 0.0]), [1.0, 2.0, 4.0, 1.0]);
-        assert_eq!(at(&t, [0.0, 30.0, 0.0]), [1.0, 2.0, 4.0, 1.0]);
-    }
-
-    #[test]
-    fn gradient_axis_is_normalised_and_end_may_precede_start() {
-        let t: Gradient = make("(axis: (3, 0, 4), start: 0, end: 10)").unwrap();
-        // dot(p, (0.6, 0, 0.8)) = 5 -> halfway.
-        let c = at(&t, [3.0, 100.0, 4.0]);
-        assert!(c.iter().take(3).all(|&x| (x - 0.5).abs() < 1e-6), "{c:?}");
-        let t: Gradient = make("(from: (1, 1, 1), to: (0, 0, 0), start: 2, end: -2)").unwrap();
-        assert_eq!(at(&t, [0.0, 3.0, 0.0]), WHITE);
-        assert_eq!(at(&t, [0.0, 0.0, 0.0]), [0.5, 0.5, 0.5, 1.0]);
-        assert_eq!(at(&t, [0.0, -2.0, 0.0]), BLACK);
-    }
-
-    #[test]
-    fn gradient_param_errors() {
-        for (params, name) in [
-            ("(axis: (0, 0, 0))", "`axis`"),
-            ("(axis: (0, NaN, 0))", "`axis`"),
-            ("(axis: (1e300, 1e300, 0))", "`axis`"),
-            ("(start: 1, end: 1)", "`start` and `end`"),
-            ("(start: inf)", "`start`"),
-            ("(end: NaN)", "`end`"),
-            ("(from: (-1, 0, 0))", "`from`"),
-            ("(to: (0, inf, 0))", "`to`"),
-        ] {
-            let e = make::<Gradient>(params).err().unwrap();
-            assert!(e.message.contains(name), "{params}: {}", e.message);
-        }
-    }
-
-    #[test]
-    fn constant_param_errors() {
-        let e = make::<Constant>("(color: (0.5, -1, 0))").err().unwrap();
-        assert!(
-            e.message.contains("`color` must not be negative"),
-            "{}",
-            e.message
-        );
-        let e = make::<Constant>("(color: (NaN, 0, 0))").err().unwrap();
-        assert!(
-            e.message.contains("`color` must be finite"),
-            "{}",
-            e.message
-        );
-    }
-
-    #[test]
-    fn params_tables_have_one_entry_per_line() {
-        for params in [Constant::PARAMS, Checker::PARAMS, Gradient::PARAMS] {
-            for line in params.lines() {
-                assert!(line.contains(": ") && line.contains(" = "), "{line}");
+    fn concurrent_evals_are_identical() {
+        let dir = TempDir::new("lib-threads");
+        write_png(&dir.path("a.png"), 37, 23, |x, y| [(x * 7) as u8, (y * 11) as u8, 90, 255]);
+        write_png(&dir.path("b.png"), 16, 16, |x, y| [(x * 16) as u8, 0, (y * 16) as u8, 200]);
+        let ctx = ctx_in(dir.dir());
+        let tree: Checker = make_in(
+            r#"(scale: 0.7, rotate: (10, 20, 30),
+                even: Blend(a: Marble(seed: 2), b: Image(file: "a.png"), mix: Noise(seed: 5)),
+                odd: Checker(even: Wood(), odd: Image(file: "b.png", mapping: spherical, wrap: mirror)))"#,
+            &ctx,
+        )
+        .unwrap();
+        let uv: ImageTexture = make_in(r#"(file: "a.png", scale: (0.5, 2), rotate: 15)"#, &ctx).unwrap();
+        let qs = queries();
+        let want_tree = run(&tree, &qs);
+        let want_uv = run(&uv, &qs);
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (0..4)
+                .map(|k| {
+                    let (tree, uv, qs) = (&tree, &uv, &qs);
+                    s.spawn(move || {
+                        // Each thread walks the queries from a different start.
+                        let mut order: Vec<usize> = (0..qs.len()).collect();
+                        order.rotate_left(k * 997);
+                        order
+                            .into_iter()
+                            .map(|i| (i, tree.eval(&qs[i]).map(f32::to_bits), uv.eval(&qs[i]).map(f32::to_bits)))
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            for h in handles {
+                for (i, t, u) in h.join().unwrap() {
+                    assert_eq!(t, want_tree[i], "tree, query {i}");
+                    assert_eq!(u, want_uv[i], "uv image, query {i}");
+                }
             }
+        });
+        // Every colour is finite.
+        assert!(want_tree.iter().flatten().all(|&b| f32::from_bits(b).is_finite()));
+    }
+
+    #[test]
+    fn concurrent_evals_under_a_thrashing_cache_are_identical() {
+        let dir = TempDir::new("lib-thrash");
+        for (k, name) in ["p.png", "q.png", "r.png"].iter().enumerate() {
+            write_png(&dir.path(name), 32, 32, |x, y| [(x * 8) as u8, (y * 8) as u8, 60 * k as u8, 255]);
         }
+        let cache = std::sync::Arc::new(cache::Cache::new(20_000, Box::new(|_, _| {})));
+        let ctx = ctx_in(dir.dir());
+        let textures: Vec<ImageTexture> = ["p.png", "q.png", "r.png"]
+            .iter()
+            .map(|f| {
+                let p = luxon_plugin::parse_params(&format!(r#"(file: "{f}")"#)).unwrap();
+                ImageTexture::create_in(p, &ctx, cache.clone()).unwrap()
+            })
+            .collect();
+        let qs = queries();
+        let want: Vec<Vec<[u32; 4]>> = textures.iter().map(|t| run(t, &qs)).collect();
+        std::thread::scope(|s| {
+            for k in 0..4 {
+                let (textures, qs, want) = (&textures, &qs, &want);
+                s.spawn(move || {
+                    for i in 0..qs.len() {
+                        let j = (i + k) % 3;
+                        assert_eq!(textures[j].eval(&qs[i]).map(f32::to_bits), want[j][i]);
+                    }
+                });
+            }
+        });
+        let stats = cache.stats();
+        assert!(stats.evictions > 0 && stats.decodes > 3, "{stats:?}");
     }
 }

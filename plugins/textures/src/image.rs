@@ -1,0 +1,414 @@
+//! The `image` entry: an image file mapped onto surfaces, filtered, through the shared cache.
+
+use crate::cache::{self, Cache, CachedImage};
+use crate::decode::probe;
+use crate::mapping::{Kind, Mapping};
+use crate::mipmap::{bilinear, level_pair, mip_level, nearest, trilinear, Wrap};
+use crate::params::{up, yes, Factors};
+use luxon_plugin::abi::TexQuery;
+use luxon_plugin::{invalid, Context, Describe, Error, Texture};
+use serde::Deserialize;
+use std::sync::Arc;
+
+/// What an image that cannot be decoded looks like.
+pub const MAGENTA: [f32; 4] = [1.0, 0.0, 1.0, 1.0];
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum Filter {
+    /// The texel under the point, full resolution.
+    #[serde(rename = "nearest", alias = "Nearest")]
+    Nearest,
+    /// The four nearest texels, full resolution.
+    #[serde(rename = "bilinear", alias = "Bilinear")]
+    Bilinear,
+    /// Trilinear between the two MIP levels the ray's footprint falls between.
+    #[default]
+    #[serde(rename = "mip", alias = "Mip")]
+    Mip,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageParams {
+    file: String,
+    #[serde(default = "yes")]
+    srgb: bool,
+    #[serde(default)]
+    mapping: Kind,
+    center: Option<[f64; 3]>,
+    axis: Option<[f64; 3]>,
+    #[serde(default)]
+    scale: Factors<2>,
+    #[serde(default)]
+    rotate: f64,
+    #[serde(default)]
+    offset: [f64; 2],
+    #[serde(default)]
+    wrap: Wrap,
+    #[serde(default)]
+    filter: Filter,
+}
+
+pub struct ImageTexture {
+    cache: Arc<Cache>,
+    image: Arc<CachedImage>,
+    mapping: Mapping,
+    wrap: Wrap,
+    filter: Filter,
+}
+
+impl Describe for ImageTexture {
+    const NAME: &'static str = "image";
+    const DESCRIPTION: &'static str = "An image file (PNG, JPEG, TGA, PPM, EXR) mapped by mesh uv or a planar, cylindrical or spherical projection; MIP-mapped, loaded on first use into a shared LRU cache.";
+    const PARAMS: &'static str = "\
+file: path = required  PNG, JPEG, TGA, PPM/PGM/PBM/PAM or OpenEXR file, relative to the scene file
+srgb: bool = true  integer (8/16-bit) sources are sRGB-encoded; false: already linear (EXR is always linear)
+mapping: uv|planar|cylindrical|spherical = uv  mesh texture coordinates, or a projection around `center`/`axis`
+center: (x, y, z) = (0, 0, 0)  origin of the projection (not with `uv`)
+axis: (x, y, z) = (0, 1, 0)  plane normal (planar) or pole (cylindrical, spherical); not with `uv`
+scale: f64 or (u, v) = 1.0  size of one copy of the image in mapping units (> 0)
+rotate: f64 = 0.0  turns the image counter-clockwise, degrees
+offset: (u, v) = (0, 0)  where the image's corner (0, 0) lands, mapping units
+wrap: repeat|clamp|mirror = repeat  outside the image: tile, extend the edges, or tile mirrored
+filter: nearest|bilinear|mip = mip  mip: trilinear, level chosen from the ray's footprint";
+}
+
+impl ImageTexture {
+    /// `create` with an explicit cache (the plugin uses [`cache::global`]).
+    pub fn create_in(p: ImageParams, ctx: &Context, cache: Arc<Cache>) -> Result<Self, Error> {
+        if p.mapping == Kind::Uv {
+            for (name, given) in [("center", p.center.is_some()), ("axis", p.axis.is_some())] {
+                if given {
+                    return Err(invalid(format!(
+                        "parameter `{name}` has no effect with `uv` mapping \
+                         (it places planar, cylindrical and spherical projections)"
+                    )));
+                }
+            }
+        }
+        let mapping = Mapping::new(
+            p.mapping,
+            p.center.unwrap_or_default(),
+            p.axis.unwrap_or_else(up),
+            p.scale,
+            p.rotate,
+            p.offset,
+        )?;
+        if p.file.is_empty() {
+            return Err(invalid("parameter `file` must name an image file"));
+        }
+        let path = ctx.resolve(&p.file);
+        let header = probe(&path)?;
+        let image = cache.register(&path, header, p.srgb);
+        Ok(ImageTexture {
+            cache,
+            image,
+            mapping,
+            wrap: p.wrap,
+            filter: p.filter,
+        })
+    }
+}
+
+impl Drop for ImageTexture {
+    fn drop(&mut self) {
+        self.cache.release(&self.image);
+    }
+}
+
+impl Texture for ImageTexture {
+    type Params = ImageParams;
+
+    fn create(p: ImageParams, ctx: &Context) -> Result<Self, Error> {
+        let cache = cache::global();
+        cache.set_budget(ctx.texture_cache_bytes);
+        Self::create_in(p, ctx, cache)
+    }
+
+    fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        let l = self.mapping.lookup(q);
+        let (wrap, img) = (self.wrap, &*self.image);
+        let got = match self.filter {
+            Filter::Nearest => self
+                .cache
+                .with_levels(img, 0, 0, |a, _| nearest(a, l.s, l.t, wrap)),
+            Filter::Bilinear => self
+                .cache
+                .with_levels(img, 0, 0, |a, _| bilinear(a, l.s, l.t, wrap)),
+            Filter::Mip => {
+                // The footprint in level-0 texels: the wider of the two directions.
+                let texels = (l.ds * img.width() as f64).max(l.dt * img.height() as f64);
+                let n = img.levels();
+                let (lo, hi, f) = level_pair(mip_level(texels, n), n);
+                self.cache.with_levels(img, lo, hi, |a, b| {
+                    trilinear(a, b, f, l.s, l.t, wrap)
+                })
+            }
+        };
+        got.unwrap_or(MAGENTA)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cache::Log;
+    use crate::decode::srgb_to_linear;
+    use crate::testutil::*;
+    use std::sync::Mutex;
+
+    fn quiet() -> Log {
+        Box::new(|_, _| {})
+    }
+
+    fn grey(v: f32) -> [f32; 4] {
+        [v, v, v, 1.0]
+    }
+
+    /// A 4×2 PNG: row 0 (top) greys 0, 40, 80, 120; row 1 greys 160, 200, 240, 255; alpha 255.
+    const TOP: [u8; 4] = [0, 40, 80, 120];
+    const BOTTOM: [u8; 4] = [160, 200, 240, 255];
+
+    fn fixture(dir: &TempDir) {
+        write_png(&dir.path("ramp.png"), 4, 2, |x, y| {
+            let v = if y == 0 { TOP } else { BOTTOM }[x as usize];
+            [v, v, v, 255]
+        });
+    }
+
+    fn lin(v: u8) -> f32 {
+        srgb_to_linear(v as f32 / 255.0)
+    }
+
+    fn tex(dir: &TempDir, params: &str) -> ImageTexture {
+        make_in(params, &ctx_in(dir.dir())).unwrap()
+    }
+
+    /// uv of texel (x, y)'s centre on a 4×2 image.
+    fn centre(x: u32, y: u32) -> [f32; 2] {
+        [(x as f32 + 0.5) / 4.0, 1.0 - (y as f32 + 0.5) / 2.0]
+    }
+
+    #[test]
+    fn png_nearest_and_bilinear() {
+        let dir = TempDir::new("img-png");
+        fixture(&dir);
+        let near = tex(&dir, r#"(file: "ramp.png", filter: nearest)"#);
+        let bil = tex(&dir, r#"(file: "ramp.png", filter: bilinear, wrap: clamp)"#);
+        for y in 0..2 {
+            for x in 0..4 {
+                let v = if y == 0 { TOP } else { BOTTOM }[x as usize];
+                assert_eq!(at_uv(&near, centre(x, y), 0.0), grey(lin(v)), "({x}, {y})");
+                assert!(close(at_uv(&bil, centre(x, y), 0.0), grey(lin(v)), 1e-6));
+            }
+        }
+        // Half-way between the centres of (1, 0) and (2, 0), and of all four around (2, 1).
+        let c = at_uv(&bil, [0.5, 0.75], 0.0);
+        assert!(close(c, grey((lin(40) + lin(80)) / 2.0), 1e-6), "{c:?}");
+        assert_eq!(at_uv(&near, [0.5, 0.75], 0.0), grey(lin(80)));
+        let c = at_uv(&bil, [0.5, 0.5], 0.0);
+        let want = (lin(40) + lin(80) + lin(200) + lin(240)) / 4.0;
+        assert!(close(c, grey(want), 1e-6), "{c:?}");
+        // srgb: false reads the bytes as linear.
+        let raw = tex(&dir, r#"(file: "ramp.png", filter: nearest, srgb: false)"#);
+        assert_eq!(at_uv(&raw, centre(1, 0), 0.0), grey(40.0 / 255.0));
+    }
+
+    #[test]
+    fn wrap_modes_through_the_texture() {
+        let dir = TempDir::new("img-wrap");
+        fixture(&dir);
+        let mk = |w: &str| tex(&dir, &format!(r#"(file: "ramp.png", filter: nearest, wrap: {w})"#));
+        // u = 1.3 is column 5.2; v = 0.75 is the top row.
+        let uv = [1.3, 0.75];
+        assert_eq!(at_uv(&mk("repeat"), uv, 0.0), grey(lin(TOP[1])));
+        assert_eq!(at_uv(&mk("clamp"), uv, 0.0), grey(lin(TOP[3])));
+        assert_eq!(at_uv(&mk("mirror"), uv, 0.0), grey(lin(TOP[2])));
+        // Capitalised names are accepted too.
+        assert_eq!(at_uv(&mk("Mirror"), [-0.2, 0.75], 0.0), grey(lin(TOP[0])));
+        // v beyond the top wraps to the bottom row under repeat.
+        assert_eq!(at_uv(&mk("repeat"), [0.1, 1.25], 0.0), grey(lin(BOTTOM[0])));
+        assert_eq!(at_uv(&mk("clamp"), [0.1, 1.25], 0.0), grey(lin(TOP[0])));
+    }
+
+    #[test]
+    fn mappings_reach_known_texels() {
+        let dir = TempDir::new("img-map");
+        fixture(&dir);
+        // Planar on the floor: u = x, v = -z, one image per 2 world units.
+        let planar = tex(&dir, r#"(file: "ramp.png", filter: nearest, mapping: planar, scale: 2)"#);
+        // x = 1.1 -> s = 0.55 -> column 2; z = -0.5 -> t = 0.25 -> bottom row.
+        assert_eq!(at(&planar, [1.1, 3.0, -0.5]), grey(lin(BOTTOM[2])));
+        assert_eq!(at(&planar, [0.1, 0.0, -1.9]), grey(lin(TOP[0])));
+        // Tiled: x = 2.1 is the next copy's column 0.
+        assert_eq!(at(&planar, [2.1, 0.0, -1.9]), grey(lin(TOP[0])));
+        // Cylindrical around y: longitude 0.25 at -z -> column 1; height 0.75 -> top row.
+        let cyl = tex(&dir, r#"(file: "ramp.png", filter: nearest, mapping: cylindrical)"#);
+        assert_eq!(at(&cyl, [0.0, 0.75, -3.0]), grey(lin(TOP[1])));
+        assert_eq!(at(&cyl, [-1.0, 0.25, 0.0]), grey(lin(BOTTOM[2])));
+        // Spherical with a centre: the point due +x of the centre, slightly north -> column 0
+        // of the top row; at -z, slightly south -> column 1 of the bottom row.
+        let sph = tex(
+            &dir,
+            r#"(file: "ramp.png", filter: nearest, mapping: spherical, center: (5, 0, 0))"#,
+        );
+        assert_eq!(at(&sph, [6.0, 0.1, 0.0]), grey(lin(TOP[0])));
+        assert_eq!(at(&sph, [5.0, -0.1, -1.0]), grey(lin(BOTTOM[1])));
+        // A tilted axis: planar with normal +z (a wall): u = x, v = y.
+        let wall = tex(
+            &dir,
+            r#"(file: "ramp.png", filter: nearest, mapping: planar, axis: (0, 0, 1))"#,
+        );
+        assert_eq!(at(&wall, [0.6, 0.9, 7.0]), grey(lin(TOP[2])));
+        assert_eq!(at(&wall, [0.6, 0.1, 7.0]), grey(lin(BOTTOM[2])));
+    }
+
+    #[test]
+    fn mip_level_from_the_footprint() {
+        let dir = TempDir::new("img-mip");
+        // 64×64, texels alternate black and white: level 0 is 0 or 1, every coarser level 0.5.
+        write_png(&dir.path("fine.png"), 64, 64, |x, y| {
+            let v = if (x + y) % 2 == 0 { 255 } else { 0 };
+            [v, v, v, 255]
+        });
+        let t = tex(&dir, r#"(file: "fine.png")"#);
+        let c = |x: u32, y: u32| [(x as f32 + 0.5) / 64.0, 1.0 - (y as f32 + 0.5) / 64.0];
+        // Footprint 0: level 0, bilinear at a texel centre = the texel.
+        assert_eq!(at_uv(&t, c(0, 0), 0.0), grey(1.0));
+        assert_eq!(at_uv(&t, c(1, 0), 0.0), grey(0.0));
+        // One texel wide: still level 0.
+        assert_eq!(at_uv(&t, c(1, 0), 1.0 / 64.0), grey(0.0));
+        // 4 texels: level 2 (mean grey).
+        assert!(close(at_uv(&t, c(1, 0), 4.0 / 64.0), grey(0.5), 1e-6));
+        // √2 texels: half-way between level 0 (0) and level 1 (0.5).
+        let v = at_uv(&t, c(1, 0), std::f32::consts::SQRT_2 / 64.0);
+        assert!(close(v, grey(0.25), 1e-4), "{v:?}");
+        // Planar mapping: the world footprint goes through the mapping's scale. One image per
+        // 2 world units: 64 texels per 2 units, so a footprint of 1/32 unit is one texel and
+        // 1/8 unit is 4 texels.
+        let p = tex(&dir, r#"(file: "fine.png", mapping: planar, scale: 2)"#);
+        // Column 1, row 63 (white): u = 3/64 -> s = 1.5/64, v = 1/64 -> t = 0.5/64.
+        let q = |foot: f32| TexQuery {
+            p: [3.0 / 64.0, 0.0, -1.0 / 64.0],
+            footprint: foot,
+            ..Default::default()
+        };
+        assert_eq!(p.eval(&q(0.0)), grey(1.0));
+        assert_eq!(p.eval(&q(1.0 / 32.0)), grey(1.0));
+        assert!(close(p.eval(&q(1.0 / 8.0)), grey(0.5), 1e-6));
+    }
+
+    #[test]
+    fn exr_is_linear_and_keeps_alpha() {
+        let dir = TempDir::new("img-exr");
+        write_exr(&dir.path("hdr.exr"), 3, 2, |x, y| {
+            [x as f32 * 2.5, y as f32 + 0.25, 7.0, 0.5]
+        });
+        let t = tex(&dir, r#"(file: "hdr.exr", filter: nearest)"#);
+        let c = |x: u32, y: u32| [(x as f32 + 0.5) / 3.0, 1.0 - (y as f32 + 0.5) / 2.0];
+        assert_eq!(at_uv(&t, c(2, 1), 0.0), [5.0, 1.25, 7.0, 0.5]);
+        assert_eq!(at_uv(&t, c(0, 0), 0.0), [0.0, 0.25, 7.0, 0.5]);
+        // srgb does not touch float data.
+        let t = tex(&dir, r#"(file: "hdr.exr", filter: nearest, srgb: true)"#);
+        assert_eq!(at_uv(&t, c(1, 0), 0.0), [2.5, 0.25, 7.0, 0.5]);
+        // MIP levels of a 3×2 image: level 1 is 1×1, the mean.
+        let t = tex(&dir, r#"(file: "hdr.exr", wrap: clamp)"#);
+        let m = at_uv(&t, [0.5, 0.5], 2.0);
+        assert!(close(m, [2.5, 0.75, 7.0, 0.5], 1e-5), "{m:?}");
+    }
+
+    #[test]
+    fn other_formats_decode() {
+        let dir = TempDir::new("img-formats");
+        let img = image::RgbImage::from_fn(2, 2, |x, _| {
+            image::Rgb([if x == 0 { 0 } else { 255 }, 128, 0])
+        });
+        for ext in ["ppm", "tga"] {
+            let p = dir.path(&format!("t.{ext}"));
+            img.save(&p).unwrap();
+            let t = tex(&dir, &format!(r#"(file: "t.{ext}", filter: nearest)"#));
+            assert_eq!(at_uv(&t, [0.75, 0.75], 0.0), [1.0, lin(128), 0.0, 1.0], "{ext}");
+            assert_eq!(at_uv(&t, [0.25, 0.25], 0.0), [0.0, lin(128), 0.0, 1.0], "{ext}");
+        }
+        // JPEG is lossy: one flat colour, loose tolerance.
+        let flat = image::RgbImage::from_pixel(8, 8, image::Rgb([200, 128, 30]));
+        flat.save(dir.path("t.jpg")).unwrap();
+        let t = tex(&dir, r#"(file: "t.jpg", filter: nearest)"#);
+        let c = at_uv(&t, [0.5, 0.5], 0.0);
+        assert!(close(c, [lin(200), lin(128), lin(30), 1.0], 0.02), "{c:?}");
+    }
+
+    #[test]
+    fn create_time_errors() {
+        let dir = TempDir::new("img-errors");
+        fixture(&dir);
+        let err = |params: &str| make_in::<ImageTexture>(params, &ctx_in(dir.dir())).err().unwrap().message;
+        let e = err(r#"(file: "missing.png")"#);
+        let resolved = dir.path("missing.png");
+        assert!(e.contains(&format!("`{}` not found", resolved.display())), "{e}");
+        std::fs::write(dir.path("notes.png"), "not an image at all").unwrap();
+        let e = err(r#"(file: "notes.png")"#);
+        assert!(e.contains("cannot read image") || e.contains("not in a recognised format"), "{e}");
+        std::fs::write(dir.path("notes.txt"), "plain text").unwrap();
+        let e = err(r#"(file: "notes.txt")"#);
+        assert!(e.contains("not in a recognised format"), "{e}");
+        // A GIF header: recognised, but not a supported format.
+        std::fs::write(dir.path("anim.gif"), b"GIF89a\x01\x00\x01\x00\x00\x00\x00").unwrap();
+        let e = err(r#"(file: "anim.gif")"#);
+        assert!(e.contains("not supported"), "{e}");
+        let e = err(r#"(file: "ramp.png", wrap: tile)"#);
+        assert!(e.contains("tile"), "{e}");
+        let e = err(r#"(file: "ramp.png", filter: cubic)"#);
+        assert!(e.contains("cubic"), "{e}");
+        let e = err(r#"(file: "ramp.png", scale: (1, 0))"#);
+        assert!(e.contains("`scale`"), "{e}");
+        let e = err(r#"(file: "ramp.png", center: (1, 0, 0))"#);
+        assert!(e.contains("`center` has no effect"), "{e}");
+        let e = err(r#"(file: "ramp.png", mapping: planar, axis: (0, 0, 0))"#);
+        assert!(e.contains("`axis`"), "{e}");
+        let e = err(r#"(fiel: "ramp.png")"#);
+        assert!(e.contains("did you mean `file`"), "{e}");
+        let e = err(r#"(file: "")"#);
+        assert!(e.contains("`file`"), "{e}");
+    }
+
+    #[test]
+    fn decode_failure_on_first_use_is_magenta() {
+        let dir = TempDir::new("img-corrupt");
+        fixture(&dir);
+        let seen = Arc::new(Mutex::new(Vec::<String>::new()));
+        let s = seen.clone();
+        let cache = Arc::new(Cache::new(0, Box::new(move |_, m| s.lock().unwrap().push(m.into()))));
+        let p: ImageParams = luxon_plugin::parse_params(r#"(file: "ramp.png")"#).unwrap();
+        let t = ImageTexture::create_in(p, &ctx_in(dir.dir()), cache).unwrap();
+        // Corrupt the data after create (header intact).
+        let bytes = std::fs::read(dir.path("ramp.png")).unwrap();
+        let mut bad = bytes[..33].to_vec();
+        bad.extend_from_slice(&[0, 0, 0, 10, b'I', b'D', b'A', b'T', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0]);
+        std::fs::write(dir.path("ramp.png"), bad).unwrap();
+        assert_eq!(at_uv(&t, [0.5, 0.5], 0.0), MAGENTA);
+        assert_eq!(at_uv(&t, [0.1, 0.5], 0.0), MAGENTA);
+        assert_eq!(seen.lock().unwrap().len(), 1, "{:?}", seen.lock().unwrap());
+    }
+
+    #[test]
+    fn instances_share_one_cached_image() {
+        let dir = TempDir::new("img-share");
+        fixture(&dir);
+        let cache = Arc::new(Cache::new(0, quiet()));
+        let mk = |params: &str| {
+            let p: ImageParams = luxon_plugin::parse_params(params).unwrap();
+            ImageTexture::create_in(p, &ctx_in(dir.dir()), cache.clone()).unwrap()
+        };
+        let a = mk(r#"(file: "ramp.png", filter: nearest)"#);
+        let b = mk(r#"(file: "ramp.png", mapping: planar)"#);
+        assert!(Arc::ptr_eq(&a.image, &b.image));
+        at_uv(&a, [0.5, 0.5], 0.0);
+        at(&b, [0.5, 0.0, -0.5]);
+        assert_eq!(cache.stats().decodes, 1);
+        drop(a);
+        assert!(cache.stats().resident > 0);
+        drop(b);
+        assert_eq!(cache.stats().resident, 0, "the last instance frees the texels");
+    }
+}

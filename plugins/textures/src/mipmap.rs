@@ -1,0 +1,376 @@
+//! Texel storage, MIP pyramids and filtered lookups.
+//!
+//! A [`Level`] is linear RGBA `f32`, rows top to bottom. Texture coordinates `(s, t)` put
+//! `(0, 0)` at the bottom-left corner of the image and `(1, 1)` at the top-right, so texel
+//! `(x, y)` (column, row from the top) covers `s ∈ [x/w, (x+1)/w)`, `t ∈ (1 - (y+1)/h, 1 - y/h]`
+//! and its centre is `((x + 0.5)/w, 1 - (y + 0.5)/h)`.
+//!
+//! Level `i + 1` has `max(1, ⌊w/2⌋) × max(1, ⌊h/2⌋)` texels. Each of its texels is the exact
+//! area average of the texels of level `i` it covers: for an even size that is a 2×2 box; for
+//! an odd size `2n + 1` each output texel covers `2 + 1/n` source texels and the three it
+//! touches are weighted by their overlap, so every level keeps the image's mean.
+
+use serde::Deserialize;
+
+/// One MIP level.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<[f32; 4]>,
+}
+
+impl Level {
+    pub fn new(width: usize, height: usize, texels: Vec<[f32; 4]>) -> Level {
+        assert_eq!(texels.len(), width * height, "texel count");
+        assert!(width > 0 && height > 0, "empty level");
+        Level {
+            width,
+            height,
+            texels,
+        }
+    }
+
+    /// Bytes of texel data.
+    pub fn bytes(&self) -> usize {
+        self.texels.len() * std::mem::size_of::<[f32; 4]>()
+    }
+
+    fn at(&self, x: usize, y: usize) -> [f32; 4] {
+        self.texels[y * self.width + x]
+    }
+}
+
+/// Sizes of every level of a `width × height` image, finest first, down to 1×1.
+pub fn level_sizes(width: usize, height: usize) -> Vec<(usize, usize)> {
+    let mut sizes = vec![(width.max(1), height.max(1))];
+    while let Some(&(w, h)) = sizes.last() {
+        if w == 1 && h == 1 {
+            break;
+        }
+        sizes.push(((w / 2).max(1), (h / 2).max(1)));
+    }
+    sizes
+}
+
+/// Reduces a line of `n` samples (read through `get`) to `max(1, n/2)` area averages.
+fn reduce_line(n: usize, get: impl Fn(usize) -> [f32; 4], mut put: impl FnMut(usize, [f32; 4])) {
+    let m = (n / 2).max(1);
+    let add = |acc: &mut [f32; 4], w: f32, v: [f32; 4]| {
+        for c in 0..4 {
+            acc[c] += w * v[c];
+        }
+    };
+    for x in 0..m {
+        let mut acc = [0.0f32; 4];
+        if n == 1 {
+            acc = get(0);
+        } else if n % 2 == 0 {
+            add(&mut acc, 0.5, get(2 * x));
+            add(&mut acc, 0.5, get(2 * x + 1));
+        } else {
+            let nf = n as f32;
+            add(&mut acc, (m - x) as f32 / nf, get(2 * x));
+            add(&mut acc, m as f32 / nf, get(2 * x + 1));
+            add(&mut acc, (x + 1) as f32 / nf, get(2 * x + 2));
+        }
+        put(x, acc);
+    }
+}
+
+/// The next coarser level (separable: rows first, then columns).
+pub fn downsample(src: &Level) -> Level {
+    let (w, h) = (src.width, src.height);
+    let (mw, mh) = ((w / 2).max(1), (h / 2).max(1));
+    let mut rows = vec![[0.0f32; 4]; mw * h];
+    for y in 0..h {
+        reduce_line(w, |x| src.at(x, y), |x, v| rows[y * mw + x] = v);
+    }
+    let mut out = vec![[0.0f32; 4]; mw * mh];
+    for x in 0..mw {
+        reduce_line(h, |y| rows[y * mw + x], |y, v| out[y * mw + x] = v);
+    }
+    Level::new(mw, mh, out)
+}
+
+/// Every level, finest (the image itself) first.
+pub fn build_pyramid(base: Level) -> Vec<Level> {
+    let mut levels = vec![base];
+    loop {
+        let last = levels.last().expect("at least the base");
+        if last.width == 1 && last.height == 1 {
+            return levels;
+        }
+        let next = downsample(last);
+        levels.push(next);
+    }
+}
+
+/// What a lookup outside [0, 1) does.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum Wrap {
+    /// Tile the image (modulo).
+    #[default]
+    #[serde(rename = "repeat", alias = "Repeat")]
+    Repeat,
+    /// Extend the edge texels.
+    #[serde(rename = "clamp", alias = "Clamp")]
+    Clamp,
+    /// Tile with every other copy mirrored, so edges meet seamlessly.
+    #[serde(rename = "mirror", alias = "Mirror")]
+    Mirror,
+}
+
+/// Texel index `i` on an axis of `n` texels under `wrap`.
+pub fn wrap_index(i: i64, n: usize, wrap: Wrap) -> usize {
+    let n = n as i64;
+    (match wrap {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::Clamp => i.clamp(0, n - 1),
+        Wrap::Mirror => {
+            let k = i.rem_euclid(2 * n);
+            if k < n {
+                k
+            } else {
+                2 * n - 1 - k
+            }
+        }
+    }) as usize
+}
+
+/// Continuous texel coordinates of `(s, t)` on `level` (texel centres at integers + 0.5);
+/// non-finite coordinates become 0.
+fn texel_coords(level: &Level, s: f64, t: f64) -> (f64, f64) {
+    let s = if s.is_finite() { s } else { 0.0 };
+    let t = if t.is_finite() { t } else { 0.0 };
+    (s * level.width as f64, (1.0 - t) * level.height as f64)
+}
+
+/// The texel containing `(s, t)`.
+pub fn nearest(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
+    let (x, y) = texel_coords(level, s, t);
+    // `as` saturates, so far-away coordinates cannot overflow.
+    let xi = wrap_index(x.floor() as i64, level.width, wrap);
+    let yi = wrap_index(y.floor() as i64, level.height, wrap);
+    level.at(xi, yi)
+}
+
+/// Bilinear interpolation between the four texel centres around `(s, t)`.
+pub fn bilinear(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
+    let (x, y) = texel_coords(level, s, t);
+    let (x, y) = (x - 0.5, y - 0.5);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let xa = wrap_index(x0, level.width, wrap);
+    let xb = wrap_index(x0.saturating_add(1), level.width, wrap);
+    let ya = wrap_index(y0, level.height, wrap);
+    let yb = wrap_index(y0.saturating_add(1), level.height, wrap);
+    let (p00, p10, p01, p11) = (
+        level.at(xa, ya),
+        level.at(xb, ya),
+        level.at(xa, yb),
+        level.at(xb, yb),
+    );
+    std::array::from_fn(|c| {
+        let top = p00[c] + (p10[c] - p00[c]) * fx;
+        let bottom = p01[c] + (p11[c] - p01[c]) * fx;
+        top + (bottom - top) * fy
+    })
+}
+
+/// The continuous MIP level for a footprint `texels` wide on level 0: `log2(texels)`, clamped
+/// to `[0, levels - 1]` (a footprint of at most one texel, or 0, is level 0).
+pub fn mip_level(texels: f64, levels: usize) -> f64 {
+    if texels.is_nan() || texels <= 1.0 {
+        return 0.0;
+    }
+    texels.log2().min(levels.saturating_sub(1) as f64)
+}
+
+/// Which two levels a continuous level falls between, and the weight of the coarser one.
+pub fn level_pair(level: f64, levels: usize) -> (usize, usize, f32) {
+    let lo = (level.floor() as usize).min(levels - 1);
+    let hi = (lo + 1).min(levels - 1);
+    let f = if hi == lo { 0.0 } else { (level - lo as f64) as f32 };
+    (lo, hi, f)
+}
+
+/// Trilinear: bilinear on two adjacent levels, blended by `f` (the weight of `b`).
+pub fn trilinear(a: &Level, b: &Level, f: f32, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
+    let ca = bilinear(a, s, t, wrap);
+    if f <= 0.0 {
+        return ca;
+    }
+    let cb = bilinear(b, s, t, wrap);
+    std::array::from_fn(|c| ca[c] + (cb[c] - ca[c]) * f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grey(v: f32) -> [f32; 4] {
+        [v, v, v, 1.0]
+    }
+
+    /// A `w × h` level whose texel (x, y) is grey `x + 10 y`.
+    fn ramp(w: usize, h: usize) -> Level {
+        let t = (0..h)
+            .flat_map(|y| (0..w).map(move |x| grey((x + 10 * y) as f32)))
+            .collect();
+        Level::new(w, h, t)
+    }
+
+    fn centre(l: &Level, x: usize, y: usize) -> (f64, f64) {
+        (
+            (x as f64 + 0.5) / l.width as f64,
+            1.0 - (y as f64 + 0.5) / l.height as f64,
+        )
+    }
+
+    fn mean(l: &Level) -> f64 {
+        l.texels.iter().map(|t| t[0] as f64).sum::<f64>() / l.texels.len() as f64
+    }
+
+    #[test]
+    fn sizes_handle_non_powers_of_two() {
+        assert_eq!(level_sizes(8, 8), [(8, 8), (4, 4), (2, 2), (1, 1)]);
+        assert_eq!(
+            level_sizes(5, 3),
+            [(5, 3), (2, 1), (1, 1)],
+            "odd sizes round down"
+        );
+        assert_eq!(
+            level_sizes(7, 1),
+            [(7, 1), (3, 1), (1, 1)],
+            "a 1-texel axis stays 1"
+        );
+        assert_eq!(level_sizes(1, 1), [(1, 1)]);
+    }
+
+    #[test]
+    fn even_levels_are_2x2_boxes() {
+        let l1 = downsample(&ramp(4, 2));
+        assert_eq!((l1.width, l1.height), (2, 1));
+        // (0 + 1 + 10 + 11) / 4 and (2 + 3 + 12 + 13) / 4.
+        assert_eq!(l1.texels, [grey(5.5), grey(7.5)]);
+    }
+
+    #[test]
+    fn pyramid_of_a_non_power_of_two_image() {
+        let base = ramp(5, 3);
+        let m0 = mean(&base);
+        let p = build_pyramid(base);
+        assert_eq!(p.len(), 3);
+        assert_eq!((p[1].width, p[1].height), (2, 1));
+        assert_eq!((p[2].width, p[2].height), (1, 1));
+        // Level 1, texel 0: columns 0, 1, 2 weighted 2/5, 2/5, 1/5, of rows averaged 1/3 each.
+        // Row means of column x are x + 10; so (0.4·10 + 0.4·11 + 0.2·12) = 10.8.
+        assert!((p[1].texels[0][0] - 10.8).abs() < 1e-5, "{:?}", p[1].texels);
+        // Texel 1: columns 2, 3, 4 weighted 1/5, 2/5, 2/5: 0.2·12 + 0.4·13 + 0.4·14 = 13.2.
+        assert!((p[1].texels[1][0] - 13.2).abs() < 1e-5, "{:?}", p[1].texels);
+        // The mean survives every level; the last texel is the image's mean.
+        for l in &p {
+            assert!((mean(l) - m0).abs() < 1e-4, "{} vs {m0}", mean(l));
+        }
+        assert!((p[2].texels[0][0] as f64 - m0).abs() < 1e-4);
+        assert!(p.iter().all(|l| l.texels.iter().all(|t| t[3] == 1.0)));
+    }
+
+    #[test]
+    fn nearest_and_bilinear_at_centres_and_between() {
+        let l = ramp(4, 3);
+        for y in 0..3 {
+            for x in 0..4 {
+                let (s, t) = centre(&l, x, y);
+                let want = grey((x + 10 * y) as f32);
+                assert_eq!(nearest(&l, s, t, Wrap::Clamp), want);
+                assert_eq!(bilinear(&l, s, t, Wrap::Clamp), want);
+            }
+        }
+        // Half-way between the centres of (1, 1) and (2, 1): bilinear averages, nearest picks.
+        let s = 2.0 / 4.0;
+        let t = 1.0 - 1.5 / 3.0;
+        assert_eq!(bilinear(&l, s, t, Wrap::Clamp), grey(11.5));
+        assert_eq!(nearest(&l, s, t, Wrap::Clamp), grey(12.0));
+        // A quarter of the way towards (2, 2) as well: 11 + 0.5 + 0.25·10.
+        let t = 1.0 - 1.75 / 3.0;
+        let v = bilinear(&l, s, t, Wrap::Clamp)[0];
+        assert!((v - 14.0).abs() < 1e-5, "{v}");
+        assert_eq!(nearest(&l, 0.01, 0.99, Wrap::Clamp), grey(0.0));
+        assert_eq!(nearest(&l, 0.99, 0.01, Wrap::Clamp), grey(23.0));
+    }
+
+    #[test]
+    fn wrap_modes() {
+        assert_eq!(
+            (-3..7).map(|i| wrap_index(i, 4, Wrap::Repeat)).collect::<Vec<_>>(),
+            [1, 2, 3, 0, 1, 2, 3, 0, 1, 2]
+        );
+        assert_eq!(
+            (-3..7).map(|i| wrap_index(i, 4, Wrap::Clamp)).collect::<Vec<_>>(),
+            [0, 0, 0, 0, 1, 2, 3, 3, 3, 3]
+        );
+        assert_eq!(
+            (-3..9).map(|i| wrap_index(i, 4, Wrap::Mirror)).collect::<Vec<_>>(),
+            [2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]
+        );
+        let l = ramp(4, 1);
+        // s = 1.1 is texel 4.4: repeat -> 0, clamp -> 3, mirror -> 3.
+        assert_eq!(nearest(&l, 1.1, 0.5, Wrap::Repeat), grey(0.0));
+        assert_eq!(nearest(&l, 1.1, 0.5, Wrap::Clamp), grey(3.0));
+        assert_eq!(nearest(&l, 1.1, 0.5, Wrap::Mirror), grey(3.0));
+        // s = 1.3 is texel 5.2: repeat -> 1, clamp -> 3, mirror -> 2.
+        assert_eq!(nearest(&l, 1.3, 0.5, Wrap::Repeat), grey(1.0));
+        assert_eq!(nearest(&l, 1.3, 0.5, Wrap::Mirror), grey(2.0));
+        // s = -0.2 is texel -0.8: repeat -> 3, clamp -> 0, mirror -> 0.
+        assert_eq!(nearest(&l, -0.2, 0.5, Wrap::Repeat), grey(3.0));
+        assert_eq!(nearest(&l, -0.2, 0.5, Wrap::Clamp), grey(0.0));
+        assert_eq!(nearest(&l, -0.2, 0.5, Wrap::Mirror), grey(0.0));
+        // Bilinear across the seam at s = 0 (between texel centres 3 and 0):
+        // repeat blends the last and first texels, clamp holds the edge.
+        assert_eq!(bilinear(&l, 0.0, 0.5, Wrap::Repeat), grey(1.5));
+        assert_eq!(bilinear(&l, 0.0, 0.5, Wrap::Clamp), grey(0.0));
+        assert_eq!(bilinear(&l, 0.0, 0.5, Wrap::Mirror), grey(0.0));
+        // Far away and non-finite coordinates do not panic.
+        let _ = bilinear(&l, 1e300, -1e300, Wrap::Repeat);
+        let _ = nearest(&l, f64::NAN, f64::INFINITY, Wrap::Mirror);
+    }
+
+    #[test]
+    fn level_selection_from_footprint() {
+        assert_eq!(mip_level(0.0, 7), 0.0, "footprint 0 is level 0");
+        assert_eq!(mip_level(0.5, 7), 0.0);
+        assert_eq!(mip_level(1.0, 7), 0.0);
+        assert_eq!(mip_level(2.0, 7), 1.0);
+        assert_eq!(mip_level(4.0, 7), 2.0, "4 texels is level 2");
+        assert!((mip_level(6.0, 7) - 6f64.log2()).abs() < 1e-12);
+        assert_eq!(mip_level(1e9, 7), 6.0, "clamped to the last level");
+        assert_eq!(mip_level(f64::NAN, 7), 0.0);
+        assert_eq!(level_pair(2.0, 7), (2, 3, 0.0));
+        assert_eq!(level_pair(2.25, 7), (2, 3, 0.25));
+        assert_eq!(level_pair(6.0, 7), (6, 6, 0.0));
+    }
+
+    #[test]
+    fn trilinear_blends_between_levels() {
+        // Level k filled with the value k: the result is the continuous level itself.
+        let sizes = level_sizes(64, 64);
+        let levels: Vec<Level> = sizes
+            .iter()
+            .enumerate()
+            .map(|(k, &(w, h))| Level::new(w, h, vec![grey(k as f32); w * h]))
+            .collect();
+        for texels in [0.0, 1.0, 3.0, 4.0, 6.0, 11.0, 64.0, 1000.0] {
+            let lambda = mip_level(texels, levels.len());
+            let (lo, hi, f) = level_pair(lambda, levels.len());
+            let v = trilinear(&levels[lo], &levels[hi], f, 0.3, 0.6, Wrap::Repeat)[0];
+            assert!((v as f64 - lambda).abs() < 1e-6, "{texels}: {v} vs {lambda}");
+        }
+        // 6 texels: between level 2 and 3, 58.5 % of the way.
+        let (lo, hi, f) = level_pair(mip_level(6.0, levels.len()), levels.len());
+        assert_eq!((lo, hi), (2, 3));
+        assert!((f - 0.585).abs() < 1e-3);
+    }
+}

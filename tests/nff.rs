@@ -1,0 +1,254 @@
+//! NFF scenes rendered end to end: `luxon render FILE.nff` works directly, and every shared SPD
+//! scene looks like POV-Ray's picture of it (SSIM >= 0.6 against `../shared/spd/reference`).
+//!
+//! The renders are 256x256 in debug builds (compared with the reference averaged down 2x2)
+//! and 512x512 in release builds. Set `LUXON_NFF_OUT=DIR` to keep each render next to its
+//! reference as `DIR/NAME.png` (ours left, POV-Ray's right).
+
+mod common;
+
+use common::*;
+use std::path::{Path, PathBuf};
+
+/// SSIM (Wang, Bovik, Sheikh & Simoncelli 2004) on grayscale images: an 11x11 Gaussian window
+/// (sigma 1.5), C1 = (0.01 L)^2, C2 = (0.03 L)^2 with L = 255, averaged over every window that
+/// fits in the image.
+mod ssim {
+    /// Rec. 601 luma of 8-bit RGB.
+    pub fn gray(rgb: &[u8]) -> Vec<f64> {
+        rgb.chunks_exact(3)
+            .map(|p| 0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64)
+            .collect()
+    }
+
+    /// Halves a grayscale image by averaging 2x2 blocks.
+    pub fn half(img: &[f64], w: usize, h: usize) -> Vec<f64> {
+        let (w2, h2) = (w / 2, h / 2);
+        let mut out = vec![0.0; w2 * h2];
+        for y in 0..h2 {
+            for x in 0..w2 {
+                let p = |dx: usize, dy: usize| img[(2 * y + dy) * w + 2 * x + dx];
+                out[y * w2 + x] = (p(0, 0) + p(1, 0) + p(0, 1) + p(1, 1)) / 4.0;
+            }
+        }
+        out
+    }
+
+    /// Mirrors a grayscale image left to right.
+    pub fn mirror(img: &[f64], w: usize) -> Vec<f64> {
+        img.chunks_exact(w)
+            .flat_map(|row| row.iter().rev().copied())
+            .collect()
+    }
+
+    const N: usize = 11;
+
+    fn window() -> [f64; N] {
+        let mut g = [0.0; N];
+        let c = (N - 1) as f64 / 2.0;
+        for (i, v) in g.iter_mut().enumerate() {
+            let d = i as f64 - c;
+            *v = (-d * d / (2.0 * 1.5 * 1.5)).exp();
+        }
+        let sum: f64 = g.iter().sum();
+        g.map(|v| v / sum)
+    }
+
+    /// The image filtered by the (separable) window, "valid" part only: (w-N+1) x (h-N+1).
+    fn filter(img: &[f64], w: usize, h: usize, g: &[f64; N]) -> Vec<f64> {
+        let (ow, oh) = (w - N + 1, h - N + 1);
+        let mut rows = vec![0.0; ow * h];
+        for y in 0..h {
+            for x in 0..ow {
+                rows[y * ow + x] = (0..N).map(|k| g[k] * img[y * w + x + k]).sum();
+            }
+        }
+        let mut out = vec![0.0; ow * oh];
+        for y in 0..oh {
+            for x in 0..ow {
+                out[y * ow + x] = (0..N).map(|k| g[k] * rows[(y + k) * ow + x]).sum();
+            }
+        }
+        out
+    }
+
+    /// Mean SSIM of two grayscale images (0..=255) of `w` x `h`.
+    pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize) -> f64 {
+        assert_eq!(a.len(), w * h);
+        assert_eq!(b.len(), w * h);
+        assert!(w >= N && h >= N, "images smaller than the window");
+        let g = window();
+        let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
+        let prod = |x: &[f64], y: &[f64]| -> Vec<f64> { x.iter().zip(y).map(|(p, q)| p * q).collect() };
+        let ma = filter(a, w, h, &g);
+        let mb = filter(b, w, h, &g);
+        let saa = filter(&prod(a, a), w, h, &g);
+        let sbb = filter(&prod(b, b), w, h, &g);
+        let sab = filter(&prod(a, b), w, h, &g);
+        let mut total = 0.0;
+        for i in 0..ma.len() {
+            let (mx, my) = (ma[i], mb[i]);
+            let vx = saa[i] - mx * mx;
+            let vy = sbb[i] - my * my;
+            let cov = sab[i] - mx * my;
+            total += ((2.0 * mx * my + c1) * (2.0 * cov + c2))
+                / ((mx * mx + my * my + c1) * (vx + vy + c2));
+        }
+        total / ma.len() as f64
+    }
+}
+
+#[test]
+fn ssim_behaves() {
+    let (w, h) = (64, 48);
+    // A structured picture: a gradient with a bright disc off centre.
+    let img: Vec<f64> = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64, (i / w) as f64);
+            let d = ((x - 20.0).powi(2) + (y - 20.0).powi(2)).sqrt();
+            if d < 10.0 {
+                230.0
+            } else {
+                2.0 * x + y
+            }
+        })
+        .collect();
+    assert!((ssim::ssim(&img, &img, w, h) - 1.0).abs() < 1e-12);
+    let mirrored = ssim::mirror(&img, w);
+    let s_mirror = ssim::ssim(&img, &mirrored, w, h);
+    assert!(s_mirror < 0.9, "mirroring must show: {s_mirror}");
+    // Mild noise costs less than the wrong orientation.
+    let mut seed = 1u32;
+    let noisy: Vec<f64> = img
+        .iter()
+        .map(|v| {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (v + (seed >> 24) as f64 / 64.0 - 2.0).clamp(0.0, 255.0)
+        })
+        .collect();
+    let s_noise = ssim::ssim(&img, &noisy, w, h);
+    assert!(s_noise > s_mirror && s_noise < 1.0, "{s_noise} vs {s_mirror}");
+    // Symmetric.
+    assert!((ssim::ssim(&noisy, &img, w, h) - s_noise).abs() < 1e-12);
+    // Constant images: equal gives 1, a different constant less.
+    let a = vec![100.0; w * h];
+    let b = vec![150.0; w * h];
+    assert!((ssim::ssim(&a, &a, w, h) - 1.0).abs() < 1e-12);
+    assert!(ssim::ssim(&a, &b, w, h) < 0.95);
+    assert_eq!(ssim::half(&img, w, h).len(), w * h / 4);
+}
+
+fn shared() -> Option<PathBuf> {
+    let d = root().join("../shared/spd");
+    d.is_dir().then_some(d)
+}
+
+/// Grayscale of a reference PNG at `size` (512 or 256).
+fn reference(path: &Path, size: usize) -> Vec<f64> {
+    let img = image::open(path).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (512, 512), "{}", path.display());
+    let g = ssim::gray(img.as_raw());
+    if size == 512 {
+        g
+    } else {
+        ssim::half(&g, 512, 512)
+    }
+}
+
+/// Saves ours and the reference side by side (8-bit RGB).
+fn save_side_by_side(dir: &Path, name: &str, ours: &[u8], size: u32, reference: &Path) {
+    let r = image::imageops::resize(
+        &image::open(reference).unwrap().to_rgb8(),
+        size,
+        size,
+        image::imageops::FilterType::Triangle,
+    );
+    let mut out = image::RgbImage::new(size * 2, size);
+    for y in 0..size {
+        for x in 0..size {
+            let i = ((y * size + x) * 3) as usize;
+            out.put_pixel(x, y, image::Rgb([ours[i], ours[i + 1], ours[i + 2]]));
+            out.put_pixel(x + size, y, *r.get_pixel(x, y));
+        }
+    }
+    std::fs::create_dir_all(dir).unwrap();
+    out.save(dir.join(format!("{name}.png"))).unwrap();
+}
+
+#[test]
+fn spd_scenes_look_like_pov_ray() {
+    let Some(dir) = shared() else {
+        eprintln!("note: ../shared/spd is absent; skipping the SSIM comparison with POV-Ray");
+        return;
+    };
+    let size: u32 = if cfg!(debug_assertions) { 256 } else { 512 };
+    let keep = std::env::var_os("LUXON_NFF_OUT").map(PathBuf::from);
+    let names = [
+        "balls4", "balls5", "gears", "lattice", "mount", "rings", "teapot6", "teapot12",
+        "teapot48", "tetra", "tree",
+    ];
+    let mut failed = Vec::new();
+    for name in names {
+        let scene = dir.join(format!("{name}.nff.gz"));
+        let fb = render_with(&scene, |d| {
+            d.render.width = size;
+            d.render.height = size;
+        });
+        let rgb = to_srgb8(&fb);
+        let refpath = dir.join(format!("reference/{name}.png"));
+        let ours = ssim::gray(&rgb);
+        let theirs = reference(&refpath, size as usize);
+        let s = ssim::ssim(&ours, &theirs, size as usize, size as usize);
+        let s_mirror = ssim::ssim(
+            &ssim::mirror(&ours, size as usize),
+            &theirs,
+            size as usize,
+            size as usize,
+        );
+        println!("{name:9} {size}x{size}  SSIM {s:.3}  (mirrored {s_mirror:.3})");
+        if let Some(k) = &keep {
+            save_side_by_side(k, name, &rgb, size, &refpath);
+        }
+        if s < 0.6 || s <= s_mirror {
+            failed.push(format!("{name}: SSIM {s:.3}, mirrored {s_mirror:.3}"));
+        }
+    }
+    assert!(failed.is_empty(), "unlike POV-Ray's pictures: {failed:?}");
+}
+
+const SMALL: &str = "# a small NFF scene\n\
+v\nfrom 0 -6 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\nresolution 64 48\n\
+b 0.2 0.3 0.6\nl 4 -4 6\nl -4 -2 5 0.5 0.5 0.5\n\
+f 1 0.8 0.3 0.8 0 1 0 1\np 4\n-3 -3 0\n3 -3 0\n3 3 0\n-3 3 0\n\
+f 0.9 0.2 0.2 0.6 0.4 30 0 0\ns 0 0 1 1\nc 1.5 0 0 0.3 1.5 0 2 0.3\n";
+
+#[test]
+fn luxon_renders_nff_directly() {
+    let dir = temp_dir("nff-cli");
+    let scene = dir.join("small.nff");
+    std::fs::write(&scene, SMALL).unwrap();
+    let out = dir.join("small.png");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (64, 48), "the NFF resolution");
+    // The red sphere is in the middle, the sky at the top.
+    let mid = img.get_pixel(32, 22);
+    assert!(mid[0] > 100 && mid[1] < mid[0] / 2, "sphere: {mid:?}");
+    let sky = img.get_pixel(32, 1);
+    assert!(sky[2] > sky[0] && sky[2] > 150, "background: {sky:?}");
+
+    // An error names file:line:col.
+    let bad = dir.join("bad.nff");
+    std::fs::write(&bad, SMALL.replace("s 0 0 1 1", "s 0 0 1")).unwrap();
+    let o = run(&["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("bad.nff:20:8:") && e.contains("takes 4 numbers"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
