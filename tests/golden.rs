@@ -83,3 +83,8 @@ fn torus_custom_primitive() {
 fn molecule_cylinders_cones_rings() {
     check("molecule");
 }
+
+#[test]
+fn every_texture_kind() {
+    check("textures");
+}

@@ -72,6 +72,31 @@ impl Whitted<'_> {
         media: &IorStack,
         c: &mut Counters,
     ) -> Vec3A {
+        self.trace(ray, depth, weight, media, 0.0, c)
+    }
+
+    /// Texture `t` at a surface point; a panicking plugin raises the scene's fault.
+    fn texture(&self, t: u32, q: &TexQuery) -> [f32; 4] {
+        let tex = &self.scene.textures[t as usize];
+        tex.eval(q).unwrap_or_else(|| {
+            let message = format!("plugin `{}` panicked evaluating a texture", tex.plugin);
+            self.scene.customs.fault.raise(message);
+            [0.0; 4]
+        })
+    }
+
+    /// `width` is the width of the ray's footprint at its origin: rays are traced as thin cones
+    /// (a pixel wide at the camera, widening by the pixel angle per unit of distance) so textures
+    /// know how much of them a pixel covers and can filter (MIP mapping).
+    fn trace(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        weight: f32,
+        media: &IorStack,
+        width: f32,
+        c: &mut Counters,
+    ) -> Vec3A {
         let scene = self.scene;
         let Some(hit) = scene.intersect(ray, f32::INFINITY, c) else {
             return scene.background;
@@ -80,6 +105,7 @@ impl Whitted<'_> {
         let mat = &scene.materials[s.material as usize];
         let features = scene.features;
         let settings = &scene.settings;
+        let footprint = width + scene.pixel_spread * hit.t;
 
         // Orient normals toward the viewer; remember which side was hit for media changes.
         let entering = s.ng.dot(ray.dir) < 0.0;
@@ -91,28 +117,33 @@ impl Whitted<'_> {
         }
 
         let mut base = mat.color;
-        if let (true, Some(t)) = (features.textures, mat.texture) {
+        let (mut kr, mut kt) = (mat.reflect, mat.transmit);
+        if features.textures {
             let q = TexQuery {
                 p: (s.p.as_dvec3() + scene.world_offset).into(),
                 n: n.into(),
                 uv: s.uv,
-                footprint: 0.0,
-                uv_footprint: 0.0,
+                footprint,
+                uv_footprint: footprint * s.uv_scale,
                 time: ray.time,
             };
-            match scene.textures[t as usize].eval(&q) {
-                Some(rgba) => base = Vec3A::new(rgba[0], rgba[1], rgba[2]),
-                None => scene.customs.fault.raise(format!(
-                    "plugin `{}` panicked evaluating a texture",
-                    scene.textures[t as usize].plugin
-                )),
+            let mean = |c: [f32; 4]| (c[0] + c[1] + c[2]) / 3.0;
+            if let Some(t) = mat.texture {
+                let rgba = self.texture(t, &q);
+                base = Vec3A::new(rgba[0], rgba[1], rgba[2]);
+            }
+            if let Some(t) = mat.reflect_texture {
+                kr *= mean(self.texture(t, &q)).clamp(0.0, 1.0);
+            }
+            if let Some(t) = mat.transmit_texture {
+                kt *= mean(self.texture(t, &q)).clamp(0.0, 1.0);
             }
         }
         if let Some(vc) = s.color {
             base *= vc;
         }
 
-        let opacity = 1.0 - mat.transmit;
+        let opacity = 1.0 - kt;
         let view = -ray.dir;
         let mut color = mat.ambient * opacity * base;
         for light in &scene.lights {
@@ -163,21 +194,21 @@ impl Whitted<'_> {
         }
 
         let next = depth + 1;
-        if features.reflection && mat.reflect > 0.0 {
-            let w = weight * mat.reflect;
+        if features.reflection && kr > 0.0 {
+            let w = weight * kr;
             if next > settings.max_depth {
-                color += mat.reflect * scene.background;
+                color += kr * scene.background;
             } else if w >= settings.min_weight {
                 c.reflection += 1;
                 let r = spawn(s.p, s.p_error, ng, reflect(ray.dir, n), ray.time);
-                color += mat.reflect * self.radiance(&r, next, w, media, c);
+                color += kr * self.trace(&r, next, w, media, footprint, c);
             }
         }
 
-        if features.transmission && mat.transmit > 0.0 {
-            let w = weight * mat.transmit;
+        if features.transmission && kt > 0.0 {
+            let w = weight * kt;
             if next > settings.max_depth {
-                color += mat.transmit * base * scene.background;
+                color += kt * base * scene.background;
             } else if w >= settings.min_weight {
                 // Which media are on each side of the surface.
                 let mut inside = *media;
@@ -197,7 +228,7 @@ impl Whitted<'_> {
                 c.refraction += 1;
                 let r = spawn(s.p, s.p_error, ng, dir, ray.time);
                 let stack = if through { &inside } else { media };
-                color += mat.transmit * base * self.radiance(&r, next, w, stack, c);
+                color += kt * base * self.trace(&r, next, w, stack, footprint, c);
             }
         }
         color

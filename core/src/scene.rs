@@ -22,6 +22,9 @@ use std::time::{Duration, Instant};
 pub struct Material {
     pub color: Vec3A,
     pub texture: Option<u32>,
+    /// Textures scaling `reflect` and `transmit` point by point.
+    pub reflect_texture: Option<u32>,
+    pub transmit_texture: Option<u32>,
     pub ambient: f32,
     pub diffuse: f32,
     pub specular: f32,
@@ -135,6 +138,8 @@ pub struct Scene {
     /// to it in f32, so a scene far from the world origin keeps its precision.
     pub world_offset: DVec3,
     pub settings: Settings,
+    /// Angle one pixel spans at the image centre (radians): how fast ray footprints widen.
+    pub pixel_spread: f32,
     pub outputs: Vec<OutputDesc>,
     pub features: Features,
     /// Objects per plugin name, in first-use order.
@@ -202,19 +207,23 @@ impl Scene {
         }
 
         let mut material_names = vec!["default".to_string()];
-        let mut materials = vec![material(&Default::default(), None)];
+        let mut materials = vec![material(&Default::default(), [None; 3])];
         for (name, m) in &desc.materials {
-            let tex = match &m.value.texture {
-                Some(t) => Some(
-                    texture_names
+            let find = |t: &Option<luxon_formats::Spanned<String>>| -> Result<Option<u32>, Error> {
+                match t {
+                    Some(t) => texture_names
                         .iter()
                         .position(|n| n == &t.value)
-                        .ok_or_else(|| {
-                            Error::at(&t.at, format!("no texture named `{}`", t.value))
-                        })? as u32,
-                ),
-                None => None,
+                        .map(|i| Some(i as u32))
+                        .ok_or_else(|| Error::at(&t.at, format!("no texture named `{}`", t.value))),
+                    None => Ok(None),
+                }
             };
+            let tex = [
+                find(&m.value.texture)?,
+                find(&m.value.reflect_texture)?,
+                find(&m.value.transmit_texture)?,
+            ];
             let mat = material(&m.value, tex);
             if let Some(i) = material_names.iter().position(|n| n == name) {
                 materials[i] = mat;
@@ -365,7 +374,12 @@ impl Scene {
             shadows: has_geometry && lights.iter().any(Light::casts_shadows),
             reflection: used_mats.iter().any(|m| m.reflect > 0.0),
             transmission: used_mats.iter().any(|m| m.transmit > 0.0),
-            textures: used_mats.iter().any(|m| m.texture.is_some()),
+            textures: used_mats.iter().any(|m| {
+                m.texture
+                    .or(m.reflect_texture)
+                    .or(m.transmit_texture)
+                    .is_some()
+            }),
             antialiasing: r.samples > 1,
         };
 
@@ -383,9 +397,11 @@ impl Scene {
             decomposition: r.parallel.decomposition,
             io: r.parallel.io,
         };
+        let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
         Ok(Scene {
             source: desc.source.clone(),
-            camera: Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height),
+            camera: camera.clone(),
+            pixel_spread: 2.0 * camera.up.length() / r.height as f32,
             background: v3(desc.background),
             lights,
             materials,
@@ -483,10 +499,13 @@ impl Scene {
     }
 }
 
-fn material(m: &luxon_formats::MaterialDesc, texture: Option<u32>) -> Material {
+/// `textures`: the material's colour, reflect and transmit textures.
+fn material(m: &luxon_formats::MaterialDesc, textures: [Option<u32>; 3]) -> Material {
     Material {
         color: v3(m.color),
-        texture,
+        texture: textures[0],
+        reflect_texture: textures[1],
+        transmit_texture: textures[2],
         ambient: m.ambient as f32,
         diffuse: m.diffuse as f32,
         specular: m.specular as f32,

@@ -257,6 +257,12 @@ impl Checker<'_> {
                 None => d.color,
             },
             texture: m.texture.map(|t| self.spanned(t, field("texture"))),
+            reflect_texture: m
+                .reflect_texture
+                .map(|t| self.spanned(t, field("reflect_texture"))),
+            transmit_texture: m
+                .transmit_texture
+                .map(|t| self.spanned(t, field("transmit_texture"))),
             ambient: coefficient("ambient", m.ambient, d.ambient, inf)?,
             diffuse: coefficient("diffuse", m.diffuse, d.diffuse, inf)?,
             specular: coefficient("specular", m.specular, d.specular, inf)?,

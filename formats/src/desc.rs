@@ -109,6 +109,10 @@ pub struct MaterialDesc {
     pub color: [f64; 3],
     /// Name of a texture that replaces `color`.
     pub texture: Option<Spanned<String>>,
+    /// Name of a texture whose mean of R, G, B scales `reflect` at each point.
+    pub reflect_texture: Option<Spanned<String>>,
+    /// Name of a texture whose mean of R, G, B scales `transmit` at each point.
+    pub transmit_texture: Option<Spanned<String>>,
     pub ambient: f64,
     pub diffuse: f64,
     pub specular: f64,
@@ -128,6 +132,8 @@ impl Default for MaterialDesc {
         MaterialDesc {
             color: [0.8, 0.8, 0.8],
             texture: None,
+            reflect_texture: None,
+            transmit_texture: None,
             ambient: 0.1,
             diffuse: 0.9,
             specular: 0.0,

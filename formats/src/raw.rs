@@ -86,6 +86,8 @@ pub(crate) struct Texture {
 pub(crate) struct Material {
     pub color: Option<Vec3>,
     pub texture: Option<String>,
+    pub reflect_texture: Option<String>,
+    pub transmit_texture: Option<String>,
     pub ambient: Option<f64>,
     pub diffuse: Option<f64>,
     pub specular: Option<f64>,

@@ -153,7 +153,11 @@ fn literal_is_finite(text: &str) -> bool {
 pub(crate) fn references(scene: &SceneDesc) -> Result<(), SceneError> {
     let textures: Vec<&str> = scene.textures.iter().map(|(n, _)| n.as_str()).collect();
     for (_, material) in &scene.materials {
-        if let Some(texture) = &material.value.texture {
+        let m = &material.value;
+        for texture in [&m.texture, &m.reflect_texture, &m.transmit_texture]
+            .into_iter()
+            .flatten()
+        {
             if !textures.contains(&texture.value.as_str()) {
                 let message = unknown_name("texture", &texture.value, "", textures.iter().copied());
                 return Err(SceneError::at(texture.at.clone(), message));

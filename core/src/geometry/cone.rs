@@ -166,6 +166,7 @@ impl Set<Cone> {
             uv: [u, (s / h).clamp(0.0, 1.0)],
             material: self.material[hit.index as usize],
             color: None,
+            uv_scale: 0.0,
         }
     }
 }

@@ -211,6 +211,7 @@ impl Customs {
             uv: hit.uv,
             material: self.material[hit.index as usize],
             color: None,
+            uv_scale: 0.0,
         }
     }
 }

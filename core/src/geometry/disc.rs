@@ -102,6 +102,7 @@ impl Set<Disc> {
             ],
             material: self.material[hit.index as usize],
             color: None,
+            uv_scale: 0.0,
         }
     }
 }

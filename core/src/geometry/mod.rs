@@ -59,6 +59,8 @@ pub struct Surface {
     /// Unit shading normal, in the same hemisphere as `ng`.
     pub ns: Vec3A,
     pub uv: [f32; 2],
+    /// uv units per world unit near `p` (0: unknown), to measure footprints in uv space.
+    pub uv_scale: f32,
     pub material: u32,
     /// Per-vertex colour, when the mesh has one.
     pub color: Option<Vec3A>,

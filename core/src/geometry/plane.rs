@@ -94,6 +94,7 @@ impl Planes {
             uv: [(p - pl.point).dot(t), (p - pl.point).dot(b)],
             material: pl.material,
             color: None,
+            uv_scale: 0.0,
         }
     }
 }

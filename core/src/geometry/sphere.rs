@@ -132,6 +132,8 @@ impl Set<Sphere> {
             uv: [u, v],
             material: self.material[hit.index as usize],
             color: None,
+            // u spans 2πr, v spans πr: their geometric mean.
+            uv_scale: 1.0 / (std::f32::consts::PI * std::f32::consts::SQRT_2 * s.radius),
         }
     }
 }

@@ -261,6 +261,7 @@ impl Triangles {
             uv: [b1, b2],
             material: self.set.material[i],
             color: None,
+            uv_scale: 0.0,
         };
         if a != NO_ATTR {
             let va = &self.attrs[a as usize];
@@ -282,6 +283,15 @@ impl Triangles {
             }
             let uv = |k: usize| b0 * va[0].uv[k] + b1 * va[1].uv[k] + b2 * va[2].uv[k];
             s.uv = [uv(0), uv(1)];
+            let (d1, d2) = (
+                [va[1].uv[0] - va[0].uv[0], va[1].uv[1] - va[0].uv[1]],
+                [va[2].uv[0] - va[0].uv[0], va[2].uv[1] - va[0].uv[1]],
+            );
+            let uv_area = (d1[0] * d2[1] - d1[1] * d2[0]).abs();
+            let world_area = e1.cross(e2).length() as f32;
+            if world_area > 0.0 {
+                s.uv_scale = (uv_area / world_area).sqrt();
+            }
         }
         s
     }

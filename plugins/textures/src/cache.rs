@@ -471,7 +471,10 @@ mod tests {
     use crate::decode::probe;
     use crate::testutil::{write_png, TempDir};
 
-    fn recorder() -> (Log, Arc<Mutex<Vec<(u32, String)>>>) {
+    /// Messages a test cache logged: (level, text).
+    type Seen = Arc<Mutex<Vec<(u32, String)>>>;
+
+    fn recorder() -> (Log, Seen) {
         let seen = Arc::new(Mutex::new(Vec::new()));
         let s = seen.clone();
         (
@@ -547,9 +550,15 @@ mod tests {
         }
         let s = cache.stats();
         assert!(s.evictions > 0, "{s:?}");
-        assert_eq!(s.decodes, 12, "every lookup evicted the previous image: {s:?}");
+        assert_eq!(
+            s.decodes, 12,
+            "every lookup evicted the previous image: {s:?}"
+        );
         let seen = seen.lock().unwrap();
-        let thrash: Vec<_> = seen.iter().filter(|(_, m)| m.contains("thrashing")).collect();
+        let thrash: Vec<_> = seen
+            .iter()
+            .filter(|(_, m)| m.contains("thrashing"))
+            .collect();
         assert_eq!(thrash.len(), 1, "{seen:?}");
         assert_eq!(thrash[0].0, 1, "a warning");
         assert!(thrash[0].1.contains("budget is 1.5 KiB"), "{}", thrash[0].1);
@@ -570,7 +579,9 @@ mod tests {
         assert!(!img.is_resident(1) && !img.is_resident(3));
         assert_eq!(cache.stats().resident, 1024);
         // Trilinear between levels 2 and 3: both kept, level 0 evicted.
-        let v = cache.with_levels(&img, 2, 3, |a, b| (a.width, b.width)).unwrap();
+        let v = cache
+            .with_levels(&img, 2, 3, |a, b| (a.width, b.width))
+            .unwrap();
         assert_eq!(v, (2, 1));
         assert!(!img.is_resident(0) && img.is_resident(2) && img.is_resident(3));
     }
@@ -613,7 +624,11 @@ mod tests {
         let seen = seen.lock().unwrap();
         assert_eq!(seen.len(), 1, "{seen:?}");
         assert_eq!(seen[0].0, 0);
-        assert!(seen[0].1.contains("broken.png") && seen[0].1.contains("magenta"), "{}", seen[0].1);
+        assert!(
+            seen[0].1.contains("broken.png") && seen[0].1.contains("magenta"),
+            "{}",
+            seen[0].1
+        );
     }
 
     #[test]
@@ -625,7 +640,10 @@ mod tests {
             .map(|k| {
                 let v = 40 + 50 * k;
                 let p = flat(&dir, &format!("t{k}.png"), v);
-                (cache.register(&p, probe(&p).unwrap(), false), v as f32 / 255.0)
+                (
+                    cache.register(&p, probe(&p).unwrap(), false),
+                    v as f32 / 255.0,
+                )
             })
             .collect();
         std::thread::scope(|s| {
@@ -636,7 +654,9 @@ mod tests {
                         let (img, want) = &imgs[(i * (t + 1) + t) % 4];
                         let lv = (i + t) % 4;
                         let got = cache
-                            .with_levels(img, lv, (lv + 1).min(3), |a, b| (a.texels[0][1], b.texels[0][2]))
+                            .with_levels(img, lv, (lv + 1).min(3), |a, b| {
+                                (a.texels[0][1], b.texels[0][2])
+                            })
                             .unwrap();
                         assert_eq!(got, (*want, *want));
                     }

@@ -57,12 +57,12 @@ pub fn probe(path: &Path) -> Result<Header, Error> {
     if !path.is_file() {
         return Err(Error::new(format!("image file `{shown}` not found")));
     }
-    let cannot = |e: &dyn std::fmt::Display| Error::new(format!("cannot read image `{shown}`: {e}"));
+    let cannot =
+        |e: &dyn std::fmt::Display| Error::new(format!("cannot read image `{shown}`: {e}"));
     let (width, height, format) = if is_exr(path).map_err(|e| cannot(&e))? {
         let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| cannot(&e))?;
-        let has = |h: &exr::meta::header::Header, c: &str| {
-            h.channels.list.iter().any(|d| d.name.eq(c))
-        };
+        let has =
+            |h: &exr::meta::header::Header, c: &str| h.channels.list.iter().any(|d| d.name.eq(c));
         let header = meta
             .headers
             .iter()
@@ -85,7 +85,9 @@ pub fn probe(path: &Path) -> Result<Header, Error> {
             .and_then(|r| r.with_guessed_format())
             .map_err(|e| cannot(&e))?;
         let format = match reader.format() {
-            Some(f @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::Tga | ImageFormat::Pnm)) => f,
+            Some(
+                f @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::Tga | ImageFormat::Pnm),
+            ) => f,
             Some(other) => {
                 return Err(Error::new(format!(
                     "image `{shown}` is {other:?}, which is not supported (supported: {SUPPORTED})"
@@ -101,7 +103,9 @@ pub fn probe(path: &Path) -> Result<Header, Error> {
         (w as usize, h as usize, Format::Raster(format))
     };
     if width == 0 || height == 0 {
-        return Err(Error::new(format!("image `{shown}` is empty ({width}x{height})")));
+        return Err(Error::new(format!(
+            "image `{shown}` is empty ({width}x{height})"
+        )));
     }
     if width as u64 * height as u64 > MAX_TEXELS {
         return Err(Error::new(format!(
@@ -150,11 +154,9 @@ pub fn decode(path: &Path, header: &Header, srgb: bool) -> Result<Level, String>
 fn convert(img: DynamicImage, srgb: bool) -> Level {
     let (w, h) = (img.width() as usize, img.height() as usize);
     let texels = match img {
-        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => img
-            .to_rgba32f()
-            .pixels()
-            .map(|p| p.0)
-            .collect(),
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
+            img.to_rgba32f().pixels().map(|p| p.0).collect()
+        }
         DynamicImage::ImageLuma16(_)
         | DynamicImage::ImageLumaA16(_)
         | DynamicImage::ImageRgb16(_)

@@ -140,9 +140,8 @@ impl Texture for ImageTexture {
                 let texels = (l.ds * img.width() as f64).max(l.dt * img.height() as f64);
                 let n = img.levels();
                 let (lo, hi, f) = level_pair(mip_level(texels, n), n);
-                self.cache.with_levels(img, lo, hi, |a, b| {
-                    trilinear(a, b, f, l.s, l.t, wrap)
-                })
+                self.cache
+                    .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
             }
         };
         got.unwrap_or(MAGENTA)
@@ -218,7 +217,12 @@ mod tests {
     fn wrap_modes_through_the_texture() {
         let dir = TempDir::new("img-wrap");
         fixture(&dir);
-        let mk = |w: &str| tex(&dir, &format!(r#"(file: "ramp.png", filter: nearest, wrap: {w})"#));
+        let mk = |w: &str| {
+            tex(
+                &dir,
+                &format!(r#"(file: "ramp.png", filter: nearest, wrap: {w})"#),
+            )
+        };
         // u = 1.3 is column 5.2; v = 0.75 is the top row.
         let uv = [1.3, 0.75];
         assert_eq!(at_uv(&mk("repeat"), uv, 0.0), grey(lin(TOP[1])));
@@ -236,14 +240,20 @@ mod tests {
         let dir = TempDir::new("img-map");
         fixture(&dir);
         // Planar on the floor: u = x, v = -z, one image per 2 world units.
-        let planar = tex(&dir, r#"(file: "ramp.png", filter: nearest, mapping: planar, scale: 2)"#);
+        let planar = tex(
+            &dir,
+            r#"(file: "ramp.png", filter: nearest, mapping: planar, scale: 2)"#,
+        );
         // x = 1.1 -> s = 0.55 -> column 2; z = -0.5 -> t = 0.25 -> bottom row.
         assert_eq!(at(&planar, [1.1, 3.0, -0.5]), grey(lin(BOTTOM[2])));
         assert_eq!(at(&planar, [0.1, 0.0, -1.9]), grey(lin(TOP[0])));
         // Tiled: x = 2.1 is the next copy's column 0.
         assert_eq!(at(&planar, [2.1, 0.0, -1.9]), grey(lin(TOP[0])));
         // Cylindrical around y: longitude 0.25 at -z -> column 1; height 0.75 -> top row.
-        let cyl = tex(&dir, r#"(file: "ramp.png", filter: nearest, mapping: cylindrical)"#);
+        let cyl = tex(
+            &dir,
+            r#"(file: "ramp.png", filter: nearest, mapping: cylindrical)"#,
+        );
         assert_eq!(at(&cyl, [0.0, 0.75, -3.0]), grey(lin(TOP[1])));
         assert_eq!(at(&cyl, [-1.0, 0.25, 0.0]), grey(lin(BOTTOM[2])));
         // Spherical with a centre: the point due +x of the centre, slightly north -> column 0
@@ -327,8 +337,16 @@ mod tests {
             let p = dir.path(&format!("t.{ext}"));
             img.save(&p).unwrap();
             let t = tex(&dir, &format!(r#"(file: "t.{ext}", filter: nearest)"#));
-            assert_eq!(at_uv(&t, [0.75, 0.75], 0.0), [1.0, lin(128), 0.0, 1.0], "{ext}");
-            assert_eq!(at_uv(&t, [0.25, 0.25], 0.0), [0.0, lin(128), 0.0, 1.0], "{ext}");
+            assert_eq!(
+                at_uv(&t, [0.75, 0.75], 0.0),
+                [1.0, lin(128), 0.0, 1.0],
+                "{ext}"
+            );
+            assert_eq!(
+                at_uv(&t, [0.25, 0.25], 0.0),
+                [0.0, lin(128), 0.0, 1.0],
+                "{ext}"
+            );
         }
         // JPEG is lossy: one flat colour, loose tolerance.
         let flat = image::RgbImage::from_pixel(8, 8, image::Rgb([200, 128, 30]));
@@ -342,13 +360,24 @@ mod tests {
     fn create_time_errors() {
         let dir = TempDir::new("img-errors");
         fixture(&dir);
-        let err = |params: &str| make_in::<ImageTexture>(params, &ctx_in(dir.dir())).err().unwrap().message;
+        let err = |params: &str| {
+            make_in::<ImageTexture>(params, &ctx_in(dir.dir()))
+                .err()
+                .unwrap()
+                .message
+        };
         let e = err(r#"(file: "missing.png")"#);
         let resolved = dir.path("missing.png");
-        assert!(e.contains(&format!("`{}` not found", resolved.display())), "{e}");
+        assert!(
+            e.contains(&format!("`{}` not found", resolved.display())),
+            "{e}"
+        );
         std::fs::write(dir.path("notes.png"), "not an image at all").unwrap();
         let e = err(r#"(file: "notes.png")"#);
-        assert!(e.contains("cannot read image") || e.contains("not in a recognised format"), "{e}");
+        assert!(
+            e.contains("cannot read image") || e.contains("not in a recognised format"),
+            "{e}"
+        );
         std::fs::write(dir.path("notes.txt"), "plain text").unwrap();
         let e = err(r#"(file: "notes.txt")"#);
         assert!(e.contains("not in a recognised format"), "{e}");
@@ -378,13 +407,18 @@ mod tests {
         fixture(&dir);
         let seen = Arc::new(Mutex::new(Vec::<String>::new()));
         let s = seen.clone();
-        let cache = Arc::new(Cache::new(0, Box::new(move |_, m| s.lock().unwrap().push(m.into()))));
+        let cache = Arc::new(Cache::new(
+            0,
+            Box::new(move |_, m| s.lock().unwrap().push(m.into())),
+        ));
         let p: ImageParams = luxon_plugin::parse_params(r#"(file: "ramp.png")"#).unwrap();
         let t = ImageTexture::create_in(p, &ctx_in(dir.dir()), cache).unwrap();
         // Corrupt the data after create (header intact).
         let bytes = std::fs::read(dir.path("ramp.png")).unwrap();
         let mut bad = bytes[..33].to_vec();
-        bad.extend_from_slice(&[0, 0, 0, 10, b'I', b'D', b'A', b'T', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0]);
+        bad.extend_from_slice(&[
+            0, 0, 0, 10, b'I', b'D', b'A', b'T', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0,
+        ]);
         std::fs::write(dir.path("ramp.png"), bad).unwrap();
         assert_eq!(at_uv(&t, [0.5, 0.5], 0.0), MAGENTA);
         assert_eq!(at_uv(&t, [0.1, 0.5], 0.0), MAGENTA);
@@ -409,6 +443,10 @@ mod tests {
         drop(a);
         assert!(cache.stats().resident > 0);
         drop(b);
-        assert_eq!(cache.stats().resident, 0, "the last instance frees the texels");
+        assert_eq!(
+            cache.stats().resident,
+            0,
+            "the last instance frees the texels"
+        );
     }
 }

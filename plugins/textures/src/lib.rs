@@ -18,7 +18,7 @@
 //! ## Placement of solid textures
 //!
 //! `constant`, `checker`, `gradient`, `marble`, `wood` and `noise` share three parameters that
-//! place the pattern in the world ([`transform`]):
+//! place the pattern in the world (`transform.rs`):
 //!
 //! | name        | type                   | default     | meaning |
 //! |-------------|------------------------|-------------|---------|
@@ -144,7 +144,7 @@
 //!
 //! Names of `mapping`, `wrap` and `filter` may also be capitalised (`Planar`). Image
 //! coordinates `(s, t)` have `(0, 0)` at the image's bottom-left corner and `(1, 1)` at its
-//! top-right. The mappings are defined in [`mapping`]: `planar` gives `u = d · e1`,
+//! top-right. The mappings are defined in `mapping.rs`: `planar` gives `u = d · e1`,
 //! `v = d · e2` for `d = p - center` in a frame `e1` (world x made perpendicular to `axis`),
 //! `e2 = axis × e1` (floor, default axis: `u = x`, `v = -z`; wall with axis `(0, 0, 1)`:
 //! `u = x`, `v = y`); `cylindrical` gives the longitude / 2π and the height along the axis;
@@ -156,7 +156,7 @@
 //! mapping's derivatives and `scale` (planar: `footprint / scale` image widths). The level is
 //! `log2(texels)`, clamped to the pyramid (a footprint of 0 or 1 texel is level 0; 4 texels is
 //! level 2), blended linearly between the two levels around it. The pyramid is built once per
-//! decode with an exact area (box) filter that also handles odd sizes ([`mipmap`]).
+//! decode with an exact area (box) filter that also handles odd sizes (`mipmap.rs`).
 //!
 //! **Loading and the cache.** `create` checks that the file exists and reads its header
 //! (errors name the resolved path); the texels are decoded on the first lookup. Every image of
@@ -165,7 +165,7 @@
 //! Least recently used levels are evicted when the budget is exceeded and decoded again when
 //! needed, so scenes with more texture data than the budget still render; a warning says once
 //! when that happens (the cache is thrashing), with the budget and the data size. An image
-//! that cannot be decoded renders magenta, with one error in the log. See [`cache`].
+//! that cannot be decoded renders magenta, with one error in the log. See `cache.rs`.
 //!
 //! ## Scene
 //!
@@ -230,7 +230,10 @@ mod tests {
                         (t * 0.414_214).fract() * 6.0 - 3.0,
                         (t * 0.732_051).fract() * 6.0 - 3.0,
                     ],
-                    uv: [(t * 0.1234).fract() as f32 * 3.0, (t * 0.377).fract() as f32],
+                    uv: [
+                        (t * 0.1234).fract() as f32 * 3.0,
+                        (t * 0.377).fract() as f32,
+                    ],
                     footprint: (i % 5) as f32 * 0.01,
                     uv_footprint: (i % 7) as f32 * 0.02,
                     ..Default::default()
@@ -246,8 +249,12 @@ mod tests {
     #[test]
     fn concurrent_evals_are_identical() {
         let dir = TempDir::new("lib-threads");
-        write_png(&dir.path("a.png"), 37, 23, |x, y| [(x * 7) as u8, (y * 11) as u8, 90, 255]);
-        write_png(&dir.path("b.png"), 16, 16, |x, y| [(x * 16) as u8, 0, (y * 16) as u8, 200]);
+        write_png(&dir.path("a.png"), 37, 23, |x, y| {
+            [(x * 7) as u8, (y * 11) as u8, 90, 255]
+        });
+        write_png(&dir.path("b.png"), 16, 16, |x, y| {
+            [(x * 16) as u8, 0, (y * 16) as u8, 200]
+        });
         let ctx = ctx_in(dir.dir());
         let tree: Checker = make_in(
             r#"(scale: 0.7, rotate: (10, 20, 30),
@@ -256,7 +263,8 @@ mod tests {
             &ctx,
         )
         .unwrap();
-        let uv: ImageTexture = make_in(r#"(file: "a.png", scale: (0.5, 2), rotate: 15)"#, &ctx).unwrap();
+        let uv: ImageTexture =
+            make_in(r#"(file: "a.png", scale: (0.5, 2), rotate: 15)"#, &ctx).unwrap();
         let qs = queries();
         let want_tree = run(&tree, &qs);
         let want_uv = run(&uv, &qs);
@@ -270,7 +278,13 @@ mod tests {
                         order.rotate_left(k * 997);
                         order
                             .into_iter()
-                            .map(|i| (i, tree.eval(&qs[i]).map(f32::to_bits), uv.eval(&qs[i]).map(f32::to_bits)))
+                            .map(|i| {
+                                (
+                                    i,
+                                    tree.eval(&qs[i]).map(f32::to_bits),
+                                    uv.eval(&qs[i]).map(f32::to_bits),
+                                )
+                            })
                             .collect::<Vec<_>>()
                     })
                 })
@@ -283,14 +297,19 @@ mod tests {
             }
         });
         // Every colour is finite.
-        assert!(want_tree.iter().flatten().all(|&b| f32::from_bits(b).is_finite()));
+        assert!(want_tree
+            .iter()
+            .flatten()
+            .all(|&b| f32::from_bits(b).is_finite()));
     }
 
     #[test]
     fn concurrent_evals_under_a_thrashing_cache_are_identical() {
         let dir = TempDir::new("lib-thrash");
         for (k, name) in ["p.png", "q.png", "r.png"].iter().enumerate() {
-            write_png(&dir.path(name), 32, 32, |x, y| [(x * 8) as u8, (y * 8) as u8, 60 * k as u8, 255]);
+            write_png(&dir.path(name), 32, 32, |x, y| {
+                [(x * 8) as u8, (y * 8) as u8, 60 * k as u8, 255]
+            });
         }
         let cache = std::sync::Arc::new(cache::Cache::new(20_000, Box::new(|_, _| {})));
         let ctx = ctx_in(dir.dir());

@@ -1,6 +1,6 @@
 //! How a shading point becomes texture coordinates: a mapping gives `(u, v)`, then the 2-D
 //! placement (`scale`, `rotate`, `offset`) gives the image coordinates `(s, t)` (see
-//! [`crate::mipmap`] for where texels sit in `(s, t)`).
+//! `mipmap.rs` for where texels sit in `(s, t)`).
 //!
 //! Projected mappings work in a frame around `center`: `w` is `axis` (normalised); `e1` is the
 //! world x axis made perpendicular to `w` (the world z axis when `axis` is along x); `e2 = w × e1`.
@@ -118,10 +118,6 @@ impl Mapping {
         })
     }
 
-    pub fn kind(&self) -> Kind {
-        self.kind
-    }
-
     /// `(u, v)` and the footprint's size in `(u, v)` units along u and v.
     fn uv(&self, q: &TexQuery) -> (f64, f64, f64, f64) {
         if self.kind == Kind::Uv {
@@ -154,7 +150,12 @@ impl Mapping {
                 let r = dot(d, d).sqrt();
                 let lat = (h / r).clamp(-1.0, 1.0).asin();
                 let ring = a.hypot(b);
-                (longitude(), 0.5 + lat / PI, fp / (TAU * ring), fp / (PI * r))
+                (
+                    longitude(),
+                    0.5 + lat / PI,
+                    fp / (TAU * ring),
+                    fp / (PI * r),
+                )
             }
         }
     }
@@ -189,7 +190,15 @@ mod tests {
     }
 
     fn m(kind: Kind) -> Mapping {
-        Mapping::new(kind, [0.0; 3], [0.0, 1.0, 0.0], Factors([1.0; 2]), 0.0, [0.0; 2]).unwrap()
+        Mapping::new(
+            kind,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            Factors([1.0; 2]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap()
     }
 
     fn near(l: Lookup, s: f64, t: f64) -> bool {
@@ -202,7 +211,15 @@ mod tests {
         assert_eq!(mp.e1, [1.0, 0.0, 0.0]);
         assert_eq!(mp.e2, [0.0, 0.0, -1.0]);
         // Along x, the reference switches to z.
-        let mx = Mapping::new(Kind::Planar, [0.0; 3], [2.0, 0.0, 0.0], Factors([1.0; 2]), 0.0, [0.0; 2]).unwrap();
+        let mx = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [2.0, 0.0, 0.0],
+            Factors([1.0; 2]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap();
         assert_eq!(mx.e1, [0.0, 0.0, 1.0]);
         assert_eq!(mx.e2, [0.0, -1.0, 0.0]);
     }
@@ -216,7 +233,15 @@ mod tests {
             footprint: 9.0,
             ..Default::default()
         });
-        assert_eq!(l, Lookup { s: 0.25, t: 0.75, ds: 0.125, dt: 0.125 });
+        assert_eq!(
+            l,
+            Lookup {
+                s: 0.25,
+                t: 0.75,
+                ds: 0.125,
+                dt: 0.125
+            }
+        );
     }
 
     #[test]
@@ -236,27 +261,63 @@ mod tests {
         // 45° north: v = 0.75.
         assert!(near(s.lookup(&q([1.0, 1.0, 0.0])), 0.0, 0.75));
         // A centre moves the frame.
-        let moved = Mapping::new(Kind::Spherical, [5.0, 0.0, 0.0], [0.0, 1.0, 0.0], Factors([1.0; 2]), 0.0, [0.0; 2]).unwrap();
+        let moved = Mapping::new(
+            Kind::Spherical,
+            [5.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            Factors([1.0; 2]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap();
         assert!(near(moved.lookup(&q([5.0, 0.0, -1.0])), 0.25, 0.5));
     }
 
     #[test]
     fn placement_scales_rotates_and_offsets() {
-        let p = Mapping::new(Kind::Planar, [0.0; 3], [0.0, 1.0, 0.0], Factors([2.0, 4.0]), 0.0, [1.0, 0.0]).unwrap();
+        let p = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            Factors([2.0, 4.0]),
+            0.0,
+            [1.0, 0.0],
+        )
+        .unwrap();
         // u = 3 -> (3 - 1) / 2 = 1; v = 2 -> 2 / 4 = 0.5.
         assert!(near(p.lookup(&q([3.0, 0.0, -2.0])), 1.0, 0.5));
         // Rotating the image 90° counter-clockwise: the point (0, 1) in (u, v) reads image (1, 0).
-        let r = Mapping::new(Kind::Planar, [0.0; 3], [0.0, 1.0, 0.0], Factors([1.0; 2]), 90.0, [0.0; 2]).unwrap();
+        let r = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            Factors([1.0; 2]),
+            90.0,
+            [0.0; 2],
+        )
+        .unwrap();
         assert!(near(r.lookup(&q([0.0, 0.0, -1.0])), 1.0, 0.0));
     }
 
     #[test]
     fn footprints_in_texture_units() {
         let foot = |mp: &Mapping, p: [f64; 3]| {
-            let l = mp.lookup(&TexQuery { p, footprint: 0.5, ..Default::default() });
+            let l = mp.lookup(&TexQuery {
+                p,
+                footprint: 0.5,
+                ..Default::default()
+            });
             (l.ds, l.dt)
         };
-        let planar = Mapping::new(Kind::Planar, [0.0; 3], [0.0, 1.0, 0.0], Factors([2.0, 0.5]), 0.0, [0.0; 2]).unwrap();
+        let planar = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            Factors([2.0, 0.5]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap();
         assert_eq!(foot(&planar, [1.0, 0.0, 1.0]), (0.25, 1.0));
         let cyl = m(Kind::Cylindrical);
         let (ds, dt) = foot(&cyl, [2.0, 0.0, 0.0]);
@@ -273,11 +334,35 @@ mod tests {
 
     #[test]
     fn bad_params() {
-        let e = Mapping::new(Kind::Planar, [0.0; 3], [0.0; 3], Factors([1.0; 2]), 0.0, [0.0; 2]).unwrap_err();
+        let e = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [0.0; 3],
+            Factors([1.0; 2]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap_err();
         assert!(e.message.contains("`axis`"), "{}", e.message);
-        let e = Mapping::new(Kind::Planar, [0.0; 3], [0.0, 1.0, 0.0], Factors([0.0, 1.0]), 0.0, [0.0; 2]).unwrap_err();
+        let e = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            Factors([0.0, 1.0]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap_err();
         assert!(e.message.contains("`scale`"), "{}", e.message);
-        let e = Mapping::new(Kind::Planar, [f64::NAN, 0.0, 0.0], [0.0, 1.0, 0.0], Factors([1.0; 2]), 0.0, [0.0; 2]).unwrap_err();
+        let e = Mapping::new(
+            Kind::Planar,
+            [f64::NAN, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            Factors([1.0; 2]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap_err();
         assert!(e.message.contains("`center`"), "{}", e.message);
     }
 }

@@ -65,7 +65,7 @@ fn reduce_line(n: usize, get: impl Fn(usize) -> [f32; 4], mut put: impl FnMut(us
         let mut acc = [0.0f32; 4];
         if n == 1 {
             acc = get(0);
-        } else if n % 2 == 0 {
+        } else if n.is_multiple_of(2) {
             add(&mut acc, 0.5, get(2 * x));
             add(&mut acc, 0.5, get(2 * x + 1));
         } else {
@@ -192,7 +192,11 @@ pub fn mip_level(texels: f64, levels: usize) -> f64 {
 pub fn level_pair(level: f64, levels: usize) -> (usize, usize, f32) {
     let lo = (level.floor() as usize).min(levels - 1);
     let hi = (lo + 1).min(levels - 1);
-    let f = if hi == lo { 0.0 } else { (level - lo as f64) as f32 };
+    let f = if hi == lo {
+        0.0
+    } else {
+        (level - lo as f64) as f32
+    };
     (lo, hi, f)
 }
 
@@ -305,15 +309,21 @@ mod tests {
     #[test]
     fn wrap_modes() {
         assert_eq!(
-            (-3..7).map(|i| wrap_index(i, 4, Wrap::Repeat)).collect::<Vec<_>>(),
+            (-3..7)
+                .map(|i| wrap_index(i, 4, Wrap::Repeat))
+                .collect::<Vec<_>>(),
             [1, 2, 3, 0, 1, 2, 3, 0, 1, 2]
         );
         assert_eq!(
-            (-3..7).map(|i| wrap_index(i, 4, Wrap::Clamp)).collect::<Vec<_>>(),
+            (-3..7)
+                .map(|i| wrap_index(i, 4, Wrap::Clamp))
+                .collect::<Vec<_>>(),
             [0, 0, 0, 0, 1, 2, 3, 3, 3, 3]
         );
         assert_eq!(
-            (-3..9).map(|i| wrap_index(i, 4, Wrap::Mirror)).collect::<Vec<_>>(),
+            (-3..9)
+                .map(|i| wrap_index(i, 4, Wrap::Mirror))
+                .collect::<Vec<_>>(),
             [2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]
         );
         let l = ramp(4, 1);
@@ -366,7 +376,10 @@ mod tests {
             let lambda = mip_level(texels, levels.len());
             let (lo, hi, f) = level_pair(lambda, levels.len());
             let v = trilinear(&levels[lo], &levels[hi], f, 0.3, 0.6, Wrap::Repeat)[0];
-            assert!((v as f64 - lambda).abs() < 1e-6, "{texels}: {v} vs {lambda}");
+            assert!(
+                (v as f64 - lambda).abs() < 1e-6,
+                "{texels}: {v} vs {lambda}"
+            );
         }
         // 6 texels: between level 2 and 3, 58.5 % of the way.
         let (lo, hi, f) = level_pair(mip_level(6.0, levels.len()), levels.len());

@@ -9,10 +9,7 @@ pub struct TempDir(PathBuf);
 
 impl TempDir {
     pub fn new(name: &str) -> TempDir {
-        let p = std::env::temp_dir().join(format!(
-            "luxon-textures-{}-{name}",
-            std::process::id()
-        ));
+        let p = std::env::temp_dir().join(format!("luxon-textures-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&p);
         std::fs::create_dir_all(&p).unwrap();
         TempDir(p)

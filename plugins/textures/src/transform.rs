@@ -116,7 +116,8 @@ mod tests {
         assert!(Transform::new(Factors([1.0, -1.0, 1.0]), [0.0; 3], [0.0; 3]).is_err());
         let e = Transform::new(Factors::default(), [f64::NAN, 0.0, 0.0], [0.0; 3]).unwrap_err();
         assert!(e.message.contains("`rotate`"), "{}", e.message);
-        let e = Transform::new(Factors::default(), [0.0; 3], [f64::INFINITY, 0.0, 0.0]).unwrap_err();
+        let e =
+            Transform::new(Factors::default(), [0.0; 3], [f64::INFINITY, 0.0, 0.0]).unwrap_err();
         assert!(e.message.contains("`translate`"), "{}", e.message);
     }
 }

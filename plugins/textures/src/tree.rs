@@ -15,7 +15,8 @@ use crate::procedural::{
 };
 use luxon_plugin::abi::TexQuery;
 use luxon_plugin::{Context, Describe, Error, Texture};
-use serde::de::{Deserializer, Error as _};
+use serde::de::value::{MapAccessDeserializer, MapDeserializer};
+use serde::de::{Deserializer, Error as _, MapAccess, Visitor};
 use serde::Deserialize;
 
 /// Anything that can be evaluated at a shading point (every texture of this plugin).
@@ -32,14 +33,38 @@ impl<T: Texture> Eval for T {
 /// A nested texture: the variant names the texture, its fields are that texture's parameters.
 #[derive(Deserialize)]
 pub enum Spec {
-    Constant(ConstantParams),
-    Checker(CheckerParams),
-    Blend(BlendParams),
-    Gradient(GradientParams),
-    Marble(MarbleParams),
-    Wood(WoodParams),
-    Noise(NoiseParams),
-    Image(ImageParams),
+    Constant(Args<ConstantParams>),
+    Checker(Args<CheckerParams>),
+    Blend(Args<BlendParams>),
+    Gradient(Args<GradientParams>),
+    Marble(Args<MarbleParams>),
+    Wood(Args<WoodParams>),
+    Noise(Args<NoiseParams>),
+    Image(Args<ImageParams>),
+}
+
+/// A nested texture's parameters: `(name: value, ...)`, or `()` for every default (which RON
+/// hands over as a unit value rather than an empty struct).
+pub struct Args<T>(T);
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Args<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
+            type Value = Args<T>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("the texture's parameters in parentheses, `(name: value, ...)`")
+            }
+            fn visit_unit<E: serde::de::Error>(self) -> Result<Args<T>, E> {
+                let none = std::iter::empty::<((), ())>();
+                T::deserialize(MapDeserializer::new(none)).map(Args)
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Args<T>, A::Error> {
+                T::deserialize(MapAccessDeserializer::new(map)).map(Args)
+            }
+        }
+        d.deserialize_any(V(std::marker::PhantomData))
+    }
 }
 
 /// The variant names of [`Spec`], for messages.
@@ -47,8 +72,8 @@ const SPEC_NAMES: &str = "Constant, Checker, Blend, Gradient, Marble, Wood, Nois
 
 impl Spec {
     fn build(self, ctx: &Context) -> Result<Box<dyn Eval>, Error> {
-        fn make<T: Texture>(p: T::Params, ctx: &Context) -> Result<Box<dyn Eval>, Error> {
-            Ok(Box::new(T::create(p, ctx)?))
+        fn make<T: Texture>(p: Args<T::Params>, ctx: &Context) -> Result<Box<dyn Eval>, Error> {
+            Ok(Box::new(T::create(p.0, ctx)?))
         }
         match self {
             Spec::Constant(p) => make::<Constant>(p, ctx),
@@ -77,7 +102,8 @@ impl<'de> Deserialize<'de> for Attempt {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         Ok(Attempt(Spec::deserialize(d).map(Box::new).map_err(|e| {
             let m = e.to_string();
-            if m.contains("expected enum") {
+            // Not an enum-shaped value at all (a number, a tuple of the wrong length...).
+            if m.contains("string or map") || m.starts_with("invalid type") {
                 format!(
                     "expected a grey level, a colour `(r, g, b)` or a texture such as \
                      `Marble(scale: 0.5)` (one of: {SPEC_NAMES})"
@@ -199,7 +225,10 @@ impl Texture for Blend {
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
         let a = self.a.eval(q);
         let b = self.b.eval(q);
-        let m = self.mix.eval(q).map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) });
+        let m = self
+            .mix
+            .eval(q)
+            .map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) });
         // Alpha is mixed by the mean of the colour weights.
         let ma = (m[0] + m[1] + m[2]) / 3.0;
         let w = [m[0], m[1], m[2], ma];
@@ -223,7 +252,12 @@ mod tests {
         .unwrap();
         let marble: Marble = make("(scale: 0.5, turbulence: 0, sharpness: 1)").unwrap();
         // Even cells show the marble, evaluated at the same world point.
-        for p in [[0.1, 0.2, 0.3], [0.25, 0.5, 0.5], [1.7, 0.1, 0.9], [-0.5, -0.5, 0.2]] {
+        for p in [
+            [0.1, 0.2, 0.3],
+            [0.25, 0.5, 0.5],
+            [1.7, 1.1, 0.9],
+            [-0.5, -0.5, 0.2],
+        ] {
             assert_eq!(at(&tree, p), at(&marble, p), "{p:?}");
         }
         // Odd cells the constant.
@@ -256,10 +290,9 @@ mod tests {
         let t: Blend = make("()").unwrap();
         assert_eq!(at(&t, [3.0; 3]), [0.5, 0.5, 0.5, 1.0]);
         // A texture as the weight: a gradient from a to b along y; out-of-range weights clamp.
-        let t: Blend = make(
-            "(a: Constant(color: (2, 2, 2)), b: 0, mix: Gradient(to: (4, 4, 4), end: 4))",
-        )
-        .unwrap();
+        let t: Blend =
+            make("(a: Constant(color: (2, 2, 2)), b: 0, mix: Gradient(to: (4, 4, 4), end: 4))")
+                .unwrap();
         assert_eq!(at(&t, [0.0, 0.0, 0.0]), [2.0, 2.0, 2.0, 1.0]);
         assert_eq!(at(&t, [0.0, 0.5, 0.0]), [1.0, 1.0, 1.0, 1.0]);
         assert_eq!(at(&t, [0.0, 3.0, 0.0]), [0.0, 0.0, 0.0, 1.0]);
@@ -281,25 +314,57 @@ mod tests {
             .err()
             .unwrap();
         assert!(e.message.starts_with("`odd`: "), "{}", e.message);
-        assert!(e.message.contains(&dir.path("gone.png").display().to_string()), "{}", e.message);
+        assert!(
+            e.message
+                .contains(&dir.path("gone.png").display().to_string()),
+            "{}",
+            e.message
+        );
     }
 
     #[test]
     fn nested_errors_are_clear() {
         let e = make::<Checker>("(even: Marble(scael: 2))").err().unwrap();
-        assert!(e.message.contains("unknown parameter `scael`, did you mean `scale`?"), "{}", e.message);
+        assert!(
+            e.message
+                .contains("unknown parameter `scael`, did you mean `scale`?"),
+            "{}",
+            e.message
+        );
         let e = make::<Checker>("(even: Marbel(scale: 2))").err().unwrap();
-        assert!(e.message.contains("`Marbel`") && e.message.contains("Marble"), "{}", e.message);
+        assert!(
+            e.message.contains("`Marbel`") && e.message.contains("Marble"),
+            "{}",
+            e.message
+        );
         let e = make::<Checker>("(even: (1, 2))").err().unwrap();
         assert!(e.message.contains("a colour `(r, g, b)`"), "{}", e.message);
         let e = make::<Checker>("(even: Constant())").err().unwrap();
-        assert!(e.message.contains("missing parameter `color`"), "{}", e.message);
+        assert!(
+            e.message.contains("missing parameter `color`"),
+            "{}",
+            e.message
+        );
         let e = make::<Blend>("(mix: Noise(octaves: 0))").err().unwrap();
-        assert_eq!(e.message, "`mix`: parameter `octaves` must be between 1 and 16, got 0");
-        let e = make::<Checker>("(odd: Checker(even: Wood(turbulence: -1)))").err().unwrap();
-        assert!(e.message.starts_with("`odd`: `even`: parameter `turbulence`"), "{}", e.message);
+        assert_eq!(
+            e.message,
+            "`mix`: parameter `octaves` must be between 1 and 16, got 0"
+        );
+        let e = make::<Checker>("(odd: Checker(even: Wood(turbulence: -1)))")
+            .err()
+            .unwrap();
+        assert!(
+            e.message
+                .starts_with("`odd`: `even`: parameter `turbulence`"),
+            "{}",
+            e.message
+        );
         let e = make::<Checker>("(even: -0.5)").err().unwrap();
-        assert!(e.message.contains("`even` must not be negative"), "{}", e.message);
+        assert!(
+            e.message.contains("`even` must not be negative"),
+            "{}",
+            e.message
+        );
     }
 
     #[test]
