@@ -88,3 +88,13 @@ fn molecule_cylinders_cones_rings() {
 fn every_texture_kind() {
     check("textures");
 }
+
+#[test]
+fn lights_spot_area_attenuation_fog() {
+    check("lights");
+}
+
+#[test]
+fn ambient_occlusion_through_a_transparent_surface() {
+    check("ao-molecule");
+}

@@ -6,7 +6,8 @@
 use crate::geometry::Counters;
 use crate::math::{reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
-use crate::scene::{Light, Scene};
+use crate::sampler::{mix, pixel_sample};
+use crate::scene::{Ao, Light, Material, Scene};
 use luxon_plugin::abi::TexQuery;
 
 /// Media the ray is inside, innermost last: (material, index of refraction).
@@ -146,51 +147,35 @@ impl Whitted<'_> {
         let opacity = 1.0 - kt;
         let view = -ray.dir;
         let mut color = mat.ambient * opacity * base;
-        for light in &scene.lights {
-            let (to_light, light_color, shadows) = match light {
-                Light::Point {
-                    position,
-                    color,
-                    shadows,
-                } => ((*position - s.p).normalize(), *color, *shadows),
-                Light::Directional {
-                    to_light,
-                    color,
-                    shadows,
-                } => (*to_light, *color, *shadows),
-            };
-            let ndotl = n.dot(to_light);
-            if ndotl <= 0.0 {
-                continue;
-            }
-            let mut arriving = light_color;
-            if shadows && features.shadows {
-                c.shadow += 1;
-                let (sray, t_max) = match light {
-                    Light::Point { position, .. } => {
-                        spawn_to(s.p, s.p_error, ng, *position, ray.time)
-                    }
-                    Light::Directional { .. } => {
-                        (spawn(s.p, s.p_error, ng, to_light, ray.time), f32::INFINITY)
-                    }
-                };
-                arriving *= scene.transmittance(&sray, t_max, settings.min_weight, c);
-                if arriving == Vec3A::ZERO {
-                    continue;
-                }
-            }
-            let mut lit = mat.diffuse * opacity * ndotl * base;
-            if mat.specular > 0.0 {
-                let cos = if mat.blinn {
-                    n.dot((to_light + view).normalize())
+        // Random numbers for area lights and occlusion, from the ray itself: deterministic for
+        // any thread count or decomposition, different for every path.
+        let seed = ray_seed(ray);
+        let shade = Shade {
+            p: s.p,
+            p_error: s.p_error,
+            n,
+            ng,
+            view,
+            base,
+            opacity,
+            time: ray.time,
+        };
+        for (k, light) in scene.lights.iter().enumerate() {
+            color += self.direct(&shade, mat, light, mix(seed ^ k as u32), c);
+        }
+        if let (true, Some(ao)) = (features.ambient_occlusion, &scene.ao) {
+            color += mat.diffuse * opacity * base * ao.sky * self.unoccluded(&shade, ao, seed, c);
+        }
+        if depth == 0 {
+            if let (true, Some(fog)) = (features.fog, &scene.fog) {
+                let d = if fog.planar {
+                    hit.t * ray.dir.dot(scene.camera.forward)
                 } else {
-                    reflect(-to_light, n).dot(view)
+                    hit.t
                 };
-                if cos > 0.0 {
-                    lit += Vec3A::splat(mat.specular * cos.powf(mat.shininess));
-                }
+                let v = fog.visibility(d);
+                color = color * v + fog.color * (1.0 - v);
             }
-            color += arriving * lit;
         }
 
         let next = depth + 1;
@@ -232,6 +217,202 @@ impl Whitted<'_> {
             }
         }
         color
+    }
+}
+
+/// What lighting needs to know about a shading point.
+struct Shade {
+    p: Vec3A,
+    p_error: Vec3A,
+    /// Shading normal and geometric normal, both facing the viewer.
+    n: Vec3A,
+    ng: Vec3A,
+    view: Vec3A,
+    base: Vec3A,
+    opacity: f32,
+    time: f32,
+}
+
+/// A hash of a ray's bits.
+fn ray_seed(ray: &Ray) -> u32 {
+    let b = |v: f32| v.to_bits();
+    mix(b(ray.dir.x)
+        ^ mix(b(ray.dir.y)
+            ^ mix(
+                b(ray.dir.z) ^ mix(b(ray.origin.x) ^ mix(b(ray.origin.y) ^ mix(b(ray.origin.z))))
+            )))
+}
+
+/// Sample `i` of `n` stratified over the unit square, decorrelated by `seed`.
+fn square(seed: u32, i: u32, n: u32) -> (f32, f32) {
+    if n <= 1 {
+        return (0.5, 0.5);
+    }
+    pixel_sample(seed, mix(seed), i, n, 0)
+}
+
+fn attenuate(a: &[f32; 3], d: f32) -> f32 {
+    1.0 / (a[0] + a[1] * d + a[2] * d * d)
+}
+
+impl Whitted<'_> {
+    /// Light from one source reaching a shading point: diffuse and highlight, times what the
+    /// shadow rays let through. Area lights average `samples` points on the light.
+    fn direct(
+        &self,
+        sh: &Shade,
+        mat: &Material,
+        light: &Light,
+        seed: u32,
+        c: &mut Counters,
+    ) -> Vec3A {
+        let scene = self.scene;
+        let shadows = light.casts_shadows() && scene.features.shadows;
+        // (point on the light or None for a direction, direction to it, radiance arriving)
+        let one =
+            |target: Option<Vec3A>, to_light: Vec3A, arriving: Vec3A, c: &mut Counters| -> Vec3A {
+                let ndotl = sh.n.dot(to_light);
+                if ndotl <= 0.0 || arriving == Vec3A::ZERO {
+                    return Vec3A::ZERO;
+                }
+                let mut arriving = arriving;
+                if shadows {
+                    c.shadow += 1;
+                    let (sray, t_max) = match target {
+                        Some(t) => spawn_to(sh.p, sh.p_error, sh.ng, t, sh.time),
+                        None => (
+                            spawn(sh.p, sh.p_error, sh.ng, to_light, sh.time),
+                            f32::INFINITY,
+                        ),
+                    };
+                    arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                    if arriving == Vec3A::ZERO {
+                        return Vec3A::ZERO;
+                    }
+                }
+                let mut lit = mat.diffuse * sh.opacity * ndotl * sh.base;
+                if mat.specular > 0.0 {
+                    let cos = if mat.blinn {
+                        sh.n.dot((to_light + sh.view).normalize())
+                    } else {
+                        reflect(-to_light, sh.n).dot(sh.view)
+                    };
+                    if cos > 0.0 {
+                        lit += Vec3A::splat(mat.specular * cos.powf(mat.shininess));
+                    }
+                }
+                arriving * lit
+            };
+        let from_point = |q: Vec3A, color: Vec3A, a: &[f32; 3], c: &mut Counters| {
+            let d = q - sh.p;
+            let dist = d.length();
+            one(Some(q), d / dist, color * attenuate(a, dist), c)
+        };
+        match light {
+            Light::Directional {
+                to_light, color, ..
+            } => one(None, *to_light, *color, c),
+            Light::Point {
+                position,
+                color,
+                attenuation,
+                ..
+            } => from_point(*position, *color, attenuation, c),
+            Light::Spot {
+                position,
+                axis,
+                cos_inner,
+                cos_outer,
+                color,
+                attenuation,
+                ..
+            } => {
+                let cos = (sh.p - *position).normalize().dot(*axis);
+                if cos <= *cos_outer {
+                    return Vec3A::ZERO;
+                }
+                // Smoothstep across the fall-off band: no visible edge.
+                let x = if cos >= *cos_inner {
+                    1.0
+                } else {
+                    (cos - cos_outer) / (cos_inner - cos_outer)
+                };
+                from_point(
+                    *position,
+                    *color * (x * x * (3.0 - 2.0 * x)),
+                    attenuation,
+                    c,
+                )
+            }
+            Light::Sphere {
+                center,
+                radius,
+                samples,
+                color,
+                attenuation,
+                ..
+            } => {
+                // Points on the disc the sphere shows to the shading point.
+                let w = (*center - sh.p).normalize_or_zero();
+                if w == Vec3A::ZERO {
+                    return Vec3A::ZERO;
+                }
+                let u = crate::math::orthogonal(w);
+                let v = w.cross(u);
+                let mut sum = Vec3A::ZERO;
+                for i in 0..*samples {
+                    let (a, b) = square(seed, i, *samples);
+                    let (r, phi) = (a.sqrt() * radius, b * std::f32::consts::TAU);
+                    let q = *center + r * (phi.cos() * u + phi.sin() * v);
+                    sum += from_point(q, *color, attenuation, c);
+                }
+                sum / *samples as f32
+            }
+            Light::Rect {
+                corner,
+                edge1,
+                edge2,
+                normal,
+                samples,
+                color,
+                attenuation,
+                ..
+            } => {
+                if (sh.p - *corner).dot(*normal) <= 0.0 {
+                    return Vec3A::ZERO;
+                }
+                let mut sum = Vec3A::ZERO;
+                for i in 0..*samples {
+                    let (a, b) = square(seed, i, *samples);
+                    sum += from_point(*corner + a * *edge1 + b * *edge2, *color, attenuation, c);
+                }
+                sum / *samples as f32
+            }
+        }
+    }
+
+    /// The fraction of the sky a point sees within the occlusion distance: cosine-weighted
+    /// hemisphere rays; transparent occluders block only by their opacity (what VMD users
+    /// expect of transparent molecular surfaces).
+    fn unoccluded(&self, sh: &Shade, ao: &Ao, seed: u32, c: &mut Counters) -> f32 {
+        let u = crate::math::orthogonal(sh.n);
+        let v = sh.n.cross(u);
+        let seed = mix(seed ^ 0x0a0c_c1de);
+        let mut seen = 0.0;
+        for i in 0..ao.samples {
+            let (a, b) = square(seed, i, ao.samples);
+            let (r, phi) = (a.sqrt(), b * std::f32::consts::TAU);
+            let dir = (r * phi.cos() * u + r * phi.sin() * v + (1.0 - a).max(0.0).sqrt() * sh.n)
+                .normalize();
+            if dir.dot(sh.ng) <= 0.0 {
+                continue;
+            }
+            c.occlusion += 1;
+            let ray = spawn(sh.p, sh.p_error, sh.ng, dir, sh.time);
+            let t = self.scene.transmittance(&ray, ao.max_distance, 0.0, c);
+            seen += (t.x + t.y + t.z) / 3.0;
+        }
+        seen / ao.samples as f32
     }
 }
 

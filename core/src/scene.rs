@@ -49,6 +49,7 @@ pub enum Light {
         position: Vec3A,
         color: Vec3A,
         shadows: bool,
+        attenuation: [f32; 3],
     },
     /// `to_light` is the unit direction toward the light.
     Directional {
@@ -56,20 +57,87 @@ pub enum Light {
         color: Vec3A,
         shadows: bool,
     },
+    /// `axis` points from the light into the scene; full strength where the angle to it has a
+    /// cosine above `cos_inner`, none below `cos_outer`.
+    Spot {
+        position: Vec3A,
+        axis: Vec3A,
+        cos_inner: f32,
+        cos_outer: f32,
+        color: Vec3A,
+        shadows: bool,
+        attenuation: [f32; 3],
+    },
+    Sphere {
+        center: Vec3A,
+        radius: f32,
+        samples: u32,
+        color: Vec3A,
+        shadows: bool,
+        attenuation: [f32; 3],
+    },
+    /// Shines to the side of `normal` = unit(edge1 × edge2).
+    Rect {
+        corner: Vec3A,
+        edge1: Vec3A,
+        edge2: Vec3A,
+        normal: Vec3A,
+        samples: u32,
+        color: Vec3A,
+        shadows: bool,
+        attenuation: [f32; 3],
+    },
 }
 
 impl Light {
     pub fn casts_shadows(&self) -> bool {
         match self {
-            Light::Point { shadows, .. } | Light::Directional { shadows, .. } => *shadows,
+            Light::Point { shadows, .. }
+            | Light::Directional { shadows, .. }
+            | Light::Spot { shadows, .. }
+            | Light::Sphere { shadows, .. }
+            | Light::Rect { shadows, .. } => *shadows,
         }
     }
+}
+
+/// Fog over the distance camera rays travel; `planar` measures it along the view direction.
+#[derive(Clone, Debug)]
+pub struct Fog {
+    pub mode: luxon_formats::FogMode,
+    pub color: Vec3A,
+    pub planar: bool,
+}
+
+impl Fog {
+    /// The fraction of the surface's colour left after distance `d`.
+    pub fn visibility(&self, d: f32) -> f32 {
+        use luxon_formats::FogMode;
+        match self.mode {
+            FogMode::Linear { start, end } => {
+                (1.0 - (d - start as f32) / (end - start) as f32).clamp(0.0, 1.0)
+            }
+            FogMode::Exp { density } => (-(density as f32) * d).exp(),
+            FogMode::Exp2 { density } => (-(density as f32 * d).powi(2)).exp(),
+        }
+    }
+}
+
+/// Ambient occlusion settings.
+#[derive(Clone, Debug)]
+pub struct Ao {
+    pub samples: u32,
+    pub max_distance: f32,
+    /// Sky colour times intensity.
+    pub sky: Vec3A,
 }
 
 /// The effects a scene calls for; the integrator skips the rest.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Features {
     pub shadows: bool,
+    pub ambient_occlusion: bool,
+    pub fog: bool,
     pub reflection: bool,
     /// Any used material lets light through (refraction or plain transparency).
     pub transmission: bool,
@@ -82,6 +150,8 @@ impl std::fmt::Display for Features {
         let mut v = Vec::new();
         for (on, name) in [
             (self.shadows, "shadows"),
+            (self.ambient_occlusion, "ambient occlusion"),
+            (self.fog, "fog"),
             (self.reflection, "reflection"),
             (self.transmission, "refraction/transparency"),
             (self.textures, "textures"),
@@ -121,6 +191,8 @@ pub struct Scene {
     pub camera: Camera,
     pub background: Vec3A,
     pub lights: Vec<Light>,
+    pub fog: Option<Fog>,
+    pub ao: Option<Ao>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     pub textures: Vec<TextureInstance>,
@@ -333,6 +405,11 @@ impl Scene {
         custom_result.map_err(Error::Plugin)?;
         let bvh_time = t1.elapsed();
 
+        let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - world_offset).as_vec3());
+        let unit = |d: &[f64; 3]| Vec3A::from(DVec3::from(*d).normalize().as_vec3());
+        let att = |a: &luxon_formats::Attenuation| {
+            [a.constant as f32, a.linear as f32, a.quadratic as f32]
+        };
         let lights: Vec<Light> = desc
             .lights
             .iter()
@@ -342,10 +419,12 @@ impl Scene {
                     color,
                     intensity,
                     shadows,
+                    attenuation,
                 } => Light::Point {
-                    position: Vec3A::from((DVec3::from(*position) - world_offset).as_vec3()),
+                    position: at(position),
                     color: v3(*color) * *intensity as f32,
                     shadows: *shadows,
+                    attenuation: att(attenuation),
                 },
                 LightDesc::Directional {
                     direction,
@@ -353,12 +432,75 @@ impl Scene {
                     intensity,
                     shadows,
                 } => Light::Directional {
-                    to_light: -Vec3A::from(DVec3::from(*direction).normalize().as_vec3()),
+                    to_light: -unit(direction),
                     color: v3(*color) * *intensity as f32,
                     shadows: *shadows,
                 },
+                LightDesc::Spot {
+                    position,
+                    direction,
+                    cone_deg,
+                    falloff_deg,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Spot {
+                    position: at(position),
+                    axis: unit(direction),
+                    cos_inner: ((cone_deg - falloff_deg) * 0.5).to_radians().cos() as f32,
+                    cos_outer: (cone_deg * 0.5).to_radians().cos() as f32,
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
+                LightDesc::Sphere {
+                    center,
+                    radius,
+                    samples,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Sphere {
+                    center: at(center),
+                    radius: *radius as f32,
+                    samples: *samples,
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
+                LightDesc::Rect {
+                    corner,
+                    edge1,
+                    edge2,
+                    samples,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Rect {
+                    corner: at(corner),
+                    edge1: v3(*edge1),
+                    edge2: v3(*edge2),
+                    normal: v3(*edge1).cross(v3(*edge2)).normalize(),
+                    samples: *samples,
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
             })
             .collect();
+        let fog = desc.fog.as_ref().map(|f| Fog {
+            mode: f.mode,
+            color: v3(f.color),
+            planar: f.planar,
+        });
+        let ao = desc.ambient_occlusion.as_ref().map(|a| Ao {
+            samples: a.samples,
+            max_distance: a.max_distance as f32,
+            sky: v3(a.color) * a.intensity as f32,
+        });
 
         let used_mats: Vec<&Material> = materials
             .iter()
@@ -372,6 +514,8 @@ impl Scene {
             && customs.is_empty());
         let features = Features {
             shadows: has_geometry && lights.iter().any(Light::casts_shadows),
+            ambient_occlusion: has_geometry && ao.is_some(),
+            fog: fog.is_some(),
             reflection: used_mats.iter().any(|m| m.reflect > 0.0),
             transmission: used_mats.iter().any(|m| m.transmit > 0.0),
             textures: used_mats.iter().any(|m| {
@@ -404,6 +548,8 @@ impl Scene {
             pixel_spread: 2.0 * camera.up.length() / r.height as f32,
             background: v3(desc.background),
             lights,
+            fog,
+            ao,
             materials,
             material_names,
             textures,

@@ -13,6 +13,8 @@ pub(crate) struct Part {
     pub camera: Option<Spanned<CameraDesc>>,
     pub background: Option<[f64; 3]>,
     pub lights: Vec<Spanned<LightDesc>>,
+    pub fog: Option<FogDesc>,
+    pub ambient_occlusion: Option<AoDesc>,
     pub textures: Vec<(String, Spanned<PluginCall>)>,
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
@@ -44,6 +46,12 @@ impl Checker<'_> {
         }
         if let Some(background) = scene.background {
             part.background = Some(self.colour(field("background"), "background", background)?);
+        }
+        if let Some(fog) = scene.fog {
+            part.fog = Some(self.fog(fog, field("fog"))?);
+        }
+        if let Some(ao) = scene.ambient_occlusion {
+            part.ambient_occlusion = Some(self.ao(ao, field("ambient_occlusion"))?);
         }
         for (i, light) in scene.lights.into_iter().enumerate() {
             let node = field("lights").item(i).unwrap_or(root);
@@ -122,121 +130,6 @@ impl Checker<'_> {
         };
         let call = self.call(plugin, node);
         Ok(self.spanned(VolumeDescEntry { call, name }, node))
-    }
-
-    fn camera(&self, c: raw::Camera, node: &Node) -> Result<Spanned<CameraDesc>> {
-        let field = |name| node.field(name).unwrap_or(node);
-        let projection = match (c.fov, c.zoom) {
-            (Some(_), Some(_)) => {
-                return Err(self.error(
-                    field("zoom"),
-                    "the camera gives both `fov` and `zoom`; expected only one of them",
-                ))
-            }
-            (_, Some(zoom)) => Projection::PerspectiveZoom {
-                zoom: self.positive(field("zoom"), "zoom", zoom)?,
-            },
-            (fov, None) => {
-                let fov_deg = fov.unwrap_or(45.0);
-                if !(fov_deg > 0.0 && fov_deg < 180.0) {
-                    return Err(self.error(
-                        field("fov"),
-                        format!("`fov` is {fov_deg}; expected degrees between 0 and 180 (both excluded)"),
-                    ));
-                }
-                Projection::Perspective { fov_deg }
-            }
-        };
-        let aspect = match c.aspect {
-            Some(a) => Some(self.positive(field("aspect"), "aspect", a)?),
-            None => None,
-        };
-        let up = c.up.unwrap_or([0.0, 1.0, 0.0]);
-        let view = sub(c.look_at, c.position);
-        if length(view) == 0.0 {
-            return Err(self.error(
-                field("look_at"),
-                "the camera's `look_at` equals its `position`; expected a point away from the camera",
-            ));
-        }
-        if length(up) == 0.0 {
-            return Err(self.error(
-                field("up"),
-                "the camera's `up` has zero length; expected a direction such as (0, 1, 0)",
-            ));
-        }
-        // Parallel when the sine of the angle between them is (almost) zero.
-        if length(cross(view, up)) <= 1e-9 * length(view) * length(up) {
-            let given = if c.up.is_some() { "" } else { " (the default)" };
-            return Err(self.error(
-                field("up"),
-                format!(
-                    "the camera's `up` ({}, {}, {}){given} is parallel to its view direction \
-                     (from `position` to `look_at`); expected an `up` at an angle to it",
-                    up[0], up[1], up[2]
-                ),
-            ));
-        }
-        let camera = CameraDesc {
-            position: c.position,
-            look_at: c.look_at,
-            up,
-            projection,
-            aspect,
-        };
-        Ok(self.spanned(camera, node))
-    }
-
-    fn light(&self, light: raw::Light, node: &Node) -> Result<Spanned<LightDesc>> {
-        let field = |name| node.field(name).unwrap_or(node);
-        let common = |color: Option<[f64; 3]>, intensity: Option<f64>| -> Result<_> {
-            let color = self.colour(field("color"), "color", color.unwrap_or([1.0; 3]))?;
-            let intensity = self.range(
-                field("intensity"),
-                "intensity",
-                intensity.unwrap_or(1.0),
-                0.0,
-                f64::INFINITY,
-            )?;
-            Ok((color, intensity))
-        };
-        let light = match light {
-            raw::Light::Point {
-                position,
-                color,
-                intensity,
-                shadows,
-            } => {
-                let (color, intensity) = common(color, intensity)?;
-                LightDesc::Point {
-                    position,
-                    color,
-                    intensity,
-                    shadows: shadows.unwrap_or(true),
-                }
-            }
-            raw::Light::Directional {
-                direction,
-                color,
-                intensity,
-                shadows,
-            } => {
-                if length(direction) == 0.0 {
-                    return Err(self.error(
-                        field("direction"),
-                        "the light's `direction` has zero length; expected a non-zero vector",
-                    ));
-                }
-                let (color, intensity) = common(color, intensity)?;
-                LightDesc::Directional {
-                    direction,
-                    color,
-                    intensity,
-                    shadows: shadows.unwrap_or(true),
-                }
-            }
-        };
-        Ok(self.spanned(light, node))
     }
 
     fn material(&self, m: raw::Material, node: &Node) -> Result<MaterialDesc> {
@@ -385,20 +278,4 @@ impl Checker<'_> {
             },
         })
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn length(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }

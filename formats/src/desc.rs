@@ -47,6 +47,8 @@ pub struct SceneDesc {
     /// Linear RGB.
     pub background: [f64; 3],
     pub lights: Vec<Spanned<LightDesc>>,
+    pub fog: Option<FogDesc>,
+    pub ambient_occlusion: Option<AoDesc>,
     /// Named textures, in file order (later definitions of a name replace earlier ones).
     pub textures: Vec<(String, Spanned<PluginCall>)>,
     /// Named materials, in file order (later definitions of a name replace earlier ones).
@@ -67,8 +69,14 @@ pub struct CameraDesc {
     pub look_at: [f64; 3],
     pub up: [f64; 3],
     pub projection: Projection,
-    /// Width / height of the image plane; `None`: the image's width / height.
+    /// Width / height of the image plane (of one eye's image in stereo); `None`: the image's
+    /// width / height. Not used by `Equirectangular` nor with a `frustum`.
     pub aspect: Option<f64>,
+    /// Tachyon's explicit image-plane window; replaces the size `projection` gives (only with
+    /// `Perspective`, `PerspectiveZoom` and `Orthographic`).
+    pub frustum: Option<Frustum>,
+    pub depth_of_field: Option<DepthOfField>,
+    pub stereo: Option<Stereo>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -77,6 +85,70 @@ pub enum Projection {
     Perspective { fov_deg: f64 },
     /// Tachyon's zoom: the image plane's half-height at unit distance is `1 / zoom`.
     PerspectiveZoom { zoom: f64 },
+    /// Parallel rays; `height` is the view window's full height in world units.
+    Orthographic { height: f64 },
+    /// Angular (equidistant) fisheye: the angle from the view direction grows linearly with
+    /// the distance from the image centre; `fov_deg` (in (0, 360]) spans the image height.
+    Fisheye { fov_deg: f64 },
+    /// Latitude-longitude panorama: 360° across the width, 180° down the height.
+    Equirectangular,
+}
+
+/// The image window: at unit distance from the eye for perspective cameras, in world units
+/// around the camera position for orthographic ones. `left < right`, `bottom < top`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frustum {
+    pub left: f64,
+    pub right: f64,
+    pub bottom: f64,
+    pub top: f64,
+}
+
+/// A thin lens: points at `focal_distance` are sharp; the blur grows with `aperture`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthOfField {
+    /// Lens radius in world units, `>= 0` (0: a pinhole).
+    pub aperture: f64,
+    /// Distance of the sharp plane along the view direction (perspective, orthographic) or of
+    /// the sharp sphere around the camera (fisheye, equirectangular), `> 0`.
+    pub focal_distance: f64,
+}
+
+/// Two eyes in one image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stereo {
+    pub layout: StereoLayout,
+    /// Distance between the eyes in world units, `>= 0`.
+    pub eye_separation: f64,
+    /// Distance at which the eyes' views coincide (zero parallax), `> 0`.
+    pub convergence: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StereoLayout {
+    /// Left eye in the left half, right eye in the right half.
+    SideBySide,
+    /// Left eye in the top half, right eye in the bottom half.
+    OverUnder,
+}
+
+/// Light falling off with distance `d` as 1 / (constant + linear·d + quadratic·d²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attenuation {
+    pub constant: f64,
+    pub linear: f64,
+    pub quadratic: f64,
+}
+
+impl Default for Attenuation {
+    /// No fall-off: the classic Whitted light.
+    fn default() -> Self {
+        Attenuation {
+            constant: 1.0,
+            linear: 0.0,
+            quadratic: 0.0,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -86,6 +158,7 @@ pub enum LightDesc {
         color: [f64; 3],
         intensity: f64,
         shadows: bool,
+        attenuation: Attenuation,
     },
     /// Light arriving along `direction` (pointing from the light into the scene).
     Directional {
@@ -94,6 +167,70 @@ pub enum LightDesc {
         intensity: f64,
         shadows: bool,
     },
+    /// A point light shining into a cone: full strength inside `cone_deg - falloff_deg`
+    /// (full angles), fading smoothly to nothing at `cone_deg`.
+    Spot {
+        position: [f64; 3],
+        direction: [f64; 3],
+        cone_deg: f64,
+        falloff_deg: f64,
+        color: [f64; 3],
+        intensity: f64,
+        shadows: bool,
+        attenuation: Attenuation,
+    },
+    /// A spherical area light: soft shadows from `samples` shadow rays per shading point.
+    Sphere {
+        center: [f64; 3],
+        radius: f64,
+        samples: u32,
+        color: [f64; 3],
+        intensity: f64,
+        shadows: bool,
+        attenuation: Attenuation,
+    },
+    /// A rectangular area light `corner + s·edge1 + t·edge2` (s, t in [0, 1]), shining to the
+    /// side of `edge1 × edge2`.
+    Rect {
+        corner: [f64; 3],
+        edge1: [f64; 3],
+        edge2: [f64; 3],
+        samples: u32,
+        color: [f64; 3],
+        intensity: f64,
+        shadows: bool,
+        attenuation: Attenuation,
+    },
+}
+
+/// Fog over the distance a camera ray travels to its first hit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FogDesc {
+    pub mode: FogMode,
+    pub color: [f64; 3],
+    /// Distance measured along the view direction (VMD's planar fog) instead of along the ray
+    /// (radial).
+    pub planar: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FogMode {
+    /// No fog before `start`, all fog after `end`.
+    Linear { start: f64, end: f64 },
+    /// Visibility exp(-density·d).
+    Exp { density: f64 },
+    /// Visibility exp(-(density·d)²).
+    Exp2 { density: f64 },
+}
+
+/// Ambient occlusion: the ambient term lit by a sky of `color`, seen through `samples` rays
+/// over the hemisphere up to `max_distance`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AoDesc {
+    pub samples: u32,
+    pub max_distance: f64,
+    pub color: [f64; 3],
+    pub intensity: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -4,24 +4,26 @@
 //! [`SceneDesc`]: plain data with the source position of everything, so that every error names
 //! `file:line:col` and what was expected. Depends on no renderer code and knows no plugins.
 
+mod camera;
 mod convert;
 pub mod desc;
-pub mod geometry;
+mod effects;
 mod error;
+pub mod geometry;
 pub mod nff;
-pub mod spd;
 mod raw;
 mod ron_error;
 mod ron_scene;
 mod scanner;
 mod spans;
+pub mod spd;
 mod validate;
 
 use std::path::Path;
 
 pub use desc::*;
-pub use geometry::{InlineGeometry, InlineMesh};
 pub use error::{suggest, SceneError};
+pub use geometry::{InlineGeometry, InlineMesh};
 pub use ron_scene::load_ron_str;
 
 /// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`

@@ -23,6 +23,10 @@ pub(crate) struct Scene {
     #[serde(default)]
     pub lights: Vec<Light>,
     #[serde(default)]
+    pub fog: Option<Fog>,
+    #[serde(default)]
+    pub ambient_occlusion: Option<Ao>,
+    #[serde(default)]
     pub textures: Named<Texture>,
     #[serde(default)]
     pub materials: Named<Material>,
@@ -47,6 +51,69 @@ pub(crate) struct Camera {
     pub zoom: Option<f64>,
     #[serde(default)]
     pub aspect: Option<f64>,
+    #[serde(default)]
+    pub projection: Option<Projection>,
+    #[serde(default)]
+    pub frustum: Option<Frustum>,
+    #[serde(default)]
+    pub depth_of_field: Option<DepthOfField>,
+    #[serde(default)]
+    pub stereo: Option<Stereo>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Projection", deny_unknown_fields)]
+pub(crate) enum Projection {
+    Perspective {
+        #[serde(default)]
+        fov: Option<f64>,
+        #[serde(default)]
+        zoom: Option<f64>,
+    },
+    Orthographic {
+        #[serde(default)]
+        height: Option<f64>,
+    },
+    Fisheye {
+        #[serde(default)]
+        fov: Option<f64>,
+    },
+    Equirectangular,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Frustum", deny_unknown_fields)]
+pub(crate) struct Frustum {
+    pub left: f64,
+    pub right: f64,
+    pub bottom: f64,
+    pub top: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "DepthOfField", deny_unknown_fields)]
+pub(crate) struct DepthOfField {
+    pub aperture: f64,
+    #[serde(default)]
+    pub focal_distance: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Stereo", deny_unknown_fields)]
+pub(crate) struct Stereo {
+    #[serde(default)]
+    pub layout: Option<StereoLayout>,
+    #[serde(default)]
+    pub eye_separation: Option<f64>,
+    #[serde(default)]
+    pub convergence: Option<f64>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "StereoLayout")]
+pub(crate) enum StereoLayout {
+    SideBySide,
+    OverUnder,
 }
 
 #[derive(Deserialize)]
@@ -60,6 +127,8 @@ pub(crate) enum Light {
         intensity: Option<f64>,
         #[serde(default)]
         shadows: Option<bool>,
+        #[serde(default)]
+        attenuation: Option<Vec3>,
     },
     Directional {
         direction: Vec3,
@@ -70,6 +139,82 @@ pub(crate) enum Light {
         #[serde(default)]
         shadows: Option<bool>,
     },
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        /// Full cone angle, degrees.
+        angle: f64,
+        #[serde(default)]
+        falloff: Option<f64>,
+        #[serde(default)]
+        color: Option<Vec3>,
+        #[serde(default)]
+        intensity: Option<f64>,
+        #[serde(default)]
+        shadows: Option<bool>,
+        #[serde(default)]
+        attenuation: Option<Vec3>,
+    },
+    SphereLight {
+        center: Vec3,
+        radius: f64,
+        #[serde(default)]
+        samples: Option<f64>,
+        #[serde(default)]
+        color: Option<Vec3>,
+        #[serde(default)]
+        intensity: Option<f64>,
+        #[serde(default)]
+        shadows: Option<bool>,
+        #[serde(default)]
+        attenuation: Option<Vec3>,
+    },
+    RectLight {
+        corner: Vec3,
+        edge1: Vec3,
+        edge2: Vec3,
+        #[serde(default)]
+        samples: Option<f64>,
+        #[serde(default)]
+        color: Option<Vec3>,
+        #[serde(default)]
+        intensity: Option<f64>,
+        #[serde(default)]
+        shadows: Option<bool>,
+        #[serde(default)]
+        attenuation: Option<Vec3>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Fog", deny_unknown_fields)]
+pub(crate) struct Fog {
+    pub mode: FogMode,
+    #[serde(default)]
+    pub color: Option<Vec3>,
+    #[serde(default)]
+    pub planar: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "FogMode", deny_unknown_fields)]
+pub(crate) enum FogMode {
+    Linear { start: f64, end: f64 },
+    Exp { density: f64 },
+    Exp2 { density: f64 },
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "AmbientOcclusion", deny_unknown_fields)]
+pub(crate) struct Ao {
+    #[serde(default)]
+    pub samples: Option<f64>,
+    #[serde(default)]
+    pub distance: Option<f64>,
+    #[serde(default)]
+    pub color: Option<Vec3>,
+    #[serde(default)]
+    pub intensity: Option<f64>,
 }
 
 /// `params` is only skipped here; its text is taken verbatim from the source.

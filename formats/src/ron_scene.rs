@@ -33,6 +33,8 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         camera,
         background: part.background.unwrap_or([0.0; 3]),
         lights: part.lights,
+        fog: part.fog,
+        ambient_occlusion: part.ambient_occlusion,
         textures: part.textures,
         materials: part.materials,
         objects: part.objects,
@@ -123,13 +125,23 @@ impl Part {
         if later.background.is_some() {
             self.background = later.background;
         }
+        if later.fog.is_some() {
+            self.fog = later.fog;
+        }
+        if later.ambient_occlusion.is_some() {
+            self.ambient_occlusion = later.ambient_occlusion;
+        }
         if later.render.is_some() {
             self.render = later.render;
         }
         self.lights.extend(later.lights);
         self.objects.extend(later.objects);
         self.volumes.extend(later.volumes);
-        self.outputs.extend(later.outputs);
+        // Outputs belong to the file that renders: an including file that names any replaces
+        // those of its includes (including a scene must not also write that scene's image).
+        if !later.outputs.is_empty() {
+            self.outputs = later.outputs;
+        }
         self.plugin_path.extend(later.plugin_path);
         upsert(&mut self.textures, later.textures);
         upsert(&mut self.materials, later.materials);

@@ -67,7 +67,10 @@ fn view_maps_to_the_camera_and_render_settings() {
     let Projection::Perspective { fov_deg } = c.projection else {
         panic!("perspective expected")
     };
-    let want = 2.0 * ((22.5f64).to_radians().tan() * 48.0 / 47.0).atan().to_degrees();
+    let want = 2.0
+        * ((22.5f64).to_radians().tan() * 48.0 / 47.0)
+            .atan()
+            .to_degrees();
     assert!((fov_deg - want).abs() < 1e-12, "{fov_deg} vs {want}");
     assert!(fov_deg > 45.0 && fov_deg < 46.0);
     assert_eq!((d.camera.at.line, d.camera.at.col), (1, 1));
@@ -97,7 +100,9 @@ fn background_is_linear() {
 
 #[test]
 fn lights_share_unit_brightness_unless_coloured() {
-    let i = parse(&format!("{VIEW}l 1 2 3\nl 4 5 6\nl 7 8 9\nl 0 0 9 1 0.5 0\n"));
+    let i = parse(&format!(
+        "{VIEW}l 1 2 3\nl 4 5 6\nl 7 8 9\nl 0 0 9 1 0.5 0\n"
+    ));
     let l = &i.desc.lights;
     assert_eq!(l.len(), 4);
     assert_eq!(i.stats.lights, 4);
@@ -106,6 +111,7 @@ fn lights_share_unit_brightness_unless_coloured() {
         color,
         intensity,
         shadows,
+        ..
     } = &l[0].value
     else {
         panic!("point light expected")
@@ -146,7 +152,10 @@ fn fill_maps_as_nff_txt_says() {
     assert_eq!(a.ambient, 0.0, "not purely diffuse: no ambient");
     let b = &m[1].1.value;
     assert_eq!(b.ior, 1.0, "ior 0 means 1");
-    assert!((b.ambient - 0.2).abs() < 1e-12, "purely diffuse: ambient 1 - Kd");
+    assert!(
+        (b.ambient - 0.2).abs() < 1e-12,
+        "purely diffuse: ambient 1 - Kd"
+    );
     assert_eq!((m[1].1.at.line, m[1].1.at.col), (10, 1));
     // Each sphere is in its material's group.
     let names: Vec<String> = all(&i.desc)
@@ -206,23 +215,58 @@ fn polygons_and_patches() {
         "{VIEW}p 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\npp 3\n0 0 1 0 0 1\n1 0 1 0 0.5 1\n0 1 1 0 0 2\n"
     );
     let i = parse(&text);
-    assert_eq!((i.stats.polygons, i.stats.patches, i.stats.triangles), (1, 1, 3));
+    assert_eq!(
+        (i.stats.polygons, i.stats.patches, i.stats.triangles),
+        (1, 1, 3)
+    );
     let plain = all(&i.desc).find(|g| g.mesh.normals.is_empty()).unwrap();
     assert_eq!(plain.mesh.positions.len(), 4);
     assert_eq!(plain.mesh.indices.len(), 2);
     let patch = all(&i.desc).find(|g| !g.mesh.normals.is_empty()).unwrap();
-    assert_eq!(patch.mesh.positions, vec![[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]]);
-    assert_eq!(patch.mesh.normals, vec![[0.0, 0.0, 1.0], [0.0, 0.5, 1.0], [0.0, 0.0, 2.0]]);
+    assert_eq!(
+        patch.mesh.positions,
+        vec![[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]]
+    );
+    assert_eq!(
+        patch.mesh.normals,
+        vec![[0.0, 0.0, 1.0], [0.0, 0.5, 1.0], [0.0, 0.0, 2.0]]
+    );
     assert_eq!(patch.mesh.indices, vec![[0, 1, 2]]);
     let at = patch.at.as_ref().unwrap();
-    assert_eq!((at.line, at.col), (13, 1), "a group is positioned at its first `pp`");
+    assert_eq!(
+        (at.line, at.col),
+        (13, 1),
+        "a group is positioned at its first `pp`"
+    );
+}
+
+#[test]
+fn shared_vertices_are_stored_once() {
+    // Two quads sharing an edge, then a patch triangle whose corner repeats with a different
+    // normal: positions are shared only when the normal is the same too.
+    let text = format!(
+        "{VIEW}p 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\np 4\n1 0 0\n2 0 0\n2 1 0\n1 1 0\n\
+         pp 3\n0 0 1 0 0 1\n1 0 1 0 0 1\n0 1 1 0 0 1\npp 3\n1 0 1 0 0 1\n1 1 1 0 0 1\n0 1 1 0 1 0\n"
+    );
+    let i = parse(&text);
+    let plain = all(&i.desc).find(|g| g.mesh.normals.is_empty()).unwrap();
+    assert_eq!(plain.mesh.positions.len(), 6);
+    assert_eq!(plain.mesh.indices.len(), 4);
+    let patch = all(&i.desc).find(|g| !g.mesh.normals.is_empty()).unwrap();
+    assert_eq!(patch.mesh.positions.len(), 5, "(0 1 1) twice: two normals");
+    assert_eq!(patch.mesh.indices, vec![[0, 1, 2], [1, 3, 4]]);
+    assert_eq!(patch.mesh.normals[4], [0.0, 1.0, 0.0]);
 }
 
 /// Area of a triangle in 3-D.
 fn area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
     (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0
 }
 
@@ -230,7 +274,9 @@ fn point_in_polygon(p: &[[f64; 2]], q: [f64; 2]) -> bool {
     let mut inside = false;
     for i in 0..p.len() {
         let (a, b) = (p[i], p[(i + 1) % p.len()]);
-        if (a[1] > q[1]) != (b[1] > q[1]) && q[0] < a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) {
+        if (a[1] > q[1]) != (b[1] > q[1])
+            && q[0] < a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0])
+        {
             inside = !inside;
         }
     }
@@ -268,7 +314,10 @@ fn concave_polygon_is_ear_clipped() {
         let [a, b, c] = t.map(|k| p[k as usize]);
         total += area(a, b, c);
         let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
-        assert!(point_in_polygon(&ring, centroid), "triangle {t:?} lies outside the star");
+        assert!(
+            point_in_polygon(&ring, centroid),
+            "triangle {t:?} lies outside the star"
+        );
     }
     assert!((total - want).abs() < 1e-9, "area {total} vs {want}");
 }
@@ -289,13 +338,24 @@ fn busy_file() -> String {
     for k in 0..60 {
         let x = k as f64;
         if k % 7 == 0 {
-            t.push_str(&format!("f {} 0.5 0.5 0.8 0.2 10 0 0\n", (k % 3) as f64 / 2.0));
+            t.push_str(&format!(
+                "f {} 0.5 0.5 0.8 0.2 10 0 0\n",
+                (k % 3) as f64 / 2.0
+            ));
         }
         match k % 5 {
             0 => t.push_str(&format!("s {x} 0 0 0.5\n")),
             1 => t.push_str(&format!("c\n{x} 0 0 0.2\n{x} 0 1 0.1\n")),
-            2 => t.push_str(&format!("p 5\n{x} 0 0\n{} 0 0\n{} 1 0\n{} 0.5 0\n{x} 1 0\n", x + 1.0, x + 1.0, x + 0.5)),
-            3 => t.push_str(&format!("pp 3\n{x} 0 2 0 0 1\n{} 0 2 0 0 1\n{x} 1 2 0 0 1\n", x + 1.0)),
+            2 => t.push_str(&format!(
+                "p 5\n{x} 0 0\n{} 0 0\n{} 1 0\n{} 0.5 0\n{x} 1 0\n",
+                x + 1.0,
+                x + 1.0,
+                x + 0.5
+            )),
+            3 => t.push_str(&format!(
+                "pp 3\n{x} 0 2 0 0 1\n{} 0 2 0 0 1\n{x} 1 2 0 0 1\n",
+                x + 1.0
+            )),
             _ => t.push_str(&format!("c {x} 0 0 0.2 {x} 1 0 0.2\n# comment {k}\n\n")),
         }
     }
@@ -307,7 +367,10 @@ fn busy_file() -> String {
 fn flatten(d: &SceneDesc) -> Vec<String> {
     let mut out = Vec::new();
     for g in &d.inline {
-        let m = g.material.as_ref().map_or("default".to_string(), |m| m.value.clone());
+        let m = g
+            .material
+            .as_ref()
+            .map_or("default".to_string(), |m| m.value.clone());
         for s in &g.spheres {
             out.push(format!("{m} s {s:?}"));
         }
@@ -333,7 +396,10 @@ fn blocks_of_any_size_give_the_same_scene() {
     let text = busy_file();
     let whole = parse(&text);
     let want = flatten(&whole.desc);
-    assert_eq!(want.len() as u64, whole.stats.spheres + whole.stats.cones + whole.stats.triangles);
+    assert_eq!(
+        want.len() as u64,
+        whole.stats.spheres + whole.stats.cones + whole.stats.triangles
+    );
     for block in [1, 5, 33, 100, 1000, 1 << 20] {
         let i = nff::import_reader_blocks(text.as_bytes(), path(), block).unwrap();
         assert_eq!(flatten(&i.desc), want, "blocks of {block} bytes");
@@ -347,7 +413,10 @@ fn blocks_of_any_size_give_the_same_scene() {
             let at = g.at.as_ref().unwrap();
             let line = text.lines().nth(at.line as usize - 1).unwrap();
             let word = line.split_whitespace().next().unwrap();
-            assert!(["s", "c", "p", "pp"].contains(&word), "group at {at}: {line}");
+            assert!(
+                ["s", "c", "p", "pp"].contains(&word),
+                "group at {at}: {line}"
+            );
         }
     }
 }
@@ -388,9 +457,14 @@ fn gzip_and_extension_dispatch() {
     e.write_all(format!("{VIEW}s 1 2 3\n").as_bytes()).unwrap();
     e.finish().unwrap();
     let err = luxon_formats::load(&bad).unwrap_err().to_string();
-    assert!(err.starts_with(&format!("{}:8:8: ", bad.display())), "{err}");
+    assert!(
+        err.starts_with(&format!("{}:8:8: ", bad.display())),
+        "{err}"
+    );
     // A missing file is an I/O error naming it.
-    let err = luxon_formats::load(&dir.join("none.nff")).unwrap_err().to_string();
+    let err = luxon_formats::load(&dir.join("none.nff"))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("none.nff"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -399,52 +473,189 @@ fn gzip_and_extension_dispatch() {
 
 #[test]
 fn unknown_keyword() {
-    check(error_of(&format!("{VIEW}sphere 0 0 0 1\n")), 8, 1, &["unknown NFF keyword `sphere`", "expected"]);
-    check(error_of(&format!("{VIEW}  pq 3\n")), 8, 3, &["`pq`", "did you mean"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangel 40\n"), 5, 1, &["`angel`", "did you mean `angle`"]);
-    check(error_of(&format!("{VIEW}from 1 2 3\n")), 8, 1, &["`from` belongs in a `v` view"]);
+    check(
+        error_of(&format!("{VIEW}sphere 0 0 0 1\n")),
+        8,
+        1,
+        &["unknown NFF keyword `sphere`", "expected"],
+    );
+    check(
+        error_of(&format!("{VIEW}  pq 3\n")),
+        8,
+        3,
+        &["`pq`", "did you mean"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangel 40\n"),
+        5,
+        1,
+        &["`angel`", "did you mean `angle`"],
+    );
+    check(
+        error_of(&format!("{VIEW}s 0 0 0 1\nfrom 1 2 3\n")),
+        9,
+        1,
+        &["`from` belongs in a `v` view"],
+    );
 }
 
 #[test]
 fn wrong_number_of_values() {
-    check(error_of(&format!("{VIEW}s 1 2 3\n")), 8, 8, &["`s` sphere takes 4 numbers", "found 3"]);
-    check(error_of(&format!("{VIEW}s 1 2 3 4 5\n")), 8, 11, &["takes 4 numbers", "found 5", "unexpected `5`"]);
-    check(error_of(&format!("{VIEW}f 1 1 1 0.5 0.5 3\n")), 8, 19, &["`f` fill takes 8 numbers", "found 6"]);
-    check(error_of(&format!("{VIEW}c 0 0 0 1 0 0 1\n")), 8, 3, &["`c` takes 8 numbers", "or none", "found 7"]);
-    check(error_of(&format!("{VIEW}c\n0 0 0 1\n0 0 1\n")), 10, 6, &["cone apex takes 4 numbers", "found 3"]);
-    check(error_of(&format!("{VIEW}l 1 2\n")), 8, 6, &["`l` light takes 3 numbers", "or 6", "found 2"]);
-    check(error_of(&format!("{VIEW}p 3\n0 0 0\n1 0 0 5\n0 1 0\n")), 10, 7, &["`p` vertex takes 3 numbers", "found 4"]);
-    check(error_of(&format!("{VIEW}pp 3\n0 0 0 0 0 1\n1 0 0\n0 1 0 0 0 1\n")), 10, 6, &["`pp` vertex takes 6 numbers", "found 3"]);
-    check(error_of(&format!("{VIEW}b 1 1\n")), 8, 6, &["`b` background takes 3 numbers"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0\n"), 3, 7, &["`at` takes 3 numbers", "found 2"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nresolution 512\n"), 6, 15, &["`resolution` takes 2"]);
+    check(
+        error_of(&format!("{VIEW}s 1 2 3\n")),
+        8,
+        8,
+        &["`s` sphere takes 4 numbers", "found 3"],
+    );
+    check(
+        error_of(&format!("{VIEW}s 1 2 3 4 5\n")),
+        8,
+        11,
+        &["takes 4 numbers", "found 5", "unexpected `5`"],
+    );
+    check(
+        error_of(&format!("{VIEW}f 1 1 1 0.5 0.5 3\n")),
+        8,
+        18,
+        &["`f` fill takes 8 numbers", "found 6"],
+    );
+    check(
+        error_of(&format!("{VIEW}c 0 0 0 1 0 0 1\n")),
+        8,
+        3,
+        &["`c` takes 8 numbers", "or none", "found 7"],
+    );
+    check(
+        error_of(&format!("{VIEW}c\n0 0 0 1\n0 0 1\n")),
+        10,
+        6,
+        &["cone apex takes 4 numbers", "found 3"],
+    );
+    check(
+        error_of(&format!("{VIEW}l 1 2\n")),
+        8,
+        6,
+        &["`l` light takes 3 numbers", "or 6", "found 2"],
+    );
+    check(
+        error_of(&format!("{VIEW}p 3\n0 0 0\n1 0 0 5\n0 1 0\n")),
+        10,
+        7,
+        &["`p` vertex takes 3 numbers", "found 4"],
+    );
+    check(
+        error_of(&format!("{VIEW}pp 3\n0 0 0 0 0 1\n1 0 0\n0 1 0 0 0 1\n")),
+        10,
+        6,
+        &["`pp` vertex takes 6 numbers", "found 3"],
+    );
+    check(
+        error_of(&format!("{VIEW}b 1 1\n")),
+        8,
+        6,
+        &["`b` background takes 3 numbers"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0\n"),
+        3,
+        7,
+        &["`at` takes 3 numbers", "found 2"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nresolution 512\n"),
+        6,
+        15,
+        &["`resolution` takes 2"],
+    );
     check(error_of("v 1\n"), 1, 3, &["`v` stands alone"]);
-    check(error_of(&format!("{VIEW}p 3 0 0 0\n")), 8, 5, &["takes 1 number on its line", "vertex count"]);
+    check(
+        error_of(&format!("{VIEW}p 3 0 0 0\n")),
+        8,
+        5,
+        &["takes 1 number on its line", "vertex count"],
+    );
     // More vertex lines than the count says.
-    check(error_of(&format!("{VIEW}p 3\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n")), 12, 1, &["expected an NFF entity keyword", "found the number `1`"]);
+    check(
+        error_of(&format!("{VIEW}p 3\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n")),
+        12,
+        1,
+        &["expected an NFF entity keyword", "found the number `1`"],
+    );
 }
 
 #[test]
 fn bad_numbers() {
-    check(error_of(&format!("{VIEW}s 1 2x 3 4\n")), 8, 5, &["expected a number", "x y z radius", "found `2x`"]);
-    check(error_of(&format!("{VIEW}p 3\n0 0 0\n1 0,5 0\n0 1 0\n")), 10, 3, &["expected a number", "found `0,5`"]);
-    check(error_of(&format!("{VIEW}p three\n")), 8, 3, &["whole vertex count", "found `three`"]);
-    check(error_of(&format!("{VIEW}p 3.5\n")), 8, 3, &["whole vertex count"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nresolution 512 0\n"), 6, 16, &["1..=65536", "height", "found `0`"]);
+    check(
+        error_of(&format!("{VIEW}s 1 2x 3 4\n")),
+        8,
+        5,
+        &["expected a number", "x y z radius", "found `2x`"],
+    );
+    check(
+        error_of(&format!("{VIEW}p 3\n0 0 0\n1 0,5 0\n0 1 0\n")),
+        10,
+        3,
+        &["expected a number", "found `0,5`"],
+    );
+    check(
+        error_of(&format!("{VIEW}p three\n")),
+        8,
+        3,
+        &["whole vertex count", "found `three`"],
+    );
+    check(
+        error_of(&format!("{VIEW}p 3.5\n")),
+        8,
+        3,
+        &["whole vertex count"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 40\nresolution 512 0\n"),
+        6,
+        16,
+        &["1..=65536", "height", "found `0`"],
+    );
 }
 
 #[test]
 fn nan_and_infinity() {
-    check(error_of(&format!("{VIEW}s 1 nan 3 4\n")), 8, 5, &["finite number", "found `nan`", "NaN and infinities"]);
-    check(error_of(&format!("{VIEW}p 3\n0 0 0\ninf 0 0\n0 1 0\n")), 10, 1, &["finite number", "found `inf`"]);
-    check(error_of(&format!("{VIEW}pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1e999\n")), 11, 11, &["finite number", "found `1e999`"]);
+    check(
+        error_of(&format!("{VIEW}s 1 nan 3 4\n")),
+        8,
+        5,
+        &["finite number", "found `nan`", "NaN and infinities"],
+    );
+    check(
+        error_of(&format!("{VIEW}p 3\n0 0 0\ninf 0 0\n0 1 0\n")),
+        10,
+        1,
+        &["finite number", "found `inf`"],
+    );
+    check(
+        error_of(&format!(
+            "{VIEW}pp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1e999\n"
+        )),
+        11,
+        11,
+        &["finite number", "found `1e999`"],
+    );
     check(error_of("v\nfrom 0 0 NaN\n"), 2, 10, &["finite number"]);
 }
 
 #[test]
 fn polygon_with_too_few_vertices() {
-    check(error_of(&format!("{VIEW}p 2\n0 0 0\n1 0 0\n")), 8, 3, &["at least 3 vertices", "found 2"]);
-    check(error_of(&format!("{VIEW}pp 0\n")), 8, 4, &["at least 3 vertices", "found 0"]);
+    check(
+        error_of(&format!("{VIEW}p 2\n0 0 0\n1 0 0\n")),
+        8,
+        3,
+        &["at least 3 vertices", "found 2"],
+    );
+    check(
+        error_of(&format!("{VIEW}pp 0\n")),
+        8,
+        4,
+        &["at least 3 vertices", "found 0"],
+    );
 }
 
 #[test]
@@ -459,34 +670,109 @@ fn polygon_cut_short_by_the_next_entity() {
 
 #[test]
 fn truncated_file() {
-    check(error_of(&format!("{VIEW}p 4\n0 0 0\n1 0 0\n")), 11, 1, &["file ends early", "vertex 3 of 4"]);
-    check(error_of(&format!("{VIEW}pp 3\n0 0 0 0 0 1")), 9, 12, &["file ends early", "vertex 2 of 3", "x y z nx ny nz"]);
-    check(error_of(&format!("{VIEW}c\n0 0 0 1\n")), 10, 1, &["file ends early", "apex line"]);
+    check(
+        error_of(&format!("{VIEW}p 4\n0 0 0\n1 0 0\n")),
+        11,
+        1,
+        &["file ends early", "vertex 3 of 4"],
+    );
+    check(
+        error_of(&format!("{VIEW}pp 3\n0 0 0 0 0 1")),
+        9,
+        12,
+        &["file ends early", "vertex 2 of 3", "x y z nx ny nz"],
+    );
+    check(
+        error_of(&format!("{VIEW}c\n0 0 0 1\n")),
+        10,
+        1,
+        &["file ends early", "apex line"],
+    );
 }
 
 #[test]
 fn view_errors() {
     check(error_of("s 0 0 0 1\n"), 1, 1, &["no `v` view"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 0\nangle 40\ns 0 0 0 1\n"), 1, 1, &["lacks `up`"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 1\nup 0 1 0\nangle 40\n"), 1, 1, &["`from` and `at` are the same"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 0 2\nangle 40\n"), 4, 4, &["parallel"]);
-    check(error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 180\n"), 5, 7, &["(0, 180)"]);
-    check(error_of("v\nfrom 0 0 1\nfrom 0 0 2\n"), 3, 1, &["`from` given twice"]);
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 0\nangle 40\ns 0 0 0 1\n"),
+        1,
+        1,
+        &["lacks `up`"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 1\nup 0 1 0\nangle 40\n"),
+        1,
+        1,
+        &["`from` and `at` are the same"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 0 2\nangle 40\n"),
+        4,
+        4,
+        &["parallel"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 180\n"),
+        5,
+        7,
+        &["(0, 180)"],
+    );
+    check(
+        error_of("v\nfrom 0 0 1\nfrom 0 0 2\n"),
+        3,
+        1,
+        &["`from` given twice"],
+    );
 }
 
 #[test]
 fn value_errors() {
-    check(error_of(&format!("{VIEW}s 0 0 0 0\n")), 8, 9, &["radius is 0"]);
-    check(error_of(&format!("{VIEW}c 0 0 0 0 0 0 1 0\n")), 8, 1, &["radii are both 0"]);
-    check(error_of(&format!("{VIEW}c 1 1 1 1 1 1 1 2\n")), 8, 1, &["same point"]);
-    check(error_of(&format!("{VIEW}f 1 1 1 -0.5 0 1 0 1\n")), 8, 9, &["Kd", ">= 0"]);
-    check(error_of(&format!("{VIEW}l 0 0 0 1 -1 1\n")), 8, 11, &["negative"]);
+    check(
+        error_of(&format!("{VIEW}s 0 0 0 0\n")),
+        8,
+        9,
+        &["radius is 0"],
+    );
+    check(
+        error_of(&format!("{VIEW}c 0 0 0 0 0 0 1 0\n")),
+        8,
+        1,
+        &["radii are both 0"],
+    );
+    check(
+        error_of(&format!("{VIEW}c 1 1 1 1 1 1 1 2\n")),
+        8,
+        1,
+        &["same point"],
+    );
+    check(
+        error_of(&format!("{VIEW}f 1 1 1 -0.5 0 1 0 1\n")),
+        8,
+        9,
+        &["Kd", ">= 0"],
+    );
+    check(
+        error_of(&format!("{VIEW}l 0 0 0 1 -1 1\n")),
+        8,
+        11,
+        &["negative"],
+    );
 }
 
 #[test]
 fn non_ascii_tokens_are_shown() {
-    check(error_of(&format!("{VIEW}s 1 2 3 é\n")), 8, 9, &["found `é`"]);
-    check(error_of(&format!("{VIEW}ßphere 1 2 3\n")), 8, 1, &["unknown NFF keyword `ßphere`"]);
+    check(
+        error_of(&format!("{VIEW}s 1 2 3 é\n")),
+        8,
+        9,
+        &["found `é`"],
+    );
+    check(
+        error_of(&format!("{VIEW}ßphere 1 2 3\n")),
+        8,
+        1,
+        &["unknown NFF keyword `ßphere`"],
+    );
 }
 
 // ---- The shared SPD files ----
@@ -537,7 +823,11 @@ fn shared_spd_files_import_with_their_counts() {
         // Every material a group names exists.
         for g in all(d) {
             if let Some(m) = &g.material {
-                assert!(d.materials.iter().any(|(n, _)| n == &m.value), "{name}: {}", m.value);
+                assert!(
+                    d.materials.iter().any(|(n, _)| n == &m.value),
+                    "{name}: {}",
+                    m.value
+                );
             }
         }
     }

@@ -39,7 +39,10 @@ fn parse(text: &str) -> Vec<Entity> {
     let mut out = Vec::new();
     let nums = |s: &str| -> Vec<f64> {
         s.split_whitespace()
-            .map(|t| t.parse().unwrap_or_else(|_| panic!("bad number `{t}` in `{s}`")))
+            .map(|t| {
+                t.parse()
+                    .unwrap_or_else(|_| panic!("bad number `{t}` in `{s}`"))
+            })
             .collect()
     };
     while let Some(line) = lines.next() {
@@ -98,7 +101,10 @@ fn generated(name: &str, size: u32) -> String {
 fn counts(e: &[Entity]) -> Vec<(String, usize, usize)> {
     let mut c: Vec<(String, usize, usize)> = Vec::new();
     for x in e {
-        match c.iter_mut().find(|(k, v, _)| *k == x.kind && *v == x.vertices) {
+        match c
+            .iter_mut()
+            .find(|(k, v, _)| *k == x.kind && *v == x.vertices)
+        {
             Some(entry) => entry.2 += 1,
             None => c.push((x.kind.clone(), x.vertices, 1)),
         }
@@ -148,7 +154,12 @@ fn check(file: &str, name: &str, size: u32) {
     let Some(dir) = shared() else { return };
     let theirs = parse(&reference(&dir, file));
     let mine = parse(&generated(name, size));
-    compare(&format!("{name} -s {size} vs {file}"), &mine, &theirs, false);
+    compare(
+        &format!("{name} -s {size} vs {file}"),
+        &mine,
+        &theirs,
+        false,
+    );
 }
 
 #[test]
@@ -255,7 +266,13 @@ fn counts_of_large_sizes() {
 fn ron_matches_nff() {
     let dir = std::env::temp_dir().join(format!("luxon-spd-ron-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for (name, size) in [("gears", 1), ("lattice", 2), ("teapot", 3), ("balls", 2), ("tree", 3)] {
+    for (name, size) in [
+        ("gears", 1),
+        ("lattice", 2),
+        ("teapot", 3),
+        ("balls", 2),
+        ("tree", 3),
+    ] {
         let mut ron = Vec::new();
         spd::generate_ron(name, size, &mut ron).unwrap();
         let ron_path = dir.join(format!("{name}.ron"));
@@ -266,8 +283,16 @@ fn ron_matches_nff() {
         let from_nff = luxon_formats::load(&nff_path).unwrap();
 
         let (a, b) = (&from_ron.camera.value, &from_nff.camera.value);
-        assert_eq!((a.position, a.look_at, a.up), (b.position, b.look_at, b.up), "{name}");
-        assert_eq!(format!("{:?}", a.projection), format!("{:?}", b.projection), "{name}");
+        assert_eq!(
+            (a.position, a.look_at, a.up),
+            (b.position, b.look_at, b.up),
+            "{name}"
+        );
+        assert_eq!(
+            format!("{:?}", a.projection),
+            format!("{:?}", b.projection),
+            "{name}"
+        );
         assert_eq!(from_ron.lights.len(), from_nff.lights.len(), "{name}");
         for (l, m) in from_ron.lights.iter().zip(&from_nff.lights) {
             assert_eq!(l.value, m.value, "{name}");

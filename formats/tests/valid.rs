@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use luxon_formats::Attenuation;
 use luxon_formats::*;
 
 const SCENE: &str = r#"// A comment
@@ -190,6 +191,7 @@ fn defaults_fill_what_is_left_out() {
             color: [1.0; 3],
             intensity: 1.0,
             shadows: true,
+            attenuation: Attenuation::default(),
         }
     );
 }

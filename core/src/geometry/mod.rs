@@ -73,6 +73,8 @@ pub struct Counters {
     pub shadow: u64,
     pub reflection: u64,
     pub refraction: u64,
+    /// Ambient occlusion rays.
+    pub occlusion: u64,
     /// Ray/primitive intersection tests (all kinds).
     pub tests: u64,
     /// Pixels whose value was NaN or infinite (clamped to 0).
@@ -85,11 +87,12 @@ impl Counters {
         self.shadow += o.shadow;
         self.reflection += o.reflection;
         self.refraction += o.refraction;
+        self.occlusion += o.occlusion;
         self.tests += o.tests;
         self.nan_pixels += o.nan_pixels;
     }
 
     pub fn rays(&self) -> u64 {
-        self.primary + self.shadow + self.reflection + self.refraction
+        self.primary + self.shadow + self.reflection + self.refraction + self.occlusion
     }
 }

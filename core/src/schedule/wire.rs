@@ -64,7 +64,7 @@ pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
     r.0.is_empty().then_some(Chunk { spans, rgba })
 }
 
-/// `[rank][time ns][threads][units pixels primary shadow reflection refraction tests nan busy]*`
+/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan busy]*`
 pub fn encode_stats(s: &RankStats) -> Vec<u8> {
     let mut b = Vec::new();
     put64(&mut b, s.rank as u64);
@@ -79,6 +79,7 @@ pub fn encode_stats(s: &RankStats) -> Vec<u8> {
             c.shadow,
             c.reflection,
             c.refraction,
+            c.occlusion,
             c.tests,
             c.nan_pixels,
             w.busy.as_nanos() as u64,
@@ -94,7 +95,7 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
     let rank = r.u64()? as usize;
     let time = Duration::from_nanos(r.u64()?);
     let n = r.u64()? as usize;
-    let mut threads = Vec::with_capacity(n.min(bytes.len() / 72));
+    let mut threads = Vec::with_capacity(n.min(bytes.len() / 80));
     for _ in 0..n {
         threads.push(WorkerStats {
             units: r.u64()?,
@@ -104,6 +105,7 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
                 shadow: r.u64()?,
                 reflection: r.u64()?,
                 refraction: r.u64()?,
+                occlusion: r.u64()?,
                 tests: r.u64()?,
                 nan_pixels: r.u64()?,
             },
@@ -154,6 +156,7 @@ mod tests {
                     shadow: 7,
                     reflection: 6,
                     refraction: 5,
+                    occlusion: 2,
                     tests: 4,
                     nan_pixels: 1,
                 },
