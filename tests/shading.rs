@@ -181,3 +181,56 @@ fn glass_ball_lens_inverts_what_is_behind_it() {
     // Without the lens it would be in the top half (rows < 20); through it, in the bottom half.
     assert!(red_rows.iter().any(|&y| y > 20), "rows {red_rows:?}");
 }
+
+/// One or two panes between the camera and a blue background, in a given transparency mode.
+fn panes(name: &str, mode: &str, tilt: f32, second: bool, extra: &str) -> [f32; 3] {
+    // The pane spans x and the direction (0, cos, sin) of the tilt: its normal makes the angle
+    // `tilt` with the view direction.
+    let (y, z) = (tilt.to_radians().cos() * 5.0, tilt.to_radians().sin() * 5.0);
+    let pane = |d: f32| {
+        format!(
+            r#"(plugin: "mesh", params: (positions: [(-5, {y0}, {z0}), (5, {y0}, {z0}), (5, {y1}, {z1}), (-5, {y1}, {z1})], indices: [(0, 1, 2), (0, 2, 3)]), material: "pane"),"#,
+            y0 = -y,
+            z0 = d - z,
+            y1 = y,
+            z1 = d + z
+        )
+    };
+    let scene = format!(
+        r#"Scene(
+        camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 20),
+        background: (0, 0, 1),
+        materials: {{ "pane": (color: (1, 0, 0), ambient: 1, diffuse: 0, transmit: 0.5, ior: 1) }},
+        objects: [{}{}],
+        render: (transparency: (mode: {mode}{extra})),
+    )"#,
+        pane(10.0),
+        if second { pane(20.0) } else { String::new() }
+    );
+    centre(name, &scene)
+}
+
+#[test]
+fn transparency_modes() {
+    // Filter (Tachyon): ambient·opacity·base + transmit·base·behind = (0.5, 0, 0).
+    let f = panes("t-filter", "Filter", 0.0, false, "");
+    assert!(close(f, [0.5, 0.0, 0.0]), "{f:?}");
+    // Post-multiplied (VMD): opacity·shaded + transmit·behind, unfiltered.
+    let p = panes("t-post", "PostMultiplied", 0.0, false, "");
+    assert!(close(p, [0.5, 0.0, 0.5]), "{p:?}");
+    // Angle-modulated (Raster3D-style): head-on as Filter; seen at 60 degrees, t = 0.5^2.
+    let a0 = panes("t-angle0", "AngleModulated", 0.0, false, "");
+    assert!(close(a0, f), "{a0:?}");
+    let a60 = panes("t-angle60", "AngleModulated", 60.0, false, "");
+    assert!(close(a60, [0.75, 0.0, 0.0]), "{a60:?}");
+}
+
+#[test]
+fn transparent_surface_limit_shows_the_next_one_opaque() {
+    // Two panes, both half transparent: 0.5 + 0.5·(0.5 + 0.5·blue·red) = (0.75, 0, 0).
+    let both = panes("t-two", "Filter", 0.0, true, "");
+    assert!(close(both, [0.75, 0.0, 0.0]), "{both:?}");
+    // Limit 1: the second pane is opaque: 0.5 + 0.5·red = (1.0, 0, 0).
+    let limited = panes("t-limit", "Filter", 0.0, true, ", max_surfaces: 1");
+    assert!(close(limited, [1.0, 0.0, 0.0]), "{limited:?}");
+}

@@ -8,13 +8,16 @@ use crate::math::{reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
 use crate::sampler::{mix, pixel_sample};
 use crate::scene::{Ao, Light, Material, Scene};
+use luxon_formats::TransparencyMode;
 use luxon_plugin::abi::TexQuery;
 
-/// Media the ray is inside, innermost last: (material, index of refraction).
+/// Media the ray is inside, innermost last: (material, index of refraction); and how many
+/// transparent surfaces the path has passed through.
 #[derive(Clone, Copy, Debug)]
 pub struct IorStack {
     items: [(u32, f32); 8],
     len: usize,
+    pub surfaces: u32,
 }
 
 impl Default for IorStack {
@@ -22,6 +25,7 @@ impl Default for IorStack {
         IorStack {
             items: [(0, 1.0); 8],
             len: 0,
+            surfaces: 0,
         }
     }
 }
@@ -143,10 +147,26 @@ impl Whitted<'_> {
         if let Some(vc) = s.color {
             base *= vc;
         }
+        let transparency = settings.transparency;
+        if kt > 0.0 {
+            if transparency
+                .max_surfaces
+                .is_some_and(|n| media.surfaces >= n)
+            {
+                kt = 0.0;
+            } else if transparency.mode == TransparencyMode::AngleModulated {
+                // A slab seen at angle θ is 1/|cos θ| thick: edge-on surfaces look opaque.
+                let cos = ray.dir.dot(n).abs().max(1e-3);
+                kt = kt.powf(1.0 / cos);
+            }
+        }
+        let post = transparency.mode == TransparencyMode::PostMultiplied;
 
         let opacity = 1.0 - kt;
+        // Post-multiplied: shade as if opaque, then scale everything by the opacity.
+        let shade_opacity = if post { 1.0 } else { opacity };
         let view = -ray.dir;
-        let mut color = mat.ambient * opacity * base;
+        let mut color = mat.ambient * shade_opacity * base;
         // Random numbers for area lights and occlusion, from the ray itself: deterministic for
         // any thread count or decomposition, different for every path.
         let seed = ray_seed(ray);
@@ -157,15 +177,20 @@ impl Whitted<'_> {
             ng,
             view,
             base,
-            opacity,
+            opacity: shade_opacity,
             time: ray.time,
         };
         for (k, light) in scene.lights.iter().enumerate() {
             color += self.direct(&shade, mat, light, mix(seed ^ k as u32), c);
         }
         if let (true, Some(ao)) = (features.ambient_occlusion, &scene.ao) {
-            color += mat.diffuse * opacity * base * ao.sky * self.unoccluded(&shade, ao, seed, c);
+            color +=
+                mat.diffuse * shade_opacity * base * ao.sky * self.unoccluded(&shade, ao, seed, c);
         }
+        if post {
+            color *= opacity;
+        }
+        let filter = if post { Vec3A::ONE } else { base };
         if depth == 0 {
             if let (true, Some(fog)) = (features.fog, &scene.fog) {
                 let d = if fog.planar {
@@ -193,10 +218,11 @@ impl Whitted<'_> {
         if features.transmission && kt > 0.0 {
             let w = weight * kt;
             if next > settings.max_depth {
-                color += kt * base * scene.background;
+                color += kt * filter * scene.background;
             } else if w >= settings.min_weight {
                 // Which media are on each side of the surface.
                 let mut inside = *media;
+                inside.surfaces += 1;
                 let (n1, n2) = if entering {
                     let n1 = media.current();
                     inside.push(s.material, mat.ior);
@@ -212,8 +238,10 @@ impl Whitted<'_> {
                 };
                 c.refraction += 1;
                 let r = spawn(s.p, s.p_error, ng, dir, ray.time);
-                let stack = if through { &inside } else { media };
-                color += kt * base * self.trace(&r, next, w, stack, footprint, c);
+                let mut outside = *media;
+                outside.surfaces += 1;
+                let stack = if through { &inside } else { &outside };
+                color += kt * filter * self.trace(&r, next, w, stack, footprint, c);
             }
         }
         color

@@ -181,6 +181,7 @@ pub struct Settings {
     pub time: f32,
     pub threads: Option<u32>,
     pub tile_size: u32,
+    pub transparency: luxon_formats::TransparencyDesc,
     pub mode: luxon_formats::ParallelMode,
     pub decomposition: luxon_formats::Decomposition,
     pub io: luxon_formats::OutputIo,
@@ -385,7 +386,12 @@ impl Scene {
                     indices: g.mesh.indices.as_flattened(),
                     normals: g.mesh.normals.as_flattened(),
                     colors: &[],
-                    uvs: &[],
+                    uvs: &g
+                        .mesh
+                        .uvs
+                        .iter()
+                        .flat_map(|u| u.map(|x| x as f32))
+                        .collect::<Vec<_>>(),
                 };
                 dropped += triangles.push_mesh(&input, world_offset, m).map_err(fail)?;
             }
@@ -537,6 +543,7 @@ impl Scene {
             time: r.time as f32,
             threads: r.parallel.threads,
             tile_size: r.parallel.tile_size,
+            transparency: r.transparency,
             mode: r.parallel.mode,
             decomposition: r.parallel.decomposition,
             io: r.parallel.io,

@@ -220,6 +220,28 @@ impl Checker<'_> {
             },
             frame: whole("frame", r.frame, d.frame, 0, u32::MAX)?,
             time: r.time.unwrap_or(d.time),
+            transparency: match r.transparency {
+                Some(t) => {
+                    let at = field("transparency");
+                    let at = at.field("max_surfaces").unwrap_or(at);
+                    TransparencyDesc {
+                        mode: match t.mode {
+                            Some(raw::TransparencyMode::Filter) | None => TransparencyMode::Filter,
+                            Some(raw::TransparencyMode::AngleModulated) => {
+                                TransparencyMode::AngleModulated
+                            }
+                            Some(raw::TransparencyMode::PostMultiplied) => {
+                                TransparencyMode::PostMultiplied
+                            }
+                        },
+                        max_surfaces: match t.max_surfaces {
+                            Some(n) => Some(self.whole(at, "max_surfaces", n, 0, 1024)?),
+                            None => None,
+                        },
+                    }
+                }
+                None => d.transparency,
+            },
         };
         Ok((render, outputs))
     }

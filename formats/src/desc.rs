@@ -331,6 +331,38 @@ pub struct RenderDesc {
     pub frame: u32,
     /// Shutter time of the frame (rays carry it).
     pub time: f64,
+    pub transparency: TransparencyDesc,
+}
+
+/// How transparent surfaces combine with what is behind them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TransparencyDesc {
+    pub mode: TransparencyMode,
+    /// After this many transparent surfaces along a path, the next one is shown opaque
+    /// (Tachyon's limit: deep stacks of molecular surfaces stay legible). `None`: no limit.
+    pub max_surfaces: Option<u32>,
+}
+
+impl Default for TransparencyDesc {
+    fn default() -> Self {
+        TransparencyDesc {
+            mode: TransparencyMode::Filter,
+            max_surfaces: None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransparencyMode {
+    /// Tachyon's original: diffuse and ambient scaled by opacity, highlights kept, light from
+    /// behind filtered by the surface colour.
+    Filter,
+    /// Raster3D-style: a surface is more opaque seen edge-on (its transmittance t becomes
+    /// t^(1/|cos θ|), a slab seen at angle θ).
+    AngleModulated,
+    /// VMD's post-multiplied: the fully shaded colour (highlights too) times opacity, plus the
+    /// unfiltered light from behind times transmittance.
+    PostMultiplied,
 }
 
 impl Default for RenderDesc {
@@ -345,6 +377,7 @@ impl Default for RenderDesc {
             parallel: ParallelDesc::default(),
             frame: 0,
             time: 0.0,
+            transparency: TransparencyDesc::default(),
         }
     }
 }

@@ -283,6 +283,22 @@ pub(crate) struct Render {
     #[serde(default)]
     pub outputs: Vec<Output>,
     pub parallel: Option<Parallel>,
+    pub transparency: Option<Transparency>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Transparency", deny_unknown_fields)]
+pub(crate) struct Transparency {
+    pub mode: Option<TransparencyMode>,
+    pub max_surfaces: Option<f64>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "TransparencyMode")]
+pub(crate) enum TransparencyMode {
+    Filter,
+    AngleModulated,
+    PostMultiplied,
 }
 
 #[derive(Deserialize)]
