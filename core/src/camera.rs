@@ -1,70 +1,656 @@
-//! The perspective camera. The world is re-centred on the camera, so its origin is (0, 0, 0)
-//! in render space and precision is best where the viewer looks from.
+//! Cameras: perspective, orthographic, angular fisheye and equirectangular projections, each
+//! optionally with a frustum override (perspective, orthographic), a thin lens (depth of field)
+//! and two eyes in one image (stereo). The world is re-centred on the camera, so its origin is
+//! (0, 0, 0) in render space and precision is best where the viewer looks from.
+//!
+//! A camera ray is built in up to three steps:
+//!
+//! 1. **Projection**: the image position gives a ray from the (mono) camera. Perspective:
+//!    through the window `forward + shift + sx·right + sy·up` at unit distance. Orthographic:
+//!    along `forward` from the window point `origin + shift + sx·right + sy·up`. Fisheye
+//!    (angular, equidistant): the angle from `forward` is proportional to the distance from the
+//!    image centre, `fov / 2` at half the image height. Equirectangular: longitude −180° at the
+//!    left edge to +180° at the right, latitude +90° at the top to −90° at the bottom.
+//! 2. **Stereo**: the eye sits `eye_separation / 2` to the left or right of the camera (along
+//!    `right`; for equirectangular along the horizontal perpendicular of each ray's longitude:
+//!    omni-directional stereo, so every viewing direction of a VR panorama has a correct pair).
+//!    The eyes look parallel, each ray aimed at the point the mono ray meets the convergence
+//!    surface: the plane at depth `convergence` (perspective, orthographic: asymmetric,
+//!    off-axis frusta, no keystone distortion) or the sphere of radius `convergence` (fisheye,
+//!    equirectangular). Points at that distance have zero parallax.
+//! 3. **Depth of field**: the ray starts at a point of a thin lens of radius `aperture` around
+//!    the eye and passes through the point where the pinhole ray meets the focal surface (plane
+//!    at depth `focal_distance`, or for fisheye and equirectangular the sphere of that radius,
+//!    the lens then lying across the ray). The lens point comes from a hash of the bits of the
+//!    ray's (x, y, time), mapped to the disk concentrically (Shirley & Chiu): deterministic per
+//!    pixel sample whatever the thread, rank or decomposition, and different for every
+//!    antialiasing sample since the jittered positions differ. Aperture 0 is a pinhole.
 
 use crate::math::Vec3A;
 use crate::ray::Ray;
-use luxon_formats::{CameraDesc, Projection};
+use crate::sampler::{hash, to_unit};
+use luxon_formats::{CameraDesc, Projection, StereoLayout};
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    Perspective,
+    Orthographic,
+    /// Angle from `forward` at unit image radius, and the horizontal scale (aspect).
+    Fisheye {
+        half_angle: f32,
+        aspect: f32,
+    },
+    Equirectangular,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Eyes {
+    layout: StereoLayout,
+    half_separation: f32,
+    convergence: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Lens {
+    radius: f32,
+    focal_distance: f32,
+}
 
 #[derive(Clone, Debug)]
 pub struct Camera {
     pub origin: Vec3A,
     pub forward: Vec3A,
-    /// Right and up, scaled to the image plane's half width and half height at unit distance.
+    /// Right and up, scaled to the image window's half width and half height: at unit distance
+    /// (perspective), in world units (orthographic), in radians (fisheye: the angle at the
+    /// window's edge; equirectangular: π and π/2).
     pub right: Vec3A,
     pub up: Vec3A,
+    /// The window's centre relative to `forward` (perspective) or to `origin` (orthographic):
+    /// non-zero only for an off-centre `frustum`.
+    shift: Vec3A,
+    right_unit: Vec3A,
+    up_unit: Vec3A,
+    kind: Kind,
+    eyes: Option<Eyes>,
+    lens: Option<Lens>,
+    /// Texture footprint of a primary ray: width at the eye and growth per unit distance.
+    footprint: (f32, f32),
 }
 
 impl Camera {
     /// `origin` is the camera position in render space (zero when the world is centred on it).
+    /// `width` × `height` is the whole image (both eyes for stereo).
     pub fn new(desc: &CameraDesc, origin: Vec3A, width: u32, height: u32) -> Camera {
         let pos = glam::DVec3::from(desc.position);
         let forward = (glam::DVec3::from(desc.look_at) - pos).normalize();
         let right = forward.cross(glam::DVec3::from(desc.up)).normalize();
         let up = right.cross(forward);
-        let half_h = match desc.projection {
-            Projection::Perspective { fov_deg } => (fov_deg.to_radians() * 0.5).tan(),
-            Projection::PerspectiveZoom { zoom } => 1.0 / zoom,
+        let (eye_w, eye_h) = match desc.stereo.map(|s| s.layout) {
+            None => (width as f64, height as f64),
+            Some(StereoLayout::SideBySide) => (width as f64 / 2.0, height as f64),
+            Some(StereoLayout::OverUnder) => (width as f64, height as f64 / 2.0),
         };
-        let aspect = desc.aspect.unwrap_or(width as f64 / height as f64);
-        let half_w = half_h * aspect;
+        let aspect = desc.aspect.unwrap_or(eye_w / eye_h);
+        // Half width, half height and centre of the window.
+        let window = |half_h: f64| (half_h * aspect, half_h, 0.0, 0.0);
+        let (kind, (half_w, half_h, cx, cy)) = match desc.projection {
+            Projection::Perspective { fov_deg } => (
+                Kind::Perspective,
+                window((fov_deg.to_radians() * 0.5).tan()),
+            ),
+            Projection::PerspectiveZoom { zoom } => (Kind::Perspective, window(1.0 / zoom)),
+            Projection::Orthographic { height } => (Kind::Orthographic, window(height * 0.5)),
+            Projection::Fisheye { fov_deg } => {
+                let half_angle = fov_deg.to_radians() * 0.5;
+                let kind = Kind::Fisheye {
+                    half_angle: half_angle as f32,
+                    aspect: aspect as f32,
+                };
+                (kind, window(half_angle))
+            }
+            Projection::Equirectangular => (
+                Kind::Equirectangular,
+                (std::f64::consts::PI, std::f64::consts::FRAC_PI_2, 0.0, 0.0),
+            ),
+        };
+        let (half_w, half_h, cx, cy) = match (desc.frustum, kind) {
+            (Some(f), Kind::Perspective | Kind::Orthographic) => (
+                (f.right - f.left) * 0.5,
+                (f.top - f.bottom) * 0.5,
+                (f.right + f.left) * 0.5,
+                (f.top + f.bottom) * 0.5,
+            ),
+            _ => (half_w, half_h, cx, cy),
+        };
+        let v = |d: glam::DVec3| Vec3A::from(d.as_vec3());
+        let per_pixel = (2.0 * half_h / eye_h) as f32;
+        let footprint = match kind {
+            Kind::Orthographic => (per_pixel, 0.0),
+            _ => (0.0, per_pixel),
+        };
         Camera {
             origin,
-            forward: Vec3A::from(forward.as_vec3()),
-            right: Vec3A::from((right * half_w).as_vec3()),
-            up: Vec3A::from((up * half_h).as_vec3()),
+            forward: v(forward),
+            right: v(right * half_w),
+            up: v(up * half_h),
+            shift: v(right * cx + up * cy),
+            right_unit: v(right),
+            up_unit: v(up),
+            kind,
+            eyes: desc.stereo.map(|s| Eyes {
+                layout: s.layout,
+                half_separation: (s.eye_separation * 0.5) as f32,
+                convergence: s.convergence as f32,
+            }),
+            lens: desc
+                .depth_of_field
+                .filter(|d| d.aperture > 0.0)
+                .map(|d| Lens {
+                    radius: d.aperture as f32,
+                    focal_distance: d.focal_distance as f32,
+                }),
+            footprint,
         }
     }
 
-    /// The ray through image position (`x`, `y`) in pixels from the top-left corner.
+    /// Texture footprint of primary rays as (width at the eye, growth per unit distance along
+    /// the ray), for one pixel: (0, window height per pixel at unit distance) for perspective,
+    /// (pixel size, 0) for orthographic, (0, radians per pixel) for fisheye and
+    /// equirectangular; per eye image for stereo.
+    pub fn footprint(&self) -> (f32, f32) {
+        self.footprint
+    }
+
+    /// The ray through image position (`x`, `y`) in pixels from the top-left corner. A position
+    /// outside a fisheye's image circle has no ray ([`Camera::primary`] says `None`); this
+    /// returns a ray looking straight back there.
     #[inline]
     pub fn ray(&self, x: f32, y: f32, width: u32, height: u32, time: f32) -> Ray {
-        let sx = 2.0 * x / width as f32 - 1.0;
-        let sy = 1.0 - 2.0 * y / height as f32;
-        let d = (self.forward + sx * self.right + sy * self.up).normalize();
-        Ray::new(self.origin, d, time)
+        self.primary(x, y, width, height, time)
+            .unwrap_or_else(|| Ray::new(self.origin, -self.forward, time))
     }
+
+    /// The ray through image position (`x`, `y`) in pixels from the top-left corner, or `None`
+    /// outside a fisheye's image circle (Tachyon draws those pixels black).
+    pub fn primary(&self, x: f32, y: f32, width: u32, height: u32, time: f32) -> Option<Ray> {
+        // Which eye, and the position in its half of the image.
+        let (mut w, mut h) = (width as f32, height as f32);
+        let (mut ex, mut ey, mut eye) = (x, y, 0.0);
+        if let Some(e) = &self.eyes {
+            match e.layout {
+                StereoLayout::SideBySide => {
+                    w *= 0.5;
+                    eye = if x < w { -1.0 } else { 1.0 };
+                    if x >= w {
+                        ex -= w;
+                    }
+                }
+                StereoLayout::OverUnder => {
+                    h *= 0.5;
+                    eye = if y < h { -1.0 } else { 1.0 };
+                    if y >= h {
+                        ey -= h;
+                    }
+                }
+            }
+        }
+        let sx = 2.0 * ex / w - 1.0;
+        let sy = 1.0 - 2.0 * ey / h;
+
+        // 1. The mono ray; `flat`: focus and convergence on planes (else on spheres).
+        let (mut o, mut d, flat, eye_axis) = match self.kind {
+            Kind::Perspective => {
+                let d = (self.forward + self.shift + sx * self.right + sy * self.up).normalize();
+                (self.origin, d, true, self.right_unit)
+            }
+            Kind::Orthographic => {
+                let o = self.origin + self.shift + sx * self.right + sy * self.up;
+                (o, self.forward, true, self.right_unit)
+            }
+            Kind::Fisheye { half_angle, aspect } => {
+                let (fx, fy) = (sx * aspect, sy);
+                let r = (fx * fx + fy * fy).sqrt();
+                if r > 1.0 {
+                    return None;
+                }
+                let (sin_t, cos_t) = (r * half_angle).sin_cos();
+                let radial = if r > 0.0 {
+                    (fx * self.right_unit + fy * self.up_unit) / r
+                } else {
+                    Vec3A::ZERO
+                };
+                let d = (cos_t * self.forward + sin_t * radial).normalize();
+                (self.origin, d, false, self.right_unit)
+            }
+            Kind::Equirectangular => {
+                let (sin_lon, cos_lon) = (sx * PI).sin_cos();
+                let (sin_lat, cos_lat) = (sy * FRAC_PI_2).sin_cos();
+                let horizontal = sin_lon * self.right_unit + cos_lon * self.forward;
+                let d = (cos_lat * horizontal + sin_lat * self.up_unit).normalize();
+                let axis = cos_lon * self.right_unit - sin_lon * self.forward;
+                (self.origin, d, false, axis)
+            }
+        };
+        // Distance along `d` from `o` to the plane at depth `depth`, or to the sphere.
+        let reach = |d: Vec3A, depth: f32| {
+            if flat {
+                depth / d.dot(self.forward)
+            } else {
+                depth
+            }
+        };
+
+        // 2. The eye: shifted sideways, aimed at the mono ray's convergence point.
+        if let Some(e) = &self.eyes {
+            let target = o + d * reach(d, e.convergence);
+            o += eye * e.half_separation * eye_axis;
+            d = (target - o).normalize();
+        }
+
+        // 3. The lens: from a point of the aperture through the focal point.
+        if let Some(lens) = &self.lens {
+            let focus = o + d * reach(d, lens.focal_distance);
+            let (a, b) = if flat {
+                (self.right_unit, self.up_unit)
+            } else {
+                basis(d)
+            };
+            let u1 = to_unit(hash(x.to_bits(), y.to_bits(), time.to_bits(), 7));
+            let u2 = to_unit(hash(x.to_bits(), y.to_bits(), time.to_bits(), 8));
+            let (lx, ly) = concentric_disk(u1, u2);
+            o += lens.radius * (lx * a + ly * b);
+            d = (focus - o).normalize();
+        }
+        Some(Ray::new(o, d, time))
+    }
+}
+
+/// [0, 1)² onto the unit disk, keeping strata compact (Shirley & Chiu's concentric mapping).
+fn concentric_disk(u1: f32, u2: f32) -> (f32, f32) {
+    let (a, b) = (2.0 * u1 - 1.0, 2.0 * u2 - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a.abs() > b.abs() {
+        (a, FRAC_PI_4 * (b / a))
+    } else {
+        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+    };
+    let (s, c) = phi.sin_cos();
+    (r * c, r * s)
+}
+
+/// Two unit vectors perpendicular to unit `n` and to each other (Duff et al. 2017).
+fn basis(n: Vec3A) -> (Vec3A, Vec3A) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        Vec3A::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3A::new(b, sign + n.y * n.y * a, -n.y),
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use luxon_formats::{DepthOfField, Frustum, Stereo};
 
-    #[test]
-    fn centre_pixel_looks_forward_and_corners_span_the_fov() {
-        let desc = CameraDesc {
+    const EPS: f32 = 1e-5;
+
+    /// At the origin looking down −z, up +y: right is +x.
+    fn desc(projection: Projection) -> CameraDesc {
+        CameraDesc {
             position: [0.0, 0.0, 0.0],
             look_at: [0.0, 0.0, -1.0],
             up: [0.0, 1.0, 0.0],
-            projection: Projection::Perspective { fov_deg: 90.0 },
+            projection,
             aspect: None,
-        };
-        let cam = Camera::new(&desc, Vec3A::ZERO, 200, 100);
+            frustum: None,
+            depth_of_field: None,
+            stereo: None,
+        }
+    }
+
+    #[track_caller]
+    fn close(a: Vec3A, b: Vec3A) {
+        assert!((a - b).length() < EPS, "{a} != {b}");
+    }
+
+    #[test]
+    fn centre_pixel_looks_forward_and_corners_span_the_fov() {
+        let cam = Camera::new(
+            &desc(Projection::Perspective { fov_deg: 90.0 }),
+            Vec3A::ZERO,
+            200,
+            100,
+        );
         let c = cam.ray(100.0, 50.0, 200, 100, 0.0);
-        assert!((c.dir - Vec3A::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        close(c.dir, Vec3A::new(0.0, 0.0, -1.0));
         // Top edge: 45 degrees up. Right edge: atan(2) to the right (aspect 2).
         let top = cam.ray(100.0, 0.0, 200, 100, 0.0);
         assert!((top.dir.y - (0.5f32).sqrt()).abs() < 1e-6);
         let right = cam.ray(200.0, 50.0, 200, 100, 0.0);
         assert!(right.dir.x > 0.0 && (right.dir.x / -right.dir.z - 2.0).abs() < 1e-5);
+        // `up` is the window's half-height at unit distance (the scene's pixel spread).
+        assert!((cam.up.length() - 1.0).abs() < EPS);
+        assert_eq!(cam.footprint(), (0.0, 2.0 / 100.0));
+    }
+
+    #[test]
+    fn perspective_frustum_sets_an_off_centre_window_at_unit_distance() {
+        let mut d = desc(Projection::Perspective { fov_deg: 45.0 });
+        d.frustum = Some(Frustum {
+            left: 0.0,
+            right: 1.0,
+            bottom: -0.25,
+            top: 0.5,
+        });
+        let cam = Camera::new(&d, Vec3A::ZERO, 100, 50);
+        // Top-left corner: (left, top) at unit distance; bottom-right: (right, bottom).
+        let tl = cam.ray(0.0, 0.0, 100, 50, 0.0);
+        close(tl.dir, Vec3A::new(0.0, 0.5, -1.0).normalize());
+        let br = cam.ray(100.0, 50.0, 100, 50, 0.0);
+        close(br.dir, Vec3A::new(1.0, -0.25, -1.0).normalize());
+        let centre = cam.ray(50.0, 25.0, 100, 50, 0.0);
+        close(centre.dir, Vec3A::new(0.5, 0.125, -1.0).normalize());
+        assert!((cam.up.length() - 0.375).abs() < EPS);
+    }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_spread_over_the_window() {
+        let cam = Camera::new(
+            &desc(Projection::Orthographic { height: 4.0 }),
+            Vec3A::ZERO,
+            200,
+            100,
+        );
+        let forward = Vec3A::new(0.0, 0.0, -1.0);
+        for (x, y, ox, oy) in [
+            (100.0, 50.0, 0.0, 0.0),
+            (0.0, 0.0, -4.0, 2.0),
+            (200.0, 100.0, 4.0, -2.0),
+            (150.0, 25.0, 2.0, 1.0),
+        ] {
+            let r = cam.ray(x, y, 200, 100, 0.0);
+            close(r.dir, forward);
+            close(r.origin, Vec3A::new(ox, oy, 0.0));
+        }
+        assert_eq!(cam.footprint(), (4.0 / 100.0, 0.0));
+    }
+
+    #[test]
+    fn orthographic_frustum_is_in_world_units() {
+        let mut d = desc(Projection::Orthographic { height: 4.0 });
+        d.frustum = Some(Frustum {
+            left: -1.0,
+            right: 3.0,
+            bottom: 0.0,
+            top: 2.0,
+        });
+        let cam = Camera::new(&d, Vec3A::new(0.0, 0.0, 1.0), 100, 100);
+        close(
+            cam.ray(0.0, 0.0, 100, 100, 0.0).origin,
+            Vec3A::new(-1.0, 2.0, 1.0),
+        );
+        close(
+            cam.ray(100.0, 100.0, 100, 100, 0.0).origin,
+            Vec3A::new(3.0, 0.0, 1.0),
+        );
+    }
+
+    #[test]
+    fn fisheye_centre_is_forward_and_circle_edge_is_half_the_fov() {
+        let cam = Camera::new(
+            &desc(Projection::Fisheye { fov_deg: 180.0 }),
+            Vec3A::ZERO,
+            200,
+            100,
+        );
+        close(
+            cam.ray(100.0, 50.0, 200, 100, 0.0).dir,
+            Vec3A::new(0.0, 0.0, -1.0),
+        );
+        // The circle's radius is half the image height: 90° there.
+        close(
+            cam.ray(100.0, 0.0, 200, 100, 0.0).dir,
+            Vec3A::new(0.0, 1.0, 0.0),
+        );
+        close(
+            cam.ray(150.0, 50.0, 200, 100, 0.0).dir,
+            Vec3A::new(1.0, 0.0, 0.0),
+        );
+        // Halfway to the edge: 45° (equidistant), along the diagonal too.
+        let h = 25.0 / 2f32.sqrt();
+        let r = cam.ray(100.0 - h, 50.0 + h, 200, 100, 0.0);
+        close(r.dir, Vec3A::new(-0.5, -0.5, -(0.5f32).sqrt()));
+        // Outside the circle: no ray.
+        assert!(cam.primary(160.0, 50.0, 200, 100, 0.0).is_none());
+        assert!(cam.primary(0.0, 0.0, 200, 100, 0.0).is_none());
+        close(
+            cam.ray(0.0, 0.0, 200, 100, 0.0).dir,
+            Vec3A::new(0.0, 0.0, 1.0),
+        );
+        assert!((cam.footprint().1 - PI / 100.0).abs() < EPS);
+    }
+
+    #[test]
+    fn fisheye_360_edge_looks_back() {
+        let cam = Camera::new(
+            &desc(Projection::Fisheye { fov_deg: 360.0 }),
+            Vec3A::ZERO,
+            100,
+            100,
+        );
+        let r = cam.primary(50.0, 0.0, 100, 100, 0.0).unwrap();
+        close(r.dir, Vec3A::new(0.0, 0.0, 1.0));
+        let r = cam.primary(75.0, 50.0, 100, 100, 0.0).unwrap();
+        close(r.dir, Vec3A::new(1.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn equirectangular_spans_the_sphere() {
+        let cam = Camera::new(&desc(Projection::Equirectangular), Vec3A::ZERO, 360, 180);
+        let at = |x: f32, y: f32| cam.ray(x, y, 360, 180, 0.0).dir;
+        close(at(180.0, 90.0), Vec3A::new(0.0, 0.0, -1.0));
+        // Left edge: −180° (behind); a quarter in: −90° (left); right edge: +180°.
+        close(at(0.0, 90.0), Vec3A::new(0.0, 0.0, 1.0));
+        close(at(90.0, 90.0), Vec3A::new(-1.0, 0.0, 0.0));
+        close(at(270.0, 90.0), Vec3A::new(1.0, 0.0, 0.0));
+        close(at(360.0, 90.0), Vec3A::new(0.0, 0.0, 1.0));
+        // Top: straight up; bottom: straight down; 45° up ahead.
+        close(at(123.0, 0.0), Vec3A::new(0.0, 1.0, 0.0));
+        close(at(17.0, 180.0), Vec3A::new(0.0, -1.0, 0.0));
+        close(at(180.0, 45.0), Vec3A::new(0.0, 1.0, -1.0).normalize());
+        assert!((cam.footprint().1 - PI / 180.0).abs() < EPS);
+    }
+
+    fn stereo(projection: Projection, layout: StereoLayout) -> CameraDesc {
+        let mut d = desc(projection);
+        d.stereo = Some(Stereo {
+            layout,
+            eye_separation: 0.2,
+            convergence: 5.0,
+        });
+        d
+    }
+
+    #[test]
+    fn stereo_side_by_side_left_half_is_the_left_eye() {
+        let d = stereo(
+            Projection::Perspective { fov_deg: 90.0 },
+            StereoLayout::SideBySide,
+        );
+        // Each eye is 100 × 100: aspect 1.
+        let cam = Camera::new(&d, Vec3A::ZERO, 200, 100);
+        let left = cam.ray(50.0, 50.0, 200, 100, 0.0);
+        let right = cam.ray(150.0, 50.0, 200, 100, 0.0);
+        close(left.origin, Vec3A::new(-0.1, 0.0, 0.0));
+        close(right.origin, Vec3A::new(0.1, 0.0, 0.0));
+        // Both centre rays meet on the convergence plane, 5 ahead.
+        let converge = Vec3A::new(0.0, 0.0, -5.0);
+        close(left.dir, (converge - left.origin).normalize());
+        close(right.dir, (converge - right.origin).normalize());
+        // The same pixel of each eye meets the convergence plane at one point, which the mono
+        // camera sees at that pixel (off-axis frusta: zero parallax there).
+        let mono = Camera::new(
+            &desc(Projection::Perspective { fov_deg: 90.0 }),
+            Vec3A::ZERO,
+            100,
+            100,
+        );
+        let m = mono.ray(80.0, 10.0, 100, 100, 0.0);
+        let p = m.at(5.0 / -m.dir.z);
+        for r in [
+            cam.ray(80.0, 10.0, 200, 100, 0.0),
+            cam.ray(180.0, 10.0, 200, 100, 0.0),
+        ] {
+            close(r.at((p.z - r.origin.z) / r.dir.z), p);
+        }
+        assert!((cam.up.length() - 1.0).abs() < EPS);
+        assert!((cam.right.length() - 1.0).abs() < EPS);
+    }
+
+    #[test]
+    fn stereo_over_under_top_half_is_the_left_eye() {
+        let d = stereo(
+            Projection::Orthographic { height: 2.0 },
+            StereoLayout::OverUnder,
+        );
+        let cam = Camera::new(&d, Vec3A::ZERO, 100, 200);
+        let top = cam.ray(50.0, 50.0, 100, 200, 0.0);
+        let bottom = cam.ray(50.0, 150.0, 100, 200, 0.0);
+        close(top.origin, Vec3A::new(-0.1, 0.0, 0.0));
+        close(bottom.origin, Vec3A::new(0.1, 0.0, 0.0));
+        close(top.dir, Vec3A::new(0.1, 0.0, -5.0).normalize());
+        close(bottom.dir, Vec3A::new(-0.1, 0.0, -5.0).normalize());
+        // Each eye's window is 2 × 2 (aspect 1): the top-left corner of the bottom half.
+        let r = cam.ray(0.0, 100.0, 100, 200, 0.0);
+        close(r.origin, Vec3A::new(-1.0 + 0.1, 1.0, 0.0));
+        assert_eq!(cam.footprint(), (2.0 / 100.0, 0.0));
+    }
+
+    #[test]
+    fn stereo_equirectangular_shifts_eyes_across_each_direction() {
+        let d = stereo(Projection::Equirectangular, StereoLayout::OverUnder);
+        let cam = Camera::new(&d, Vec3A::ZERO, 360, 360);
+        // Top half: left eye. Each eye sits half the separation along the right of the
+        // direction it looks in (view × up), and aims at the convergence sphere.
+        for (x, y, eye) in [(270.0, 90.0, -1.0), (270.0, 270.0, 1.0), (90.0, 90.0, -1.0)] {
+            let r = cam.ray(x, y, 360, 360, 0.0);
+            let (sin_lon, cos_lon) = ((x / 180.0 - 1.0) * PI).sin_cos();
+            let view = Vec3A::new(sin_lon, 0.0, -cos_lon);
+            let right_of_view = view.cross(Vec3A::Y);
+            close(r.origin, eye * 0.1 * right_of_view);
+            close(r.dir, (5.0 * view - r.origin).normalize());
+        }
+    }
+
+    #[test]
+    fn depth_of_field_rays_meet_on_the_focal_plane() {
+        let mut d = desc(Projection::Perspective { fov_deg: 60.0 });
+        d.depth_of_field = Some(DepthOfField {
+            aperture: 0.5,
+            focal_distance: 4.0,
+        });
+        let cam = Camera::new(&d, Vec3A::ZERO, 64, 48);
+        let pin = Camera::new(
+            &desc(Projection::Perspective { fov_deg: 60.0 }),
+            Vec3A::ZERO,
+            64,
+            48,
+        );
+        let (px, py) = (20.25f32, 7.5f32);
+        let p = pin.ray(px, py, 64, 48, 0.0);
+        let focus = p.at(4.0 / -p.dir.z);
+        let mut origins = Vec::new();
+        for i in 0..16 {
+            // Sub-pixel offsets and times give different lens points for the same pixel.
+            let r = cam.ray(px, py, 64, 48, i as f32 * 0.01);
+            close(r.at((focus.z - r.origin.z) / r.dir.z), focus);
+            assert!(r.origin.z == 0.0 && r.origin.length() <= 0.5 + EPS);
+            origins.push(r.origin);
+        }
+        assert!(origins.windows(2).all(|w| w[0] != w[1]));
+        // Deterministic: the same sample gives the same ray.
+        let (a, b) = (
+            cam.ray(3.3, 4.4, 64, 48, 0.5),
+            cam.ray(3.3, 4.4, 64, 48, 0.5),
+        );
+        assert_eq!((a.origin, a.dir), (b.origin, b.dir));
+    }
+
+    #[test]
+    fn depth_of_field_on_a_fisheye_focuses_on_a_sphere() {
+        let mut d = desc(Projection::Fisheye { fov_deg: 180.0 });
+        d.depth_of_field = Some(DepthOfField {
+            aperture: 0.3,
+            focal_distance: 2.0,
+        });
+        let cam = Camera::new(&d, Vec3A::ZERO, 100, 100);
+        let pin = Camera::new(
+            &desc(Projection::Fisheye { fov_deg: 180.0 }),
+            Vec3A::ZERO,
+            100,
+            100,
+        );
+        let p = pin.ray(80.0, 30.0, 100, 100, 0.0);
+        let focus = p.at(2.0);
+        for i in 0..8 {
+            let r = cam.ray(80.0, 30.0, 100, 100, i as f32);
+            // The lens lies across the pinhole ray.
+            assert!(r.origin.dot(p.dir).abs() < EPS && r.origin.length() <= 0.3 + EPS);
+            let t = (focus - r.origin).dot(r.dir);
+            close(r.at(t), focus);
+        }
+    }
+
+    #[test]
+    fn zero_aperture_is_the_pinhole_camera() {
+        let mut d = desc(Projection::Perspective { fov_deg: 50.0 });
+        d.depth_of_field = Some(DepthOfField {
+            aperture: 0.0,
+            focal_distance: 3.0,
+        });
+        let cam = Camera::new(&d, Vec3A::ZERO, 40, 30);
+        let pin = Camera::new(
+            &desc(Projection::Perspective { fov_deg: 50.0 }),
+            Vec3A::ZERO,
+            40,
+            30,
+        );
+        for (x, y) in [(0.0, 0.0), (12.3, 4.5), (39.9, 29.9)] {
+            let (a, b) = (cam.ray(x, y, 40, 30, 0.0), pin.ray(x, y, 40, 30, 0.0));
+            assert_eq!((a.origin, a.dir), (b.origin, b.dir));
+        }
+    }
+
+    #[test]
+    fn concentric_disk_stays_inside_and_reaches_the_rim() {
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let (x, y) = concentric_disk(i as f32 / 20.0, j as f32 / 20.0);
+                assert!(x * x + y * y <= 1.0 + 1e-6);
+            }
+        }
+        let (x, y) = concentric_disk(1.0, 0.5);
+        assert!((x - 1.0).abs() < 1e-6 && y.abs() < 1e-6);
+        assert_eq!(concentric_disk(0.5, 0.5), (0.0, 0.0));
+    }
+
+    #[test]
+    fn basis_is_orthonormal() {
+        for n in [
+            Vec3A::X,
+            Vec3A::Y,
+            Vec3A::Z,
+            -Vec3A::Z,
+            Vec3A::new(1.0, -2.0, 0.5).normalize(),
+        ] {
+            let (a, b) = basis(n);
+            assert!(a.dot(b).abs() < EPS && a.dot(n).abs() < EPS && b.dot(n).abs() < EPS);
+            assert!((a.length() - 1.0).abs() < EPS && (b.length() - 1.0).abs() < EPS);
+        }
     }
 }

@@ -27,9 +27,9 @@ pub mod output;
 pub mod plugin;
 pub mod ray;
 pub mod render;
-pub mod schedule;
 pub mod sampler;
 pub mod scene;
+pub mod schedule;
 pub mod volume;
 
 pub use error::Error;

@@ -77,8 +77,11 @@ fn make_big(src: &Path, out: &Path, copies: usize) {
         Box::new(file)
     };
     let mut text = String::new();
-    reader.read_to_string(&mut text).expect("cannot read the source");
-    let mut w = BufWriter::with_capacity(1 << 20, std::fs::File::create(out).expect("cannot create"));
+    reader
+        .read_to_string(&mut text)
+        .expect("cannot read the source");
+    let mut w =
+        BufWriter::with_capacity(1 << 20, std::fs::File::create(out).expect("cannot create"));
     for copy in 0..copies {
         let dx = copy as f64 * 8.0;
         let mut in_view = false;
@@ -88,7 +91,9 @@ fn make_big(src: &Path, out: &Path, copies: usize) {
             let numeric = first.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '.');
             if first == "v" {
                 in_view = true;
-            } else if !numeric && !["from", "at", "up", "angle", "hither", "resolution"].contains(&first) {
+            } else if !numeric
+                && !["from", "at", "up", "angle", "hither", "resolution"].contains(&first)
+            {
                 in_view = false;
             }
             let header = in_view || ["v", "b", "l"].contains(&first);
@@ -97,7 +102,10 @@ fn make_big(src: &Path, out: &Path, copies: usize) {
                     writeln!(w, "{line}").unwrap();
                 }
             } else if numeric {
-                let mut v: Vec<f64> = line.split_whitespace().map(|t| t.parse().unwrap()).collect();
+                let mut v: Vec<f64> = line
+                    .split_whitespace()
+                    .map(|t| t.parse().unwrap())
+                    .collect();
                 v[0] += dx;
                 let s: Vec<String> = v.iter().map(|x| format!("{:.5}", x)).collect();
                 writeln!(w, "{}", s.join(" ")).unwrap();

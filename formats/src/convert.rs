@@ -19,10 +19,19 @@ pub(crate) struct Part {
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
+    /// `meshes:` entries, read after merging (see `ron_scene`).
+    pub meshes: Vec<MeshRef>,
     /// Without outputs: those are merged as a list, the rest as a whole.
     pub render: Option<RenderDesc>,
     pub outputs: Vec<OutputDesc>,
     pub plugin_path: Vec<PathBuf>,
+}
+
+/// A mesh file named by a scene: the path resolved against that scene file, at the `file`
+/// string; the material that replaces the file's own, at its string.
+pub(crate) struct MeshRef {
+    pub file: Spanned<PathBuf>,
+    pub material: Option<Spanned<String>>,
 }
 
 type Result<T> = std::result::Result<T, crate::SceneError>;
@@ -89,6 +98,23 @@ impl Checker<'_> {
         for (i, volume) in scene.volumes.into_iter().enumerate() {
             let node = field("volumes").item(i).unwrap_or(root);
             part.volumes.push(self.volume(volume, node)?);
+        }
+        for (i, mesh) in scene.meshes.into_iter().enumerate() {
+            let node = field("meshes").item(i).unwrap_or(root);
+            let file_node = node.field("file").unwrap_or(node);
+            if mesh.file.trim().is_empty() {
+                return Err(self.error(
+                    file_node,
+                    "the mesh file name is empty; expected a path such as \"teapot.obj\"",
+                ));
+            }
+            let material = mesh
+                .material
+                .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
+            part.meshes.push(MeshRef {
+                file: self.spanned(dir.join(&mesh.file), file_node),
+                material,
+            });
         }
         if let Some(render) = scene.render {
             let (render, outputs) = self.render(render, field("render"), &dir)?;

@@ -23,12 +23,15 @@ pub struct InlineGeometry {
     pub mesh: InlineMesh,
 }
 
-/// Triangles indexing shared vertices; `normals` is empty or has one entry per position.
+/// Triangles indexing shared vertices; `normals` and `uvs` are empty or have one entry per
+/// position.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct InlineMesh {
     pub positions: Vec<[f64; 3]>,
     pub normals: Vec<[f64; 3]>,
     pub indices: Vec<[u64; 3]>,
+    /// Texture coordinates (u, v).
+    pub uvs: Vec<[f64; 2]>,
 }
 
 impl InlineGeometry {

@@ -11,6 +11,7 @@ mod effects;
 mod error;
 pub mod geometry;
 pub mod nff;
+pub mod obj;
 mod raw;
 mod ron_error;
 mod ron_scene;
@@ -27,10 +28,14 @@ pub use geometry::{InlineGeometry, InlineMesh};
 pub use ron_scene::load_ron_str;
 
 /// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
-/// through the [`nff`] importer; any case).
+/// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
+/// any case).
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
     if nff::is_nff_path(path) {
         return nff::load(path);
+    }
+    if obj::is_obj_path(path) {
+        return obj::load(path);
     }
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !extension.eq_ignore_ascii_case("ron") {
@@ -39,7 +44,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             e => format!("unsupported scene file extension `.{e}`"),
         };
         let message = format!(
-            "{found}; expected one of {}, `.nff`, `.nff.gz`",
+            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`",
             ron_scene::supported_extensions()
         );
         return Err(SceneError::Io {

@@ -35,6 +35,8 @@ pub(crate) struct Scene {
     #[serde(default)]
     pub volumes: Vec<Volume>,
     #[serde(default)]
+    pub meshes: Vec<Mesh>,
+    #[serde(default)]
     pub render: Option<Render>,
 }
 
@@ -116,6 +118,8 @@ pub(crate) enum StereoLayout {
     OverUnder,
 }
 
+// The scene syntax says `SphereLight(...)`: the names read well in a `lights:` list.
+#[allow(clippy::enum_variant_names)]
 #[derive(Deserialize)]
 #[serde(rename = "Light", deny_unknown_fields)]
 pub(crate) enum Light {
@@ -256,6 +260,16 @@ pub(crate) struct Object {
     pub plugin: String,
     #[serde(default, rename = "params")]
     pub _params: IgnoredAny,
+    #[serde(default)]
+    pub material: Option<String>,
+}
+
+/// A mesh file (`.obj`) whose triangles join the scene.
+#[derive(Deserialize)]
+#[serde(rename = "Mesh", deny_unknown_fields)]
+pub(crate) struct Mesh {
+    pub file: String,
+    /// Replaces the file's own (MTL) materials.
     #[serde(default)]
     pub material: Option<String>,
 }

@@ -4,9 +4,10 @@ use std::path::{Path, PathBuf};
 
 use ron::extensions::Extensions;
 
-use crate::convert::Part;
+use crate::convert::{MeshRef, Part};
 use crate::desc::SceneDesc;
-use crate::error::{quoted_list, SceneError};
+use crate::error::{quoted_list, unknown_name, SceneError};
+use crate::obj::{is_obj_path, load_obj};
 use crate::raw;
 use crate::ron_error::ron_error;
 use crate::spans::{scan, SourceMap};
@@ -18,7 +19,7 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         key: identity(path),
         shown: path.to_path_buf(),
     }];
-    let part = load_part(text.to_string(), path, &mut chain)?;
+    let mut part = load_part(text.to_string(), path, &mut chain)?;
     let origin = SourceMap::new(path.to_path_buf(), String::new()).origin_at(1, 1);
     let camera = part.camera.ok_or_else(|| {
         SceneError::at(
@@ -28,7 +29,8 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
     })?;
     let mut render = part.render.unwrap_or_default();
     render.outputs = part.outputs;
-    let scene = SceneDesc {
+    let meshes = std::mem::take(&mut part.meshes);
+    let mut scene = SceneDesc {
         source: path.to_path_buf(),
         camera,
         background: part.background.unwrap_or([0.0; 3]),
@@ -44,7 +46,50 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         plugin_path: part.plugin_path,
     };
     references(&scene)?;
+    add_meshes(&mut scene, meshes)?;
     Ok(scene)
+}
+
+/// Reads the `meshes:` files into `inline` geometry (and their materials, unless the entry
+/// names one), in file order; warnings go to standard error.
+fn add_meshes(scene: &mut SceneDesc, meshes: Vec<MeshRef>) -> Result<(), SceneError> {
+    for mesh in &meshes {
+        if let Some(material) = &mesh.material {
+            if !scene.materials.iter().any(|(n, _)| *n == material.value) {
+                let names = scene.materials.iter().map(|(n, _)| n.as_str());
+                let message = unknown_name("material", &material.value, "", names);
+                return Err(SceneError::at(material.at.clone(), message));
+            }
+        }
+    }
+    for mesh in meshes {
+        if !is_obj_path(&mesh.file.value) {
+            return Err(SceneError::at(
+                mesh.file.at,
+                format!(
+                    "unsupported mesh file `{}`; expected a Wavefront `.obj` file",
+                    mesh.file.value.display()
+                ),
+            ));
+        }
+        let import = load_obj(&mesh.file.value, Some(mesh.file.at.clone()))?;
+        for w in &import.warnings {
+            eprintln!("luxon: warning: {}: {w}", mesh.file.at);
+        }
+        match mesh.material {
+            Some(material) => {
+                for mut g in import.geometry {
+                    g.material = Some(material.clone());
+                    scene.inline.push(g);
+                }
+            }
+            None => {
+                upsert(&mut scene.materials, import.materials);
+                scene.inline.extend(import.geometry);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A file on the include chain: `key` to compare, `shown` for messages.
@@ -137,6 +182,7 @@ impl Part {
         self.lights.extend(later.lights);
         self.objects.extend(later.objects);
         self.volumes.extend(later.volumes);
+        self.meshes.extend(later.meshes);
         // Outputs belong to the file that renders: an including file that names any replaces
         // those of its includes (including a scene must not also write that scene's image).
         if !later.outputs.is_empty() {

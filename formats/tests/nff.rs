@@ -421,6 +421,30 @@ fn blocks_of_any_size_give_the_same_scene() {
     }
 }
 
+#[test]
+fn the_scene_does_not_depend_on_the_thread_count() {
+    // About 3 MB: several parallel chunks.
+    let mut text = busy_file();
+    let body = text.split_once("l 1 1 1\n").unwrap().1.to_string();
+    while text.len() < 3 << 20 {
+        text.push_str(&body);
+    }
+    let with = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| parse(&text))
+    };
+    let one = with(1);
+    assert!(one.desc.inline.len() > 3, "several chunks");
+    for threads in [2, 3] {
+        let many = with(threads);
+        assert!(many.desc == one.desc, "{threads} threads");
+        assert_eq!(many.stats, one.stats);
+    }
+}
+
 // ---- Files ----
 
 fn temp_dir(name: &str) -> PathBuf {

@@ -17,6 +17,7 @@ pub enum Cluster {}
 
 pub enum Job {
     Local,
+    #[cfg_attr(not(feature = "mpi"), allow(dead_code))]
     Mpi(Cluster),
 }
 
@@ -54,6 +55,14 @@ impl Job {
             )));
         }
         Ok(Job::Local)
+    }
+
+    /// Ends this process with status 1 and no message (another rank reports the cause),
+    /// finalising MPI first.
+    pub fn exit_quietly(self) -> ! {
+        #[cfg(feature = "mpi")]
+        drop(self);
+        std::process::exit(1)
     }
 
     pub fn rank(&self) -> usize {

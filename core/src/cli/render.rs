@@ -159,12 +159,7 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let threads = match job.agree(status) {
         Ok(t) => t,
         Err(Some(e)) => return Err(e),
-        Err(None) => {
-            // Another rank failed and rank 0 reports it: end quietly (dropping the job
-            // finalises MPI).
-            drop(job);
-            std::process::exit(1);
-        }
+        Err(None) => job.exit_quietly(),
     };
     let Some((desc, scene, plan)) = ready else {
         return Err(Error::Render("not ready to render".into()));

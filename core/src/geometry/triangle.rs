@@ -163,7 +163,7 @@ impl Triangles {
         material: u32,
     ) -> Result<u64, String> {
         let nv = m.positions.len() / 3;
-        if m.positions.len() % 3 != 0 || m.indices.len() % 3 != 0 {
+        if !m.positions.len().is_multiple_of(3) || !m.indices.len().is_multiple_of(3) {
             return Err("mesh arrays are not whole vertices or triangles".into());
         }
         for (what, len, per) in [

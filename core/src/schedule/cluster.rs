@@ -155,217 +155,22 @@ impl Cluster {
         keep: bool,
         sink: Sink,
     ) -> Rendered {
-        let pool = super::thread_pool(threads[self.rank]).unwrap_or_else(|e| fail(&e.to_string()));
         let s = &scene.settings;
-        let tiles = decompose::tiles(s.width, s.height, s.tile_size);
-        let kept = Mutex::new(Vec::new());
-        let injected = Injected::from_env(self.rank);
-        let local_sink = |c: Chunk| {
-            injected.on_chunk();
-            if keep {
-                kept.lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .push(c.clone());
-            }
-            sink(c);
+        let run = Run {
+            cluster: self,
+            scene,
+            pool: super::thread_pool(threads[self.rank]).unwrap_or_else(|e| fail(&e.to_string())),
+            tiles: decompose::tiles(s.width, s.height, s.tile_size),
+            threads,
+            gather,
+            keep,
+            injected: Injected::from_env(self.rank),
         };
-        let ranks = if self.rank == 0 {
-            self.lead(
-                scene,
-                &pool,
-                &tiles,
-                threads,
-                gather,
-                &local_sink,
-                &injected,
-            )
+        if self.rank == 0 {
+            run.lead(sink)
         } else {
-            let (tx, rx) = mpsc::channel();
-            let injected = &injected;
-            let to_main = move |c: Chunk| {
-                injected.on_chunk();
-                let _ = tx.send(c);
-            };
-            let (mine, chunks) = self.follow(
-                scene, &pool, &tiles, threads, gather, &to_main, rx, injected,
-            );
-            if keep {
-                kept.lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .extend(chunks);
-            }
-            vec![mine]
-        };
-        Rendered {
-            ranks,
-            kept: kept.into_inner().unwrap_or_else(|e| e.into_inner()),
+            run.follow()
         }
-    }
-
-    fn share<'a>(
-        &self,
-        scene: &Scene,
-        threads: &[usize],
-        tiles: &'a [decompose::Rect],
-        next: &'a (dyn Fn() -> Option<usize> + Sync),
-    ) -> Share<'a> {
-        match scene.settings.decomposition {
-            Decomposition::Dynamic => Share::Queue { tiles, next },
-            how => Share::Static {
-                how,
-                first: threads[..self.rank].iter().sum(),
-                workers: threads.iter().sum(),
-            },
-        }
-    }
-
-    /// Rank 0: renders, hands out tiles, takes chunks and statistics from the other ranks.
-    #[allow(clippy::too_many_arguments)]
-    fn lead(
-        &self,
-        scene: &Scene,
-        pool: &rayon::ThreadPool,
-        tiles: &[decompose::Rect],
-        threads: &[usize],
-        gather: bool,
-        sink: Sink,
-        injected: &Injected,
-    ) -> Vec<RankStats> {
-        let counter = AtomicUsize::new(0);
-        let take = || {
-            let i = counter.fetch_add(1, Ordering::Relaxed);
-            (i < tiles.len()).then_some(i)
-        };
-        let share = self.share(scene, threads, tiles, &take);
-        let mut stats: Vec<Option<RankStats>> = vec![None; self.size];
-        let mut done_sent = vec![false; self.size];
-        let mut finished = 0;
-        std::thread::scope(|sc| {
-            let local = sc.spawn(|| run_share(scene, pool, share, sink));
-            loop {
-                while let Some((msg, status)) = self.world.any_process().immediate_matched_probe() {
-                    let (from, tag) = (status.source_rank(), status.tag());
-                    let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
-                    let to = self.world.process_at_rank(from);
-                    match tag {
-                        TAG_REQUEST => {
-                            for _ in 0..word(&bytes) {
-                                match take() {
-                                    Some(i) => to.send_with_tag(&bytes_of(i as u64)[..], TAG_TILE),
-                                    None if !done_sent[from as usize] => {
-                                        done_sent[from as usize] = true;
-                                        to.send_with_tag(&bytes_of(0)[..], TAG_DONE);
-                                    }
-                                    None => {}
-                                }
-                            }
-                        }
-                        TAG_CHUNK if gather => match wire::decode_chunk(&bytes) {
-                            Some(c) => sink(c),
-                            None => fail(&format!("rank {from} sent a corrupt chunk")),
-                        },
-                        TAG_FINISHED => {
-                            let s = wire::decode_stats(&bytes).unwrap_or_else(|| {
-                                fail(&format!("rank {from} sent corrupt statistics"))
-                            });
-                            stats[from as usize] = Some(s);
-                            finished += 1;
-                        }
-                        TAG_ERROR => {
-                            let m = String::from_utf8_lossy(&bytes);
-                            eprintln!("luxon: error: rank {from}: {m}");
-                            abort_job();
-                        }
-                        _ => {}
-                    }
-                }
-                check(scene, injected);
-                if finished == self.size - 1 && local.is_finished() {
-                    break;
-                }
-                std::thread::sleep(POLL);
-            }
-            let mine = local
-                .join()
-                .unwrap_or_else(|_| fail("a render thread panicked"));
-            check(scene, injected);
-            stats[0] = Some(mine);
-        });
-        stats
-            .into_iter()
-            .enumerate()
-            .map(|(rank, s)| RankStats {
-                rank,
-                ..s.unwrap_or_default()
-            })
-            .collect()
-    }
-
-    /// Ranks above 0: render, send chunks (when gathering) and statistics to rank 0; for the
-    /// dynamic decomposition, keep `threads + 1` tiles requested. Returns this rank's
-    /// statistics and its chunks.
-    #[allow(clippy::too_many_arguments)]
-    fn follow(
-        &self,
-        scene: &Scene,
-        pool: &rayon::ThreadPool,
-        tiles: &[decompose::Rect],
-        threads: &[usize],
-        gather: bool,
-        sink: Sink,
-        chunks: mpsc::Receiver<Chunk>,
-        injected: &Injected,
-    ) -> (RankStats, Vec<Chunk>) {
-        let queue = TileQueue::default();
-        let next = || queue.pop();
-        let share = self.share(scene, threads, tiles, &next);
-        let dynamic = matches!(share, Share::Queue { .. });
-        let root = self.world.process_at_rank(0);
-        let mut mine = Vec::new();
-        let mut no_more_tiles = !dynamic;
-        if dynamic {
-            root.send_with_tag(&bytes_of(threads[self.rank] as u64 + 1)[..], TAG_REQUEST);
-        }
-        let mut stats = std::thread::scope(|sc| {
-            let local = sc.spawn(|| run_share(scene, pool, share, sink));
-            loop {
-                let finished = local.is_finished();
-                match chunks.recv_timeout(POLL) {
-                    Ok(c) => {
-                        if gather {
-                            root.send_with_tag(&wire::encode_chunk(&c)[..], TAG_CHUNK);
-                        }
-                        if !no_more_tiles {
-                            root.send_with_tag(&bytes_of(1)[..], TAG_REQUEST);
-                        }
-                        mine.push(c);
-                    }
-                    // Every chunk is sent before the render threads finish.
-                    Err(_) if finished => break,
-                    Err(_) => {}
-                }
-                while let Some((msg, status)) = root.immediate_matched_probe() {
-                    let tag = status.tag();
-                    let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
-                    match tag {
-                        TAG_TILE => queue.push(word(&bytes) as usize),
-                        TAG_DONE => {
-                            no_more_tiles = true;
-                            queue.close();
-                        }
-                        _ => {}
-                    }
-                }
-                check(scene, injected);
-            }
-            local
-                .join()
-                .unwrap_or_else(|_| fail("a render thread panicked"))
-        });
-        check(scene, injected);
-        stats.rank = self.rank;
-        root.send_with_tag(&wire::encode_stats(&stats)[..], TAG_FINISHED);
-        (stats, mine)
     }
 
     /// Collective: rank 0's process id, so every rank names the same temporary file.
@@ -391,6 +196,199 @@ impl Cluster {
             super::mpi_io::write_ppm(self.world.as_raw(), tmp, &header, width, height, mine)
         {
             fail(&format!("{}: MPI-IO: {e}", tmp.display()));
+        }
+    }
+}
+
+/// One render of this rank's share.
+struct Run<'a> {
+    cluster: &'a Cluster,
+    scene: &'a Scene,
+    pool: rayon::ThreadPool,
+    tiles: Vec<decompose::Rect>,
+    threads: &'a [usize],
+    gather: bool,
+    keep: bool,
+    injected: Injected,
+}
+
+impl Run<'_> {
+    fn share<'s>(&'s self, next: &'s (dyn Fn() -> Option<usize> + Sync)) -> Share<'s> {
+        let rank = self.cluster.rank;
+        match self.scene.settings.decomposition {
+            Decomposition::Dynamic => Share::Queue {
+                tiles: &self.tiles,
+                next,
+            },
+            how => Share::Static {
+                how,
+                first: self.threads[..rank].iter().sum(),
+                workers: self.threads.iter().sum(),
+            },
+        }
+    }
+
+    fn check(&self) {
+        check(self.scene, &self.injected);
+    }
+
+    /// Rank 0: renders, hands out tiles, takes chunks and statistics from the other ranks.
+    fn lead(&self, sink: Sink) -> Rendered {
+        let world = &self.cluster.world;
+        let size = self.cluster.size;
+        // The closures handed to render threads borrow fields, never `self` (MPI handles are
+        // not Sync).
+        let (tiles, injected, keep) = (&self.tiles, &self.injected, self.keep);
+        let counter = AtomicUsize::new(0);
+        let take = || {
+            let i = counter.fetch_add(1, Ordering::Relaxed);
+            (i < tiles.len()).then_some(i)
+        };
+        let kept = Mutex::new(Vec::new());
+        let local_sink = |c: Chunk| {
+            injected.on_chunk();
+            if keep {
+                kept.lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(c.clone());
+            }
+            sink(c);
+        };
+        let share = self.share(&take);
+        let mut stats: Vec<Option<RankStats>> = vec![None; size];
+        let mut done_sent = vec![false; size];
+        let mut finished = 0;
+        std::thread::scope(|sc| {
+            let (scene, pool) = (self.scene, &self.pool);
+            let local = sc.spawn(|| run_share(scene, pool, share, &local_sink));
+            loop {
+                while let Some((msg, status)) = world.any_process().immediate_matched_probe() {
+                    let (from, tag) = (status.source_rank(), status.tag());
+                    let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
+                    let to = world.process_at_rank(from);
+                    match tag {
+                        TAG_REQUEST => {
+                            for _ in 0..word(&bytes) {
+                                match take() {
+                                    Some(i) => to.send_with_tag(&bytes_of(i as u64)[..], TAG_TILE),
+                                    None if !done_sent[from as usize] => {
+                                        done_sent[from as usize] = true;
+                                        to.send_with_tag(&bytes_of(0)[..], TAG_DONE);
+                                    }
+                                    None => {}
+                                }
+                            }
+                        }
+                        TAG_CHUNK if self.gather => match wire::decode_chunk(&bytes) {
+                            Some(c) => sink(c),
+                            None => fail(&format!("rank {from} sent a corrupt chunk")),
+                        },
+                        TAG_FINISHED => {
+                            let s = wire::decode_stats(&bytes).unwrap_or_else(|| {
+                                fail(&format!("rank {from} sent corrupt statistics"))
+                            });
+                            stats[from as usize] = Some(s);
+                            finished += 1;
+                        }
+                        TAG_ERROR => {
+                            let m = String::from_utf8_lossy(&bytes);
+                            eprintln!("luxon: error: rank {from}: {m}");
+                            abort_job();
+                        }
+                        _ => {}
+                    }
+                }
+                self.check();
+                if finished == size - 1 && local.is_finished() {
+                    break;
+                }
+                std::thread::sleep(POLL);
+            }
+            let mine = local
+                .join()
+                .unwrap_or_else(|_| fail("a render thread panicked"));
+            self.check();
+            stats[0] = Some(mine);
+        });
+        let ranks = stats
+            .into_iter()
+            .enumerate()
+            .map(|(rank, s)| RankStats {
+                rank,
+                ..s.unwrap_or_default()
+            })
+            .collect();
+        Rendered {
+            ranks,
+            kept: kept.into_inner().unwrap_or_else(|e| e.into_inner()),
+        }
+    }
+
+    /// Ranks above 0: render, send chunks (when gathering) and statistics to rank 0; for the
+    /// dynamic decomposition, keep `threads + 1` tiles requested.
+    fn follow(&self) -> Rendered {
+        let (tx, chunks) = mpsc::channel();
+        let injected = &self.injected;
+        let to_main = move |c: Chunk| {
+            injected.on_chunk();
+            let _ = tx.send(c);
+        };
+        let queue = TileQueue::default();
+        let next = || queue.pop();
+        let share = self.share(&next);
+        let dynamic = matches!(share, Share::Queue { .. });
+        let root = self.cluster.world.process_at_rank(0);
+        let mut kept = Vec::new();
+        let mut no_more_tiles = !dynamic;
+        if dynamic {
+            let ahead = self.threads[self.cluster.rank] as u64 + 1;
+            root.send_with_tag(&bytes_of(ahead)[..], TAG_REQUEST);
+        }
+        let mut stats = std::thread::scope(|sc| {
+            let (scene, pool) = (self.scene, &self.pool);
+            let local = sc.spawn(|| run_share(scene, pool, share, &to_main));
+            loop {
+                let finished = local.is_finished();
+                match chunks.recv_timeout(POLL) {
+                    Ok(c) => {
+                        if self.gather {
+                            root.send_with_tag(&wire::encode_chunk(&c)[..], TAG_CHUNK);
+                        }
+                        if !no_more_tiles {
+                            root.send_with_tag(&bytes_of(1)[..], TAG_REQUEST);
+                        }
+                        if self.keep {
+                            kept.push(c);
+                        }
+                    }
+                    // Every chunk is sent before the render threads finish.
+                    Err(_) if finished => break,
+                    Err(_) => {}
+                }
+                while let Some((msg, status)) = root.immediate_matched_probe() {
+                    let tag = status.tag();
+                    let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
+                    match tag {
+                        TAG_TILE => queue.push(word(&bytes) as usize),
+                        TAG_DONE => {
+                            no_more_tiles = true;
+                            queue.close();
+                        }
+                        _ => {}
+                    }
+                }
+                self.check();
+            }
+            local
+                .join()
+                .unwrap_or_else(|_| fail("a render thread panicked"))
+        });
+        self.check();
+        stats.rank = self.cluster.rank;
+        root.send_with_tag(&wire::encode_stats(&stats)[..], TAG_FINISHED);
+        Rendered {
+            ranks: vec![stats],
+            kept,
         }
     }
 }

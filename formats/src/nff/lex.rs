@@ -180,7 +180,11 @@ impl<'a> Lines<'a> {
     /// Where the text ends: (0-based line, 1-based column).
     pub fn end_position(&self) -> (u32, u32) {
         let n = self.text.len();
-        let start = self.text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let start = self
+            .text
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |i| i + 1);
         let line = self.text.iter().filter(|&&b| b == b'\n').count() as u32;
         (line, column(&self.text[start..n]))
     }
@@ -273,11 +277,17 @@ fn digits(text: &[u8], mut i: usize) -> (u64, usize) {
         let other = high | big;
         let flags = (((other & 0x7f7f_7f7f_7f7f_7f7f) + 0x7f7f_7f7f_7f7f_7f7f) | other)
             & 0x8080_8080_8080_8080;
-        let k = if flags == 0 { 8 } else { (flags.trailing_zeros() / 8) as usize };
+        let k = if flags == 0 {
+            8
+        } else {
+            (flags.trailing_zeros() / 8) as usize
+        };
         if k > 0 {
             // The k digits, most significant first in memory: shift them to the top bytes.
             let d = t << (8 * (8 - k));
-            value = value.wrapping_mul(pow10_u64(k)).wrapping_add(eight_digits(d));
+            value = value
+                .wrapping_mul(pow10_u64(k))
+                .wrapping_add(eight_digits(d));
             i += k;
         }
         if k < 8 {
@@ -416,10 +426,28 @@ mod tests {
     #[test]
     fn numbers_parse_exactly() {
         for t in [
-            "0", "1", "-1", "+2.5", "0.272166", "-0.5", "12", "3.0827", "100000", "1e-05",
-            "1E5", ".5", "5.", "-.25e+2", "0.0000000000001234", "123456789012345678",
-            "1234567890123456789012", "0.1", "2.2250738585072014e-308", "1.7976931348623157e308",
-            "9007199254740993", "4.9e-324",
+            "0",
+            "1",
+            "-1",
+            "+2.5",
+            "0.272166",
+            "-0.5",
+            "12",
+            "3.0827",
+            "100000",
+            "1e-05",
+            "1E5",
+            ".5",
+            "5.",
+            "-.25e+2",
+            "0.0000000000001234",
+            "123456789012345678",
+            "1234567890123456789012",
+            "0.1",
+            "2.2250738585072014e-308",
+            "1.7976931348623157e308",
+            "9007199254740993",
+            "4.9e-324",
         ] {
             let want: f64 = t.parse().unwrap();
             assert_eq!(parse_f64(t.as_bytes()), Ok(want), "{t}");
@@ -428,7 +456,9 @@ mod tests {
 
     #[test]
     fn bad_numbers_are_classified() {
-        for t in ["", "-", ".", "e5", "1e", "1.2.3", "1-2", "0x10", "abc", "1,5"] {
+        for t in [
+            "", "-", ".", "e5", "1e", "1.2.3", "1-2", "0x10", "abc", "1,5",
+        ] {
             assert_eq!(parse_f64(t.as_bytes()), Err(NumError::NotANumber), "{t}");
         }
         for t in ["nan", "NaN", "inf", "-inf", "infinity", "1e400", "-1e999"] {
@@ -439,9 +469,21 @@ mod tests {
     #[test]
     fn numbers_in_lines() {
         for t in [
-            "0", "-3.83333", "12345678", "123456789", "0.000000001234567", "+7", "1e5",
-            "-2.5E-3", "123456789012345678", "12345678901234567890123", "3.", ".25", "0.1",
-            "9007199254740993", "1.2345678901234567890",
+            "0",
+            "-3.83333",
+            "12345678",
+            "123456789",
+            "0.000000001234567",
+            "+7",
+            "1e5",
+            "-2.5E-3",
+            "123456789012345678",
+            "12345678901234567890123",
+            "3.",
+            ".25",
+            "0.1",
+            "9007199254740993",
+            "1.2345678901234567890",
         ] {
             let want: f64 = t.parse().unwrap();
             for tail in ["", " ", "\n", "\t1", " # c"] {
@@ -498,4 +540,3 @@ mod tests {
         assert_eq!(column("été ".as_bytes()), 5);
     }
 }
-

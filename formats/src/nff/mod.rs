@@ -73,7 +73,6 @@ use crate::error::SceneError;
 use crate::geometry::{InlineGeometry, InlineMesh};
 use parse::{ChunkError, ChunkOut, Directive, Fill, View};
 
-
 /// What an NFF file held.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NffStats {
@@ -183,8 +182,6 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Imported, SceneError> {
 
 /// sRGB-encoded display value to linear.
 fn linear(c: f64) -> f64 {
-    if std::env::var("NFF_EXP").is_ok_and(|v| v == "raw") { return c; }
-    if std::env::var("NFF_EXP").is_ok_and(|v| v == "g22") { return c.powf(2.2); }
     if c <= 0.04045 {
         c / 12.92
     } else {
@@ -201,7 +198,6 @@ pub fn material_of_fill(f: [f64; 8]) -> MaterialDesc {
     let [r, g, b, kd, ks, shine, t, ior] = f;
     MaterialDesc {
         color: linear_rgb([r, g, b]),
-        texture: None,
         ambient: if ks == 0.0 && t == 0.0 {
             (1.0 - kd).max(0.0)
         } else {
@@ -214,6 +210,7 @@ pub fn material_of_fill(f: [f64; 8]) -> MaterialDesc {
         reflect: ks,
         transmit: t,
         ior: if ior > 0.0 { ior } else { 1.0 },
+        ..MaterialDesc::default()
     }
 }
 
@@ -228,6 +225,8 @@ pub fn fov_of_angle(angle: f64, height: u32) -> f64 {
     2.0 * half.atan().to_degrees()
 }
 
+type Rgb = [f64; 3];
+
 /// Puts parsed chunks together in file order.
 struct Assembler {
     file: Arc<PathBuf>,
@@ -240,7 +239,8 @@ struct Assembler {
     inline: Vec<InlineGeometry>,
     view: Option<Spanned<View>>,
     background: Option<[f64; 3]>,
-    lights: Vec<(Spanned<[f64; 3]>, Option<[f64; 3]>)>,
+    /// Position and colour (`None`: white, sharing the brightness).
+    lights: Vec<(Spanned<[f64; 3]>, Option<Rgb>)>,
     stats: NffStats,
 }
 
@@ -325,6 +325,7 @@ impl Assembler {
                     positions: b.positions,
                     normals: b.normals,
                     indices: b.indices,
+                    uvs: Vec::new(),
                 },
             });
         }
@@ -378,6 +379,9 @@ impl Assembler {
                     fov_deg: fov_of_angle(v.angle, height),
                 },
                 aspect: Some(width as f64 / height as f64),
+                frustum: None,
+                depth_of_field: None,
+                stereo: None,
             },
             at: view.at.clone(),
         };
@@ -390,6 +394,7 @@ impl Assembler {
                     position: p.value,
                     color: color.map_or([1.0; 3], linear_rgb),
                     intensity: if color.is_some() { 1.0 } else { 1.0 / n.sqrt() },
+                    attenuation: Default::default(),
                     shadows: true,
                 },
                 at: p.at,
@@ -401,6 +406,8 @@ impl Assembler {
             camera,
             background: linear_rgb(self.background.unwrap_or([0.0; 3])),
             lights,
+            fog: None,
+            ambient_occlusion: None,
             textures: Vec::new(),
             materials: self.materials,
             objects: Vec::new(),

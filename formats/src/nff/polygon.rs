@@ -52,7 +52,9 @@ impl Triangulator {
                 self.keep.push(i as u32);
             }
         }
-        while self.keep.len() > 1 && v[self.keep[0] as usize] == v[*self.keep.last().unwrap() as usize] {
+        while self.keep.len() > 1
+            && v[self.keep[0] as usize] == v[*self.keep.last().unwrap() as usize]
+        {
             self.keep.pop();
         }
         let normal = newell_normal(v);
@@ -74,13 +76,18 @@ impl Triangulator {
         self.pts.clear();
         for &k in &self.keep {
             let p = v[k as usize];
-            self.pts.push(if flip { [p[ay], p[ax]] } else { [p[ax], p[ay]] });
+            self.pts
+                .push(if flip { [p[ay], p[ax]] } else { [p[ax], p[ay]] });
         }
         // Convex (no reflex corner): a fan is exact.
         self.reflex.clear();
         let mut any_reflex = false;
         for i in 0..m {
-            let c = cross2(self.pts[(i + m - 1) % m], self.pts[i], self.pts[(i + 1) % m]);
+            let c = cross2(
+                self.pts[(i + m - 1) % m],
+                self.pts[i],
+                self.pts[(i + 1) % m],
+            );
             any_reflex |= c < 0.0;
             self.reflex.push(c < 0.0);
         }
@@ -234,12 +241,21 @@ mod tests {
         for tri in &out {
             let q = tri.map(|i| p2[i as usize]);
             let a = area2(&q);
-            assert!(a * total > 0.0, "triangle {tri:?} is wound against the polygon");
+            assert!(
+                a * total > 0.0,
+                "triangle {tri:?} is wound against the polygon"
+            );
             sum += a;
-            let c = [(q[0][0] + q[1][0] + q[2][0]) / 3.0, (q[0][1] + q[1][1] + q[2][1]) / 3.0];
+            let c = [
+                (q[0][0] + q[1][0] + q[2][0]) / 3.0,
+                (q[0][1] + q[1][1] + q[2][1]) / 3.0,
+            ];
             assert!(inside(p2, c), "centroid of {tri:?} is outside the polygon");
         }
-        assert!((sum - total).abs() < 1e-9 * total.abs().max(1.0), "area {sum} != {total}");
+        assert!(
+            (sum - total).abs() < 1e-9 * total.abs().max(1.0),
+            "area {sum} != {total}"
+        );
         out
     }
 
@@ -254,7 +270,14 @@ mod tests {
     #[test]
     fn concave_polygons_are_ear_clipped() {
         // An L and an arrow head, both windings.
-        let l = [[0.0, 0.0], [3.0, 0.0], [3.0, 1.0], [1.0, 1.0], [1.0, 3.0], [0.0, 3.0]];
+        let l = [
+            [0.0, 0.0],
+            [3.0, 0.0],
+            [3.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 3.0],
+            [0.0, 3.0],
+        ];
         check_cover(&l);
         let mut r = l;
         r.reverse();
@@ -277,7 +300,10 @@ mod tests {
         // A fan from vertex 0 would not do: some of its triangles leave the polygon.
         let outside = (1..143).any(|i| {
             let q = [p[0], p[i], p[i + 1]];
-            let c = [(q[0][0] + q[1][0] + q[2][0]) / 3.0, (q[0][1] + q[1][1] + q[2][1]) / 3.0];
+            let c = [
+                (q[0][0] + q[1][0] + q[2][0]) / 3.0,
+                (q[0][1] + q[1][1] + q[2][1]) / 3.0,
+            ];
             !inside(&p, c)
         });
         assert!(outside);
@@ -307,16 +333,34 @@ mod tests {
     fn duplicates_and_degenerate_polygons_do_not_panic() {
         let mut t = Triangulator::default();
         let mut out = Vec::new();
-        let d = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]];
+        let d = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+        ];
         t.triangulate(&d, &mut out);
         assert!(!out.is_empty());
         out.clear();
-        let line = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]];
+        let line = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+        ];
         t.triangulate(&line, &mut out);
         assert_eq!(out.len(), 2);
         // A bow tie (not simple) still terminates with n - 2 triangles.
         out.clear();
-        let bow = [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.5, 2.0, 0.0]];
+        let bow = [
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.5, 2.0, 0.0],
+        ];
         t.triangulate(&bow, &mut out);
         assert!(out.len() <= 3);
     }

@@ -19,8 +19,9 @@ use super::parse::{parse_chunk, ChunkError, ChunkOut, Next, ENTITIES};
 
 /// Bytes of text read at a time.
 pub(crate) const BLOCK: usize = 8 << 20;
-/// Smallest chunk worth a parallel task.
-const MIN_CHUNK: usize = 64 << 10;
+/// Bytes of text per parallel task. Fixed, not derived from the thread count, so that the
+/// scene (its geometry groups and their order) is the same however many threads parse it.
+const CHUNK: usize = 1 << 20;
 
 /// A block of whole entities and what starts the text after it (`None`: the file ends).
 pub(crate) struct Block {
@@ -52,10 +53,13 @@ pub(crate) fn entity_at(text: &[u8], p: usize) -> Option<Next> {
         return None;
     }
     let word = &text[start..i];
-    ENTITIES.iter().find(|k| k.as_bytes() == word).map(|k| Next {
-        keyword: k,
-        col: column(&text[p..start]),
-    })
+    ENTITIES
+        .iter()
+        .find(|k| k.as_bytes() == word)
+        .map(|k| Next {
+            keyword: k,
+            col: column(&text[p..start]),
+        })
 }
 
 /// The last position > 0 in `text` where a line starts an entity.
@@ -84,7 +88,11 @@ fn next_boundary(text: &[u8], from: usize) -> Option<(usize, Next)> {
 }
 
 /// Cuts a block into chunks of about `target` bytes at entity lines.
-pub(crate) fn split(text: &[u8], next: Option<Next>, target: usize) -> Vec<(Range<usize>, Option<Next>)> {
+pub(crate) fn split(
+    text: &[u8],
+    next: Option<Next>,
+    target: usize,
+) -> Vec<(Range<usize>, Option<Next>)> {
     let mut out = Vec::new();
     let mut start = 0;
     while text.len() - start > target + target / 2 {
@@ -102,9 +110,7 @@ pub(crate) fn split(text: &[u8], next: Option<Next>, target: usize) -> Vec<(Rang
 
 /// Parses a block's chunks in parallel; results in file order.
 pub(crate) fn parse_block(block: &Block) -> Vec<Result<ChunkOut, ChunkError>> {
-    let threads = rayon::current_num_threads().max(1);
-    let target = (block.text.len() / (threads * 4)).max(MIN_CHUNK);
-    let chunks = split(&block.text, block.next, target);
+    let chunks = split(&block.text, block.next, CHUNK);
     chunks
         .into_par_iter()
         .map(|(range, next)| parse_chunk(&block.text[range], next))
@@ -124,7 +130,9 @@ pub(crate) fn read_blocks<R: Read>(
         let have = buf.len();
         if have < want {
             buf.reserve(want - have);
-            let got = (&mut reader).take((want - have) as u64).read_to_end(&mut buf)?;
+            let got = (&mut reader)
+                .take((want - have) as u64)
+                .read_to_end(&mut buf)?;
             if got < want - have {
                 // The end of the input.
                 take(Block {
@@ -200,7 +208,8 @@ mod tests {
 
     #[test]
     fn blocks_end_before_entity_lines() {
-        let text = b"v\nfrom 0 0 0\nat 1 0 0\nup 0 0 1\nangle 40\np 3\n0 0 0\n1 0 0\n0 1 0\ns 0 0 0 1\n";
+        let text =
+            b"v\nfrom 0 0 0\nat 1 0 0\nup 0 0 1\nangle 40\np 3\n0 0 0\n1 0 0\n0 1 0\ns 0 0 0 1\n";
         for block in 1..text.len() + 2 {
             let mut blocks = Vec::new();
             read_blocks(&text[..], block, |b| {

@@ -68,7 +68,14 @@ fn flake(s: &mut dyn Sink, dirs: &[V3; 9], c: V3, r: f64, m: &M3, depth: u32) ->
     }
     for d in dirs {
         let w = super::apply(m, *d);
-        flake(s, dirs, add(c, mul(w, r * 4.0 / 3.0)), r / 3.0, &frame(w), depth - 1)?;
+        flake(
+            s,
+            dirs,
+            add(c, mul(w, r * 4.0 / 3.0)),
+            r / 3.0,
+            &frame(w),
+            depth - 1,
+        )?;
     }
     Ok(())
 }

@@ -10,9 +10,12 @@
 //! `38 u` apart and the outer centres `20 u` inside the square [-1, 1]; layer `k` spans
 //! z = `1 - k / size` down by `0.4 / size`.
 //!
-//! Every gear has its own colour (a fully bright colour whose three components take one of seven
-//! levels each, varying linearly across the grid, modulo 7); every fifth along the same kind
-//! of pattern is clear glass-like plastic (T 0.8, index 1.1), the rest matte.
+//! Every gear has its own fully bright colour and finish. The SPD's rule is not published; this
+//! one reproduces its output exactly (found by reading the colours of its 64 gears): each
+//! component takes one of seven levels `k` as `(r + 0.07) / (max + 0.07)`, the levels varying
+//! linearly modulo 7 across the grid (see `material`); the gears where
+//! `col + 3 row + 4 layer` is a multiple of 5 are clear plastic (T 0.8, index 1.1), the rest
+//! matte.
 //!
 //! The faces are written top first (counter-clockwise seen from above, starting at the first
 //! tip corner), then the sides, then the bottom (clockwise from above: the outline reversed).
@@ -57,7 +60,11 @@ pub fn generate(size: u32, s: &mut dyn Sink) -> io::Result<()> {
             for col in 0..n {
                 s.fill(&material(layer, row, col))?;
                 let (cx, cy) = (centre(col), centre(row));
-                let phase = if (layer + row + col) % 2 == 1 { 5.0 } else { 0.0 };
+                let phase = if (layer + row + col) % 2 == 1 {
+                    5.0
+                } else {
+                    0.0
+                };
                 for t in 0..TEETH {
                     for (k, &(a, on_tip)) in TOOTH.iter().enumerate() {
                         let a = (10.0 * t as f64 + a + phase).to_radians();
@@ -81,13 +88,15 @@ pub fn generate(size: u32, s: &mut dyn Sink) -> io::Result<()> {
     Ok(())
 }
 
-/// The colour and finish of the gear in `layer` (from the top), `row` (y) and `col` (x).
+/// The colour and finish of the gear in `layer` (from the top), `row` (y) and `col` (x):
+/// levels `(5 + col + 3 row + 5 layer, 3 + 3 col + 2 row + 6 layer, 2 + 4 col + 2 row + 6 layer)`
+/// modulo 7.
 fn material(layer: usize, row: usize, col: usize) -> super::Fill {
     let level = |c: usize, a: usize, b: usize, d: usize| (c + a * col + b * row + d * layer) % 7;
     let raw = [level(5, 1, 3, 5), level(3, 3, 2, 6), level(2, 4, 2, 6)];
     let max = *raw.iter().max().unwrap() as f64;
     let color = raw.map(|v| (v as f64 + 0.07) / (max + 0.07));
-    if (col + 3 * row + 4 * layer) % 5 == 0 {
+    if (col + 3 * row + 4 * layer).is_multiple_of(5) {
         fill(color, 0.2, 0.0, 0.0, 0.8, 1.1)
     } else {
         fill(color, 1.0, 0.0, 0.0, 0.0, 0.0)

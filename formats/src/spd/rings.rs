@@ -24,7 +24,12 @@ const TUBE: f64 = 0.07412;
 pub fn generate(size: u32, s: &mut dyn Sink) -> io::Result<()> {
     let d = 1.0 / (std::f64::consts::PI / 8.0).sin();
     s.background(BACKGROUND)?;
-    s.view(&view([-1.0, -d, 0.5], [-1.0, 1.0 - d, 0.5], [0.0, 0.0, 1.0], 1.0))?;
+    s.view(&view(
+        [-1.0, -d, 0.5],
+        [-1.0, 1.0 - d, 0.5],
+        [0.0, 0.0, 1.0],
+        1.0,
+    ))?;
     for l in [[3.0, -d, 3.0], [-4.0, -d, 1.0], [2.0, -d, -4.0]] {
         s.light(l)?;
     }

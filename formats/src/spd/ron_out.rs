@@ -117,7 +117,9 @@ impl<'a> RonWriter<'a> {
              Procedural Databases).\nScene(",
             scene.name, size, scene.about
         );
-        let v = h.view.unwrap_or(super::view([0.0, 0.0, 1.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0));
+        let v = h
+            .view
+            .unwrap_or(super::view([0.0, 0.0, 1.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0));
         let (w, hgt) = v.resolution;
         b.extend_from_slice(b"    camera: (\n        position: ");
         tuple(b, &v.from);
@@ -202,13 +204,17 @@ impl<'a> RonWriter<'a> {
         self.buf
             .extend_from_slice(b"        (plugin: \"spheres\", params: (\n            centers: [");
         for (k, (c, _)) in spheres.iter().enumerate() {
-            self.buf
-                .extend_from_slice(if k % 4 == 0 { b"\n                " } else { b" " });
+            self.buf.extend_from_slice(if k.is_multiple_of(4) {
+                b"\n                "
+            } else {
+                b" "
+            });
             tuple(&mut self.buf, c);
             self.buf.push(b',');
             self.spill()?;
         }
-        self.buf.extend_from_slice(b"\n            ],\n            ");
+        self.buf
+            .extend_from_slice(b"\n            ],\n            ");
         let r0 = spheres[0].1;
         if spheres.iter().all(|s| s.1 == r0) {
             self.buf.extend_from_slice(b"radius: ");
@@ -259,18 +265,28 @@ impl<'a> RonWriter<'a> {
         Ok(())
     }
 
-    fn mesh(&mut self, positions: &[V3], normals: Option<&[V3]>, tris: &[[u32; 3]]) -> io::Result<()> {
+    fn mesh(
+        &mut self,
+        positions: &[V3],
+        normals: Option<&[V3]>,
+        tris: &[[u32; 3]],
+    ) -> io::Result<()> {
         self.buf
             .extend_from_slice(b"        (plugin: \"mesh\", params: (\n            positions: [");
         self.vectors(positions)?;
         if let Some(normals) = normals {
-            self.buf.extend_from_slice(b"\n            ],\n            normals: [");
+            self.buf
+                .extend_from_slice(b"\n            ],\n            normals: [");
             self.vectors(normals)?;
         }
-        self.buf.extend_from_slice(b"\n            ],\n            indices: [");
+        self.buf
+            .extend_from_slice(b"\n            ],\n            indices: [");
         for (k, t) in tris.iter().enumerate() {
-            self.buf
-                .extend_from_slice(if k % 8 == 0 { b"\n                " } else { b" " });
+            self.buf.extend_from_slice(if k.is_multiple_of(8) {
+                b"\n                "
+            } else {
+                b" "
+            });
             let _ = write!(self.buf, "({}, {}, {}),", t[0], t[1], t[2]);
             self.spill()?;
         }
@@ -281,8 +297,11 @@ impl<'a> RonWriter<'a> {
 
     fn vectors(&mut self, v: &[V3]) -> io::Result<()> {
         for (k, p) in v.iter().enumerate() {
-            self.buf
-                .extend_from_slice(if k % 3 == 0 { b"\n                " } else { b" " });
+            self.buf.extend_from_slice(if k.is_multiple_of(3) {
+                b"\n                "
+            } else {
+                b" "
+            });
             tuple(&mut self.buf, p);
             self.buf.push(b',');
             self.spill()?;
@@ -484,7 +503,12 @@ mod tests {
 
     #[test]
     fn convex_polygons_are_fanned() {
-        let sq = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let sq = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
         let mut t = Vec::new();
         triangulate(&sq, &mut t);
         assert_eq!(t, vec![[0, 1, 2], [0, 2, 3]]);

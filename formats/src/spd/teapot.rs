@@ -83,7 +83,12 @@ fn bernstein(t: f64) -> [f64; 4] {
 
 fn bernstein_d(t: f64) -> [f64; 4] {
     let s = 1.0 - t;
-    [-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t]
+    [
+        -3.0 * s * s,
+        3.0 * s * s - 6.0 * t * s,
+        6.0 * t * s - 3.0 * t * t,
+        3.0 * t * t,
+    ]
 }
 
 /// Point and derivatives in u and v of the patch with control points `c` (row `i` = u).
@@ -117,6 +122,7 @@ fn evaluate(c: &[V3; 16], u: f64, v: f64) -> (V3, V3) {
 }
 
 /// The 32 patches: 16 control-point indices each (0-based), rows of constant `u` first.
+#[rustfmt::skip]
 const PATCHES: [[u16; 16]; 32] = [
     [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15],
     [3, 16, 17, 18, 7, 19, 20, 21, 11, 22, 23, 24, 15, 25, 26, 27],
@@ -153,6 +159,7 @@ const PATCHES: [[u16; 16]; 32] = [
 ];
 
 /// The 306 control points of Newell's teapot (z up, spout towards +x).
+#[rustfmt::skip]
 const POINTS: [[f64; 3]; 306] = [
     [1.4, 0.0, 2.4], [1.4, -0.784, 2.4], [0.784, -1.4, 2.4],
     [0.0, -1.4, 2.4], [1.3375, 0.0, 2.53125], [1.3375, -0.749, 2.53125],

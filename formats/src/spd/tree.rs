@@ -15,7 +15,12 @@ use super::{add, apply, fill, mat_mul, rotation, view, Sink, BACKGROUND, M3, V3}
 
 pub fn generate(size: u32, s: &mut dyn Sink) -> io::Result<()> {
     s.background(BACKGROUND)?;
-    s.view(&view([4.5, 0.4, 2.0], [0.0, 0.0, 1.5], [0.0, 0.0, 1.0], 1.0))?;
+    s.view(&view(
+        [4.5, 0.4, 2.0],
+        [0.0, 0.0, 1.5],
+        [0.0, 0.0, 1.0],
+        1.0,
+    ))?;
     for l in [
         [-5.0, 5.0, 50.0],
         [30.0, -30.0, 30.0],
@@ -35,10 +40,7 @@ pub fn generate(size: u32, s: &mut dyn Sink) -> io::Result<()> {
         [50.0, -50.0, 0.0],
     ])?;
     s.fill(&fill([0.55, 0.4, 0.2], 1.0, 0.0, 0.0, 0.0, 0.0))?;
-    let forks = [
-        fork(90.0, 40.0, 0.65),
-        fork(230.0, 25.0, 0.7),
-    ];
+    let forks = [fork(90.0, 40.0, 0.65), fork(230.0, 25.0, 0.7)];
     branch(s, &forks, [0.0; 3], &rot_z(-90.0), 1.0, 0.15, size)
 }
 

@@ -32,7 +32,7 @@ fn cone_with_caps(
 ) -> Result<Built, Error> {
     let axis = sub(apex, base);
     let h = length(axis);
-    if !(h > 0.0) {
+    if h <= 0.0 || h.is_nan() {
         return Err(invalid(
             "`base` and `apex` are the same point; expected a length > 0",
         ));
@@ -207,8 +207,11 @@ pub struct PolycylinderParams {
     pub radius: f64,
 }
 
+/// Cones (cylinders) and spheres as the host takes them.
+pub type Chain = (Vec<[f64; 8]>, Vec<[f64; 4]>);
+
 /// Cylinders between consecutive points with a sphere at every point, so bends are smooth.
-pub fn polycylinder(p: &PolycylinderParams) -> Result<(Vec<[f64; 8]>, Vec<[f64; 4]>), Error> {
+pub fn polycylinder(p: &PolycylinderParams) -> Result<Chain, Error> {
     let r = positive("radius", p.radius)?;
     if p.points.len() < 2 {
         return Err(invalid("parameter `points` needs at least two points"));

@@ -101,7 +101,9 @@
 //! ]
 //! ```
 
-pub(crate) use luxon_plugin::{finite, invalid, Context, Describe, Error, Geometry, Mesh, Primitive};
+pub(crate) use luxon_plugin::{
+    finite, invalid, Context, Describe, Error, Geometry, Mesh, Primitive,
+};
 use serde::Deserialize;
 
 const LIBRARY: &str = "luxon-shapes";

@@ -1,0 +1,288 @@
+//! The camera: serde values into a checked `CameraDesc`, defaults resolved.
+//!
+//! Defaults that depend on the scene are taken from the distance `d` from `position` to
+//! `look_at`: the orthographic window's height (what a 45° perspective camera sees at `d`), the
+//! focal distance and the stereo convergence distance (`d`: `look_at` is sharp and at screen
+//! depth) and the eye separation (`convergence / 30`, the stereographers' rule of thumb).
+
+use crate::desc::*;
+use crate::raw;
+use crate::spans::Node;
+use crate::validate::Checker;
+
+type Result<T> = std::result::Result<T, crate::SceneError>;
+
+impl Checker<'_> {
+    pub(crate) fn camera(&self, c: raw::Camera, node: &Node) -> Result<Spanned<CameraDesc>> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let up = c.up.unwrap_or([0.0, 1.0, 0.0]);
+        let view = sub(c.look_at, c.position);
+        if length(view) == 0.0 {
+            return Err(self.error(
+                field("look_at"),
+                "the camera's `look_at` equals its `position`; expected a point away from the camera",
+            ));
+        }
+        if length(up) == 0.0 {
+            return Err(self.error(
+                field("up"),
+                "the camera's `up` has zero length; expected a direction such as (0, 1, 0)",
+            ));
+        }
+        // Parallel when the sine of the angle between them is (almost) zero.
+        if length(cross(view, up)) <= 1e-9 * length(view) * length(up) {
+            let given = if c.up.is_some() { "" } else { " (the default)" };
+            return Err(self.error(
+                field("up"),
+                format!(
+                    "the camera's `up` ({}, {}, {}){given} is parallel to its view direction \
+                     (from `position` to `look_at`); expected an `up` at an angle to it",
+                    up[0], up[1], up[2]
+                ),
+            ));
+        }
+        let distance = length(view);
+
+        // The projection, and the name of the field that sized it explicitly (if any).
+        let (projection, sized_by) = match &c.projection {
+            Some(p) => {
+                for (name, given) in [("fov", c.fov.is_some()), ("zoom", c.zoom.is_some())] {
+                    if given {
+                        return Err(self.error(
+                            field(name),
+                            format!(
+                                "the camera gives both `projection` and `{name}`; expected \
+                                 `{name}` inside the projection, such as \
+                                 `projection: Perspective({name}: 2)`, or no `projection`"
+                            ),
+                        ));
+                    }
+                }
+                self.projection(p, field("projection"), distance)?
+            }
+            None => self.perspective(c.fov, c.zoom, node)?,
+        };
+
+        let aspect = match c.aspect {
+            Some(a) => Some(self.positive(field("aspect"), "aspect", a)?),
+            None => None,
+        };
+        if aspect.is_some() && projection == Projection::Equirectangular {
+            return Err(self.error(
+                field("aspect"),
+                "`aspect` has no effect on an Equirectangular camera (it always spans 360° by \
+                 180°); expected no `aspect`",
+            ));
+        }
+
+        let frustum = match &c.frustum {
+            Some(f) => {
+                let at = field("frustum");
+                let kind = match projection {
+                    Projection::Fisheye { .. } => Some("Fisheye"),
+                    Projection::Equirectangular => Some("Equirectangular"),
+                    _ => None,
+                };
+                if let Some(kind) = kind {
+                    return Err(self.error(
+                        at,
+                        format!(
+                            "a `frustum` sets the image window of a Perspective or Orthographic \
+                             camera; expected no `frustum` with a {kind} projection"
+                        ),
+                    ));
+                }
+                if let Some(name) = sized_by {
+                    return Err(self.error(
+                        at,
+                        format!(
+                            "the camera gives both `{name}` and `frustum`; expected only one of \
+                             them (the frustum sets the window)"
+                        ),
+                    ));
+                }
+                if aspect.is_some() {
+                    return Err(self.error(
+                        field("aspect"),
+                        "the camera gives both `aspect` and `frustum`; expected only one of them \
+                         (the frustum sets the window's shape)",
+                    ));
+                }
+                for (lo, hi, a, b) in [
+                    ("left", "right", f.left, f.right),
+                    ("bottom", "top", f.bottom, f.top),
+                ] {
+                    if a >= b {
+                        return Err(self.error(
+                            at.field(hi).unwrap_or(at),
+                            format!(
+                                "the frustum's `{hi}` ({b}) is not greater than its `{lo}` ({a}); \
+                                 expected {lo} < {hi}"
+                            ),
+                        ));
+                    }
+                }
+                Some(Frustum {
+                    left: f.left,
+                    right: f.right,
+                    bottom: f.bottom,
+                    top: f.top,
+                })
+            }
+            None => None,
+        };
+
+        let depth_of_field = match &c.depth_of_field {
+            Some(d) => {
+                let at = field("depth_of_field");
+                let at = |name| at.field(name).unwrap_or(at);
+                let aperture =
+                    self.range(at("aperture"), "aperture", d.aperture, 0.0, f64::INFINITY)?;
+                let focal_distance = match d.focal_distance {
+                    Some(f) => self.positive(at("focal_distance"), "focal_distance", f)?,
+                    None => distance,
+                };
+                Some(DepthOfField {
+                    aperture,
+                    focal_distance,
+                })
+            }
+            None => None,
+        };
+
+        let stereo = match &c.stereo {
+            Some(s) => {
+                let at = field("stereo");
+                let at = |name| at.field(name).unwrap_or(at);
+                let convergence = match s.convergence {
+                    Some(v) => self.positive(at("convergence"), "convergence", v)?,
+                    None => distance,
+                };
+                let eye_separation = match s.eye_separation {
+                    Some(v) => self.range(
+                        at("eye_separation"),
+                        "eye_separation",
+                        v,
+                        0.0,
+                        f64::INFINITY,
+                    )?,
+                    None => convergence / 30.0,
+                };
+                let layout = match s.layout {
+                    Some(raw::StereoLayout::OverUnder) => StereoLayout::OverUnder,
+                    Some(raw::StereoLayout::SideBySide) | None => StereoLayout::SideBySide,
+                };
+                Some(Stereo {
+                    layout,
+                    eye_separation,
+                    convergence,
+                })
+            }
+            None => None,
+        };
+
+        let camera = CameraDesc {
+            position: c.position,
+            look_at: c.look_at,
+            up,
+            projection,
+            aspect,
+            frustum,
+            depth_of_field,
+            stereo,
+        };
+        Ok(self.spanned(camera, node))
+    }
+
+    /// `projection: ...`; `node` is its value.
+    fn projection(
+        &self,
+        p: &raw::Projection,
+        node: &Node,
+        distance: f64,
+    ) -> Result<(Projection, Option<&'static str>)> {
+        let field = |name| node.field(name).unwrap_or(node);
+        Ok(match *p {
+            raw::Projection::Perspective { fov, zoom } => self.perspective(fov, zoom, node)?,
+            raw::Projection::Orthographic { height } => match height {
+                Some(h) => (
+                    Projection::Orthographic {
+                        height: self.positive(field("height"), "height", h)?,
+                    },
+                    Some("height"),
+                ),
+                None => {
+                    let height = 2.0 * distance * 22.5f64.to_radians().tan();
+                    (Projection::Orthographic { height }, None)
+                }
+            },
+            raw::Projection::Fisheye { fov } => {
+                let fov_deg = fov.unwrap_or(180.0);
+                if !(fov_deg > 0.0 && fov_deg <= 360.0) {
+                    return Err(self.error(
+                        field("fov"),
+                        format!(
+                            "`fov` is {fov_deg}; expected degrees for a fisheye from 0 \
+                             (excluded) to 360"
+                        ),
+                    ));
+                }
+                (Projection::Fisheye { fov_deg }, fov.map(|_| "fov"))
+            }
+            raw::Projection::Equirectangular => (Projection::Equirectangular, None),
+        })
+    }
+
+    /// A perspective projection from `fov` or `zoom`, fields of `node` (the camera itself for
+    /// the `fov:` / `zoom:` shorthand).
+    fn perspective(
+        &self,
+        fov: Option<f64>,
+        zoom: Option<f64>,
+        node: &Node,
+    ) -> Result<(Projection, Option<&'static str>)> {
+        let field = |name| node.field(name).unwrap_or(node);
+        Ok(match (fov, zoom) {
+            (Some(_), Some(_)) => {
+                return Err(self.error(
+                    field("zoom"),
+                    "the camera gives both `fov` and `zoom`; expected only one of them",
+                ))
+            }
+            (_, Some(zoom)) => (
+                Projection::PerspectiveZoom {
+                    zoom: self.positive(field("zoom"), "zoom", zoom)?,
+                },
+                Some("zoom"),
+            ),
+            (fov, None) => {
+                let fov_deg = fov.unwrap_or(45.0);
+                if !(fov_deg > 0.0 && fov_deg < 180.0) {
+                    return Err(self.error(
+                        field("fov"),
+                        format!(
+                            "`fov` is {fov_deg}; expected degrees between 0 and 180 (both excluded)"
+                        ),
+                    ));
+                }
+                (Projection::Perspective { fov_deg }, fov.map(|_| "fov"))
+            }
+        })
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn length(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
