@@ -218,3 +218,39 @@ fn empty_scene_renders_the_background() {
     let want = [0.2f32, 0.4, 0.6].map(|v| (luxon_plugin::linear_to_srgb(v) * 255.0 + 0.5) as u8);
     assert_eq!(px, want);
 }
+
+#[test]
+fn renders_an_obj_file_with_its_mtl_colour() {
+    let dir = temp_dir("obj");
+    // A cube; its MTL makes it teal. No normals in the file: they are computed.
+    let mut obj = String::from("mtllib cube.mtl\nusemtl teal\n");
+    for z in [-1, 1] {
+        for y in [-1, 1] {
+            for x in [-1, 1] {
+                obj.push_str(&format!("v {x} {y} {z}\n"));
+            }
+        }
+    }
+    for f in [
+        "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+    ] {
+        obj.push_str(&format!("f {f}\n"));
+    }
+    std::fs::write(dir.join("cube.obj"), obj).unwrap();
+    std::fs::write(dir.join("cube.mtl"), "newmtl teal\nKd 0.1 0.6 0.6\n").unwrap();
+    let out = dir.join("cube.png");
+    let o = run(&[
+        "render",
+        dir.join("cube.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--res",
+        "32x32",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let px = image::open(&out).unwrap().to_rgb8().get_pixel(16, 16).0;
+    assert!(
+        px[1] > px[0] + 40 && px[2] > px[0] + 40,
+        "centre pixel {px:?} is not teal"
+    );
+}

@@ -88,6 +88,8 @@ pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError
     };
     let warnings = RefCell::new(Vec::new());
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    // The update fills the fields tobj's optional features (merging, reordering) add.
+    #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
