@@ -9,7 +9,7 @@ use crate::geometry::disc::Discs;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::{MeshInput, Triangles};
-use crate::geometry::{Counters, Hit, Kind, Surface};
+use crate::geometry::{pack, Clips, Counters, Hit, Kind, Surface, MAX_CLIP_GROUPS, MAX_MATERIALS};
 use crate::math::{DVec3, Vec3A};
 use crate::plugin::calls::{create_primitive, create_texture, GeometryBuilder, TextureInstance};
 use crate::plugin::{PluginKind, Registry};
@@ -204,6 +204,8 @@ pub struct Scene {
     pub cones: Cones,
     pub discs: Discs,
     pub customs: Customs,
+    /// Clip groups (render space) that objects are cut by.
+    pub clips: Clips,
     /// Volumes read by volume-reader plugins, in scene order. (Rendering them comes with the
     /// volume-rendering work; for now they are read, checked and described.)
     pub volumes: Vec<crate::volume::Volume>,
@@ -306,6 +308,35 @@ impl Scene {
             }
         }
 
+        if materials.len() as u32 > MAX_MATERIALS {
+            return Err(Error::Render(format!(
+                "the scene defines {} materials; at most {MAX_MATERIALS} are supported",
+                materials.len()
+            )));
+        }
+        if desc.clip_groups.len() as u32 >= MAX_CLIP_GROUPS {
+            return Err(Error::Render(format!(
+                "the scene defines {} clip groups; at most {} are supported",
+                desc.clip_groups.len(),
+                MAX_CLIP_GROUPS - 1
+            )));
+        }
+        let clips = Clips {
+            groups: desc
+                .clip_groups
+                .iter()
+                .map(|(_, g)| {
+                    g.value
+                        .iter()
+                        .map(|p| {
+                            let q = Vec3A::from((DVec3::from(p.point) - world_offset).as_vec3());
+                            (q, Vec3A::from(DVec3::from(p.normal).normalize().as_vec3()))
+                        })
+                        .collect()
+                })
+                .collect(),
+        };
+
         let mut spheres = Spheres::default();
         let mut triangles = Triangles::default();
         let mut planes = Planes::default();
@@ -328,6 +359,18 @@ impl Scene {
                 None => 0,
             };
             used[material] = true;
+            let clip = match &obj.value.clip {
+                Some(c) => {
+                    1 + desc
+                        .clip_groups
+                        .iter()
+                        .position(|(n, _)| n == &c.value)
+                        .ok_or_else(|| {
+                            Error::at(&c.at, format!("no clip group named `{}`", c.value))
+                        })? as u32
+                }
+                None => 0,
+            };
             let mut b = GeometryBuilder {
                 spheres: &mut spheres,
                 triangles: &mut triangles,
@@ -335,7 +378,7 @@ impl Scene {
                 cones: &mut cones,
                 discs: &mut discs,
                 customs: &mut customs,
-                material: material as u32,
+                material: pack(material as u32, clip),
                 world_offset,
                 plugin: entry.name.clone(),
                 dropped: 0,
@@ -567,6 +610,7 @@ impl Scene {
             cones,
             discs,
             customs,
+            clips,
             volumes,
             world_offset,
             settings,
@@ -583,12 +627,19 @@ impl Scene {
     #[inline]
     pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
         let mut hit = None;
-        self.spheres.intersect(ray, &mut t_max, &mut hit, c);
-        self.triangles.set.intersect(ray, &mut t_max, &mut hit, c);
-        self.planes.intersect(ray, &mut t_max, &mut hit, c);
-        self.cones.intersect(ray, &mut t_max, &mut hit, c);
-        self.discs.intersect(ray, &mut t_max, &mut hit, c);
-        self.customs.intersect(ray, &mut t_max, &mut hit, c);
+        self.spheres
+            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        self.triangles
+            .set
+            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        self.planes
+            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        self.cones
+            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        self.discs
+            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        self.customs
+            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         hit
     }
 
@@ -609,12 +660,15 @@ impl Scene {
     pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
         if !self.features.transmission {
             // Opaque world: the first hit anywhere ends the query.
-            let blocked = self.spheres.any(ray, t_max, c, |_, _| true)
-                || self.triangles.set.any(ray, t_max, c, |_, _| true)
-                || self.planes.any(ray, t_max, c, |_, _| true)
-                || self.cones.any(ray, t_max, c, |_, _| true)
-                || self.discs.any(ray, t_max, c, |_, _| true)
-                || self.customs.any(ray, t_max, c, |_, _| true);
+            let blocked = self.spheres.any(ray, t_max, &self.clips, c, |_, _| true)
+                || self
+                    .triangles
+                    .set
+                    .any(ray, t_max, &self.clips, c, |_, _| true)
+                || self.planes.any(ray, t_max, &self.clips, c, |_, _| true)
+                || self.cones.any(ray, t_max, &self.clips, c, |_, _| true)
+                || self.discs.any(ray, t_max, &self.clips, c, |_, _| true)
+                || self.customs.any(ray, t_max, &self.clips, c, |_, _| true);
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
         let mut filter = Vec3A::ONE;
@@ -630,12 +684,15 @@ impl Scene {
             }
             filter.max_element() < min_weight
         };
-        if self.spheres.any(ray, t_max, c, &mut on_hit)
-            || self.triangles.set.any(ray, t_max, c, &mut on_hit)
-            || self.planes.any(ray, t_max, c, &mut on_hit)
-            || self.cones.any(ray, t_max, c, &mut on_hit)
-            || self.discs.any(ray, t_max, c, &mut on_hit)
-            || self.customs.any(ray, t_max, c, &mut on_hit)
+        if self.spheres.any(ray, t_max, &self.clips, c, &mut on_hit)
+            || self
+                .triangles
+                .set
+                .any(ray, t_max, &self.clips, c, &mut on_hit)
+            || self.planes.any(ray, t_max, &self.clips, c, &mut on_hit)
+            || self.cones.any(ray, t_max, &self.clips, c, &mut on_hit)
+            || self.discs.any(ray, t_max, &self.clips, c, &mut on_hit)
+            || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
         {
             return Vec3A::ZERO;
         }

@@ -17,6 +17,7 @@ pub(crate) struct Part {
     pub ambient_occlusion: Option<AoDesc>,
     pub textures: Vec<(String, Spanned<PluginCall>)>,
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
+    pub clip_groups: Vec<(String, Spanned<Vec<ClipPlaneDesc>>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
     /// `meshes:` entries, read after merging (see `ron_scene`).
@@ -81,6 +82,25 @@ impl Checker<'_> {
             let material = self.material(material, node)?;
             part.materials.push((name, self.spanned(material, key)));
         }
+        for (i, (name, planes)) in scene.clip_groups.0.into_iter().enumerate() {
+            let (key, node) = field("clip_groups").entry(i).unwrap_or((root, root));
+            let mut group = Vec::new();
+            for (k, p) in planes.into_iter().enumerate() {
+                let at = node.item(k).unwrap_or(node);
+                let n = p.normal;
+                if (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) == 0.0 {
+                    return Err(self.error(
+                        at.field("normal").unwrap_or(at),
+                        "the clip plane's `normal` has zero length; expected a non-zero vector",
+                    ));
+                }
+                group.push(ClipPlaneDesc {
+                    point: p.point,
+                    normal: n,
+                });
+            }
+            part.clip_groups.push((name, self.spanned(group, key)));
+        }
         for (i, object) in scene.objects.into_iter().enumerate() {
             let node = field("objects").item(i).unwrap_or(root);
             let plugin = self.plugin_name(
@@ -91,9 +111,18 @@ impl Checker<'_> {
             let material = object
                 .material
                 .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
+            let clip = object
+                .clip
+                .map(|c| self.spanned(c, node.field("clip").unwrap_or(node)));
             let call = self.call(plugin, node);
-            part.objects
-                .push(self.spanned(ObjectDesc { call, material }, node));
+            part.objects.push(self.spanned(
+                ObjectDesc {
+                    call,
+                    material,
+                    clip,
+                },
+                node,
+            ));
         }
         for (i, volume) in scene.volumes.into_iter().enumerate() {
             let node = field("volumes").item(i).unwrap_or(root);

@@ -53,6 +53,8 @@ pub struct SceneDesc {
     pub textures: Vec<(String, Spanned<PluginCall>)>,
     /// Named materials, in file order (later definitions of a name replace earlier ones).
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
+    /// Named groups of clip planes (Tachyon's clip groups), in file order.
+    pub clip_groups: Vec<(String, Spanned<Vec<ClipPlaneDesc>>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
     /// Native geometry from importers (NFF, OBJ...), stored by the core without plugins.
     pub inline: Vec<crate::geometry::InlineGeometry>,
@@ -288,6 +290,15 @@ pub struct ObjectDesc {
     pub call: PluginCall,
     /// Material name; `None`: the built-in default material.
     pub material: Option<Spanned<String>>,
+    /// Clip group name: the object is cut away on the far side of the group's planes.
+    pub clip: Option<Spanned<String>>,
+}
+
+/// A clip plane: what lies on the side its normal points to is cut away.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipPlaneDesc {
+    pub point: [f64; 3],
+    pub normal: [f64; 3],
 }
 
 /// A volume: a volume-reader plugin call and the scene's name for the grid it reads.

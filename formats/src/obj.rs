@@ -470,6 +470,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
         ambient_occlusion: None,
         textures: Vec::new(),
         materials: import.materials,
+        clip_groups: Vec::new(),
         objects: Vec::new(),
         inline: import.geometry,
         volumes: Vec::new(),

@@ -31,6 +31,8 @@ pub(crate) struct Scene {
     #[serde(default)]
     pub materials: Named<Material>,
     #[serde(default)]
+    pub clip_groups: Named<Vec<ClipPlane>>,
+    #[serde(default)]
     pub objects: Vec<Object>,
     #[serde(default)]
     pub volumes: Vec<Volume>,
@@ -262,6 +264,16 @@ pub(crate) struct Object {
     pub _params: IgnoredAny,
     #[serde(default)]
     pub material: Option<String>,
+    #[serde(default)]
+    pub clip: Option<String>,
+}
+
+/// Keeps the side of the plane its normal points away from; cuts away the other.
+#[derive(Deserialize)]
+#[serde(rename = "ClipPlane", deny_unknown_fields)]
+pub(crate) struct ClipPlane {
+    pub point: Vec3,
+    pub normal: Vec3,
 }
 
 /// A mesh file (`.obj`) whose triangles join the scene.

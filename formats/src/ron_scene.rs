@@ -39,6 +39,7 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         ambient_occlusion: part.ambient_occlusion,
         textures: part.textures,
         materials: part.materials,
+        clip_groups: part.clip_groups,
         objects: part.objects,
         inline: Vec::new(),
         volumes: part.volumes,
@@ -191,6 +192,7 @@ impl Part {
         self.plugin_path.extend(later.plugin_path);
         upsert(&mut self.textures, later.textures);
         upsert(&mut self.materials, later.materials);
+        upsert(&mut self.clip_groups, later.clip_groups);
     }
 }
 

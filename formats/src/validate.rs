@@ -174,6 +174,15 @@ pub(crate) fn references(scene: &SceneDesc) -> Result<(), SceneError> {
             }
         }
     }
+    let groups: Vec<&str> = scene.clip_groups.iter().map(|(n, _)| n.as_str()).collect();
+    for object in &scene.objects {
+        if let Some(clip) = &object.value.clip {
+            if !groups.contains(&clip.value.as_str()) {
+                let message = unknown_name("clip group", &clip.value, "", groups.iter().copied());
+                return Err(SceneError::at(clip.at.clone(), message));
+            }
+        }
+    }
     let names: Vec<&Spanned<String>> = scene
         .volumes
         .iter()

@@ -2,7 +2,7 @@
 //! 32 bytes each, in their own BVH. Molecular bonds and the SPD's `c` primitives are these.
 
 use super::set::{Set, Shape};
-use super::{Hit, Kind, Surface};
+use super::{material_of, Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
 use glam::Vec3;
@@ -29,7 +29,7 @@ pub fn disc_bounds(c: Vec3A, w: Vec3A, r: f32) -> Aabb {
 /// The roots of the cone's quadric along the ray that lie on the finite, correct-nappe part of
 /// the surface within (0, t_max), nearest first; solved in f64.
 #[inline(always)]
-fn cone_roots(c: &Cone, o: Vec3A, d: Vec3A, t_max: f32) -> ([f64; 2], usize) {
+fn cone_roots(c: &Cone, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> ([f64; 2], usize) {
     let b = c.base.as_dvec3();
     let a = c.apex.as_dvec3();
     let (rb, ra) = (c.base_radius as f64, c.apex_radius as f64);
@@ -51,7 +51,7 @@ fn cone_roots(c: &Cone, o: Vec3A, d: Vec3A, t_max: f32) -> ([f64; 2], usize) {
     let mut roots = [0.0f64; 2];
     let mut count = 0;
     let mut consider = |t: f64| {
-        if t > 0.0 && t < t_max as f64 {
+        if t > t_min as f64 && t < t_max as f64 {
             let s = so + t * sd;
             if (0.0..=h).contains(&s) && m + n * t >= 0.0 {
                 roots[count] = t;
@@ -94,15 +94,15 @@ impl Shape for Cone {
     }
 
     #[inline(always)]
-    fn hit(&self, ray: &Ray, _: &(), t_max: f32) -> Option<(f32, f32, f32)> {
-        let (r, n) = cone_roots(self, ray.origin, ray.dir, t_max);
+    fn hit_after(&self, ray: &Ray, _: &(), t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+        let (r, n) = cone_roots(self, ray.origin, ray.dir, t_min, t_max);
         let t = r[0] as f32;
-        (n > 0 && t > 0.0 && t < t_max).then_some((t, 0.0, 0.0))
+        (n > 0 && t > t_min && t < t_max).then_some((t, 0.0, 0.0))
     }
 
     #[inline(always)]
     fn crossings(&self, ray: &Ray, _: &(), t_max: f32) -> u32 {
-        cone_roots(self, ray.origin, ray.dir, t_max).1 as u32
+        cone_roots(self, ray.origin, ray.dir, 0.0, t_max).1 as u32
     }
 }
 
@@ -164,7 +164,7 @@ impl Set<Cone> {
             ng: n,
             ns: n,
             uv: [u, (s / h).clamp(0.0, 1.0)],
-            material: self.material[hit.index as usize],
+            material: material_of(self.material[hit.index as usize]),
             color: None,
             uv_scale: 0.0,
         }
@@ -184,16 +184,40 @@ mod tests {
 
     #[test]
     fn cylinder_hit_from_outside_inside_and_along_the_axis() {
-        let (r, n) = cone_roots(&CYL, Vec3A::new(-5.0, 0.0, 2.0), Vec3A::X, f32::INFINITY);
+        let (r, n) = cone_roots(
+            &CYL,
+            Vec3A::new(-5.0, 0.0, 2.0),
+            Vec3A::X,
+            0.0,
+            f32::INFINITY,
+        );
         assert_eq!(n, 2);
         assert!((r[0] - 4.0).abs() < 1e-9 && (r[1] - 6.0).abs() < 1e-9);
-        let (r, n) = cone_roots(&CYL, Vec3A::new(0.0, 0.0, 2.0), Vec3A::X, f32::INFINITY);
+        let (r, n) = cone_roots(
+            &CYL,
+            Vec3A::new(0.0, 0.0, 2.0),
+            Vec3A::X,
+            0.0,
+            f32::INFINITY,
+        );
         assert_eq!((n, r[0]), (1, 1.0));
         // Along the axis through the open ends: no hit.
-        let (_, n) = cone_roots(&CYL, Vec3A::new(0.0, 0.0, -1.0), Vec3A::Z, f32::INFINITY);
+        let (_, n) = cone_roots(
+            &CYL,
+            Vec3A::new(0.0, 0.0, -1.0),
+            Vec3A::Z,
+            0.0,
+            f32::INFINITY,
+        );
         assert_eq!(n, 0);
         // Beyond the ends: no hit.
-        let (_, n) = cone_roots(&CYL, Vec3A::new(-5.0, 0.0, 5.0), Vec3A::X, f32::INFINITY);
+        let (_, n) = cone_roots(
+            &CYL,
+            Vec3A::new(-5.0, 0.0, 5.0),
+            Vec3A::X,
+            0.0,
+            f32::INFINITY,
+        );
         assert_eq!(n, 0);
     }
 
@@ -206,11 +230,23 @@ mod tests {
             apex: Vec3::Z,
             apex_radius: 0.0,
         };
-        let (r, n) = cone_roots(&cone, Vec3A::new(-5.0, 0.0, 0.5), Vec3A::X, f32::INFINITY);
+        let (r, n) = cone_roots(
+            &cone,
+            Vec3A::new(-5.0, 0.0, 0.5),
+            Vec3A::X,
+            0.0,
+            f32::INFINITY,
+        );
         assert_eq!(n, 2);
         assert!((r[0] - 4.5).abs() < 1e-6, "{r:?}");
         // Through the mirrored nappe above the apex: nothing.
-        let (_, n) = cone_roots(&cone, Vec3A::new(-5.0, 0.0, 1.5), Vec3A::X, f32::INFINITY);
+        let (_, n) = cone_roots(
+            &cone,
+            Vec3A::new(-5.0, 0.0, 1.5),
+            Vec3A::X,
+            0.0,
+            f32::INFINITY,
+        );
         assert_eq!(n, 0);
     }
 

@@ -2,7 +2,7 @@
 //! its `intersect`/`occluded` are called through its function table (Embree's user geometry).
 //! Rays cross the boundary in f64 world coordinates (the core works re-centred in f32).
 
-use super::{Counters, Hit, Kind, Surface};
+use super::{clip_of, material_of, Clips, Counters, Hit, Kind, Surface};
 use crate::bvh::Bvh;
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
@@ -137,7 +137,15 @@ impl Customs {
     }
 
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+    /// A clipped custom hit counts as a miss (the plugin returns one root only).
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        clips: &Clips,
+        c: &mut Counters,
+    ) {
         if self.refs.is_empty() {
             return;
         }
@@ -153,6 +161,9 @@ impl Customs {
                     let t = h.t as f32;
                     let n = Vec3A::from(DVec3::from(h.normal).normalize_or_zero().as_vec3());
                     if !(t > 0.0 && t < tm) || n == Vec3A::ZERO {
+                        return None;
+                    }
+                    if clips.cut(clip_of(self.material[i as usize]), ray.at(t)) {
                         return None;
                     }
                     let mut hh = Hit::new(t, Kind::Custom, i);
@@ -175,20 +186,40 @@ impl Customs {
         &self,
         ray: &Ray,
         t_max: f32,
+        clips: &Clips,
         c: &mut Counters,
         mut on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
         if self.refs.is_empty() {
             return false;
         }
+        // Occlusion through the plugin gives no hit point: clipped primitives use intersect.
+        let clipped = |i: u32| clip_of(self.material[i as usize]) != 0;
         let wr = self.world_ray(ray, t_max);
         self.bvh.any(ray.origin, ray.dir, t_max, |i| {
             c.tests += 1;
             let (o, idx) = self.refs[i as usize];
             let obj = &self.objects[o as usize];
             // SAFETY: valid table of a loaded plugin.
+            if clipped(i) {
+                let mut h = abi::HitF64::default();
+                let mut r = wr;
+                r.tmax = t_max as f64;
+                // SAFETY: valid table of a loaded plugin.
+                return match unsafe { ((*obj.vtable).intersect)(obj.object, idx, &r, &mut h) } {
+                    1 => {
+                        !clips.cut(clip_of(self.material[i as usize]), ray.at(h.t as f32))
+                            && on_hit(material_of(self.material[i as usize]), 1)
+                    }
+                    abi::HIT_PANIC => {
+                        self.panicked(o);
+                        false
+                    }
+                    _ => false,
+                };
+            }
             match unsafe { ((*obj.vtable).occluded)(obj.object, idx, &wr) } {
-                1 => on_hit(self.material[i as usize], 1),
+                1 => on_hit(material_of(self.material[i as usize]), 1),
                 abi::HIT_PANIC => {
                     self.panicked(o);
                     false
@@ -209,7 +240,7 @@ impl Customs {
             ng: hit.n,
             ns: hit.n,
             uv: hit.uv,
-            material: self.material[hit.index as usize],
+            material: material_of(self.material[hit.index as usize]),
             color: None,
             uv_scale: 0.0,
         }

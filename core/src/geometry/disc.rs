@@ -2,7 +2,7 @@
 
 use super::cone::disc_bounds;
 use super::set::{Set, Shape};
-use super::{Hit, Kind, Surface};
+use super::{material_of, Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
 use glam::Vec3;
@@ -20,7 +20,7 @@ pub struct Disc {
 pub type Discs = Set<Disc>;
 
 #[inline(always)]
-fn disc_t(d: &Disc, o: Vec3A, dir: Vec3A, t_max: f32) -> Option<f32> {
+fn disc_t(d: &Disc, o: Vec3A, dir: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
     let c = Vec3A::from(d.center);
     let n = Vec3A::from(d.normal);
     let denom = n.dot(dir);
@@ -28,7 +28,7 @@ fn disc_t(d: &Disc, o: Vec3A, dir: Vec3A, t_max: f32) -> Option<f32> {
         return None;
     }
     let t = n.dot(c - o) / denom;
-    if !(t > 0.0 && t < t_max) {
+    if !(t > t_min && t < t_max) {
         return None;
     }
     let r2 = (o + t * dir - c).length_squared();
@@ -45,8 +45,8 @@ impl Shape for Disc {
     }
 
     #[inline(always)]
-    fn hit(&self, ray: &Ray, _: &(), t_max: f32) -> Option<(f32, f32, f32)> {
-        disc_t(self, ray.origin, ray.dir, t_max).map(|t| (t, 0.0, 0.0))
+    fn hit_after(&self, ray: &Ray, _: &(), t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+        disc_t(self, ray.origin, ray.dir, t_min, t_max).map(|t| (t, 0.0, 0.0))
     }
 }
 
@@ -100,7 +100,7 @@ impl Set<Disc> {
                 (r.length() - d.inner) / (d.outer - d.inner),
                 0.5 + angle / std::f32::consts::TAU,
             ],
-            material: self.material[hit.index as usize],
+            material: material_of(self.material[hit.index as usize]),
             color: None,
             uv_scale: 0.0,
         }
@@ -119,14 +119,23 @@ mod tests {
             inner: 1.0,
             outer: 2.0,
         };
-        assert_eq!(disc_t(&ring, Vec3A::ZERO, Vec3A::Z, f32::INFINITY), None);
+        assert_eq!(
+            disc_t(&ring, Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY),
+            None
+        );
         let o = Vec3A::new(1.5, 0.0, 0.0);
-        assert_eq!(disc_t(&ring, o, Vec3A::Z, f32::INFINITY), Some(5.0));
+        assert_eq!(disc_t(&ring, o, Vec3A::Z, 0.0, f32::INFINITY), Some(5.0));
         let far = Vec3A::new(2.5, 0.0, 0.0);
-        assert_eq!(disc_t(&ring, far, Vec3A::Z, f32::INFINITY), None);
+        assert_eq!(disc_t(&ring, far, Vec3A::Z, 0.0, f32::INFINITY), None);
         // Parallel to the disc: no division by zero, no hit.
         assert_eq!(
-            disc_t(&ring, Vec3A::new(0.0, 0.0, 5.0), Vec3A::X, f32::INFINITY),
+            disc_t(
+                &ring,
+                Vec3A::new(0.0, 0.0, 5.0),
+                Vec3A::X,
+                0.0,
+                f32::INFINITY
+            ),
             None
         );
     }

@@ -21,6 +21,42 @@ pub enum Kind {
     Custom,
 }
 
+/// Each primitive stores its material index and clip group in one u32 (no extra memory for
+/// clipping): the low `CLIP_SHIFT` bits are the material, the rest the clip group (0: none).
+pub const CLIP_SHIFT: u32 = 20;
+pub const MAX_MATERIALS: u32 = 1 << CLIP_SHIFT;
+pub const MAX_CLIP_GROUPS: u32 = 1 << (32 - CLIP_SHIFT);
+
+pub fn pack(material: u32, clip: u32) -> u32 {
+    material | (clip << CLIP_SHIFT)
+}
+
+pub fn material_of(packed: u32) -> u32 {
+    packed & (MAX_MATERIALS - 1)
+}
+
+pub fn clip_of(packed: u32) -> u32 {
+    packed >> CLIP_SHIFT
+}
+
+/// Clip groups in render space: group `k` is `groups[k - 1]`; a plane is (point, normal) and cuts
+/// away what lies on the side its normal points to.
+#[derive(Clone, Debug, Default)]
+pub struct Clips {
+    pub groups: Vec<Vec<(Vec3A, Vec3A)>>,
+}
+
+impl Clips {
+    /// Whether point `p` of a primitive in clip group `clip` is cut away.
+    #[inline]
+    pub fn cut(&self, clip: u32, p: Vec3A) -> bool {
+        clip != 0
+            && self.groups[clip as usize - 1]
+                .iter()
+                .any(|(q, n)| (p - *q).dot(*n) > 0.0)
+    }
+}
+
 /// The closest hit found so far. Kind-specific extras (`b1`, `b2`: triangle barycentrics;
 /// `n`, `uv`: custom geometry's answer) are filled by the kind that found it.
 #[derive(Clone, Copy, Debug)]

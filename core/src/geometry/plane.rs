@@ -1,6 +1,6 @@
 //! Infinite planes: unbounded, so they stay outside the BVHs and are tested one by one.
 
-use super::{Counters, Hit, Kind, Surface};
+use super::{clip_of, material_of, Clips, Counters, Hit, Kind, Surface};
 use crate::math::{gamma, DVec3, Vec3A};
 use crate::ray::Ray;
 
@@ -54,10 +54,19 @@ impl Planes {
     }
 
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        clips: &Clips,
+        c: &mut Counters,
+    ) {
         for (i, p) in self.planes.iter().enumerate() {
             c.tests += 1;
-            if let Some(t) = plane_t(p, ray, *t_max) {
+            if let Some(t) =
+                plane_t(p, ray, *t_max).filter(|&t| !clips.cut(clip_of(p.material), ray.at(t)))
+            {
                 *t_max = t;
                 *hit = Some(Hit::new(t, Kind::Plane, i as u32));
             }
@@ -69,12 +78,14 @@ impl Planes {
         &self,
         ray: &Ray,
         t_max: f32,
+        clips: &Clips,
         c: &mut Counters,
         mut on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
         self.planes.iter().any(|p| {
             c.tests += 1;
-            plane_t(p, ray, t_max).is_some() && on_hit(p.material, 1)
+            plane_t(p, ray, t_max).is_some_and(|t| !clips.cut(clip_of(p.material), ray.at(t)))
+                && on_hit(material_of(p.material), 1)
         })
     }
 
@@ -92,7 +103,7 @@ impl Planes {
             ng: pl.normal,
             ns: pl.normal,
             uv: [(p - pl.point).dot(t), (p - pl.point).dot(b)],
-            material: pl.material,
+            material: material_of(pl.material),
             color: None,
             uv_scale: 0.0,
         }

@@ -2,7 +2,7 @@
 //! the ray test); the set supplies storage, building, closest-hit and any-hit traversal, so a
 //! new native primitive is one small file.
 
-use super::{Counters, Hit, Kind};
+use super::{clip_of, material_of, Clips, Counters, Hit, Kind};
 use crate::bvh::Bvh;
 use crate::math::Aabb;
 use crate::ray::Ray;
@@ -14,7 +14,17 @@ pub trait Shape: Copy + Send + Sync {
     fn prep(ray: &Ray) -> Self::Prep;
     fn bounds(&self) -> Aabb;
     /// The nearest hit in (0, t_max): t and two kind-specific values (triangle barycentrics).
-    fn hit(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> Option<(f32, f32, f32)>;
+    fn hit(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> Option<(f32, f32, f32)> {
+        self.hit_after(ray, prep, 0.0, t_max)
+    }
+    /// The nearest hit in (t_min, t_max): clipping asks again past a root it cut away.
+    fn hit_after(
+        &self,
+        ray: &Ray,
+        prep: &Self::Prep,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32)>;
     /// How many times the ray crosses the surface in (0, t_max) (filtered shadows).
     fn crossings(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> u32 {
         u32::from(self.hit(ray, prep, t_max).is_some())
@@ -23,6 +33,7 @@ pub trait Shape: Copy + Send + Sync {
 
 pub struct Set<S> {
     pub data: Vec<S>,
+    /// Material and clip group, packed (see `pack`).
     pub material: Vec<u32>,
     bvh: Bvh,
 }
@@ -60,15 +71,47 @@ impl<S: Shape> Set<S> {
         self.bvh = bvh;
     }
 
+    /// The nearest hit of primitive `i` in (0, t_max) that its clip group keeps.
+    #[inline(always)]
+    fn kept_hit(
+        &self,
+        i: usize,
+        ray: &Ray,
+        prep: &S::Prep,
+        t_max: f32,
+        clips: &Clips,
+    ) -> Option<(f32, f32, f32)> {
+        let clip = clip_of(self.material[i]);
+        let shape = &self.data[i];
+        if clip == 0 {
+            return shape.hit(ray, prep, t_max);
+        }
+        let mut lo = 0.0;
+        loop {
+            let h = shape.hit_after(ray, prep, lo, t_max)?;
+            if !clips.cut(clip, ray.at(h.0)) {
+                return Some(h);
+            }
+            lo = h.0;
+        }
+    }
+
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: &mut f32, hit: &mut Option<Hit>, c: &mut Counters) {
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        clips: &Clips,
+        c: &mut Counters,
+    ) {
         if self.data.is_empty() {
             return;
         }
         let prep = S::prep(ray);
         *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
             c.tests += 1;
-            let (t, b1, b2) = self.data[i as usize].hit(ray, &prep, tm)?;
+            let (t, b1, b2) = self.kept_hit(i as usize, ray, &prep, tm, clips)?;
             let mut h = Hit::new(t, S::KIND, i);
             h.b1 = b1;
             h.b2 = b2;
@@ -84,6 +127,7 @@ impl<S: Shape> Set<S> {
         &self,
         ray: &Ray,
         t_max: f32,
+        clips: &Clips,
         c: &mut Counters,
         mut on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
@@ -93,8 +137,19 @@ impl<S: Shape> Set<S> {
         let prep = S::prep(ray);
         self.bvh.any(ray.origin, ray.dir, t_max, |i| {
             c.tests += 1;
-            let n = self.data[i as usize].crossings(ray, &prep, t_max);
-            n > 0 && on_hit(self.material[i as usize], n)
+            let packed = self.material[i as usize];
+            let n = if clip_of(packed) == 0 {
+                self.data[i as usize].crossings(ray, &prep, t_max)
+            } else {
+                // Count only the crossings the clip group keeps.
+                let (mut n, mut lo) = (0, 0.0);
+                while let Some(h) = self.data[i as usize].hit_after(ray, &prep, lo, t_max) {
+                    n += u32::from(!clips.cut(clip_of(packed), ray.at(h.0)));
+                    lo = h.0;
+                }
+                n
+            };
+            n > 0 && on_hit(material_of(packed), n)
         })
     }
 }

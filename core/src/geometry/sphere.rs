@@ -1,7 +1,7 @@
 //! Spheres: 16 bytes each (centre + radius) plus a material index, in their own BVH.
 
 use super::set::{Set, Shape};
-use super::{Hit, Kind, Surface};
+use super::{material_of, Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
 use glam::Vec3;
@@ -22,7 +22,13 @@ pub type Spheres = Set<Sphere>;
 /// are solved in f64 so that a huge sphere seen from close by (an Earth-sized ground) keeps its
 /// precision: in f32, |f|² − r² loses every digit when |f| ≈ r ≈ 1e6.
 #[inline(always)]
-pub fn intersect_sphere(s: &Sphere, o: Vec3A, d: Vec3A, t_max: f32) -> (Option<f32>, u32) {
+pub fn intersect_sphere(
+    s: &Sphere,
+    o: Vec3A,
+    d: Vec3A,
+    t_min: f32,
+    t_max: f32,
+) -> (Option<f32>, u32) {
     let c = Vec3A::from(s.center);
     let r = s.radius;
     let f = o - c;
@@ -49,8 +55,8 @@ pub fn intersect_sphere(s: &Sphere, o: Vec3A, d: Vec3A, t_max: f32) -> (Option<f
     if t0 > t1 {
         std::mem::swap(&mut t0, &mut t1);
     }
-    let in0 = t0 > 0.0 && t0 < t_max;
-    let in1 = t1 > 0.0 && t1 < t_max;
+    let in0 = t0 > t_min && t0 < t_max;
+    let in1 = t1 > t_min && t1 < t_max;
     let n = u32::from(in0) + u32::from(in1);
     if in0 {
         (Some(t0), n)
@@ -72,15 +78,15 @@ impl Shape for Sphere {
     }
 
     #[inline(always)]
-    fn hit(&self, ray: &Ray, _: &(), t_max: f32) -> Option<(f32, f32, f32)> {
-        intersect_sphere(self, ray.origin, ray.dir, t_max)
+    fn hit_after(&self, ray: &Ray, _: &(), t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+        intersect_sphere(self, ray.origin, ray.dir, t_min, t_max)
             .0
             .map(|t| (t, 0.0, 0.0))
     }
 
     #[inline(always)]
     fn crossings(&self, ray: &Ray, _: &(), t_max: f32) -> u32 {
-        intersect_sphere(self, ray.origin, ray.dir, t_max).1
+        intersect_sphere(self, ray.origin, ray.dir, 0.0, t_max).1
     }
 }
 
@@ -130,7 +136,7 @@ impl Set<Sphere> {
             ng: n,
             ns: n,
             uv: [u, v],
-            material: self.material[hit.index as usize],
+            material: material_of(self.material[hit.index as usize]),
             color: None,
             // u spans 2πr, v spans πr: their geometric mean.
             uv_scale: 1.0 / (std::f32::consts::PI * std::f32::consts::SQRT_2 * s.radius),
@@ -148,13 +154,13 @@ mod tests {
             center: Vec3::new(0.0, 0.0, 5.0),
             radius: 1.0,
         };
-        let (t, n) = intersect_sphere(s, Vec3A::ZERO, Vec3A::Z, f32::INFINITY);
+        let (t, n) = intersect_sphere(s, Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
         assert_eq!((t, n), (Some(4.0), 2));
-        let (t, n) = intersect_sphere(s, Vec3A::new(0.0, 0.0, 5.0), Vec3A::Z, f32::INFINITY);
+        let (t, n) = intersect_sphere(s, Vec3A::new(0.0, 0.0, 5.0), Vec3A::Z, 0.0, f32::INFINITY);
         assert_eq!((t, n), (Some(1.0), 1));
-        let (t, _) = intersect_sphere(s, Vec3A::ZERO, -Vec3A::Z, f32::INFINITY);
+        let (t, _) = intersect_sphere(s, Vec3A::ZERO, -Vec3A::Z, 0.0, f32::INFINITY);
         assert_eq!(t, None);
-        let (t, _) = intersect_sphere(s, Vec3A::ZERO, Vec3A::Z, 3.0);
+        let (t, _) = intersect_sphere(s, Vec3A::ZERO, Vec3A::Z, 0.0, 3.0);
         assert_eq!(t, None);
     }
 
@@ -166,7 +172,7 @@ mod tests {
             center: Vec3::new(0.0, -r, 0.0),
             radius: r,
         };
-        let (t, _) = intersect_sphere(s, Vec3A::new(0.0, 1.0, 0.0), -Vec3A::Y, f32::INFINITY);
+        let (t, _) = intersect_sphere(s, Vec3A::new(0.0, 1.0, 0.0), -Vec3A::Y, 0.0, f32::INFINITY);
         let t = t.unwrap();
         assert!((t - 1.0).abs() < 1e-6, "t = {t}");
     }

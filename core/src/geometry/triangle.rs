@@ -2,7 +2,7 @@
 //! attributes kept apart and read only when shading.
 
 use super::set::{Set, Shape};
-use super::{Hit, Kind, Surface};
+use super::{material_of, Hit, Kind, Surface};
 use crate::math::{gamma, Aabb, Vec3A};
 use crate::ray::Ray;
 use glam::{DVec3, Vec3};
@@ -143,6 +143,11 @@ impl Shape for Triangle {
     fn hit(&self, _: &Ray, prep: &TriRay, t_max: f32) -> Option<(f32, f32, f32)> {
         intersect_triangle(&self.v, prep, t_max)
     }
+
+    #[inline(always)]
+    fn hit_after(&self, _: &Ray, prep: &TriRay, t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+        intersect_triangle(&self.v, prep, t_max).filter(|h| h.0 > t_min)
+    }
 }
 
 impl Triangles {
@@ -259,7 +264,7 @@ impl Triangles {
             ng,
             ns: ng,
             uv: [b1, b2],
-            material: self.set.material[i],
+            material: material_of(self.set.material[i]),
             color: None,
             uv_scale: 0.0,
         };

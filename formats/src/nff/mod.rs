@@ -410,6 +410,7 @@ impl Assembler {
             ambient_occlusion: None,
             textures: Vec::new(),
             materials: self.materials,
+            clip_groups: Vec::new(),
             objects: Vec::new(),
             inline: self.inline,
             volumes: Vec::new(),
