@@ -254,3 +254,37 @@ fn renders_an_obj_file_with_its_mtl_colour() {
         "centre pixel {px:?} is not teal"
     );
 }
+
+#[test]
+fn shading_switches_change_what_is_traced() {
+    let dir = temp_dir("shade");
+    let o = dir.join("s.png");
+    let count = |args: &[&str], kind: &str| -> u64 {
+        let mut all = vec![
+            "render",
+            &*Box::leak(scene("spheres.ron").into_boxed_str()),
+            "-o",
+            o.to_str().unwrap(),
+            "--res",
+            "48x32",
+            "--stats",
+        ];
+        all.extend_from_slice(args);
+        let out = run(&all);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let e = stderr(&out);
+        let line = e
+            .lines()
+            .find(|l| l.trim_start().starts_with(kind))
+            .unwrap_or_else(|| panic!("no {kind} in {e}"));
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    assert!(count(&[], "shadow") > 0 && count(&[], "reflection") > 0);
+    assert_eq!(count(&["--shade", "medium"], "shadow"), 0);
+    assert!(count(&["--shade", "medium"], "reflection") > 0);
+    assert_eq!(count(&["--shade", "low"], "reflection"), 0);
+    assert_eq!(count(&["--no-shadows"], "shadow"), 0);
+    assert_eq!(count(&["--max-depth", "0"], "reflection"), 0);
+    assert_eq!(count(&[], "occlusion"), 0);
+    assert!(count(&["--ao", "4"], "occlusion") > 0);
+}

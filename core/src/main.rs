@@ -50,6 +50,8 @@ enum Command {
         /// Output: written while rendering, after it, or by every MPI rank (8-bit PPM).
         #[arg(long, value_parser = ["async", "sync", "mpi-io"])]
         io: Option<String>,
+        #[command(flatten)]
+        shading: cli::shading::ShadingArgs,
     },
     /// Validate a scene and print what it contains; renders nothing.
     Check { scene: PathBuf },
@@ -107,6 +109,7 @@ fn main() -> ExitCode {
             decomposition,
             block_size,
             io,
+            shading,
         } => cli::render::run(
             &scene,
             &cli::render::Overrides {
@@ -119,6 +122,7 @@ fn main() -> ExitCode {
                 decomposition,
                 block_size,
                 io,
+                shading,
             },
         ),
         Command::Check { scene } => cli::check::run(&scene),

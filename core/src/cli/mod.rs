@@ -5,4 +5,5 @@ pub mod job;
 pub mod plugins;
 pub mod progress;
 pub mod render;
+pub mod shading;
 pub mod spd;

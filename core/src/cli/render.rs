@@ -30,6 +30,8 @@ pub struct Overrides {
     pub block_size: Option<u32>,
     /// `async`, `sync` or `mpi-io`.
     pub io: Option<String>,
+    /// `--shade`, `--max-depth`, `--no-shadows`, `--ao`.
+    pub shading: super::shading::ShadingArgs,
 }
 
 pub fn cli_origin(what: &str) -> Origin {
@@ -42,6 +44,7 @@ pub fn cli_origin(what: &str) -> Origin {
 
 fn load(path: &Path, o: &Overrides) -> Result<SceneDesc, Error> {
     let mut desc = luxon_formats::load(path)?;
+    o.shading.apply(&mut desc)?;
     let r = &mut desc.render;
     if let Some((w, h)) = o.res {
         r.width = w;
@@ -325,6 +328,7 @@ fn print_stats(
     eprintln!("    shadow         {}", c.shadow);
     eprintln!("    reflection     {}", c.reflection);
     eprintln!("    refraction     {}", c.refraction);
+    eprintln!("    occlusion      {}", c.occlusion);
     eprintln!("  intersection tests {}", c.tests);
     eprintln!("  NaN pixels       {}", c.nan_pixels);
     eprintln!(

@@ -1,0 +1,86 @@
+//! Tachyon's shading switches for any scene: `--shade`, `--max-depth`, `--no-shadows`, `--ao`.
+
+use luxon::Error;
+use luxon_formats::{AoDesc, LightDesc, SceneDesc};
+
+#[derive(clap::Args, Default, Debug)]
+pub struct ShadingArgs {
+    /// Shading level: full; medium (no shadows); low (no shadows, no reflections); lowest (flat
+    /// colour: no lighting at all).
+    #[arg(long, value_parser = ["full", "medium", "low", "lowest"])]
+    pub shade: Option<String>,
+    /// Maximum ray depth (0: primary rays only).
+    #[arg(long = "max-depth")]
+    pub max_depth: Option<u32>,
+    /// No shadow rays for any light.
+    #[arg(long = "no-shadows")]
+    pub no_shadows: bool,
+    /// Ambient occlusion with SAMPLES rays per shading point, for a scene that has none.
+    #[arg(long, value_name = "SAMPLES")]
+    pub ao: Option<u32>,
+}
+
+fn no_shadows(desc: &mut SceneDesc) {
+    for l in &mut desc.lights {
+        match &mut l.value {
+            LightDesc::Point { shadows, .. }
+            | LightDesc::Directional { shadows, .. }
+            | LightDesc::Spot { shadows, .. }
+            | LightDesc::Sphere { shadows, .. }
+            | LightDesc::Rect { shadows, .. } => *shadows = false,
+        }
+    }
+}
+
+impl ShadingArgs {
+    pub fn apply(&self, desc: &mut SceneDesc) -> Result<(), Error> {
+        if let Some(d) = self.max_depth {
+            if d > 1024 {
+                return Err(Error::Usage(format!("--max-depth {d}: expected 0..=1024")));
+            }
+            desc.render.max_depth = d;
+        }
+        if let Some(n) = self.ao {
+            if n == 0 || n > 4096 {
+                return Err(Error::Usage(format!("--ao {n}: expected 1..=4096 samples")));
+            }
+            match &mut desc.ambient_occlusion {
+                Some(ao) => ao.samples = n,
+                None => {
+                    desc.ambient_occlusion = Some(AoDesc {
+                        samples: n,
+                        max_distance: f64::INFINITY,
+                        color: [1.0; 3],
+                        intensity: 1.0,
+                    })
+                }
+            }
+        }
+        if self.no_shadows {
+            no_shadows(desc);
+        }
+        match self.shade.as_deref() {
+            None | Some("full") => {}
+            Some("medium") => no_shadows(desc),
+            Some("low") => {
+                no_shadows(desc);
+                for (_, m) in &mut desc.materials {
+                    m.value.reflect = 0.0;
+                }
+            }
+            Some(_) => {
+                // Flat colour: every surface shows its colour, unlit.
+                no_shadows(desc);
+                desc.ambient_occlusion = None;
+                for (_, m) in &mut desc.materials {
+                    let m = &mut m.value;
+                    (m.ambient, m.diffuse, m.specular, m.reflect, m.transmit) =
+                        (1.0, 0.0, 0.0, 0.0, 0.0);
+                    m.reflect_texture = None;
+                    m.transmit_texture = None;
+                }
+            }
+        }
+        Ok(())
+    }
+}
