@@ -98,3 +98,8 @@ fn lights_spot_area_attenuation_fog() {
 fn ambient_occlusion_through_a_transparent_surface() {
     check("ao-molecule");
 }
+
+#[test]
+fn custom_solids_box_quadric_cylinder_heightfield() {
+    check("solids");
+}
