@@ -103,3 +103,28 @@ fn ambient_occlusion_through_a_transparent_surface() {
 fn custom_solids_box_quadric_cylinder_heightfield() {
     check("solids");
 }
+
+#[test]
+fn camera_dof() {
+    check("cameras-dof");
+}
+
+#[test]
+fn camera_orthographic() {
+    check("cameras-orthographic");
+}
+
+#[test]
+fn camera_fisheye() {
+    check("cameras-fisheye");
+}
+
+#[test]
+fn camera_stereo() {
+    check("cameras-stereo");
+}
+
+#[test]
+fn camera_vr() {
+    check("cameras-vr");
+}

@@ -99,7 +99,8 @@ impl Camera {
                 Kind::Perspective,
                 window((fov_deg.to_radians() * 0.5).tan()),
             ),
-            Projection::PerspectiveZoom { zoom } => (Kind::Perspective, window(1.0 / zoom)),
+            // Tachyon's zoom 1 is a window 1 high at unit distance (measured with tachyon-nox).
+            Projection::PerspectiveZoom { zoom } => (Kind::Perspective, window(0.5 / zoom)),
             Projection::Orthographic { height } => (Kind::Orthographic, window(height * 0.5)),
             Projection::Fisheye { fov_deg } => {
                 let half_angle = fov_deg.to_radians() * 0.5;

@@ -77,7 +77,12 @@ impl Whitted<'_> {
         media: &IorStack,
         c: &mut Counters,
     ) -> Vec3A {
-        self.trace(ray, depth, weight, media, 0.0, c)
+        let width = if depth == 0 {
+            self.scene.primary_width
+        } else {
+            0.0
+        };
+        self.trace(ray, depth, weight, media, width, c)
     }
 
     /// Texture `t` at a surface point; a panicking plugin raises the scene's fault.

@@ -61,11 +61,12 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
             let mut sum = Vec3A::ZERO;
             for i in 0..n {
                 let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
-                let ray = scene
-                    .camera
-                    .ray(x as f32 + jx, y as f32 + jy, s.width, s.height, s.time);
-                c.primary += 1;
-                sum += integrator.radiance(&ray, 0, 1.0, &media, c);
+                let (px, py) = (x as f32 + jx, y as f32 + jy);
+                // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
+                if let Some(ray) = scene.camera.primary(px, py, s.width, s.height, s.time) {
+                    c.primary += 1;
+                    sum += integrator.radiance(&ray, 0, 1.0, &media, c);
+                }
             }
             let mut v = sum * inv_n;
             if !v.is_finite() {

@@ -213,6 +213,8 @@ pub struct Scene {
     /// to it in f32, so a scene far from the world origin keeps its precision.
     pub world_offset: DVec3,
     pub settings: Settings,
+    /// Width of a pixel's footprint at the camera (orthographic cameras: a pixel; else 0).
+    pub primary_width: f32,
     /// Angle one pixel spans at the image centre (radians): how fast ray footprints widen.
     pub pixel_spread: f32,
     pub outputs: Vec<OutputDesc>,
@@ -595,7 +597,8 @@ impl Scene {
         Ok(Scene {
             source: desc.source.clone(),
             camera: camera.clone(),
-            pixel_spread: 2.0 * camera.up.length() / r.height as f32,
+            primary_width: camera.footprint().0,
+            pixel_spread: camera.footprint().1,
             background: v3(desc.background),
             lights,
             fog,

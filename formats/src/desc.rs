@@ -85,7 +85,8 @@ pub struct CameraDesc {
 pub enum Projection {
     /// Full vertical field of view in degrees, in (0, 180).
     Perspective { fov_deg: f64 },
-    /// Tachyon's zoom: the image plane's half-height at unit distance is `1 / zoom`.
+    /// Tachyon's zoom: the image plane's half-height at unit distance is `0.5 / zoom`
+    /// (zoom 1: a window 1 unit high at unit distance, as in Tachyon).
     PerspectiveZoom { zoom: f64 },
     /// Parallel rays; `height` is the view window's full height in world units.
     Orthographic { height: f64 },
