@@ -47,7 +47,7 @@ fn triangles(desc: &SceneDesc) -> usize {
     desc.inline.iter().map(|g| g.mesh.indices.len()).sum()
 }
 
-fn all<'a>(desc: &'a SceneDesc) -> impl Iterator<Item = &'a InlineGeometry> {
+fn all(desc: &SceneDesc) -> impl Iterator<Item = &InlineGeometry> {
     desc.inline.iter()
 }
 

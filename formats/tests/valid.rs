@@ -206,7 +206,7 @@ fn load_reads_files_and_rejects_other_formats() {
     assert_eq!(scene.render.outputs[0].path, dir.join("out.png"));
     assert_eq!(*scene.objects[0].at.file, file);
 
-    let error = load(&dir.join("model.nff")).unwrap_err();
+    let error = load(&dir.join("model.xyz")).unwrap_err();
     assert!(error.origin().is_none());
     let message = error.to_string();
     assert!(
