@@ -154,22 +154,24 @@ fn luxon_binary() -> PathBuf {
 #[derive(Clone)]
 struct Config {
     label: String,
+    /// 0: run luxon directly, else under mpirun.
     ranks: usize,
-    threads: usize,
+    /// Render threads of all ranks together: the p of the efficiency.
+    workers: usize,
     args: Vec<String>,
 }
 
-fn config(label: &str, ranks: usize, threads: usize, args: &str) -> Config {
+fn config(label: &str, ranks: usize, workers: usize, args: &str) -> Config {
     Config {
         label: label.into(),
         ranks,
-        threads,
+        workers,
         args: args.split_whitespace().map(String::from).collect(),
     }
 }
 
-/// (render seconds, wall seconds) of one run.
-fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, a: &Args) -> (f64, f64) {
+/// Seconds of one run: render and write (as `--stats` reports them), and wall time.
+fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, a: &Args) -> [f64; 3] {
     let mut cmd = if c.ranks > 0 {
         let mut m = Command::new("mpirun");
         m.args(["--oversubscribe", "--bind-to", "none", "-np"])
@@ -198,18 +200,19 @@ fn run_once(bin: &Path, scene: &Path, out: &Path, c: &Config, a: &Args) -> (f64,
     let wall = t.elapsed().as_secs_f64();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{}: {err}", c.label);
-    let render = err
-        .lines()
-        .find_map(|l| {
-            l.trim()
-                .strip_prefix("render")?
-                .trim()
-                .strip_suffix(" s")?
-                .parse()
-                .ok()
-        })
-        .unwrap_or_else(|| panic!("no render time in {err}"));
-    (render, wall)
+    let seconds = |label: &str| -> f64 {
+        err.lines()
+            .find_map(|l| {
+                l.trim()
+                    .strip_prefix(label)?
+                    .trim()
+                    .strip_suffix(" s")?
+                    .parse()
+                    .ok()
+            })
+            .unwrap_or_else(|| panic!("no {label} time in {err}"))
+    };
+    [seconds("render"), seconds("write"), wall]
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -247,7 +250,7 @@ fn main() {
             "MPI and hybrid",
             vec![
                 config("1 rank (mpi)", 1, 1, "--parallel mpi"),
-                config("2 ranks (mpi)", 2, 1, "--parallel mpi"),
+                config("2 ranks (mpi)", 2, 2, "--parallel mpi"),
                 config("hybrid 1 rank x 2 threads", 1, 2, "--parallel hybrid"),
                 config("hybrid 2 ranks x 1 thread", 2, 2, "--parallel hybrid"),
             ],
@@ -292,7 +295,7 @@ fn main() {
     );
     // Rounds visit every configuration once, so a change in the machine's load hits them all.
     let all: Vec<&Config> = groups.iter().flat_map(|g| &g.1).collect();
-    let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); all.len()];
+    let mut times: Vec<[Vec<f64>; 3]> = vec![Default::default(); all.len()];
     for round in 0..a.runs {
         eprintln!("round {} of {}", round + 1, a.runs);
         for (c, t) in all.iter().zip(&mut times) {
@@ -301,28 +304,29 @@ fn main() {
             } else {
                 "ppm"
             };
-            let (r, w) = run_once(&bin, &scene, &dir.join(format!("out.{ext}")), c, &a);
-            t.0.push(r);
-            t.1.push(w);
+            let one = run_once(&bin, &scene, &dir.join(format!("out.{ext}")), c, &a);
+            for (v, x) in t.iter_mut().zip(one) {
+                v.push(x);
+            }
         }
     }
     let mut times = times.into_iter();
     let mut base = None;
     for (title, configs) in &groups {
         println!("### {title}\n");
-        println!("| configuration | render s (median) | min | speedup | efficiency | efficiency of min | time / first row | wall s |");
-        println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+        println!("| configuration | render s (median) | min | speedup | efficiency | efficiency of min | render / first row | write s | wall s |");
+        println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
         let mut first_in_group = None;
         for c in configs {
-            let (r, w) = times.next().unwrap_or_default();
+            let [r, write, wall] = times.next().unwrap_or_default();
             let min = r.iter().copied().fold(f64::INFINITY, f64::min);
-            let (r, w) = (median(r), median(w));
+            let (r, write, wall) = (median(r), median(write), median(wall));
             let (t1, t1_min) = *base.get_or_insert((r, min));
             let speedup = t1 / r;
             let first = *first_in_group.get_or_insert(r);
-            let p = c.threads as f64;
+            let p = c.workers as f64;
             println!(
-                "| {} | {r:.3} | {min:.3} | {speedup:.2} | {:.1} % | {:.1} % | {:.3} | {w:.3} |",
+                "| {} | {r:.3} | {min:.3} | {speedup:.2} | {:.1} % | {:.1} % | {:.3} | {write:.3} | {wall:.3} |",
                 c.label,
                 100.0 * speedup / p,
                 100.0 * t1_min / min / p,

@@ -6,10 +6,35 @@ mod common;
 
 #[cfg(not(feature = "mpi"))]
 #[test]
-fn mpi_tests_skipped_without_the_mpi_feature() {
+fn without_mpi_several_ranks_are_refused_and_mpi_scenes_render_here() {
+    use common::*;
     eprintln!(
         "skipped: the MPI tests need the `mpi` feature: cargo test --workspace --features mpi"
     );
+    let dir = temp_dir("no-mpi");
+    let out = dir.join("o.png");
+    let scene = root().join("scenes/glass.ron");
+    let args = [
+        "render",
+        scene.to_str().unwrap(),
+        "--res",
+        "24x16",
+        "--parallel",
+        "hybrid",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    // What mpirun would set for the second of two ranks.
+    let o = luxon()
+        .args(args)
+        .env("OMPI_COMM_WORLD_SIZE", "2")
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("built without MPI"), "{}", stderr(&o));
+    let o = luxon().args(args).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
 }
 
 #[cfg(feature = "mpi")]

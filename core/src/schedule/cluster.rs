@@ -4,7 +4,8 @@
 //! - Static decompositions: workers are numbered across ranks (rank r's threads follow rank
 //!   r-1's), so pixel-, scanline- and block-cyclic deal units over every thread of the job.
 //! - Dynamic: rank 0 hands out tiles from a counter its own threads also take from; each other
-//!   rank keeps `threads + 1` tiles requested (one ahead) and asks for one more per finished tile.
+//!   rank keeps `threads + 1` tiles requested (one ahead), asks for one more per finished tile,
+//!   and asks further ahead whenever one of its threads had to wait for a tile.
 //!
 //! All MPI calls are made by each rank's main thread, which polls (and sleeps briefly: OpenMPI's
 //! blocking calls spin and would steal a core from the render threads), except on failure: an
@@ -339,10 +340,13 @@ impl Run<'_> {
         let dynamic = matches!(share, Share::Queue { .. });
         let root = self.cluster.world.process_at_rank(0);
         let mut kept = Vec::new();
+        let mut outbox = Outbox::new(self.cluster.world.as_raw());
         let mut no_more_tiles = !dynamic;
+        // Tiles requested and not finished: every thread's plus at least one ahead.
+        let threads = self.threads[self.cluster.rank];
+        let (mut ahead, max_ahead) = (threads + 1, 4 * threads + 8);
         if dynamic {
-            let ahead = self.threads[self.cluster.rank] as u64 + 1;
-            root.send_with_tag(&bytes_of(ahead)[..], TAG_REQUEST);
+            root.send_with_tag(&bytes_of(ahead as u64)[..], TAG_REQUEST);
         }
         let mut stats = std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
@@ -352,10 +356,18 @@ impl Run<'_> {
                 match chunks.recv_timeout(POLL) {
                     Ok(c) => {
                         if self.gather {
-                            root.send_with_tag(&wire::encode_chunk(&c)[..], TAG_CHUNK);
+                            outbox.send(wire::encode_chunk(&c), TAG_CHUNK);
                         }
                         if !no_more_tiles {
-                            root.send_with_tag(&bytes_of(1)[..], TAG_REQUEST);
+                            // One more for the finished tile, and one further ahead when a
+                            // render thread had to wait (the round trip took longer than the
+                            // tiles in hand).
+                            let mut more = 1;
+                            if queue.starved.swap(0, Ordering::Relaxed) > 0 && ahead < max_ahead {
+                                ahead += 1;
+                                more += 1;
+                            }
+                            root.send_with_tag(&bytes_of(more)[..], TAG_REQUEST);
                         }
                         if self.keep {
                             kept.push(c);
@@ -377,6 +389,7 @@ impl Run<'_> {
                         _ => {}
                     }
                 }
+                outbox.progress();
                 self.check();
             }
             local
@@ -384,11 +397,66 @@ impl Run<'_> {
                 .unwrap_or_else(|_| fail("a render thread panicked"))
         });
         self.check();
+        outbox.flush();
         stats.rank = self.cluster.rank;
         root.send_with_tag(&wire::encode_stats(&stats)[..], TAG_FINISHED);
         Rendered {
             ranks: vec![stats],
             kept,
+        }
+    }
+}
+
+/// Chunks on their way to rank 0. Non-blocking sends: a blocking send of a large message waits
+/// for rank 0 to poll, and OpenMPI waits by spinning, which takes a core from the renderers.
+struct Outbox {
+    comm: ffi::MPI_Comm,
+    pending: Vec<(ffi::MPI_Request, Vec<u8>)>,
+}
+
+impl Outbox {
+    fn new(comm: ffi::MPI_Comm) -> Outbox {
+        Outbox {
+            comm,
+            pending: Vec::new(),
+        }
+    }
+
+    fn send(&mut self, bytes: Vec<u8>, tag: i32) {
+        // SAFETY: the buffer stays alive and unmoved (heap) in `pending` until MPI_Test says
+        // the send completed.
+        unsafe {
+            let mut req = ffi::RSMPI_REQUEST_NULL;
+            let code = ffi::MPI_Isend(
+                bytes.as_ptr() as *const c_void,
+                bytes.len() as c_int,
+                ffi::RSMPI_UINT8_T,
+                0,
+                tag,
+                self.comm,
+                &mut req,
+            );
+            if code != 0 {
+                fail("MPI_Isend failed");
+            }
+            self.pending.push((req, bytes));
+        }
+    }
+
+    /// Drops the buffers of completed sends.
+    fn progress(&mut self) {
+        self.pending.retain_mut(|(req, _)| {
+            let mut done: c_int = 0;
+            // SAFETY: `req` is a live request from MPI_Isend.
+            unsafe { ffi::MPI_Test(req, &mut done, ffi::RSMPI_STATUS_IGNORE) };
+            done == 0
+        });
+    }
+
+    fn flush(&mut self) {
+        while !self.pending.is_empty() {
+            self.progress();
+            std::thread::sleep(POLL);
         }
     }
 }
@@ -415,11 +483,13 @@ fn check(scene: &Scene, injected: &Injected) {
     }
 }
 
-/// Tiles a follower has been given and not yet started; `pop` waits for one.
+/// Tiles a follower has been given and not yet started; `pop` waits for one (and counts the
+/// waits: the follower then asks further ahead).
 #[derive(Default)]
 struct TileQueue {
     state: Mutex<(VecDeque<usize>, bool)>,
     ready: Condvar,
+    starved: AtomicUsize,
 }
 
 impl TileQueue {
@@ -444,6 +514,7 @@ impl TileQueue {
             if s.1 {
                 return None;
             }
+            self.starved.fetch_add(1, Ordering::Relaxed);
             s = self.ready.wait(s).unwrap_or_else(|e| e.into_inner());
         }
     }
