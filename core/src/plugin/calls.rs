@@ -152,20 +152,34 @@ fn checked_len(count: u64, per: u64, what: &str) -> Result<usize, String> {
         .ok_or_else(|| format!("{what} count {count} is too large"))
 }
 
+/// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`.
+fn add_batch<const N: usize>(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+    what: &str,
+    push: impl Fn(&mut GeometryBuilder, usize, [f64; N]) -> Result<(), String>,
+) -> abi::Status {
+    guard(err, || {
+        let b = builder(ctx);
+        // SAFETY: the plugin passes `count` records of N values (ABI contract).
+        let v = unsafe { slice(data, checked_len(count, N as u64, what)?) };
+        for (i, r) in v.chunks_exact(N).enumerate() {
+            push(b, i, r.try_into().expect("chunk of N"))?;
+        }
+        Ok(())
+    })
+}
+
 extern "C" fn add_spheres(
     ctx: *mut c_void,
     data: *const f64,
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
-        let v = unsafe { slice(data, checked_len(count, 4, "sphere")?) };
-        for (i, s) in v.chunks_exact(4).enumerate() {
-            let s = s.try_into().expect("chunk of 4");
-            b.spheres.push_world(i, s, b.world_offset, b.material)?;
-        }
-        Ok(())
+    add_batch(ctx, data, count, err, "sphere", |b, i, r: [f64; 4]| {
+        b.spheres.push_world(i, r, b.world_offset, b.material)
     })
 }
 
@@ -175,14 +189,8 @@ extern "C" fn add_planes(
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
-        let v = unsafe { slice(data, checked_len(count, 6, "plane")?) };
-        for (i, p) in v.chunks_exact(6).enumerate() {
-            let p = p.try_into().expect("chunk of 6");
-            b.planes.push_world(i, p, b.world_offset, b.material)?;
-        }
-        Ok(())
+    add_batch(ctx, data, count, err, "plane", |b, i, r: [f64; 6]| {
+        b.planes.push_world(i, r, b.world_offset, b.material)
     })
 }
 
@@ -192,18 +200,8 @@ extern "C" fn add_cones(
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
-        let v = unsafe { slice(data, checked_len(count, 8, "cone")?) };
-        for (i, c) in v.chunks_exact(8).enumerate() {
-            b.cones.push_world(
-                i,
-                c.try_into().expect("chunk of 8"),
-                b.world_offset,
-                b.material,
-            )?;
-        }
-        Ok(())
+    add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
+        b.cones.push_world(i, r, b.world_offset, b.material)
     })
 }
 
@@ -213,18 +211,8 @@ extern "C" fn add_discs(
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
-        let v = unsafe { slice(data, checked_len(count, 8, "disc")?) };
-        for (i, d) in v.chunks_exact(8).enumerate() {
-            b.discs.push_world(
-                i,
-                d.try_into().expect("chunk of 8"),
-                b.world_offset,
-                b.material,
-            )?;
-        }
-        Ok(())
+    add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
+        b.discs.push_world(i, r, b.world_offset, b.material)
     })
 }
 
