@@ -12,31 +12,22 @@
 //! error or panic anywhere ends the whole job through [`fail`] (`MPI_Abort`), after rank 0 has
 //! printed the cause.
 
+use super::abort::{abort_job, fail, Injected, TAG_ERROR};
+use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
 use super::{decompose, run_share, wire, Chunk, RankStats, Share, Sink};
 use crate::error::Error;
 use crate::scene::Scene;
 use luxon_formats::{Decomposition, ParallelMode};
-use mpi::ffi;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
-use std::collections::VecDeque;
-use std::os::raw::{c_int, c_void};
-use std::sync::atomic::{AtomicBool, AtomicI32, AtomicUsize, Ordering};
-use std::sync::{mpsc, Condvar, Mutex};
-use std::time::{Duration, Instant};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{mpsc, Mutex};
 
 const TAG_REQUEST: i32 = 1;
 const TAG_TILE: i32 = 2;
 const TAG_DONE: i32 = 3;
 const TAG_CHUNK: i32 = 4;
 const TAG_FINISHED: i32 = 5;
-const TAG_ERROR: i32 = 6;
-
-/// How long the main thread sleeps between polls.
-const POLL: Duration = Duration::from_micros(500);
-
-/// This process's rank once MPI is up (-1 before): read by [`fail`] from any thread.
-static RANK: AtomicI32 = AtomicI32::new(-1);
 
 pub struct Cluster {
     world: SimpleCommunicator,
@@ -62,22 +53,7 @@ impl Cluster {
             .ok_or_else(|| Error::Render("MPI was already initialised in this process".into()))?;
         let world = universe.world();
         let (rank, size) = (world.rank() as usize, world.size() as usize);
-        RANK.store(rank as i32, Ordering::SeqCst);
-        let previous = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            previous(info);
-            let p = info.payload();
-            let what = p
-                .downcast_ref::<&str>()
-                .copied()
-                .or_else(|| p.downcast_ref::<String>().map(String::as_str))
-                .unwrap_or("(no message)");
-            let at = info
-                .location()
-                .map(|l| format!(" at {l}"))
-                .unwrap_or_default();
-            fail(&format!("panic{at}: {what}"));
-        }));
+        super::abort::on_rank(rank);
         // Ranks bound to the same CPUs share them; ranks bound to other CPUs do not.
         let node = world.split_shared(0);
         let mine = cpu_set_fingerprint();
@@ -407,72 +383,6 @@ impl Run<'_> {
     }
 }
 
-/// Chunks on their way to rank 0. Non-blocking sends: a blocking send of a large message waits
-/// for rank 0 to poll, and OpenMPI waits by spinning, which takes a core from the renderers.
-struct Outbox {
-    comm: ffi::MPI_Comm,
-    pending: Vec<(ffi::MPI_Request, Vec<u8>)>,
-}
-
-impl Outbox {
-    fn new(comm: ffi::MPI_Comm) -> Outbox {
-        Outbox {
-            comm,
-            pending: Vec::new(),
-        }
-    }
-
-    fn send(&mut self, bytes: Vec<u8>, tag: i32) {
-        // SAFETY: the buffer stays alive and unmoved (heap) in `pending` until MPI_Test says
-        // the send completed.
-        unsafe {
-            let mut req = ffi::RSMPI_REQUEST_NULL;
-            let code = ffi::MPI_Isend(
-                bytes.as_ptr() as *const c_void,
-                bytes.len() as c_int,
-                ffi::RSMPI_UINT8_T,
-                0,
-                tag,
-                self.comm,
-                &mut req,
-            );
-            if code != 0 {
-                fail("MPI_Isend failed");
-            }
-            self.pending.push((req, bytes));
-        }
-    }
-
-    /// Drops the buffers of completed sends.
-    fn progress(&mut self) {
-        self.pending.retain_mut(|(req, _)| {
-            let mut done: c_int = 0;
-            // SAFETY: `req` is a live request from MPI_Isend.
-            unsafe { ffi::MPI_Test(req, &mut done, ffi::RSMPI_STATUS_IGNORE) };
-            done == 0
-        });
-    }
-
-    fn flush(&mut self) {
-        while !self.pending.is_empty() {
-            self.progress();
-            std::thread::sleep(POLL);
-        }
-    }
-}
-
-/// Every message is bytes (MPI matches datatypes); numbers are native-endian u64.
-fn bytes_of(v: u64) -> [u8; 8] {
-    v.to_ne_bytes()
-}
-
-fn word(bytes: &[u8]) -> u64 {
-    bytes
-        .get(..8)
-        .and_then(|b| b.try_into().ok())
-        .map_or(0, u64::from_ne_bytes)
-}
-
 /// Ends the job if a plugin faulted or a test asked for a failure.
 fn check(scene: &Scene, injected: &Injected) {
     if let Some(m) = scene.customs.fault.message() {
@@ -480,71 +390,6 @@ fn check(scene: &Scene, injected: &Injected) {
     }
     if injected.raised.load(Ordering::Relaxed) {
         fail("injected failure (LUXON_TEST_FAIL_RANK)");
-    }
-}
-
-/// Tiles a follower has been given and not yet started; `pop` waits for one (and counts the
-/// waits: the follower then asks further ahead).
-#[derive(Default)]
-struct TileQueue {
-    state: Mutex<(VecDeque<usize>, bool)>,
-    ready: Condvar,
-    starved: AtomicUsize,
-}
-
-impl TileQueue {
-    fn push(&self, i: usize) {
-        self.state
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .0
-            .push_back(i);
-        self.ready.notify_one();
-    }
-    fn close(&self) {
-        self.state.lock().unwrap_or_else(|e| e.into_inner()).1 = true;
-        self.ready.notify_all();
-    }
-    fn pop(&self) -> Option<usize> {
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        loop {
-            if let Some(i) = s.0.pop_front() {
-                return Some(i);
-            }
-            if s.1 {
-                return None;
-            }
-            self.starved.fetch_add(1, Ordering::Relaxed);
-            s = self.ready.wait(s).unwrap_or_else(|e| e.into_inner());
-        }
-    }
-}
-
-/// A failure injected by tests on one rank: `LUXON_TEST_FAIL_RANK=k` with
-/// `LUXON_TEST_FAIL=error` (default) or `panic`, raised when rank k finishes its first unit.
-struct Injected {
-    panic: bool,
-    armed: bool,
-    raised: AtomicBool,
-}
-
-impl Injected {
-    fn from_env(rank: usize) -> Injected {
-        let armed =
-            std::env::var("LUXON_TEST_FAIL_RANK").is_ok_and(|r| r.trim() == rank.to_string());
-        Injected {
-            panic: std::env::var("LUXON_TEST_FAIL").is_ok_and(|m| m == "panic"),
-            armed,
-            raised: AtomicBool::new(false),
-        }
-    }
-    fn on_chunk(&self) {
-        if self.armed {
-            if self.panic {
-                panic!("injected panic (LUXON_TEST_FAIL_RANK)");
-            }
-            self.raised.store(true, Ordering::Relaxed);
-        }
     }
 }
 
@@ -559,50 +404,4 @@ fn cpu_set_fingerprint() -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     line.hash(&mut h);
     h.finish()
-}
-
-/// Ends the whole job: prints `message` (rank 0 prints other ranks' causes for them), then
-/// `MPI_Abort`. Callable from any thread, including a panic hook.
-pub fn fail(message: &str) -> ! {
-    let rank = RANK.load(Ordering::SeqCst);
-    if rank > 0 {
-        // Rank 0 normally prints the cause and aborts within milliseconds; if it is not
-        // listening (busy in a collective), this rank prints it and aborts itself.
-        let bytes = message.as_bytes();
-        // SAFETY: MPI is initialised with MPI_THREAD_MULTIPLE; `bytes` outlives the request
-        // because this function never returns.
-        unsafe {
-            let mut req = ffi::RSMPI_REQUEST_NULL;
-            ffi::MPI_Isend(
-                bytes.as_ptr() as *const c_void,
-                bytes.len() as c_int,
-                ffi::RSMPI_UINT8_T,
-                0,
-                TAG_ERROR,
-                ffi::RSMPI_COMM_WORLD,
-                &mut req,
-            );
-            let deadline = Instant::now() + Duration::from_secs(3);
-            let mut flag: c_int = 0;
-            while Instant::now() < deadline {
-                if flag == 0 {
-                    ffi::MPI_Test(&mut req, &mut flag, ffi::RSMPI_STATUS_IGNORE);
-                }
-                std::thread::sleep(Duration::from_millis(5));
-            }
-        }
-        eprintln!("luxon: error: rank {rank}: {message}");
-    } else {
-        eprintln!("luxon: error: {message}");
-    }
-    abort_job()
-}
-
-fn abort_job() -> ! {
-    crate::output::stream::discard_temp_files();
-    // SAFETY: plain FFI call on the world communicator.
-    unsafe {
-        ffi::MPI_Abort(ffi::RSMPI_COMM_WORLD, 1);
-    }
-    std::process::exit(1)
 }

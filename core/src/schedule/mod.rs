@@ -6,7 +6,11 @@ pub mod decompose;
 pub mod wire;
 
 #[cfg(feature = "mpi")]
+mod abort;
+#[cfg(feature = "mpi")]
 pub mod cluster;
+#[cfg(feature = "mpi")]
+mod mailbox;
 #[cfg(feature = "mpi")]
 mod mpi_io;
 

@@ -1,0 +1,107 @@
+//! Ending an MPI job on failure (feature `mpi`): an error or panic on any rank, from any
+//! thread, reaches rank 0's stderr and ends every rank (`MPI_Abort`) within seconds.
+
+use mpi::ffi;
+use std::os::raw::{c_int, c_void};
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
+use std::time::{Duration, Instant};
+
+/// Tag of the message carrying a failing rank's cause to rank 0.
+pub(super) const TAG_ERROR: i32 = 6;
+
+/// This process's rank once MPI is up (-1 before): read by [`fail`] from any thread.
+static RANK: AtomicI32 = AtomicI32::new(-1);
+
+/// Records this process's rank and makes a panic on any thread end the whole job.
+pub(super) fn on_rank(rank: usize) {
+    RANK.store(rank as i32, Ordering::SeqCst);
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        previous(info);
+        let p = info.payload();
+        let what = p
+            .downcast_ref::<&str>()
+            .copied()
+            .or_else(|| p.downcast_ref::<String>().map(String::as_str))
+            .unwrap_or("(no message)");
+        let at = info
+            .location()
+            .map(|l| format!(" at {l}"))
+            .unwrap_or_default();
+        fail(&format!("panic{at}: {what}"));
+    }));
+}
+
+/// Ends the whole job: prints `message` (rank 0 prints other ranks' causes for them), then
+/// `MPI_Abort`. Callable from any thread, including a panic hook.
+pub fn fail(message: &str) -> ! {
+    let rank = RANK.load(Ordering::SeqCst);
+    if rank > 0 {
+        // Rank 0 normally prints the cause and aborts within milliseconds; if it is not
+        // listening (busy in a collective), this rank prints it and aborts itself.
+        let bytes = message.as_bytes();
+        // SAFETY: MPI is initialised with MPI_THREAD_MULTIPLE; `bytes` outlives the request
+        // because this function never returns.
+        unsafe {
+            let mut req = ffi::RSMPI_REQUEST_NULL;
+            ffi::MPI_Isend(
+                bytes.as_ptr() as *const c_void,
+                bytes.len() as c_int,
+                ffi::RSMPI_UINT8_T,
+                0,
+                TAG_ERROR,
+                ffi::RSMPI_COMM_WORLD,
+                &mut req,
+            );
+            let deadline = Instant::now() + Duration::from_secs(3);
+            let mut flag: c_int = 0;
+            while Instant::now() < deadline {
+                if flag == 0 {
+                    ffi::MPI_Test(&mut req, &mut flag, ffi::RSMPI_STATUS_IGNORE);
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            }
+        }
+        eprintln!("luxon: error: rank {rank}: {message}");
+    } else {
+        eprintln!("luxon: error: {message}");
+    }
+    abort_job()
+}
+
+pub(super) fn abort_job() -> ! {
+    crate::output::stream::discard_temp_files();
+    // SAFETY: plain FFI call on the world communicator.
+    unsafe {
+        ffi::MPI_Abort(ffi::RSMPI_COMM_WORLD, 1);
+    }
+    std::process::exit(1)
+}
+
+/// A failure injected by tests on one rank: `LUXON_TEST_FAIL_RANK=k` with
+/// `LUXON_TEST_FAIL=error` (default) or `panic`, raised when rank k finishes its first unit.
+pub(super) struct Injected {
+    panic: bool,
+    armed: bool,
+    pub(super) raised: AtomicBool,
+}
+
+impl Injected {
+    pub(super) fn from_env(rank: usize) -> Injected {
+        let armed =
+            std::env::var("LUXON_TEST_FAIL_RANK").is_ok_and(|r| r.trim() == rank.to_string());
+        Injected {
+            panic: std::env::var("LUXON_TEST_FAIL").is_ok_and(|m| m == "panic"),
+            armed,
+            raised: AtomicBool::new(false),
+        }
+    }
+    pub(super) fn on_chunk(&self) {
+        if self.armed {
+            if self.panic {
+                panic!("injected panic (LUXON_TEST_FAIL_RANK)");
+            }
+            self.raised.store(true, Ordering::Relaxed);
+        }
+    }
+}
