@@ -154,3 +154,17 @@ fn ambient_occlusion_sees_the_open_sky_and_transparent_covers_by_opacity() {
     let glass = cover("ao-glass", "(color: (1, 1, 1), transmit: 0.5, ior: 1.0)");
     assert!(close(glass, [0.5; 3], 1e-4), "{glass:?}");
 }
+
+#[test]
+fn ambient_occlusion_scales_direct_light_like_vmd_aodirect() {
+    // Open sky (AO term = intensity) plus a point light straight above (direct = 1 before scaling).
+    let c = floor(
+        "ao-direct",
+        "Point(position: (0, 4, 0))",
+        "ambient_occlusion: (samples: 16, distance: 10, intensity: 0.25, direct: 0.5),",
+    );
+    assert!(close(c, [0.25 + 0.5; 3], 1e-5), "{c:?}");
+    // Without occlusion, `direct` does not apply: the light alone gives 1.
+    let plain = floor("ao-direct-off", "Point(position: (0, 4, 0))", "");
+    assert!(close(plain, [1.0; 3], 1e-5), "{plain:?}");
+}

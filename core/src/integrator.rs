@@ -185,13 +185,16 @@ impl Whitted<'_> {
             opacity: shade_opacity,
             time: ray.time,
         };
+        let mut lit = Vec3A::ZERO;
         for (k, light) in scene.lights.iter().enumerate() {
-            color += self.direct(&shade, mat, light, mix(seed ^ k as u32), c);
+            lit += self.direct(&shade, mat, light, mix(seed ^ k as u32), c);
         }
         if let (true, Some(ao)) = (features.ambient_occlusion, &scene.ao) {
-            color +=
+            lit *= ao.direct;
+            lit +=
                 mat.diffuse * shade_opacity * base * ao.sky * self.unoccluded(&shade, ao, seed, c);
         }
+        color += lit;
         if post {
             color *= opacity;
         }

@@ -130,6 +130,8 @@ pub struct Ao {
     pub max_distance: f32,
     /// Sky colour times intensity.
     pub sky: Vec3A,
+    /// Scale of direct light while occlusion is on.
+    pub direct: f32,
 }
 
 /// The effects a scene calls for; the integrator skips the rest.
@@ -551,6 +553,7 @@ impl Scene {
             samples: a.samples,
             max_distance: a.max_distance as f32,
             sky: v3(a.color) * a.intensity as f32,
+            direct: a.direct as f32,
         });
 
         let used_mats: Vec<&Material> = materials

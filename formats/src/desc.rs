@@ -233,7 +233,10 @@ pub struct AoDesc {
     pub samples: u32,
     pub max_distance: f64,
     pub color: [f64; 3],
+    /// Scale of the sky light (VMD's `aoambient`).
     pub intensity: f64,
+    /// Scale of every light's direct contribution while occlusion is on (VMD's `aodirect`).
+    pub direct: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -205,6 +205,10 @@ impl Checker<'_> {
                 Some(i) => self.range(field("intensity"), "intensity", i, 0.0, f64::INFINITY)?,
                 None => 1.0,
             },
+            direct: match ao.direct {
+                Some(d) => self.range(field("direct"), "direct", d, 0.0, f64::INFINITY)?,
+                None => 1.0,
+            },
         })
     }
 }

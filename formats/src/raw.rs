@@ -221,6 +221,8 @@ pub(crate) struct Ao {
     pub color: Option<Vec3>,
     #[serde(default)]
     pub intensity: Option<f64>,
+    #[serde(default)]
+    pub direct: Option<f64>,
 }
 
 /// `params` is only skipped here; its text is taken verbatim from the source.

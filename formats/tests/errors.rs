@@ -256,6 +256,14 @@ fn light_errors() {
     check(found, 3, 37, &["`direction` has zero length", "non-zero"]);
 }
 
+#[test]
+fn ambient_occlusion_errors() {
+    let found = scene_error("    ambient_occlusion: (samples: 8, direct: -0.5),");
+    check(found, 3, 45, &["`direct` is -0.5", "0 or more"]);
+    let found = scene_error("    ambient_occlusion: (samples: 0),");
+    check(found, 3, 34, &["`samples` is 0"]);
+}
+
 // ---- Materials ----
 
 #[test]

@@ -52,6 +52,7 @@ impl ShadingArgs {
                         max_distance: f64::INFINITY,
                         color: [1.0; 3],
                         intensity: 1.0,
+                        direct: 1.0,
                     })
                 }
             }
