@@ -128,3 +128,23 @@ fn camera_stereo() {
 fn camera_vr() {
     check("cameras-vr");
 }
+
+#[test]
+fn obj_mesh_groups_ngons_computed_normals() {
+    check("obj-mesh");
+}
+
+#[test]
+fn clip_groups_cutaway() {
+    check("cutaway");
+}
+
+#[test]
+fn transparency_angle_modulated_with_surface_limit() {
+    check("transparency");
+}
+
+#[test]
+fn transparency_vmd_post_multiplied() {
+    check("transparency-vmd");
+}

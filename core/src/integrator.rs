@@ -4,7 +4,7 @@
 //! `Features`) are skipped before any ray is spawned for them.
 
 use crate::geometry::Counters;
-use crate::math::{reflect, refract, Vec3A};
+use crate::math::{gamma, reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
 use crate::sampler::{mix, pixel_sample};
 use crate::scene::{Ao, Light, Material, Scene};
@@ -175,9 +175,16 @@ impl Whitted<'_> {
         // Random numbers for area lights and occlusion, from the ray itself: deterministic for
         // any thread count or decomposition, different for every path.
         let seed = ray_seed(ray);
+        // Light and occlusion rays leave smooth meshes from the curved surface, not the facet.
+        let (light_p, light_error) = if entering && s.lift != Vec3A::ZERO {
+            let q = s.p + s.lift;
+            (q, s.p_error + gamma(4) * (s.lift.abs() + q.abs()))
+        } else {
+            (s.p, s.p_error)
+        };
         let shade = Shade {
-            p: s.p,
-            p_error: s.p_error,
+            p: light_p,
+            p_error: light_error,
             n,
             ng,
             view,
@@ -258,6 +265,7 @@ impl Whitted<'_> {
 
 /// What lighting needs to know about a shading point.
 struct Shade {
+    /// Where light and occlusion rays start (the hit point, or above it on smooth meshes).
     p: Vec3A,
     p_error: Vec3A,
     /// Shading normal and geometric normal, both facing the viewer.

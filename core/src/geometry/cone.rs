@@ -166,6 +166,7 @@ impl Set<Cone> {
             uv: [u, (s / h).clamp(0.0, 1.0)],
             material: material_of(self.material[hit.index as usize]),
             color: None,
+            lift: Vec3A::ZERO,
             uv_scale: 0.0,
         }
     }

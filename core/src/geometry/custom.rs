@@ -242,6 +242,7 @@ impl Customs {
             uv: hit.uv,
             material: material_of(self.material[hit.index as usize]),
             color: None,
+            lift: Vec3A::ZERO,
             uv_scale: 0.0,
         }
     }

@@ -102,6 +102,7 @@ impl Set<Disc> {
             ],
             material: material_of(self.material[hit.index as usize]),
             color: None,
+            lift: Vec3A::ZERO,
             uv_scale: 0.0,
         }
     }

@@ -100,6 +100,10 @@ pub struct Surface {
     pub material: u32,
     /// Per-vertex colour, when the mesh has one.
     pub color: Option<Vec3A>,
+    /// From `p` to where light rays should start on the side `ng` points to: above a flat facet
+    /// of a smooth-shaded mesh, at the curved surface its vertex normals describe, so the
+    /// facets do not shadow themselves near the terminator (zero for every other shape).
+    pub lift: Vec3A,
 }
 
 /// Per-thread counters of work done (summed after the render; deterministic).

@@ -105,6 +105,7 @@ impl Planes {
             uv: [(p - pl.point).dot(t), (p - pl.point).dot(b)],
             material: material_of(pl.material),
             color: None,
+            lift: Vec3A::ZERO,
             uv_scale: 0.0,
         }
     }

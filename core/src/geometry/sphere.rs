@@ -138,6 +138,7 @@ impl Set<Sphere> {
             uv: [u, v],
             material: material_of(self.material[hit.index as usize]),
             color: None,
+            lift: Vec3A::ZERO,
             // u spans 2πr, v spans πr: their geometric mean.
             uv_scale: 1.0 / (std::f32::consts::PI * std::f32::consts::SQRT_2 * s.radius),
         }

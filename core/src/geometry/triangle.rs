@@ -267,6 +267,7 @@ impl Triangles {
             material: material_of(self.set.material[i]),
             color: None,
             uv_scale: 0.0,
+            lift: Vec3A::ZERO,
         };
         if a != NO_ATTR {
             let va = &self.attrs[a as usize];
@@ -276,7 +277,9 @@ impl Triangles {
                     + b2 * Vec3A::from(va[2].n);
                 let n = n.normalize_or_zero();
                 if n != Vec3A::ZERO {
-                    s.ns = if n.dot(ng) < 0.0 { -n } else { n };
+                    let side = if n.dot(ng) < 0.0 { -1.0 } else { 1.0 };
+                    s.ns = side * n;
+                    s.lift = terminator_lift(p, [p0, p1, p2], [b0, b1, b2], va, side);
                 }
             }
             if va[0].c.x >= 0.0 {
@@ -302,12 +305,57 @@ impl Triangles {
     }
 }
 
+/// Hanika's shadow-terminator fix ("Hacking the shadow terminator", Ray Tracing Gems II): the
+/// offset from `p` to the barycentric blend of `p` projected onto each vertex's tangent plane,
+/// for the planes `p` lies below. Zero on concave parts and on flat facets.
+fn terminator_lift(p: Vec3A, v: [Vec3A; 3], b: [f32; 3], va: &[VertexAttr; 3], side: f32) -> Vec3A {
+    let mut lift = Vec3A::ZERO;
+    for k in 0..3 {
+        let n = side * Vec3A::from(va[k].n).normalize_or_zero();
+        let below = (p - v[k]).dot(n).min(0.0);
+        lift -= b[k] * below * n;
+    }
+    lift
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
         Ray::new(Vec3A::from(o), Vec3A::from(d).normalize(), 0.0)
+    }
+
+    #[test]
+    fn terminator_lift_moves_facet_points_onto_the_smooth_sphere() {
+        // A facet of a unit sphere with the sphere's normals at its corners.
+        let v = [Vec3A::X, Vec3A::Y, Vec3A::Z];
+        let va = v.map(|p| VertexAttr {
+            n: p.into(),
+            c: Vec3::splat(-1.0),
+            uv: [0.0; 2],
+        });
+        let b = [1.0 / 3.0; 3];
+        let p = (v[0] + v[1] + v[2]) / 3.0;
+        let lifted = p + terminator_lift(p, v, b, &va, 1.0);
+        // The facet's centre is at 0.577 from the centre; lifted, it is far closer to 1.
+        assert!((p.length() - 0.577).abs() < 1e-3);
+        assert!(
+            lifted.length() > 0.95 && lifted.length() <= 1.0 + 1e-6,
+            "{lifted}"
+        );
+        // Corners do not move; normals flipped to the other side (the inside) do not lift.
+        assert_eq!(
+            terminator_lift(v[0], v, [1.0, 0.0, 0.0], &va, 1.0),
+            Vec3A::ZERO
+        );
+        assert_eq!(terminator_lift(p, v, b, &va, -1.0), Vec3A::ZERO);
+        // A flat facet (all normals equal to the facet's) does not lift either.
+        let flat = [VertexAttr {
+            n: Vec3::ONE.normalize(),
+            ..va[0]
+        }; 3];
+        assert!(terminator_lift(p, v, b, &flat, 1.0).length() < 1e-6);
     }
 
     #[test]
