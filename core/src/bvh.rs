@@ -19,13 +19,40 @@ const STACK: usize = MAX_SAH_DEPTH + 64;
 #[repr(C)]
 struct Node {
     min: [f32; 3],
-    /// Leaf: first primitive; inner: index of the second child (the first follows this node).
-    offset: u32,
     max: [f32; 3],
-    /// 0 for inner nodes.
-    count: u16,
-    axis: u8,
-    _pad: u8,
+    /// Bits 0..48: leaf: first primitive; inner: index of the second child (the first follows
+    /// this node). Bits 48..56: primitive count (0 for inner nodes). Bits 56..58: split axis.
+    /// 64-bit indices in 32 bytes: 2^48 primitives is more than any machine holds.
+    link: u64,
+}
+
+const OFFSET_BITS: u32 = 48;
+const OFFSET_MASK: u64 = (1 << OFFSET_BITS) - 1;
+
+impl Node {
+    fn new(bounds: &Aabb, offset: usize, count: usize, axis: u8) -> Node {
+        debug_assert!((offset as u64) <= OFFSET_MASK && count <= MAX_LEAF);
+        Node {
+            min: bounds.min.into(),
+            max: bounds.max.into(),
+            link: offset as u64 | (count as u64) << OFFSET_BITS | (axis as u64) << 56,
+        }
+    }
+
+    #[inline(always)]
+    fn offset(&self) -> usize {
+        (self.link & OFFSET_MASK) as usize
+    }
+
+    #[inline(always)]
+    fn count(&self) -> usize {
+        ((self.link >> OFFSET_BITS) & 0xff) as usize
+    }
+
+    #[inline(always)]
+    fn axis(&self) -> usize {
+        ((self.link >> 56) & 3) as usize
+    }
 }
 
 /// A BVH over primitives `0..n`. After building, primitive `order[i]` is the i-th in leaf order;
@@ -51,16 +78,12 @@ enum BuildNode {
 struct BuildPrim {
     bounds: Aabb,
     centroid: Vec3A,
-    index: u32,
+    index: usize,
 }
 
 impl Bvh {
     /// Builds over the given primitive bounds; returns the BVH and the leaf order.
-    pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<u32>) {
-        assert!(
-            bounds.len() < u32::MAX as usize,
-            "too many primitives for one BVH"
-        );
+    pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<usize>) {
         if bounds.is_empty() {
             return (Bvh::default(), Vec::new());
         }
@@ -70,7 +93,7 @@ impl Bvh {
             .map(|(i, b)| BuildPrim {
                 bounds: *b,
                 centroid: b.centroid(),
-                index: i as u32,
+                index: i,
             })
             .collect();
         let root = build_node(&mut prims, 0, 0);
@@ -94,7 +117,7 @@ impl Bvh {
     /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
     /// `t_max` (and records whatever it needs). Returns the final `t_max`.
     #[inline]
-    pub fn intersect<F: FnMut(u32, f32) -> Option<f32>>(
+    pub fn intersect<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
@@ -106,27 +129,28 @@ impl Bvh {
         }
         let inv = dir.recip();
         let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
-        let mut stack = [0u32; STACK];
+        let mut stack = [0usize; STACK];
         let mut sp = 0usize;
         let mut i = 0usize;
         loop {
             let node = &self.nodes[i];
             if slab(node, origin, inv, t_max) {
-                if node.count > 0 {
-                    let start = node.offset;
-                    for p in start..start + node.count as u32 {
+                let count = node.count();
+                if count > 0 {
+                    let start = node.offset();
+                    for p in start..start + count {
                         if let Some(t) = test(p, t_max) {
                             t_max = t;
                         }
                     }
                 } else {
                     // Near child first.
-                    let (first, second) = if neg[node.axis as usize] {
-                        (node.offset as usize, i + 1)
+                    let (first, second) = if neg[node.axis()] {
+                        (node.offset(), i + 1)
                     } else {
-                        (i + 1, node.offset as usize)
+                        (i + 1, node.offset())
                     };
-                    stack[sp] = second as u32;
+                    stack[sp] = second;
                     sp += 1;
                     i = first;
                     continue;
@@ -136,14 +160,14 @@ impl Bvh {
                 break;
             }
             sp -= 1;
-            i = stack[sp] as usize;
+            i = stack[sp];
         }
         t_max
     }
 
     /// Any-hit traversal: stops as soon as `test(prim)` returns true.
     #[inline]
-    pub fn any<F: FnMut(u32) -> bool>(
+    pub fn any<F: FnMut(usize) -> bool>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
@@ -154,21 +178,22 @@ impl Bvh {
             return false;
         }
         let inv = dir.recip();
-        let mut stack = [0u32; STACK];
+        let mut stack = [0usize; STACK];
         let mut sp = 0usize;
         let mut i = 0usize;
         loop {
             let node = &self.nodes[i];
             if slab(node, origin, inv, t_max) {
-                if node.count > 0 {
-                    let start = node.offset;
-                    for p in start..start + node.count as u32 {
+                let count = node.count();
+                if count > 0 {
+                    let start = node.offset();
+                    for p in start..start + count {
                         if test(p) {
                             return true;
                         }
                     }
                 } else {
-                    stack[sp] = node.offset;
+                    stack[sp] = node.offset();
                     sp += 1;
                     i += 1;
                     continue;
@@ -178,7 +203,7 @@ impl Bvh {
                 return false;
             }
             sp -= 1;
-            i = stack[sp] as usize;
+            i = stack[sp];
         }
     }
 }
@@ -342,30 +367,16 @@ fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> usize {
             bounds,
             start,
             count,
-        } => out.push(Node {
-            min: bounds.min.into(),
-            offset: *start as u32,
-            max: bounds.max.into(),
-            count: *count as u16,
-            axis: 0,
-            _pad: 0,
-        }),
+        } => out.push(Node::new(bounds, *start, *count, 0)),
         BuildNode::Inner {
             bounds,
             axis,
             children,
         } => {
-            out.push(Node {
-                min: bounds.min.into(),
-                offset: 0,
-                max: bounds.max.into(),
-                count: 0,
-                axis: *axis,
-                _pad: 0,
-            });
+            out.push(Node::new(bounds, 0, 0, *axis));
             flatten(&children.0, out);
             let second = flatten(&children.1, out);
-            out[index].offset = second as u32;
+            out[index] = Node::new(bounds, second, 0, *axis);
         }
     }
     index
@@ -391,15 +402,29 @@ mod tests {
     }
 
     #[test]
+    fn nodes_hold_64_bit_offsets_in_32_bytes() {
+        assert_eq!(std::mem::size_of::<Node>(), 32);
+        let b = Aabb::new(Vec3A::ZERO, Vec3A::ONE);
+        // Past u32: a leaf 5 * 2^32 primitives in, and an inner node's second child.
+        let leaf = Node::new(&b, 5 << 32 | 7, MAX_LEAF, 0);
+        assert_eq!((leaf.offset(), leaf.count()), (5 << 32 | 7, MAX_LEAF));
+        let inner = Node::new(&b, (1 << 47) + 3, 0, 2);
+        assert_eq!(
+            (inner.offset(), inner.count(), inner.axis()),
+            ((1 << 47) + 3, 0, 2)
+        );
+    }
+
+    #[test]
     fn every_primitive_is_in_exactly_one_leaf() {
         let b = boxes(10_000);
         let (bvh, order) = Bvh::build(&b);
         let mut seen = order.clone();
         seen.sort();
-        assert_eq!(seen, (0..10_000).collect::<Vec<u32>>());
-        let leaf_total: usize = bvh.nodes.iter().map(|n| n.count as usize).sum();
+        assert_eq!(seen, (0..10_000).collect::<Vec<usize>>());
+        let leaf_total: usize = bvh.nodes.iter().map(Node::count).sum();
         assert_eq!(leaf_total, 10_000);
-        assert!(bvh.nodes.iter().all(|n| n.count as usize <= MAX_LEAF));
+        assert!(bvh.nodes.iter().all(|n| n.count() <= MAX_LEAF));
     }
 
     #[test]
@@ -422,7 +447,7 @@ mod tests {
                 .filter_map(|bx| hit_box(bx, o, d))
                 .fold(f32::INFINITY, f32::min);
             let got = bvh.intersect(o, d, f32::INFINITY, |p, tmax| {
-                hit_box(&b[order[p as usize] as usize], o, d).filter(|&t| t < tmax)
+                hit_box(&b[order[p]], o, d).filter(|&t| t < tmax)
             });
             assert_eq!(got, brute, "ray {k}");
         }
@@ -448,6 +473,6 @@ mod tests {
     fn coincident_centroids_still_make_small_leaves() {
         let b = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 100];
         let (bvh, _) = Bvh::build(&b);
-        assert!(bvh.nodes.iter().all(|n| n.count as usize <= MAX_LEAF));
+        assert!(bvh.nodes.iter().all(|n| n.count() <= MAX_LEAF));
     }
 }

@@ -113,8 +113,8 @@ impl Customs {
             ));
         }
         let (bvh, order) = Bvh::build(&bounds);
-        self.refs = order.iter().map(|&i| self.refs[i as usize]).collect();
-        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        self.refs = order.iter().map(|&i| self.refs[i]).collect();
+        self.material = order.iter().map(|&i| self.material[i]).collect();
         self.bvh = bvh;
         Ok(())
     }
@@ -151,7 +151,7 @@ impl Customs {
         }
         *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
             c.tests += 1;
-            let (o, idx) = self.refs[i as usize];
+            let (o, idx) = self.refs[i];
             let obj = &self.objects[o as usize];
             let wr = self.world_ray(ray, tm);
             let mut h = abi::HitF64::default();
@@ -163,7 +163,7 @@ impl Customs {
                     if !(t > 0.0 && t < tm) || n == Vec3A::ZERO {
                         return None;
                     }
-                    if clips.cut(clip_of(self.material[i as usize]), ray.at(t)) {
+                    if clips.cut(clip_of(self.material[i]), ray.at(t)) {
                         return None;
                     }
                     let mut hh = Hit::new(t, Kind::Custom, i);
@@ -194,11 +194,11 @@ impl Customs {
             return false;
         }
         // Occlusion through the plugin gives no hit point: clipped primitives use intersect.
-        let clipped = |i: u32| clip_of(self.material[i as usize]) != 0;
+        let clipped = |i: usize| clip_of(self.material[i]) != 0;
         let wr = self.world_ray(ray, t_max);
         self.bvh.any(ray.origin, ray.dir, t_max, |i| {
             c.tests += 1;
-            let (o, idx) = self.refs[i as usize];
+            let (o, idx) = self.refs[i];
             let obj = &self.objects[o as usize];
             // SAFETY: valid table of a loaded plugin.
             if clipped(i) {
@@ -208,8 +208,8 @@ impl Customs {
                 // SAFETY: valid table of a loaded plugin.
                 return match unsafe { ((*obj.vtable).intersect)(obj.object, idx, &r, &mut h) } {
                     1 => {
-                        !clips.cut(clip_of(self.material[i as usize]), ray.at(h.t as f32))
-                            && on_hit(material_of(self.material[i as usize]), 1)
+                        !clips.cut(clip_of(self.material[i]), ray.at(h.t as f32))
+                            && on_hit(material_of(self.material[i]), 1)
                     }
                     abi::HIT_PANIC => {
                         self.panicked(o);
@@ -219,7 +219,7 @@ impl Customs {
                 };
             }
             match unsafe { ((*obj.vtable).occluded)(obj.object, idx, &wr) } {
-                1 => on_hit(material_of(self.material[i as usize]), 1),
+                1 => on_hit(material_of(self.material[i]), 1),
                 abi::HIT_PANIC => {
                     self.panicked(o);
                     false

@@ -63,7 +63,8 @@ impl Clips {
 pub struct Hit {
     pub t: f32,
     pub kind: Kind,
-    pub index: u32,
+    /// The primitive within its kind (64-bit: molecular scenes reach billions of atoms).
+    pub index: u64,
     pub b1: f32,
     pub b2: f32,
     pub n: Vec3A,
@@ -71,11 +72,11 @@ pub struct Hit {
 }
 
 impl Hit {
-    pub fn new(t: f32, kind: Kind, index: u32) -> Hit {
+    pub fn new(t: f32, kind: Kind, index: usize) -> Hit {
         Hit {
             t,
             kind,
-            index,
+            index: index as u64,
             b1: 0.0,
             b2: 0.0,
             n: Vec3A::ZERO,

@@ -68,7 +68,7 @@ impl Planes {
                 plane_t(p, ray, *t_max).filter(|&t| !clips.cut(clip_of(p.material), ray.at(t)))
             {
                 *t_max = t;
-                *hit = Some(Hit::new(t, Kind::Plane, i as u32));
+                *hit = Some(Hit::new(t, Kind::Plane, i));
             }
         }
     }

@@ -66,8 +66,8 @@ impl<S: Shape> Set<S> {
     pub fn build(&mut self) {
         let bounds: Vec<Aabb> = self.data.iter().map(S::bounds).collect();
         let (bvh, order) = Bvh::build(&bounds);
-        self.data = order.iter().map(|&i| self.data[i as usize]).collect();
-        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        self.data = order.iter().map(|&i| self.data[i]).collect();
+        self.material = order.iter().map(|&i| self.material[i]).collect();
         self.bvh = bvh;
     }
 
@@ -111,7 +111,7 @@ impl<S: Shape> Set<S> {
         let prep = S::prep(ray);
         *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
             c.tests += 1;
-            let (t, b1, b2) = self.kept_hit(i as usize, ray, &prep, tm, clips)?;
+            let (t, b1, b2) = self.kept_hit(i, ray, &prep, tm, clips)?;
             let mut h = Hit::new(t, S::KIND, i);
             h.b1 = b1;
             h.b2 = b2;
@@ -137,13 +137,13 @@ impl<S: Shape> Set<S> {
         let prep = S::prep(ray);
         self.bvh.any(ray.origin, ray.dir, t_max, |i| {
             c.tests += 1;
-            let packed = self.material[i as usize];
+            let packed = self.material[i];
             let n = if clip_of(packed) == 0 {
-                self.data[i as usize].crossings(ray, &prep, t_max)
+                self.data[i].crossings(ray, &prep, t_max)
             } else {
                 // Count only the crossings the clip group keeps.
                 let (mut n, mut lo) = (0, 0.0);
-                while let Some(h) = self.data[i as usize].hit_after(ray, &prep, lo, t_max) {
+                while let Some(h) = self.data[i].hit_after(ray, &prep, lo, t_max) {
                     n += u32::from(!clips.cut(clip_of(packed), ray.at(h.0)));
                     lo = h.0;
                 }
