@@ -22,7 +22,13 @@ fn same(a: &[f32], b: &[f32]) -> bool {
 
 #[test]
 fn one_and_two_threads_and_any_tile_size_agree_bitwise() {
-    for name in ["glass", "torus", "antialiasing"] {
+    for name in [
+        "glass",
+        "torus",
+        "antialiasing",
+        "phantom",
+        "volume-geometry",
+    ] {
         let one = render(name, 1, 16, Decomposition::Dynamic);
         let two = render(name, 2, 16, Decomposition::Dynamic);
         let odd_tiles = render(name, 3, 7, Decomposition::Dynamic);

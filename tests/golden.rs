@@ -148,3 +148,39 @@ fn transparency_angle_modulated_with_surface_limit() {
 fn transparency_vmd_post_multiplied() {
     check("transparency-vmd");
 }
+
+/// Scenes reading the real data sets in `../shared/volumes` (not part of the repository): skipped
+/// with a notice when that directory is absent.
+fn check_shared_volume(name: &str, file: &str) {
+    let data = root().join("../shared/volumes").join(file);
+    if !data.is_file() {
+        eprintln!("golden {name}: skipped, {} is absent", data.display());
+        return;
+    }
+    check(name);
+}
+
+#[test]
+fn volume_mri_head() {
+    check_shared_volume("mri-head", "mri-head-256x256x109-u8.raw.gz");
+}
+
+#[test]
+fn volume_ct_engine() {
+    check_shared_volume("ct-engine", "ct-engine-256x256x110-u8.raw.gz");
+}
+
+#[test]
+fn volume_phantom_clipped_and_shaded() {
+    check("phantom");
+}
+
+#[test]
+fn volume_flow_field() {
+    check("vortex");
+}
+
+#[test]
+fn volume_with_geometry_inside() {
+    check("volume-geometry");
+}

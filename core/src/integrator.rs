@@ -108,9 +108,42 @@ impl Whitted<'_> {
         c: &mut Counters,
     ) -> Vec3A {
         let scene = self.scene;
-        let Some(hit) = scene.intersect(ray, f32::INFINITY, c) else {
-            return scene.background;
+        let hit = scene.intersect(ray, f32::INFINITY, c);
+        if !scene.features.volumes {
+            return match hit {
+                Some(hit) => self.shade(ray, &hit, depth, weight, media, width, c),
+                None => scene.background,
+            };
+        }
+        // Volumes in front of the first surface (or the background), composited over it.
+        let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+        let cutoff = scene.settings.min_weight / weight.max(f32::MIN_POSITIVE);
+        let (color, through) = crate::volume_render::march(scene, ray, t_hit, cutoff, c);
+        if through < cutoff {
+            // Early ray termination: what lies behind cannot show.
+            return color;
+        }
+        let behind = match hit {
+            Some(hit) => self.shade(ray, &hit, depth, weight * through, media, width, c),
+            None => scene.background,
         };
+        color + through * behind
+    }
+
+    /// The colour a surface hit shows along `ray` (lighting, reflection, refraction).
+    #[allow(clippy::too_many_arguments)]
+    fn shade(
+        &self,
+        ray: &Ray,
+        hit: &crate::geometry::Hit,
+        depth: u32,
+        weight: f32,
+        media: &IorStack,
+        width: f32,
+        c: &mut Counters,
+    ) -> Vec3A {
+        let scene = self.scene;
+        let hit = *hit;
         let s = scene.surface(&hit, ray);
         let mat = &scene.materials[s.material as usize];
         let features = scene.features;
@@ -330,6 +363,9 @@ impl Whitted<'_> {
                         ),
                     };
                     arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                    if scene.features.volumes && arriving != Vec3A::ZERO {
+                        arriving *= crate::volume_render::transmittance(scene, &sray, t_max, c);
+                    }
                     if arriving == Vec3A::ZERO {
                         return Vec3A::ZERO;
                     }

@@ -31,6 +31,7 @@ pub mod sampler;
 pub mod scene;
 pub mod schedule;
 pub mod volume;
+pub mod volume_render;
 
 pub use error::Error;
 pub use framebuffer::Framebuffer;

@@ -145,6 +145,8 @@ pub struct Features {
     pub transmission: bool,
     pub textures: bool,
     pub antialiasing: bool,
+    /// Some volume is drawn (has `render` settings).
+    pub volumes: bool,
 }
 
 impl std::fmt::Display for Features {
@@ -158,6 +160,7 @@ impl std::fmt::Display for Features {
             (self.transmission, "refraction/transparency"),
             (self.textures, "textures"),
             (self.antialiasing, "antialiasing"),
+            (self.volumes, "volumes"),
         ] {
             if on {
                 v.push(name);
@@ -187,6 +190,8 @@ pub struct Settings {
     pub mode: luxon_formats::ParallelMode,
     pub decomposition: luxon_formats::Decomposition,
     pub io: luxon_formats::OutputIo,
+    /// Empty-space skipping in volumes.
+    pub volume_skip: bool,
 }
 
 pub struct Scene {
@@ -208,9 +213,10 @@ pub struct Scene {
     pub customs: Customs,
     /// Clip groups (render space) that objects are cut by.
     pub clips: Clips,
-    /// Volumes read by volume-reader plugins, in scene order. (Rendering them comes with the
-    /// volume-rendering work; for now they are read, checked and described.)
+    /// Volumes read by volume-reader plugins, in scene order.
     pub volumes: Vec<crate::volume::Volume>,
+    /// The volumes that are drawn (those with `render` settings), ready for ray casting.
+    pub render_volumes: Vec<crate::volume_render::RenderVolume>,
     /// World position of render space's origin (the camera): coordinates are stored relative
     /// to it in f32, so a scene far from the world origin keeps its precision.
     pub world_offset: DVec3,
@@ -340,6 +346,8 @@ impl Scene {
                 })
                 .collect(),
         };
+
+        let render_volumes = render_volumes(desc, &volumes, world_offset)?;
 
         let mut spheres = Spheres::default();
         let mut triangles = Triangles::default();
@@ -579,6 +587,7 @@ impl Scene {
                     .is_some()
             }),
             antialiasing: r.samples > 1,
+            volumes: !render_volumes.is_empty(),
         };
 
         let settings = Settings {
@@ -595,6 +604,7 @@ impl Scene {
             mode: r.parallel.mode,
             decomposition: r.parallel.decomposition,
             io: r.parallel.io,
+            volume_skip: r.volume_skip,
         };
         let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
         Ok(Scene {
@@ -618,6 +628,7 @@ impl Scene {
             customs,
             clips,
             volumes,
+            render_volumes,
             world_offset,
             settings,
             outputs: r.outputs.clone(),
@@ -713,6 +724,49 @@ impl Scene {
             + self.discs.len()
             + self.customs.len()
     }
+}
+
+/// The volumes with `render` settings, prepared for ray casting.
+fn render_volumes(
+    desc: &SceneDesc,
+    volumes: &[crate::volume::Volume],
+    world_offset: DVec3,
+) -> Result<Vec<crate::volume_render::RenderVolume>, Error> {
+    use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
+    let mut out = Vec::new();
+    for (i, (v, volume)) in desc.volumes.iter().zip(volumes).enumerate() {
+        let Some(r) = &v.value.render else {
+            continue;
+        };
+        if out.len() == MAX_RENDERED_VOLUMES {
+            return Err(Error::at(
+                &r.at,
+                format!("more than {MAX_RENDERED_VOLUMES} volumes are drawn; at most {MAX_RENDERED_VOLUMES} may have `render` settings"),
+            ));
+        }
+        let clip = match &r.value.clip {
+            Some(c) => {
+                1 + desc
+                    .clip_groups
+                    .iter()
+                    .position(|(n, _)| n == &c.value)
+                    .ok_or_else(|| Error::at(&c.at, format!("no clip group named `{}`", c.value)))?
+                    as u32
+            }
+            None => 0,
+        };
+        let rv = RenderVolume::new(
+            &r.value,
+            volume,
+            i,
+            desc.render.volume_step,
+            world_offset,
+            clip,
+        )
+        .map_err(|m| Error::at(&r.at, m))?;
+        out.push(rv);
+    }
+    Ok(out)
 }
 
 /// `textures`: the material's colour, reflect and transmit textures.

@@ -99,22 +99,62 @@ pub struct Volume {
     /// Inclusive index-space bounds of the data (`index_min <= index_max` on every axis).
     pub index_min: [i64; 3],
     pub index_max: [i64; 3],
+    /// Bricks while the volume is being read; empty once finished (see `store`).
     bricks: BrickMap<Brick>,
+    /// The finished bricks, found through `slots` (by brick coordinate) or `table`.
+    store: Vec<Brick>,
+    slots: BrickMap<u32>,
+    /// Dense slot table over the brick coordinates of the index box (`NO_BRICK`: none), for
+    /// lookups without hashing in the renderer's inner loops; empty when that box has more
+    /// than `MAX_TABLE` bricks (sparse giants are looked up by hash).
+    table: Vec<u32>,
+    table_min: [i64; 3],
+    table_dims: [usize; 3],
     /// Voxels given by the reader.
     voxels: u64,
     /// Smallest and largest value given, `None` when no voxel was.
     range: Option<(f32, f32)>,
 }
 
+const NO_BRICK: u32 = u32::MAX;
+/// The most bricks a dense slot table may have (64 MiB of slots).
+const MAX_TABLE: u64 = 1 << 24;
+
 impl Volume {
     /// The value at voxel `ijk`: the background where the reader gave nothing.
     #[inline]
     pub fn value(&self, ijk: [i64; 3]) -> f32 {
         let key = ijk.map(|c| c >> BRICK_SHIFT);
-        match self.bricks.get(&key) {
+        match self.brick(key) {
             None => self.background,
             Some(Brick::Constant(v)) => *v,
             Some(Brick::Dense(values)) => values[local_index(ijk)],
+        }
+    }
+
+    /// Moves the bricks read into their final storage and builds the slot table.
+    fn seal(&mut self) {
+        let mut all: Vec<([i64; 3], Brick)> =
+            std::mem::take(&mut self.bricks).into_iter().collect();
+        all.sort_unstable_by_key(|(k, _)| *k);
+        self.store.reserve_exact(all.len());
+        for (key, brick) in all {
+            self.slots.insert(key, self.store.len() as u32);
+            self.store.push(brick);
+        }
+        let lo = self.index_min.map(|c| c >> BRICK_SHIFT);
+        let hi = self.index_max.map(|c| c >> BRICK_SHIFT);
+        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
+        if dims.iter().product::<u64>() <= MAX_TABLE {
+            let dims = dims.map(|d| d as usize);
+            let mut table = vec![NO_BRICK; dims[0] * dims[1] * dims[2]];
+            for (key, &slot) in &self.slots {
+                let r = [0, 1, 2].map(|a| (key[a] - lo[a]) as usize);
+                table[(r[2] * dims[1] + r[1]) * dims[0] + r[0]] = slot;
+            }
+            self.table = table;
+            self.table_min = lo;
+            self.table_dims = dims;
         }
     }
 
@@ -133,12 +173,14 @@ impl Volume {
     /// the table's control bytes and the allocator's overhead are not counted).
     pub fn memory_bytes(&self) -> usize {
         let dense = self
-            .bricks
-            .values()
+            .store
+            .iter()
             .filter(|b| matches!(b, Brick::Dense(_)))
             .count();
         std::mem::size_of::<Volume>()
-            + self.bricks.capacity() * std::mem::size_of::<([i64; 3], Brick)>()
+            + self.store.capacity() * std::mem::size_of::<Brick>()
+            + self.slots.capacity() * std::mem::size_of::<([i64; 3], u32)>()
+            + self.table.capacity() * 4
             + dense * std::mem::size_of::<[f32; BRICK_VOXELS]>()
             + self.name.capacity()
             + self.grid_name.capacity()
@@ -148,22 +190,34 @@ impl Volume {
     /// Number of (dense, constant) bricks stored.
     pub fn brick_counts(&self) -> (usize, usize) {
         let dense = self
-            .bricks
-            .values()
+            .store
+            .iter()
             .filter(|b| matches!(b, Brick::Dense(_)))
             .count();
-        (dense, self.bricks.len() - dense)
+        (dense, self.store.len() - dense)
     }
 
     /// The brick with brick coordinate `key` (voxel `ijk` lies in brick `ijk >> 3`, i.e.
     /// `floor(ijk / 8)`), if any data reached it.
+    #[inline]
     pub fn brick(&self, key: [i64; 3]) -> Option<&Brick> {
-        self.bricks.get(&key)
+        if !self.table.is_empty() {
+            let d = self.table_dims;
+            let r = [0, 1, 2].map(|a| key[a].wrapping_sub(self.table_min[a]) as u64);
+            if r[0] >= d[0] as u64 || r[1] >= d[1] as u64 || r[2] >= d[2] as u64 {
+                return None;
+            }
+            let slot = self.table[(r[2] as usize * d[1] + r[1] as usize) * d[0] + r[0] as usize];
+            return (slot != NO_BRICK).then(|| &self.store[slot as usize]);
+        }
+        self.slots.get(&key).map(|&s| &self.store[s as usize])
     }
 
     /// Every stored brick with its brick coordinate, in no particular order.
     pub fn bricks(&self) -> impl Iterator<Item = ([i64; 3], &Brick)> {
-        self.bricks.iter().map(|(k, b)| (*k, b))
+        self.slots
+            .iter()
+            .map(|(k, &s)| (*k, &self.store[s as usize]))
     }
 
     /// A point in (continuous) index space mapped to world space.
@@ -343,6 +397,11 @@ impl VolumeBuilder {
             index_min,
             index_max,
             bricks: BrickMap::default(),
+            store: Vec::new(),
+            slots: BrickMap::default(),
+            table: Vec::new(),
+            table_min: [0; 3],
+            table_dims: [0; 3],
             voxels: 0,
             range: None,
         });
@@ -466,7 +525,7 @@ impl VolumeBuilder {
                 }
             }
         }
-        volume.bricks.shrink_to_fit();
+        volume.seal();
         Ok(volume)
     }
 }

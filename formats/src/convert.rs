@@ -183,8 +183,15 @@ impl Checker<'_> {
             Some(name) => Some(self.spanned(name, field("name"))),
             None => None,
         };
+        let render = match v.render {
+            Some(r) => {
+                let at = field("render");
+                Some(self.spanned(self.volume_render(r, at)?, at))
+            }
+            None => None,
+        };
         let call = self.call(plugin, node);
-        Ok(self.spanned(VolumeDescEntry { call, name }, node))
+        Ok(self.spanned(VolumeDescEntry { call, name, render }, node))
     }
 
     fn material(&self, m: raw::Material, node: &Node) -> Result<MaterialDesc> {
@@ -297,6 +304,11 @@ impl Checker<'_> {
                 }
                 None => d.transparency,
             },
+            volume_step: match r.volume_step {
+                Some(v) => self.positive(field("volume_step"), "volume_step", v)?,
+                None => d.volume_step,
+            },
+            volume_skip: r.volume_skip.unwrap_or(d.volume_skip),
         };
         Ok((render, outputs))
     }

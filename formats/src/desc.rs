@@ -316,6 +316,131 @@ pub struct VolumeDescEntry {
     /// The scene's name for the volume (unique among the scene's volumes, not empty); `None`:
     /// unnamed (the core calls it by its index).
     pub name: Option<Spanned<String>>,
+    /// How to draw it; `None`: the volume is data only (read, checked and described by
+    /// `luxon check`, not drawn).
+    pub render: Option<Spanned<VolumeRenderDesc>>,
+}
+
+/// How a volume is drawn by ray casting (emission and absorption, front to back).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeRenderDesc {
+    pub transfer: TransferDesc,
+    /// Distance between samples along a ray in world units (> 0); `None`: half the smallest
+    /// voxel edge. The render setting `volume_step` multiplies it.
+    pub step: Option<f64>,
+    pub interpolation: Interpolation,
+    /// Gradient (central differences) shading; `None`: unshaded (each sample glows with its
+    /// transfer-function colour).
+    pub shading: Option<VolumeShadingDesc>,
+    /// A clip group of the scene: the volume is cut away on the far side of its planes.
+    pub clip: Option<Spanned<String>>,
+    /// World-space box (min, max) the volume is cropped to.
+    pub bounds: Option<([f64; 3], [f64; 3])>,
+}
+
+/// Scalar to colour and opacity: piecewise-linear over `x = (s - range.0) / (range.1 -
+/// range.0)`, clamped to [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransferDesc {
+    /// The preset the points came from, if any.
+    pub preset: Option<String>,
+    /// Control points, `x` strictly increasing in [0, 1]; at least one.
+    pub points: Vec<TransferPoint>,
+    /// Scalar window mapped to x in [0, 1]; `None`: the volume's smallest to largest value.
+    pub range: Option<[f64; 2]>,
+    /// Multiplies every point's opacity (>= 0).
+    pub opacity: f64,
+}
+
+/// One control point of a transfer function.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TransferPoint {
+    /// Position in the window, in [0, 1].
+    pub x: f64,
+    /// Linear RGB colour emitted (>= 0).
+    pub color: [f64; 3],
+    /// Extinction: opacity per unit of world length (>= 0); a slab of thickness L with this
+    /// opacity lets exp(-opacity L) of the light through.
+    pub opacity: f64,
+}
+
+/// A preset's control points: (x, colour, opacity).
+pub type PresetPoints = &'static [(f64, [f64; 3], f64)];
+
+/// The transfer-function presets, by name.
+pub const TRANSFER_PRESETS: &[(&str, PresetPoints)] = &[
+    ("grayscale", &[(0.0, [0.0; 3], 0.0), (1.0, [1.0; 3], 1.0)]),
+    (
+        "ct-bone",
+        &[
+            (0.0, [0.0; 3], 0.0),
+            (0.25, [0.6, 0.25, 0.2], 0.0),
+            (0.35, [0.8, 0.45, 0.35], 0.04),
+            (0.5, [0.9, 0.8, 0.65], 0.15),
+            (0.7, [1.0, 0.97, 0.9], 1.0),
+            (1.0, [1.0, 1.0, 1.0], 1.0),
+        ],
+    ),
+    (
+        "mri",
+        &[
+            (0.0, [0.0; 3], 0.0),
+            (0.12, [0.0; 3], 0.0),
+            (0.2, [0.85, 0.55, 0.45], 0.06),
+            (0.35, [0.9, 0.75, 0.65], 0.1),
+            (0.5, [0.95, 0.9, 0.85], 0.6),
+            (1.0, [1.0, 1.0, 1.0], 1.0),
+        ],
+    ),
+    (
+        "hot",
+        &[
+            (0.0, [0.0; 3], 0.0),
+            (0.35, [0.8, 0.05, 0.0], 0.35),
+            (0.7, [1.0, 0.75, 0.0], 0.7),
+            (1.0, [1.0, 1.0, 1.0], 1.0),
+        ],
+    ),
+    (
+        "cool-warm",
+        &[
+            (0.0, [0.23, 0.3, 0.75], 0.0),
+            (0.5, [0.86, 0.86, 0.86], 0.5),
+            (1.0, [0.71, 0.02, 0.15], 1.0),
+        ],
+    ),
+];
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interpolation {
+    /// The nearest voxel's value (blocky, faster).
+    Nearest,
+    /// Trilinear between the 8 surrounding voxel centres.
+    Trilinear,
+}
+
+/// Gradient shading of volume samples: the normal is the negated, normalised gradient of the
+/// interpolated field (central differences); lighting is two-sided.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeShadingDesc {
+    pub ambient: f64,
+    pub diffuse: f64,
+    pub specular: f64,
+    pub shininess: f64,
+    /// Shadow rays from each visible sample toward each light, through volumes and geometry.
+    pub shadows: bool,
+}
+
+impl Default for VolumeShadingDesc {
+    fn default() -> Self {
+        VolumeShadingDesc {
+            ambient: 0.3,
+            diffuse: 0.7,
+            specular: 0.2,
+            shininess: 20.0,
+            shadows: false,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -347,6 +472,10 @@ pub struct RenderDesc {
     /// Shutter time of the frame (rays carry it).
     pub time: f64,
     pub transparency: TransparencyDesc,
+    /// Multiplies every volume's step (> 0): 2 samples half as often.
+    pub volume_step: f64,
+    /// Skip bricks the transfer function makes fully transparent (same image, faster).
+    pub volume_skip: bool,
 }
 
 /// How transparent surfaces combine with what is behind them.
@@ -393,6 +522,8 @@ impl Default for RenderDesc {
             frame: 0,
             time: 0.0,
             transparency: TransparencyDesc::default(),
+            volume_step: 1.0,
+            volume_skip: true,
         }
     }
 }

@@ -19,6 +19,7 @@ mod scanner;
 mod spans;
 pub mod spd;
 mod validate;
+mod volume_render;
 
 use std::path::Path;
 

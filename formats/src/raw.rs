@@ -296,6 +296,74 @@ pub(crate) struct Volume {
     pub _params: IgnoredAny,
     #[serde(default)]
     pub name: Option<String>,
+    #[serde(default)]
+    pub render: Option<VolumeRender>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "VolumeRender", deny_unknown_fields)]
+pub(crate) struct VolumeRender {
+    pub transfer: Transfer,
+    #[serde(default)]
+    pub step: Option<f64>,
+    #[serde(default)]
+    pub interpolation: Option<Interpolation>,
+    #[serde(default)]
+    pub shading: Option<VolumeShading>,
+    #[serde(default)]
+    pub clip: Option<String>,
+    #[serde(default)]
+    pub bounds: Option<Bounds>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Transfer", deny_unknown_fields)]
+pub(crate) struct Transfer {
+    #[serde(default)]
+    pub preset: Option<String>,
+    #[serde(default)]
+    pub points: Option<Vec<TransferPoint>>,
+    #[serde(default)]
+    pub range: Option<[f64; 2]>,
+    #[serde(default)]
+    pub opacity: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "TransferPoint", deny_unknown_fields)]
+pub(crate) struct TransferPoint {
+    pub x: f64,
+    pub color: Vec3,
+    pub opacity: f64,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "Interpolation")]
+pub(crate) enum Interpolation {
+    Nearest,
+    Trilinear,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "VolumeShading", deny_unknown_fields)]
+pub(crate) struct VolumeShading {
+    #[serde(default)]
+    pub ambient: Option<f64>,
+    #[serde(default)]
+    pub diffuse: Option<f64>,
+    #[serde(default)]
+    pub specular: Option<f64>,
+    #[serde(default)]
+    pub shininess: Option<f64>,
+    #[serde(default)]
+    pub shadows: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Bounds", deny_unknown_fields)]
+pub(crate) struct Bounds {
+    pub min: Vec3,
+    pub max: Vec3,
 }
 
 #[derive(Deserialize)]
@@ -312,6 +380,8 @@ pub(crate) struct Render {
     pub outputs: Vec<Output>,
     pub parallel: Option<Parallel>,
     pub transparency: Option<Transparency>,
+    pub volume_step: Option<f64>,
+    pub volume_skip: Option<bool>,
 }
 
 #[derive(Deserialize)]

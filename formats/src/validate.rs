@@ -183,6 +183,19 @@ pub(crate) fn references(scene: &SceneDesc) -> Result<(), SceneError> {
             }
         }
     }
+    for volume in &scene.volumes {
+        let clip = volume
+            .value
+            .render
+            .as_ref()
+            .and_then(|r| r.value.clip.as_ref());
+        if let Some(clip) = clip {
+            if !groups.contains(&clip.value.as_str()) {
+                let message = unknown_name("clip group", &clip.value, "", groups.iter().copied());
+                return Err(SceneError::at(clip.at.clone(), message));
+            }
+        }
+    }
     let names: Vec<&Spanned<String>> = scene
         .volumes
         .iter()

@@ -111,7 +111,7 @@ fn unknown_field_in_a_volume() {
             "`params`",
         ],
     );
-    // Rendering fields belong to a later version: not accepted yet.
+    // Render settings belong under `render:`, not on the volume itself.
     let found = error_of(&scene_with(
         "    volumes: [(plugin: \"raw\", transfer: (0, 1))],",
     ));
@@ -226,4 +226,186 @@ fn volumes_merge_across_includes_in_order() {
     assert_eq!(*at.file, dir.0.join("main2.ron"));
     assert_eq!((at.line, at.col), (4, 37));
     assert!(e.to_string().contains("already used at"), "{e}");
+}
+
+#[test]
+fn render_settings_parse_with_defaults() {
+    let scene = load(&scene_with(
+        r#"    clip_groups: { "cut": [(point: (0, 0, 0), normal: (0, 0, 1))] },
+    volumes: [
+        (plugin: "raw", name: "a", render: (transfer: (preset: "ct-bone"))),
+        (plugin: "raw", name: "b", render: (
+            transfer: (points: [(x: 0, color: (0, 0, 0), opacity: 0), (x: 1, color: (1, 0.5, 0), opacity: 3)],
+                       range: (10, 200), opacity: 2),
+            step: 0.25, interpolation: Nearest, clip: "cut",
+            shading: (specular: 0.5, shadows: true),
+            bounds: (min: (-1, -1, -1), max: (1, 1, 0)),
+        )),
+        (plugin: "raw", name: "data"),
+    ],
+    render: (volume_step: 2, volume_skip: false),"#,
+    ));
+    let a = scene.volumes[0].value.render.as_ref().unwrap();
+    assert_eq!(at(&a.at), (5, 44));
+    let a = &a.value;
+    assert_eq!(a.transfer.preset.as_deref(), Some("ct-bone"));
+    assert!(a.transfer.points.len() >= 2);
+    assert_eq!(a.transfer.range, None);
+    assert_eq!(a.transfer.opacity, 1.0);
+    assert_eq!(a.step, None);
+    assert_eq!(a.interpolation, Interpolation::Trilinear);
+    assert_eq!(a.shading, None);
+    assert_eq!(a.clip, None);
+    let b = &scene.volumes[1].value.render.as_ref().unwrap().value;
+    assert_eq!(b.transfer.preset, None);
+    assert_eq!(
+        b.transfer.points[1],
+        TransferPoint {
+            x: 1.0,
+            color: [1.0, 0.5, 0.0],
+            opacity: 3.0
+        }
+    );
+    assert_eq!(b.transfer.range, Some([10.0, 200.0]));
+    assert_eq!(b.transfer.opacity, 2.0);
+    assert_eq!(b.step, Some(0.25));
+    assert_eq!(b.interpolation, Interpolation::Nearest);
+    assert_eq!(b.clip.as_ref().unwrap().value, "cut");
+    let sh = b.shading.unwrap();
+    assert_eq!((sh.specular, sh.ambient, sh.shadows), (0.5, 0.3, true));
+    assert_eq!(b.bounds, Some(([-1.0; 3], [1.0, 1.0, 0.0])));
+    // No `render`: data only.
+    assert_eq!(scene.volumes[2].value.render, None);
+    assert_eq!(scene.render.volume_step, 2.0);
+    assert!(!scene.render.volume_skip);
+    let plain = load("(camera: (position: (0, 0, -1), look_at: (0, 0, 0)))");
+    assert_eq!(
+        (plain.render.volume_step, plain.render.volume_skip),
+        (1.0, true)
+    );
+}
+
+#[test]
+fn every_preset_is_well_formed() {
+    for (name, points) in TRANSFER_PRESETS {
+        assert!(!points.is_empty(), "{name}");
+        assert!(
+            points.windows(2).all(|w| w[0].0 < w[1].0),
+            "{name}: x increasing"
+        );
+        assert!(
+            points
+                .iter()
+                .all(|p| (0.0..=1.0).contains(&p.0) && p.2 >= 0.0),
+            "{name}"
+        );
+        let scene = load(&scene_with(&format!(
+            "    volumes: [(plugin: \"raw\", render: (transfer: (preset: \"{name}\")))],"
+        )));
+        let t = &scene.volumes[0]
+            .value
+            .render
+            .as_ref()
+            .unwrap()
+            .value
+            .transfer;
+        assert_eq!(t.points.len(), points.len());
+    }
+}
+
+#[test]
+fn render_setting_errors() {
+    let v = |render: &str| {
+        scene_with(&format!(
+            "    volumes: [(plugin: \"raw\", render: {render})],"
+        ))
+    };
+    // Column of `render:`'s value is 40.
+    let found = error_of(&v(r#"(transfer: (preset: "ct-bones"))"#));
+    check(
+        found,
+        3,
+        59,
+        &[
+            "unknown transfer-function preset `ct-bones`",
+            "did you mean `ct-bone`?",
+            "`grayscale`",
+        ],
+    );
+    let found = error_of(&v(r#"(transfer: (presets: "mri"))"#));
+    check(
+        found,
+        3,
+        51,
+        &["unknown field `presets`", "did you mean `preset`?"],
+    );
+    let found = error_of(&v(r#"(transfer: ())"#));
+    check(found, 3, 50, &["neither `preset` nor `points`", "mri"]);
+    let found = error_of(&v(
+        r#"(transfer: (preset: "mri", points: [(x: 0, color: (0, 0, 0), opacity: 1)]))"#,
+    ));
+    check(found, 3, 74, &["both `preset` and `points`"]);
+    let found = error_of(&v(r#"(transfer: (points: []))"#));
+    check(found, 3, 59, &["no points"]);
+    let found = error_of(&v(
+        r#"(transfer: (points: [(x: 0.5, color: (0, 0, 0), opacity: 1), (x: 0.5, color: (1, 1, 1), opacity: 1)]))"#,
+    ));
+    check(
+        found,
+        3,
+        104,
+        &[
+            "`x` 0.5 does not follow the previous one (0.5)",
+            "increasing",
+        ],
+    );
+    let found = error_of(&v(
+        r#"(transfer: (points: [(x: 1.5, color: (0, 0, 0), opacity: 1)]))"#,
+    ));
+    check(found, 3, 64, &["`x` is 1.5", "from 0 to 1"]);
+    let found = error_of(&v(
+        r#"(transfer: (points: [(x: 0, color: (0, -1, 0), opacity: 1)]))"#,
+    ));
+    check(found, 3, 78, &["negative component -1"]);
+    let found = error_of(&v(
+        r#"(transfer: (points: [(x: 0, color: (0, 0, 0), opacity: -2)]))"#,
+    ));
+    check(found, 3, 94, &["`opacity` is -2", "0 or more"]);
+    let found = error_of(&v(r#"(transfer: (preset: "mri", range: (5, 5)))"#));
+    check(found, 3, 77, &["`range` (5, 5) is empty", "low < high"]);
+    let found = error_of(&v(r#"(transfer: (preset: "mri"), step: 0)"#));
+    check(found, 3, 73, &["`step` is 0", "greater than 0"]);
+    let found = error_of(&v(r#"(transfer: (preset: "mri"), interpolation: Cubic)"#));
+    check(
+        found,
+        3,
+        82,
+        &["unknown variant `Cubic`", "`Nearest`", "`Trilinear`"],
+    );
+    let found = error_of(&v(
+        r#"(transfer: (preset: "mri"), shading: (shininess: 0))"#,
+    ));
+    check(found, 3, 88, &["`shininess` is 0"]);
+    let found = error_of(&v(
+        r#"(transfer: (preset: "mri"), bounds: (min: (0, 0, 0), max: (1, 0, 1)))"#,
+    ));
+    check(found, 3, 101, &["crop box is empty", "axis 1"]);
+    let found = error_of(&v(r#"(transfer: (preset: "mri"), clip: "cutt")"#));
+    check(
+        found,
+        3,
+        73,
+        &["unknown clip group `cutt`", "none are defined"],
+    );
+    let found = error_of(&scene_with(
+        "    clip_groups: { \"cut\": [(point: (0, 0, 0), normal: (0, 0, 1))] },\n    volumes: [(plugin: \"raw\", render: (transfer: (preset: \"mri\"), clip: \"cutt\"))],",
+    ));
+    check(
+        found,
+        4,
+        73,
+        &["unknown clip group `cutt`", "did you mean `cut`?"],
+    );
+    let found = error_of(&scene_with("    render: (volume_step: -1),"));
+    check(found, 3, 27, &["`volume_step` is -1", "greater than 0"]);
 }

@@ -65,6 +65,29 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
             v.memory_bytes() as f64 / (1024.0 * 1024.0)
         );
     }
+    for (i, v) in desc.volumes.iter().enumerate() {
+        let Some(r) = &v.value.render else {
+            println!(
+                "           `{}`: data only (no `render` settings)",
+                scene.volumes[i].name
+            );
+            continue;
+        };
+        let rv = scene.render_volumes.iter().find(|rv| rv.volume == i);
+        let r = &r.value;
+        println!(
+            "           `{}`: drawn, transfer {}, step {}, {:?}, {}",
+            scene.volumes[i].name,
+            r.transfer.preset.as_deref().unwrap_or("points"),
+            rv.map_or(0.0, |rv| rv.step),
+            r.interpolation,
+            if r.shading.is_some() {
+                "shaded"
+            } else {
+                "unshaded"
+            }
+        );
+    }
     println!("lights     {}", scene.lights.len());
     println!("materials  {}", scene.material_names.join(", "));
     println!(

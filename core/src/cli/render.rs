@@ -330,6 +330,9 @@ fn print_stats(
     eprintln!("    refraction     {}", c.refraction);
     eprintln!("    occlusion      {}", c.occlusion);
     eprintln!("  intersection tests {}", c.tests);
+    if scene.features.volumes {
+        eprintln!("  volume samples   {}", c.volume_samples);
+    }
     eprintln!("  NaN pixels       {}", c.nan_pixels);
     eprintln!(
         "  load + plugins   {:.3} s (plugins {:.3} s)",

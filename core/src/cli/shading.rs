@@ -1,4 +1,5 @@
-//! Tachyon's shading switches for any scene: `--shade`, `--max-depth`, `--no-shadows`, `--ao`.
+//! Tachyon's shading switches for any scene: `--shade`, `--max-depth`, `--no-shadows`, `--ao`;
+//! and the volume sampling switches `--volume-step`, `--volume-skip`.
 
 use luxon::Error;
 use luxon_formats::{AoDesc, LightDesc, SceneDesc};
@@ -18,6 +19,13 @@ pub struct ShadingArgs {
     /// Ambient occlusion with SAMPLES rays per shading point, for a scene that has none.
     #[arg(long, value_name = "SAMPLES")]
     pub ao: Option<u32>,
+    /// Multiplies every volume's sampling step (render setting `volume_step`): 2 takes half the
+    /// samples, 0.5 twice as many.
+    #[arg(long = "volume-step", value_name = "FACTOR")]
+    pub volume_step: Option<f64>,
+    /// Empty-space skipping in volumes (render setting `volume_skip`; the image is the same).
+    #[arg(long = "volume-skip", value_parser = ["on", "off"])]
+    pub volume_skip: Option<String>,
 }
 
 fn no_shadows(desc: &mut SceneDesc) {
@@ -56,6 +64,17 @@ impl ShadingArgs {
                     })
                 }
             }
+        }
+        if let Some(f) = self.volume_step {
+            if !(f > 0.0 && f.is_finite()) {
+                return Err(Error::Usage(format!(
+                    "--volume-step {f}: expected a factor greater than 0"
+                )));
+            }
+            desc.render.volume_step = f;
+        }
+        if let Some(s) = &self.volume_skip {
+            desc.render.volume_skip = s == "on";
         }
         if self.no_shadows {
             no_shadows(desc);

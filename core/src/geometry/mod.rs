@@ -120,6 +120,8 @@ pub struct Counters {
     pub tests: u64,
     /// Pixels whose value was NaN or infinite (clamped to 0).
     pub nan_pixels: u64,
+    /// Volume samples taken (one per volume per step, camera and shadow rays alike).
+    pub volume_samples: u64,
 }
 
 impl Counters {
@@ -131,6 +133,7 @@ impl Counters {
         self.occlusion += o.occlusion;
         self.tests += o.tests;
         self.nan_pixels += o.nan_pixels;
+        self.volume_samples += o.volume_samples;
     }
 
     pub fn rays(&self) -> u64 {

@@ -64,7 +64,7 @@ pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
     r.0.is_empty().then_some(Chunk { spans, rgba })
 }
 
-/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan busy]*`
+/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan volume_samples busy]*`
 pub fn encode_stats(s: &RankStats) -> Vec<u8> {
     let mut b = Vec::new();
     put64(&mut b, s.rank as u64);
@@ -82,6 +82,7 @@ pub fn encode_stats(s: &RankStats) -> Vec<u8> {
             c.occlusion,
             c.tests,
             c.nan_pixels,
+            c.volume_samples,
             w.busy.as_nanos() as u64,
         ] {
             put64(&mut b, v);
@@ -108,6 +109,7 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
                 occlusion: r.u64()?,
                 tests: r.u64()?,
                 nan_pixels: r.u64()?,
+                volume_samples: r.u64()?,
             },
             busy: Duration::from_nanos(r.u64()?),
         });
@@ -159,6 +161,7 @@ mod tests {
                     occlusion: 2,
                     tests: 4,
                     nan_pixels: 1,
+                    volume_samples: 3,
                 },
                 busy: Duration::from_micros(99),
             }],

@@ -24,12 +24,24 @@
 //! `(0, 0, 0)` to `dims - 1`; scale by `spacing`, then translate by `origin`). The background,
 //! outside the array, is 0. The grid is named after the file.
 //!
-//! Compressed files are not read: decompress a `.raw.gz` first, e.g. `gzip -dk head.raw.gz`
-//! (a gzip file given as `file` is recognised and the error says so).
+//! gzip-compressed files (such as `mri-head-256x256x109-u8.raw.gz`) are read transparently,
+//! recognised by their magic bytes whatever their name; `header` and the size check apply to
+//! the decompressed bytes. A compressed file is decompressed into memory first (once its
+//! decompressed size is known to be right), so it briefly costs its raw size in memory.
 //!
-//! The file is streamed: slabs of at most 8 z-slices (and, for very wide slices, parts of
-//! them) are read, converted and handed to the host one at a time, so only about 1 Mi voxels
-//! are ever held besides the host's copy.
+//! An uncompressed file is streamed: slabs of at most 8 z-slices (and, for very wide slices,
+//! parts of them) are read, converted and handed to the host one at a time, so only about
+//! 1 Mi voxels are ever held besides the host's copy.
+//!
+//! ## Procedural volumes
+//!
+//! Two more readers compute their grid instead of reading a file; both fill the cube [-1, 1]³
+//! with `size`³ voxels (parameter `size`, default 64, 2 to 512):
+//!
+//! | name      | field |
+//! |-----------|-------|
+//! | `phantom` | a 3-D CT head phantom after Shepp and Logan: added ellipsoid densities (skull 1, brain 0.2, ventricles 0, small features 0.3) |
+//! | `vortex`  | vorticity magnitude of two coaxial vortex rings with rippled Gaussian cores, at most 1 |
 //!
 //! ## Scene
 //!
@@ -54,7 +66,7 @@ use luxon_plugin::{
 };
 use serde::{Deserialize, Deserializer};
 use std::fs::File;
-use std::io::{Read, Seek, SeekFrom};
+use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::path::Path;
 
 /// The most voxels read and converted at once (one dense block handed to the host).
@@ -161,9 +173,9 @@ pub struct Raw;
 impl Describe for Raw {
     const NAME: &'static str = "raw";
     const DESCRIPTION: &'static str =
-        "A raw array of u8, u16 or f32 voxels, x fastest (uncompressed: gunzip .raw.gz first).";
+        "A raw array of u8, u16 or f32 voxels, x fastest; gzip-compressed files are read too.";
     const PARAMS: &'static str = "\
-file: string = required  the raw file, relative to the scene file (not compressed)
+file: string = required  the raw file (or gzip of it), relative to the scene file
 dims: (x, y, z) = required  voxels along each axis, each >= 1
 format: \"u8\" | \"u16\" | \"f32\" = \"u8\"  type of one voxel
 endian: \"little\" | \"big\" = \"little\"  byte order of u16 and f32 voxels
@@ -284,9 +296,7 @@ fn open_error(path: &Path, e: std::io::Error) -> Error {
         gz.push(".gz");
         let hint = if Path::new(&gz).is_file() {
             format!(
-                "; `{}` does: decompress it first (e.g. `gzip -dk {}`), this reader reads \
-                 uncompressed files only",
-                Path::new(&gz).display(),
+                "; `{}` does: name that file (compressed files are read as they are)",
                 Path::new(&gz).display()
             )
         } else {
@@ -329,25 +339,26 @@ impl VolumeReader for Raw {
                 path.display()
             )));
         }
-        let actual = meta.len();
-        if actual != expected {
-            let mut message = format!(
-                "`{}`: expected {expected} bytes for {} {} voxels plus a {}-byte header, the \
-                 file has {actual}",
-                path.display(),
-                dims_text(layout.dims),
-                layout.format.name(),
-                layout.header
-            );
-            let mut magic = [0u8; 2];
-            if file.read_exact(&mut magic).is_ok() && magic == [0x1f, 0x8b] {
-                message.push_str(
-                    "; it is gzip-compressed: decompress it first (e.g. `gzip -dk`), this \
-                     reader reads uncompressed files only",
-                );
+        let mut magic = [0u8; 2];
+        let gzip = file.read_exact(&mut magic).is_ok() && magic == [0x1f, 0x8b];
+        file.seek(SeekFrom::Start(0))
+            .map_err(|e| invalid(format!("cannot read `{}`: {e}", path.display())))?;
+        let unzipped = if gzip {
+            Some(gunzip(&mut file, &path, &layout, expected)?)
+        } else {
+            let actual = meta.len();
+            if actual != expected {
+                return Err(invalid(format!(
+                    "`{}`: expected {expected} bytes for {} {} voxels plus a {}-byte header, the \
+                     file has {actual}",
+                    path.display(),
+                    dims_text(layout.dims),
+                    layout.format.name(),
+                    layout.header
+                )));
             }
-            return Err(invalid(message));
-        }
+            None
+        };
 
         let d = layout.dims;
         let name = path
@@ -365,13 +376,47 @@ impl VolumeReader for Raw {
             index_max: d.map(|n| (n - 1) as i64),
             name,
         })?;
-        stream(&mut file, &path, &layout, out, BLOCK_VOXELS)
+        match unzipped {
+            Some(bytes) => stream(&mut Cursor::new(bytes), &path, &layout, out, BLOCK_VOXELS),
+            None => stream(&mut file, &path, &layout, out, BLOCK_VOXELS),
+        }
     }
 }
 
+/// The decompressed bytes of a gzip file, which must be exactly `expected` long.
+fn gunzip(file: &mut File, path: &Path, layout: &Layout, expected: u64) -> Result<Vec<u8>, Error> {
+    let mut bytes = Vec::new();
+    // One byte more than expected is enough to tell that the file is too long.
+    flate2::read::MultiGzDecoder::new(std::io::BufReader::new(file))
+        .take(expected.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|e| {
+            invalid(format!(
+                "`{}` is gzip-compressed but cannot be decompressed: {e}",
+                path.display()
+            ))
+        })?;
+    if bytes.len() as u64 != expected {
+        let actual = if bytes.len() as u64 > expected {
+            "more".to_string()
+        } else {
+            bytes.len().to_string()
+        };
+        return Err(invalid(format!(
+            "`{}` (gzip-compressed): expected {expected} decompressed bytes for {} {} voxels \
+             plus a {}-byte header, it decompresses to {actual}",
+            path.display(),
+            dims_text(layout.dims),
+            layout.format.name(),
+            layout.header
+        )));
+    }
+    Ok(bytes)
+}
+
 /// Reads the voxels block by block and hands each to the host.
-fn stream(
-    file: &mut File,
+fn stream<R: Read + Seek>(
+    file: &mut R,
     path: &Path,
     layout: &Layout,
     out: &mut VolumeOut,
@@ -434,7 +479,10 @@ fn stream(
     Ok(())
 }
 
-export!(library: "luxon-volume-raw", volume_readers: [Raw]);
+mod procedural;
+pub use procedural::{Phantom, Vortex};
+
+export!(library: "luxon-volume-raw", volume_readers: [Raw, Phantom, Vortex]);
 
 #[cfg(test)]
 mod tests {
@@ -684,13 +732,49 @@ mod tests {
             e.contains("expected 1002 bytes for 10x10x5 u16 voxels plus a 2-byte header, the file has 1000"),
             "{e}"
         );
-        // A gzip file is recognised.
+        // A broken gzip file is recognised and named as such.
         let file = write(&dir, "head.raw.gz", &[0x1f, 0x8b, 8, 0, 0, 0]);
         let e = read(&format!(r#"(file: "{file}", dims: (2, 2, 2))"#)).unwrap_err();
         assert!(
-            e.contains("gzip-compressed") && e.contains("decompress"),
+            e.contains("gzip-compressed") && e.contains("cannot be decompressed"),
             "{e}"
         );
+    }
+
+    fn gzip(bytes: &[u8]) -> Vec<u8> {
+        use std::io::Write;
+        let mut z = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        z.write_all(bytes).unwrap();
+        z.finish().unwrap()
+    }
+
+    #[test]
+    fn gzip_files_are_read_transparently_and_size_checked() {
+        let dir = temp_dir("gzip");
+        let bytes: Vec<u8> = (0..4 * 3 * 2).map(|i| i as u8 * 10).collect();
+        let file = write(&dir, "small.raw.gz", &gzip(&bytes));
+        let got = read(&format!(
+            r#"(file: "{file}", dims: (4, 3, 2), normalize: false)"#
+        ))
+        .unwrap();
+        let want: Vec<f32> = bytes.iter().map(|&b| f32::from(b)).collect();
+        assert_eq!(got.values, want);
+        // With a header, and under a name without `.gz`.
+        let mut with_header = vec![9u8; 3];
+        with_header.extend(&bytes);
+        let file = write(&dir, "plain-name.raw", &gzip(&with_header));
+        let got = read(&format!(
+            r#"(file: "{file}", dims: (4, 3, 2), header: 3, normalize: false)"#
+        ))
+        .unwrap();
+        assert_eq!(got.values, want);
+        let e = read(&format!(r#"(file: "{file}", dims: (4, 3, 3))"#)).unwrap_err();
+        assert!(
+            e.contains("expected 36 decompressed bytes") && e.contains("decompresses to 27"),
+            "{e}"
+        );
+        let e = read(&format!(r#"(file: "{file}", dims: (2, 3, 2))"#)).unwrap_err();
+        assert!(e.contains("decompresses to more"), "{e}");
     }
 
     #[test]
@@ -704,7 +788,7 @@ mod tests {
         );
         write(&dir, "nope.raw.gz", &[0x1f, 0x8b]);
         let e = read(&format!(r#"(file: "{}", dims: (1, 1, 1))"#, path.display())).unwrap_err();
-        assert!(e.contains("nope.raw.gz` does: decompress it first"), "{e}");
+        assert!(e.contains("nope.raw.gz` does: name that file"), "{e}");
         // Relative paths resolve against the scene directory (`.` without a call context).
         let e = read(r#"(file: "rel/x.raw", dims: (1, 1, 1))"#).unwrap_err();
         assert!(e.contains("`./rel/x.raw` does not exist"), "{e}");

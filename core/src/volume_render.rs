@@ -1,0 +1,740 @@
+//! Volume ray casting (Stone 1998, ch. IV; Levoy 1988): along a ray, samples every `step` world
+//! units are classified by a transfer function into a colour and an extinction (opacity per
+//! unit length) and composited front to back, each sample covering its segment of the ray:
+//! `alpha = 1 - exp(-sigma * dt)`, `C += T * alpha * colour`, `T *= 1 - alpha`. Marching stops at
+//! the first surface (Sobierajski and Kaufman's volumetric ray tracing: the surface is shaded
+//! and composited behind what the volume let through) and early when `T` falls below the ray's
+//! cut-off. Overlapping volumes are sampled at the same points: extinctions add and colours mix
+//! in proportion to them.
+//!
+//! Empty-space skipping: for each 8³ cell of index space the largest extinction the transfer
+//! function gives over the values any sample in the cell can interpolate (the cell's brick and
+//! the next one on each axis, a conservative bound) is precomputed; a sample in a cell whose
+//! bound is 0 jumps to the first sample past the cell. Skipped samples would have added exactly
+//! nothing, so images are bitwise identical with skipping on or off.
+
+use crate::geometry::{Clips, Counters};
+use crate::math::{DVec3, Vec3A};
+use crate::ray::Ray;
+use crate::scene::{Light, Scene};
+use crate::volume::{Brick, Volume, BRICK_SIZE};
+use luxon_formats::{Interpolation, VolumeRenderDesc};
+
+/// The most rendered volumes a scene may have (a ray keeps them on the stack).
+pub const MAX_RENDERED_VOLUMES: usize = 16;
+
+/// A piecewise-linear transfer function over the window `[lo, lo + 1 / inv)`.
+#[derive(Clone, Debug)]
+pub struct Transfer {
+    xs: Vec<f32>,
+    /// Colour (linear RGB) and extinction at each point.
+    rgba: Vec<[f32; 4]>,
+    lo: f32,
+    inv: f32,
+}
+
+impl Transfer {
+    /// `points`: (x in [0, 1], increasing; colour; extinction); the window maps `range` to
+    /// [0, 1].
+    pub fn new(points: &[(f32, [f32; 3], f32)], range: (f32, f32)) -> Transfer {
+        let width = range.1 - range.0;
+        Transfer {
+            xs: points.iter().map(|p| p.0).collect(),
+            rgba: points
+                .iter()
+                .map(|p| [p.1[0], p.1[1], p.1[2], p.2])
+                .collect(),
+            lo: range.0,
+            inv: if width > 0.0 { 1.0 / width } else { 0.0 },
+        }
+    }
+
+    #[inline]
+    fn x_of(&self, s: f32) -> f32 {
+        ((s - self.lo) * self.inv).clamp(0.0, 1.0)
+    }
+
+    /// Colour and extinction at window position `x` (constant beyond the end points).
+    #[inline]
+    fn at_x(&self, x: f32) -> [f32; 4] {
+        let n = self.xs.len();
+        if x <= self.xs[0] {
+            return self.rgba[0];
+        }
+        for i in 1..n {
+            if x <= self.xs[i] {
+                let (x0, x1) = (self.xs[i - 1], self.xs[i]);
+                let f = (x - x0) / (x1 - x0);
+                let (a, b) = (self.rgba[i - 1], self.rgba[i]);
+                return [0, 1, 2, 3].map(|k| a[k] + (b[k] - a[k]) * f);
+            }
+        }
+        self.rgba[n - 1]
+    }
+
+    /// Colour and extinction of scalar `s`.
+    #[inline]
+    pub fn eval(&self, s: f32) -> [f32; 4] {
+        self.at_x(self.x_of(s))
+    }
+
+    /// The largest extinction over scalars in `[s0, s1]` (exact: a piecewise-linear function
+    /// peaks at an end or a control point).
+    pub fn max_extinction(&self, s0: f32, s1: f32) -> f32 {
+        let (x0, x1) = (self.x_of(s0), self.x_of(s1));
+        let mut m = self.at_x(x0)[3].max(self.at_x(x1)[3]);
+        for (x, c) in self.xs.iter().zip(&self.rgba) {
+            if *x > x0 && *x < x1 {
+                m = m.max(c[3]);
+            }
+        }
+        m
+    }
+}
+
+/// Gradient shading coefficients.
+#[derive(Clone, Copy, Debug)]
+struct Shading {
+    ambient: f32,
+    diffuse: f32,
+    specular: f32,
+    shininess: f32,
+    shadows: bool,
+}
+
+/// A volume prepared for ray casting (render space, index-space transform, skipping cells).
+#[derive(Clone, Debug)]
+pub struct RenderVolume {
+    /// Index into `Scene::volumes`.
+    pub volume: usize,
+    pub transfer: Transfer,
+    /// World units between samples (after the render setting's multiplier).
+    pub step: f32,
+    nearest: bool,
+    shading: Option<Shading>,
+    /// Clip group (0: none).
+    clip: u32,
+    /// Crop box in render space.
+    crop: Option<(Vec3A, Vec3A)>,
+    /// index = rows · p + offset, for a render-space point p.
+    rows: [Vec3A; 3],
+    offset: Vec3A,
+    /// Voxel-centre box (samples are clamped into it) and the volume's box, half a voxel
+    /// wider, in index space.
+    lo: Vec3A,
+    hi: Vec3A,
+    index_min: [i64; 3],
+    index_max: [i64; 3],
+    /// Largest extinction per skipping cell; cells cover index space `[8k, 8k + 8)`.
+    cells: Vec<f32>,
+    cell_min: [i64; 3],
+    cell_dims: [i64; 3],
+}
+
+/// A volume a ray crosses: its index-space ray and parameter interval.
+#[derive(Clone, Copy, Debug, Default)]
+struct Crossing {
+    v: usize,
+    o: Vec3A,
+    d: Vec3A,
+    t0: f32,
+    t1: f32,
+}
+
+impl RenderVolume {
+    /// Prepares volume `index` of the scene for drawing with `desc`; `step_scale` is the render
+    /// setting `volume_step`, `clip` the clip group (0: none).
+    pub fn new(
+        desc: &VolumeRenderDesc,
+        volume: &Volume,
+        index: usize,
+        step_scale: f64,
+        world_offset: DVec3,
+        clip: u32,
+    ) -> Result<RenderVolume, String> {
+        let m = &volume.world_from_index;
+        let col = |c: usize| DVec3::new(m[c], m[4 + c], m[8 + c]);
+        let (c0, c1, c2) = (col(0), col(1), col(2));
+        let det = c0.dot(c1.cross(c2));
+        // Inverse of the 3x3 part: rows are the cross products of its columns over det.
+        let inv = [c1.cross(c2) / det, c2.cross(c0) / det, c0.cross(c1) / det];
+        let t = DVec3::new(m[3], m[7], m[11]);
+        // index = inv · (p + world_offset - t)
+        let shift = world_offset - t;
+        let rows = inv.map(|r| Vec3A::from(r.as_vec3()));
+        let offset = Vec3A::new(
+            inv[0].dot(shift) as f32,
+            inv[1].dot(shift) as f32,
+            inv[2].dot(shift) as f32,
+        );
+        let smallest = c0.length().min(c1.length()).min(c2.length());
+        let step = desc.step.unwrap_or(0.5 * smallest) * step_scale;
+        if !(step > 0.0 && step.is_finite()) {
+            return Err(format!("volume step {step} is not a positive number"));
+        }
+        let (vmin, vmax) = volume.min_max();
+        let range = desc
+            .transfer
+            .range
+            .map_or((vmin, vmax), |r| (r[0] as f32, r[1] as f32));
+        let points: Vec<(f32, [f32; 3], f32)> = desc
+            .transfer
+            .points
+            .iter()
+            .map(|p| {
+                (
+                    p.x as f32,
+                    p.color.map(|c| c as f32),
+                    (p.opacity * desc.transfer.opacity) as f32,
+                )
+            })
+            .collect();
+        let transfer = Transfer::new(&points, range);
+        let f = |a: [i64; 3]| Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32);
+        let crop = desc.bounds.map(|(lo, hi)| {
+            let r = |p: [f64; 3]| Vec3A::from((DVec3::from(p) - world_offset).as_vec3());
+            (r(lo), r(hi))
+        });
+        let mut rv = RenderVolume {
+            volume: index,
+            transfer,
+            step: step as f32,
+            nearest: desc.interpolation == Interpolation::Nearest,
+            shading: desc.shading.map(|s| Shading {
+                ambient: s.ambient as f32,
+                diffuse: s.diffuse as f32,
+                specular: s.specular as f32,
+                shininess: s.shininess as f32,
+                shadows: s.shadows,
+            }),
+            clip,
+            crop,
+            rows,
+            offset,
+            lo: f(volume.index_min),
+            hi: f(volume.index_max),
+            index_min: volume.index_min,
+            index_max: volume.index_max,
+            cells: Vec::new(),
+            cell_min: [0; 3],
+            cell_dims: [0; 3],
+        };
+        rv.build_cells(volume);
+        Ok(rv)
+    }
+
+    /// The skipping table: per cell, the transfer function's largest extinction over the value
+    /// range of the cell's brick and its successors on each axis.
+    fn build_cells(&mut self, volume: &Volume) {
+        let shift = BRICK_SIZE.trailing_zeros();
+        let kmin = self.index_min.map(|c| (c - 1) >> shift);
+        let kmax = self.index_max.map(|c| (c + 1) >> shift);
+        let dims = [0, 1, 2].map(|a| kmax[a] - kmin[a] + 1);
+        // Cells beyond a few million would cost more than they save: no skipping then.
+        if dims.iter().product::<i64>() > 1 << 22 {
+            return;
+        }
+        // Value range of every brick in kmin ..= kmax + 1.
+        let bd = dims.map(|d| d + 1);
+        let mut ranges = Vec::with_capacity((bd[0] * bd[1] * bd[2]) as usize);
+        for z in 0..bd[2] {
+            for y in 0..bd[1] {
+                for x in 0..bd[0] {
+                    let key = [kmin[0] + x, kmin[1] + y, kmin[2] + z];
+                    ranges.push(match volume.brick(key) {
+                        None => (volume.background, volume.background),
+                        Some(Brick::Constant(v)) => (*v, *v),
+                        Some(Brick::Dense(values)) => values
+                            .iter()
+                            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| {
+                                (a.min(v), b.max(v))
+                            }),
+                    });
+                }
+            }
+        }
+        let mut cells = Vec::with_capacity((dims[0] * dims[1] * dims[2]) as usize);
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let (mut a, mut b) = (f32::INFINITY, f32::NEG_INFINITY);
+                    for dz in 0..2 {
+                        for dy in 0..2 {
+                            for dx in 0..2 {
+                                let i = ((z + dz) * bd[1] + y + dy) * bd[0] + x + dx;
+                                let r = ranges[i as usize];
+                                a = a.min(r.0);
+                                b = b.max(r.1);
+                            }
+                        }
+                    }
+                    // Widened a little: interpolation rounds.
+                    let pad = 1e-5 * (b - a).abs().max(a.abs()).max(b.abs()).max(1e-30);
+                    cells.push(self.transfer.max_extinction(a - pad, b + pad));
+                }
+            }
+        }
+        self.cells = cells;
+        self.cell_min = kmin;
+        self.cell_dims = dims;
+    }
+
+    #[inline]
+    fn to_index(&self, p: Vec3A) -> Vec3A {
+        Vec3A::new(
+            self.rows[0].dot(p),
+            self.rows[1].dot(p),
+            self.rows[2].dot(p),
+        ) + self.offset
+    }
+
+    #[inline]
+    fn dir_to_index(&self, d: Vec3A) -> Vec3A {
+        Vec3A::new(
+            self.rows[0].dot(d),
+            self.rows[1].dot(d),
+            self.rows[2].dot(d),
+        )
+    }
+
+    /// Where `ray` is inside the volume (its box, crop box and clip group) within `[0, t_end)`.
+    fn crossing(&self, v: usize, ray: &Ray, t_end: f32, clips: &Clips) -> Option<Crossing> {
+        let o = self.to_index(ray.origin);
+        let d = self.dir_to_index(ray.dir);
+        let (mut t0, mut t1) = (0.0f32, t_end);
+        slab(
+            o,
+            d,
+            self.lo - Vec3A::splat(0.5),
+            self.hi + Vec3A::splat(0.5),
+            &mut t0,
+            &mut t1,
+        );
+        if let Some((lo, hi)) = self.crop {
+            slab(ray.origin, ray.dir, lo, hi, &mut t0, &mut t1);
+        }
+        if self.clip != 0 {
+            // Kept: every plane's negative side (a clip group cuts what any plane points to).
+            for (q, n) in &clips.groups[self.clip as usize - 1] {
+                let dn = ray.dir.dot(*n);
+                let s = (*q - ray.origin).dot(*n);
+                if dn > 0.0 {
+                    t1 = t1.min(s / dn);
+                } else if dn < 0.0 {
+                    t0 = t0.max(s / dn);
+                } else if s < 0.0 {
+                    return None;
+                }
+            }
+        }
+        (t0 < t1).then_some(Crossing { v, o, d, t0, t1 })
+    }
+
+    /// The scalar at index-space point `p` (clamped into the voxel-centre box).
+    #[inline]
+    fn sample(&self, vol: &Volume, p: Vec3A) -> f32 {
+        let p = p.clamp(self.lo, self.hi);
+        if self.nearest {
+            let q = (p + Vec3A::splat(0.5)).floor();
+            let ijk = [q.x as i64, q.y as i64, q.z as i64];
+            let ijk = [0, 1, 2].map(|a| ijk[a].min(self.index_max[a]));
+            return vol.value(ijk);
+        }
+        let f0 = p.floor();
+        let f = p - f0;
+        let i0 = [f0.x as i64, f0.y as i64, f0.z as i64];
+        let i1 = [0, 1, 2].map(|a| (i0[a] + 1).min(self.index_max[a]));
+        let shift = BRICK_SIZE.trailing_zeros();
+        let key = i0.map(|c| c >> shift);
+        let mut c = [0.0f32; 8];
+        if (0..3).all(|a| i1[a] >> shift == key[a]) {
+            // The common case: all eight voxels in one brick, one lookup.
+            match vol.brick(key) {
+                None => return vol.background,
+                Some(Brick::Constant(v)) => return *v,
+                Some(Brick::Dense(values)) => {
+                    let m = BRICK_SIZE - 1;
+                    let l = |x: i64, y: i64, z: i64| {
+                        values[((x & m) + ((y & m) << shift) + ((z & m) << (2 * shift))) as usize]
+                    };
+                    for (k, v) in c.iter_mut().enumerate() {
+                        let x = if k & 1 == 0 { i0[0] } else { i1[0] };
+                        let y = if k & 2 == 0 { i0[1] } else { i1[1] };
+                        let z = if k & 4 == 0 { i0[2] } else { i1[2] };
+                        *v = l(x, y, z);
+                    }
+                }
+            }
+        } else {
+            for (k, v) in c.iter_mut().enumerate() {
+                let x = if k & 1 == 0 { i0[0] } else { i1[0] };
+                let y = if k & 2 == 0 { i0[1] } else { i1[1] };
+                let z = if k & 4 == 0 { i0[2] } else { i1[2] };
+                *v = vol.value([x, y, z]);
+            }
+        }
+        let lx = |a: f32, b: f32| a + (b - a) * f.x;
+        let (c00, c10) = (lx(c[0], c[1]), lx(c[2], c[3]));
+        let (c01, c11) = (lx(c[4], c[5]), lx(c[6], c[7]));
+        let ly = |a: f32, b: f32| a + (b - a) * f.y;
+        let (a, b) = (ly(c00, c10), ly(c01, c11));
+        a + (b - a) * f.z
+    }
+
+    /// Render-space gradient of the field at index-space point `p` (central differences one
+    /// voxel apart).
+    fn gradient(&self, vol: &Volume, p: Vec3A) -> Vec3A {
+        let g = Vec3A::new(
+            self.sample(vol, p + Vec3A::X) - self.sample(vol, p - Vec3A::X),
+            self.sample(vol, p + Vec3A::Y) - self.sample(vol, p - Vec3A::Y),
+            self.sample(vol, p + Vec3A::Z) - self.sample(vol, p - Vec3A::Z),
+        ) * 0.5;
+        // d s / d p = (d index / d p)^T · (d s / d index).
+        self.rows[0] * g.x + self.rows[1] * g.y + self.rows[2] * g.z
+    }
+
+    /// The cell's largest extinction and the ray parameter where the index-space ray leaves
+    /// it; `None` when the point is outside the table (never skipped).
+    #[inline]
+    fn cell(&self, c: &Crossing, t: f32) -> Option<(f32, f32)> {
+        if self.cells.is_empty() {
+            return None;
+        }
+        let p = c.o + t * c.d;
+        let k = (p * (1.0 / BRICK_SIZE as f32)).floor();
+        let k = [k.x as i64, k.y as i64, k.z as i64];
+        let r = [0, 1, 2].map(|a| k[a] - self.cell_min[a]);
+        if (0..3).any(|a| r[a] < 0 || r[a] >= self.cell_dims[a]) {
+            return None;
+        }
+        let d = self.cell_dims;
+        let max = self.cells[((r[2] * d[1] + r[1]) * d[0] + r[0]) as usize];
+        let size = BRICK_SIZE as f32;
+        let mut exit = f32::INFINITY;
+        for (a, &ka) in k.iter().enumerate() {
+            let (o, dir) = (c.o[a], c.d[a]);
+            if dir > 0.0 {
+                exit = exit.min(((ka + 1) as f32 * size - o) / dir);
+            } else if dir < 0.0 {
+                exit = exit.min((ka as f32 * size - o) / dir);
+            }
+        }
+        Some((max, exit))
+    }
+}
+
+/// Narrows `[t0, t1]` to where `o + t d` is inside the box `[lo, hi]`.
+fn slab(o: Vec3A, d: Vec3A, lo: Vec3A, hi: Vec3A, t0: &mut f32, t1: &mut f32) {
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            if o[a] < lo[a] || o[a] > hi[a] {
+                *t1 = f32::NEG_INFINITY;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[a];
+        let (mut n, mut f) = ((lo[a] - o[a]) * inv, (hi[a] - o[a]) * inv);
+        if n > f {
+            std::mem::swap(&mut n, &mut f);
+        }
+        *t0 = t0.max(n);
+        *t1 = t1.min(f);
+    }
+}
+
+/// Steps along `ray` through every rendered volume it crosses before `t_end`, calling
+/// `visit(t, dt, crossings active at t)` for each sample until it returns `false`. Samples sit
+/// at the middle of segments `step` long from the first entry (the last one shorter).
+fn walk(
+    scene: &Scene,
+    ray: &Ray,
+    t_end: f32,
+    c: &mut Counters,
+    mut visit: impl FnMut(f32, f32, &[Crossing], &mut Counters) -> bool,
+) {
+    let mut all = [Crossing::default(); MAX_RENDERED_VOLUMES];
+    let mut n = 0;
+    let mut step = f32::INFINITY;
+    let (mut start, mut stop) = (f32::INFINITY, f32::NEG_INFINITY);
+    for (v, rv) in scene.render_volumes.iter().enumerate() {
+        if let Some(x) = rv.crossing(v, ray, t_end, &scene.clips) {
+            all[n] = x;
+            n += 1;
+            step = step.min(rv.step);
+            start = start.min(x.t0);
+            stop = stop.max(x.t1);
+        }
+    }
+    if n == 0 {
+        return;
+    }
+    let all = &all[..n];
+    let skip = scene.settings.volume_skip;
+    let count = ((stop - start) / step).ceil().max(1.0) as u64;
+    let mut active = [Crossing::default(); MAX_RENDERED_VOLUMES];
+    let mut i = 0u64;
+    while i < count {
+        let a = start + i as f32 * step;
+        let b = (a + step).min(stop);
+        if b <= a {
+            break;
+        }
+        let t = 0.5 * (a + b);
+        let mut k = 0;
+        for x in all {
+            if t >= x.t0 && t < x.t1 {
+                active[k] = *x;
+                k += 1;
+            }
+        }
+        if skip {
+            // Skip when every volume here is transparent in its whole cell: up to the first
+            // cell exit or the next volume's entry, whichever comes first.
+            let mut target = all
+                .iter()
+                .filter(|x| x.t0 > t)
+                .fold(f32::INFINITY, |m, x| m.min(x.t0));
+            let mut empty = true;
+            for x in &active[..k] {
+                match scene.render_volumes[x.v].cell(x, t) {
+                    Some((max, exit)) if max <= 0.0 => target = target.min(exit),
+                    _ => {
+                        empty = false;
+                        break;
+                    }
+                }
+            }
+            if empty {
+                // A margin keeps samples near the cell's face (rounding) out of the skip.
+                let target = target - 1e-3 * step;
+                let j = ((target - start) / step - 0.5).floor();
+                i = if j.is_finite() && j > i as f32 {
+                    (j as u64).min(count)
+                } else {
+                    i + 1
+                };
+                continue;
+            }
+        }
+        if k > 0 && !visit(t, b - a, &active[..k], c) {
+            return;
+        }
+        i += 1;
+    }
+}
+
+/// A light as seen from point `p`: direction toward it, distance, radiance arriving (area
+/// lights are taken at their centre).
+fn toward(light: &Light, p: Vec3A) -> Option<(Vec3A, f32, Vec3A)> {
+    let point = |q: Vec3A, color: Vec3A, a: &[f32; 3]| {
+        let d = q - p;
+        let dist = d.length();
+        (dist > 0.0).then(|| {
+            let att = 1.0 / (a[0] + a[1] * dist + a[2] * dist * dist);
+            (d / dist, dist, color * att)
+        })
+    };
+    match light {
+        Light::Directional {
+            to_light, color, ..
+        } => Some((*to_light, f32::INFINITY, *color)),
+        Light::Point {
+            position,
+            color,
+            attenuation,
+            ..
+        } => point(*position, *color, attenuation),
+        Light::Spot {
+            position,
+            axis,
+            cos_inner,
+            cos_outer,
+            color,
+            attenuation,
+            ..
+        } => {
+            let cos = (p - *position).normalize_or_zero().dot(*axis);
+            if cos <= *cos_outer {
+                return None;
+            }
+            let x = if cos >= *cos_inner {
+                1.0
+            } else {
+                (cos - cos_outer) / (cos_inner - cos_outer)
+            };
+            point(*position, *color * (x * x * (3.0 - 2.0 * x)), attenuation)
+        }
+        Light::Sphere {
+            center,
+            color,
+            attenuation,
+            ..
+        } => point(*center, *color, attenuation),
+        Light::Rect {
+            corner,
+            edge1,
+            edge2,
+            normal,
+            color,
+            attenuation,
+            ..
+        } => {
+            if (p - *corner).dot(*normal) <= 0.0 {
+                return None;
+            }
+            point(*corner + 0.5 * (*edge1 + *edge2), *color, attenuation)
+        }
+    }
+}
+
+/// What the volumes add along `ray` before `t_end` and what they let through:
+/// (colour, transmittance). Marching stops once the transmittance is below `cutoff`.
+pub fn march(scene: &Scene, ray: &Ray, t_end: f32, cutoff: f32, c: &mut Counters) -> (Vec3A, f32) {
+    let mut color = Vec3A::ZERO;
+    let mut trans = 1.0f32;
+    walk(scene, ray, t_end, c, |t, dt, active, c| {
+        let mut sigma = 0.0f32;
+        let mut weighted = Vec3A::ZERO;
+        for x in active {
+            let rv = &scene.render_volumes[x.v];
+            let vol = &scene.volumes[rv.volume];
+            let p = x.o + t * x.d;
+            c.volume_samples += 1;
+            let [r, g, b, s] = rv.transfer.eval(rv.sample(vol, p));
+            if s <= 0.0 {
+                continue;
+            }
+            let mut col = Vec3A::new(r, g, b);
+            if let Some(sh) = rv.shading {
+                col = shade(scene, rv, vol, sh, col, ray, t, p, c);
+            }
+            sigma += s;
+            weighted += s * col;
+        }
+        if sigma > 0.0 {
+            let alpha = 1.0 - (-sigma * dt).exp();
+            color += (trans * alpha / sigma) * weighted;
+            trans *= 1.0 - alpha;
+        }
+        trans >= cutoff
+    });
+    (color, trans)
+}
+
+/// Gradient shading of one sample: two-sided diffuse and Blinn highlight per light, through
+/// shadow rays when asked for.
+#[allow(clippy::too_many_arguments)]
+fn shade(
+    scene: &Scene,
+    rv: &RenderVolume,
+    vol: &Volume,
+    sh: Shading,
+    base: Vec3A,
+    ray: &Ray,
+    t: f32,
+    p_index: Vec3A,
+    c: &mut Counters,
+) -> Vec3A {
+    let g = rv.gradient(vol, p_index);
+    let len = g.length();
+    // (Also catches a NaN gradient.)
+    if len.is_nan() || len <= 1e-12 {
+        // Homogeneous: no surface to light; lit as if facing every light.
+        return base * (sh.ambient + sh.diffuse);
+    }
+    let n = -g / len;
+    let p = ray.origin + t * ray.dir;
+    let view = -ray.dir;
+    let mut out = base * sh.ambient;
+    for light in &scene.lights {
+        let Some((l, dist, mut arriving)) = toward(light, p) else {
+            continue;
+        };
+        if sh.shadows && light.casts_shadows() {
+            c.shadow += 1;
+            let sray = Ray::new(p, l, ray.time);
+            if scene.features.shadows {
+                arriving *= scene.transmittance(&sray, dist, scene.settings.min_weight, c);
+            }
+            arriving *= transmittance(scene, &sray, dist, c);
+            if arriving == Vec3A::ZERO {
+                continue;
+            }
+        }
+        let ndotl = n.dot(l).abs();
+        let mut lit = sh.diffuse * ndotl * base;
+        if sh.specular > 0.0 {
+            let h = (l + view).normalize_or_zero();
+            lit += Vec3A::splat(sh.specular * n.dot(h).abs().powf(sh.shininess));
+        }
+        out += arriving * lit;
+    }
+    out
+}
+
+/// The fraction of light the volumes let through along `ray` before `t_end`: exp(-optical
+/// depth), grey (extinction has no colour).
+pub fn transmittance(scene: &Scene, ray: &Ray, t_end: f32, c: &mut Counters) -> f32 {
+    let mut depth = 0.0f32;
+    walk(scene, ray, t_end, c, |t, dt, active, c| {
+        for x in active {
+            let rv = &scene.render_volumes[x.v];
+            let vol = &scene.volumes[rv.volume];
+            c.volume_samples += 1;
+            depth += rv.transfer.eval(rv.sample(vol, x.o + t * x.d))[3] * dt;
+        }
+        // exp(-30) is below anything a pixel can show.
+        depth < 30.0
+    });
+    (-depth).exp()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transfer_interpolates_and_bounds_exactly() {
+        let t = Transfer::new(
+            &[
+                (0.0, [0.0; 3], 0.0),
+                (0.5, [1.0, 0.5, 0.0], 4.0),
+                (1.0, [1.0; 3], 1.0),
+            ],
+            (10.0, 20.0),
+        );
+        assert_eq!(t.eval(10.0), [0.0, 0.0, 0.0, 0.0]);
+        assert_eq!(t.eval(12.5), [0.5, 0.25, 0.0, 2.0]);
+        assert_eq!(t.eval(15.0)[3], 4.0);
+        assert_eq!(t.eval(-100.0)[3], 0.0);
+        assert_eq!(t.eval(100.0)[3], 1.0);
+        // The peak inside the interval counts; an interval on the zero end does not.
+        assert_eq!(t.max_extinction(11.0, 19.0), 4.0);
+        assert_eq!(t.max_extinction(0.0, 10.0), 0.0);
+        assert_eq!(t.max_extinction(17.5, 20.0), 2.5);
+    }
+
+    #[test]
+    fn slab_clips_to_the_box() {
+        let (mut t0, mut t1) = (0.0, f32::INFINITY);
+        slab(
+            Vec3A::new(-5.0, 0.5, 0.5),
+            Vec3A::X,
+            Vec3A::ZERO,
+            Vec3A::ONE,
+            &mut t0,
+            &mut t1,
+        );
+        assert_eq!((t0, t1), (5.0, 6.0));
+        let (mut t0, mut t1) = (0.0, f32::INFINITY);
+        slab(
+            Vec3A::new(-5.0, 2.0, 0.5),
+            Vec3A::X,
+            Vec3A::ZERO,
+            Vec3A::ONE,
+            &mut t0,
+            &mut t1,
+        );
+        assert!(t0 >= t1);
+    }
+}
