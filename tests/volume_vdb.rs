@@ -105,7 +105,11 @@ fn luxon_check_describes_a_vdb_volume() {
     std::fs::copy(fixture("fog_sphere.vdb"), dir.join("volumes/fog.vdb")).unwrap();
     scene(
         &dir,
-        r#"        (plugin: "vdb", name: "smoke", params: (file: "volumes/fog.vdb", grid: "density")),"#,
+        &format!(
+            r#"        (plugin: "vdb", name: "smoke", params: (file: "volumes/fog.vdb", grid: "density")),
+        (plugin: "vdb", name: "cloud", params: (file: "{}")),"#,
+            root().join("scenes/volumes/cloud.vdb").display()
+        ),
     );
     let out = run(&["check", dir.join("scene.ron").to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -113,6 +117,11 @@ fn luxon_check_describes_a_vdb_volume() {
     // 8 leaves of 512 voxels; densities from 0 to 1 (the centre).
     assert!(
         text.contains("volume     `smoke` (vdb): 4096 voxels, values 0..1,"),
+        "{text}"
+    );
+    // The shipped cloud: 160 leaves of half-float densities.
+    assert!(
+        text.contains("volume     `cloud` (vdb): 81920 voxels, values 0..1,"),
         "{text}"
     );
     let _ = std::fs::remove_dir_all(&dir);
