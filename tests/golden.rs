@@ -184,3 +184,8 @@ fn volume_flow_field() {
 fn volume_with_geometry_inside() {
     check("volume-geometry");
 }
+
+#[test]
+fn volume_openvdb_cloud() {
+    check("vdb-cloud");
+}
