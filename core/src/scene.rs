@@ -185,6 +185,8 @@ pub struct Settings {
     pub mode: luxon_formats::ParallelMode,
     pub decomposition: luxon_formats::Decomposition,
     pub io: luxon_formats::OutputIo,
+    /// Adaptive supersampling; `None`: `samples` uniform samples per pixel.
+    pub adaptive: Option<luxon_formats::AdaptiveDesc>,
 }
 
 pub struct Scene {
@@ -575,7 +577,7 @@ impl Scene {
                     .or(m.transmit_texture)
                     .is_some()
             }),
-            antialiasing: r.samples > 1,
+            antialiasing: r.samples > 1 || r.adaptive.is_some(),
         };
 
         let settings = Settings {
@@ -592,6 +594,7 @@ impl Scene {
             mode: r.parallel.mode,
             decomposition: r.parallel.decomposition,
             io: r.parallel.io,
+            adaptive: r.adaptive,
         };
         let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
         Ok(Scene {

@@ -344,7 +344,24 @@ pub struct RenderDesc {
     /// Shutter time of the frame (rays carry it).
     pub time: f64,
     pub transparency: TransparencyDesc,
+    /// Adaptive supersampling; `None`: every pixel gets `samples` samples.
+    pub adaptive: Option<AdaptiveDesc>,
 }
+
+/// Adaptive supersampling (Stone's thesis, II.E): a pixel starts with a jittered 2x2 grid per
+/// cell and a cell whose samples differ by more than `threshold` is split into four, each
+/// sampled in turn, down to `max_depth` splits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveDesc {
+    /// Largest difference (any colour channel, clamped to [0, 1]) between the samples of a cell
+    /// that is still accepted without splitting it.
+    pub threshold: f64,
+    /// How many times a cell may be split (0: never, so only the base samples).
+    pub max_depth: u32,
+}
+
+/// The deepest split allowed: 4^(6+1) samples per base cell at most.
+pub const ADAPTIVE_MAX_DEPTH: u32 = 6;
 
 /// How transparent surfaces combine with what is behind them.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -390,6 +407,7 @@ impl Default for RenderDesc {
             frame: 0,
             time: 0.0,
             transparency: TransparencyDesc::default(),
+            adaptive: None,
         }
     }
 }

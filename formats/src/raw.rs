@@ -310,6 +310,14 @@ pub(crate) struct Render {
     pub outputs: Vec<Output>,
     pub parallel: Option<Parallel>,
     pub transparency: Option<Transparency>,
+    pub adaptive: Option<Adaptive>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Adaptive", deny_unknown_fields)]
+pub(crate) struct Adaptive {
+    pub threshold: f64,
+    pub max_depth: Option<f64>,
 }
 
 #[derive(Deserialize)]
