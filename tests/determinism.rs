@@ -60,3 +60,41 @@ fn every_decomposition_agrees_bitwise() {
         }
     }
 }
+
+#[test]
+fn adaptive_supersampling_agrees_bitwise() {
+    let adaptive = |d: &mut luxon_formats::SceneDesc| {
+        d.render.samples = 4;
+        d.render.adaptive = Some(luxon_formats::AdaptiveDesc {
+            threshold: 0.05,
+            max_depth: 2,
+        });
+    };
+    for name in ["antialiasing", "glass"] {
+        let path = root().join("scenes").join(format!("{name}.ron"));
+        let img = |threads, tile, how| {
+            render_with(&path, |d| {
+                adaptive(d);
+                d.render.width = 61;
+                d.render.height = 43;
+                d.render.parallel.threads = Some(threads);
+                d.render.parallel.tile_size = tile;
+                d.render.parallel.decomposition = how;
+            })
+            .rgba
+        };
+        let one = img(1, 16, Decomposition::Dynamic);
+        assert!(one.iter().any(|&v| v > 0.05), "{name}: image is black");
+        for (threads, tile, how) in [
+            (2, 16, Decomposition::Dynamic),
+            (3, 5, Decomposition::Dynamic),
+            (2, 3, Decomposition::PixelCyclic),
+            (3, 4, Decomposition::BlockCyclic),
+        ] {
+            assert!(
+                same(&one, &img(threads, tile, how)),
+                "{name}: adaptive on {threads} threads, {how:?} (tile {tile}) differs"
+            );
+        }
+    }
+}

@@ -16,6 +16,7 @@
 //! # Ok::<(), luxon::Error>(())
 //! ```
 
+pub mod adaptive;
 pub mod bvh;
 pub mod camera;
 pub mod error;
@@ -23,6 +24,7 @@ pub mod framebuffer;
 pub mod geometry;
 pub mod integrator;
 pub mod math;
+pub mod metrics;
 pub mod output;
 pub mod plugin;
 pub mod ray;
@@ -30,6 +32,7 @@ pub mod render;
 pub mod sampler;
 pub mod scene;
 pub mod schedule;
+pub mod sweep;
 pub mod volume;
 pub mod volume_render;
 

@@ -31,6 +31,10 @@ enum Command {
         /// Samples per pixel.
         #[arg(long)]
         samples: Option<u32>,
+        /// Adaptive supersampling: split the pixel cells whose samples differ by more than
+        /// THRESHOLD (colour, 0..1), at most DEPTH times (default 3); `off` turns a scene's off.
+        #[arg(long, value_name = "THRESHOLD[:DEPTH]", value_parser = parse_adaptive)]
+        adaptive: Option<cli::render::AdaptiveArg>,
         /// Render threads per process (default: every CPU; with MPI, the rank's share of them).
         #[arg(long)]
         threads: Option<u32>,
@@ -52,6 +56,43 @@ enum Command {
         io: Option<String>,
         #[command(flatten)]
         shading: cli::shading::ShadingArgs,
+    },
+    /// Render a scene at a range of settings and report time, rays and error against a
+    /// reference (Markdown table, CSV, SVG plot, contact sheet and images in DIR).
+    ///
+    /// Each --vary is a separate curve that changes one parameter from the scene's settings
+    /// (several --vary do not make a grid).
+    Sweep {
+        scene: PathBuf,
+        /// PARAMETER=VALUE,VALUE,...: samples=1,4,16,64; max_depth=1,2,4,8;
+        /// texture_filter=nearest,bilinear,mip; adaptive=off,0.1,0.05:3 (THRESHOLD[:DEPTH]);
+        /// volume_step=... (not supported by this build).
+        #[arg(long, required = true)]
+        vary: Vec<String>,
+        /// Compare with this image (same resolution); default: a reference rendered with many
+        /// samples and every varied parameter at its most accurate value.
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        /// Samples per pixel of the rendered reference (default: 4x the most any setting
+        /// gives a pixel, 64..=1024).
+        #[arg(long = "reference-samples")]
+        reference_samples: Option<u32>,
+        /// Samples per pixel for every curve but a `samples` one (also adaptive sampling's
+        /// base); default: the scene's.
+        #[arg(long)]
+        samples: Option<u32>,
+        /// Renders per setting; the median time is reported.
+        #[arg(long, default_value_t = 3)]
+        runs: u32,
+        /// Resolution as WIDTHxHEIGHT.
+        #[arg(long, value_parser = parse_res)]
+        res: Option<(u32, u32)>,
+        /// Render threads (default: every CPU).
+        #[arg(long)]
+        threads: Option<u32>,
+        /// Directory for the report.
+        #[arg(short, long = "output")]
+        output: PathBuf,
     },
     /// Validate a scene and print what it contains; renders nothing.
     Check { scene: PathBuf },
@@ -95,6 +136,10 @@ fn parse_res(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+fn parse_adaptive(s: &str) -> Result<cli::render::AdaptiveArg, String> {
+    luxon::adaptive::parse(s, 3).map(cli::render::AdaptiveArg)
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -103,6 +148,7 @@ fn main() -> ExitCode {
             output,
             res,
             samples,
+            adaptive,
             threads,
             stats,
             parallel,
@@ -116,6 +162,7 @@ fn main() -> ExitCode {
                 output,
                 res,
                 samples,
+                adaptive,
                 threads,
                 stats,
                 parallel,
@@ -123,6 +170,29 @@ fn main() -> ExitCode {
                 block_size,
                 io,
                 shading,
+            },
+        ),
+        Command::Sweep {
+            scene,
+            vary,
+            reference,
+            reference_samples,
+            samples,
+            runs,
+            res,
+            threads,
+            output,
+        } => cli::sweep::run(
+            &scene,
+            &cli::sweep::Args {
+                vary,
+                reference,
+                reference_samples,
+                samples,
+                runs,
+                res,
+                threads,
+                out: output,
             },
         ),
         Command::Check { scene } => cli::check::run(&scene),

@@ -2,6 +2,7 @@
 //! which pixels is [`crate::schedule`]'s business; every pixel's samples come from its own
 //! deterministic sequence, so the result does not depend on it.
 
+use crate::adaptive;
 use crate::error::Error;
 use crate::framebuffer::Framebuffer;
 use crate::geometry::Counters;
@@ -58,17 +59,28 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     for span in spans {
         let y = span.y;
         for x in span.xs() {
-            let mut sum = Vec3A::ZERO;
-            for i in 0..n {
-                let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
+            let mut shade = |jx: f32, jy: f32| {
                 let (px, py) = (x as f32 + jx, y as f32 + jy);
                 // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
-                if let Some(ray) = scene.camera.primary(px, py, s.width, s.height, s.time) {
-                    c.primary += 1;
-                    sum += integrator.radiance(&ray, 0, 1.0, &media, c);
+                match scene.camera.primary(px, py, s.width, s.height, s.time) {
+                    Some(ray) => {
+                        c.primary += 1;
+                        integrator.radiance(&ray, 0, 1.0, &media, c)
+                    }
+                    None => Vec3A::ZERO,
                 }
-            }
-            let mut v = sum * inv_n;
+            };
+            let mut v = match &s.adaptive {
+                Some(a) => adaptive::pixel(x, y, s.frame, n, a, &mut shade),
+                None => {
+                    let mut sum = Vec3A::ZERO;
+                    for i in 0..n {
+                        let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
+                        sum += shade(jx, jy);
+                    }
+                    sum * inv_n
+                }
+            };
             if !v.is_finite() {
                 // A NaN never aborts a render: count it and clamp the pixel.
                 c.nan_pixels += 1;

@@ -192,6 +192,8 @@ pub struct Settings {
     pub io: luxon_formats::OutputIo,
     /// Empty-space skipping in volumes.
     pub volume_skip: bool,
+    /// Adaptive supersampling; `None`: `samples` uniform samples per pixel.
+    pub adaptive: Option<luxon_formats::AdaptiveDesc>,
 }
 
 pub struct Scene {
@@ -586,7 +588,7 @@ impl Scene {
                     .or(m.transmit_texture)
                     .is_some()
             }),
-            antialiasing: r.samples > 1,
+            antialiasing: r.samples > 1 || r.adaptive.is_some(),
             volumes: !render_volumes.is_empty(),
         };
 
@@ -605,6 +607,7 @@ impl Scene {
             decomposition: r.parallel.decomposition,
             io: r.parallel.io,
             volume_skip: r.volume_skip,
+            adaptive: r.adaptive,
         };
         let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
         Ok(Scene {

@@ -309,6 +309,31 @@ impl Checker<'_> {
                 None => d.volume_step,
             },
             volume_skip: r.volume_skip.unwrap_or(d.volume_skip),
+            adaptive: match r.adaptive {
+                Some(a) => {
+                    let at = field("adaptive");
+                    let sub = |name| at.field(name).unwrap_or(at);
+                    if !(a.threshold >= 0.0 && a.threshold.is_finite()) {
+                        return Err(self.error(
+                            sub("threshold"),
+                            format!(
+                                "`threshold` is {}; expected a number of at least 0 (a colour difference, e.g. 0.05)",
+                                a.threshold
+                            ),
+                        ));
+                    }
+                    Some(AdaptiveDesc {
+                        threshold: a.threshold,
+                        max_depth: match a.max_depth {
+                            Some(n) => {
+                                self.whole(sub("max_depth"), "max_depth", n, 0, ADAPTIVE_MAX_DEPTH)?
+                            }
+                            None => 3,
+                        },
+                    })
+                }
+                None => None,
+            },
         };
         Ok((render, outputs))
     }

@@ -476,7 +476,24 @@ pub struct RenderDesc {
     pub volume_step: f64,
     /// Skip bricks the transfer function makes fully transparent (same image, faster).
     pub volume_skip: bool,
+    /// Adaptive supersampling; `None`: every pixel gets `samples` samples.
+    pub adaptive: Option<AdaptiveDesc>,
 }
+
+/// Adaptive supersampling (Stone's thesis, II.E): a pixel starts with a jittered 2x2 grid per
+/// cell and a cell whose samples differ by more than `threshold` is split into four, each
+/// sampled in turn, down to `max_depth` splits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveDesc {
+    /// Largest difference (any colour channel, clamped to [0, 1]) between the samples of a cell
+    /// that is still accepted without splitting it.
+    pub threshold: f64,
+    /// How many times a cell may be split (0: never, so only the base samples).
+    pub max_depth: u32,
+}
+
+/// The deepest split allowed: 4^(6+1) samples per base cell at most.
+pub const ADAPTIVE_MAX_DEPTH: u32 = 6;
 
 /// How transparent surfaces combine with what is behind them.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -524,6 +541,7 @@ impl Default for RenderDesc {
             transparency: TransparencyDesc::default(),
             volume_step: 1.0,
             volume_skip: true,
+            adaptive: None,
         }
     }
 }

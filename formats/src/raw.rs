@@ -382,6 +382,14 @@ pub(crate) struct Render {
     pub transparency: Option<Transparency>,
     pub volume_step: Option<f64>,
     pub volume_skip: Option<bool>,
+    pub adaptive: Option<Adaptive>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Adaptive", deny_unknown_fields)]
+pub(crate) struct Adaptive {
+    pub threshold: f64,
+    pub max_depth: Option<f64>,
 }
 
 #[derive(Deserialize)]

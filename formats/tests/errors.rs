@@ -386,6 +386,26 @@ fn resolution_limits() {
 }
 
 #[test]
+fn adaptive_settings() {
+    check(
+        render_error("adaptive: (threshold: -1)"),
+        3,
+        36,
+        &["`threshold` is -1", "at least 0"],
+    );
+    check(
+        render_error("adaptive: (threshold: 0.1, max_depth: 9)"),
+        3,
+        52,
+        &["`max_depth` is 9", "0 to 6"],
+    );
+    let (_, _, m) = render_error("adaptive: (threshold: 0.1, depth: 2)");
+    assert!(m.contains("depth"), "{m}");
+    let (_, _, m) = render_error("adaptive: (max_depth: 2)");
+    assert!(m.contains("threshold"), "{m}");
+}
+
+#[test]
 fn render_limits() {
     check(
         render_error("samples: 0"),

@@ -137,6 +137,7 @@ fn render_outputs_and_paths() {
         (640, 480, 4, 8)
     );
     assert_eq!((r.min_weight, r.frame, r.time), (0.002, 3, 0.5));
+    assert_eq!(r.adaptive, None);
     assert_eq!(
         r.parallel,
         ParallelDesc {
@@ -217,4 +218,34 @@ fn load_reads_files_and_rejects_other_formats() {
     let error = load(&dir.join("missing.ron")).unwrap_err();
     assert!(matches!(error, SceneError::Io { .. }), "{error}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn adaptive_supersampling_settings() {
+    let scene = |render: &str| {
+        load_ron_str(
+            &format!(
+                "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), render: ({render}))"
+            ),
+            Path::new("/scenes/a.ron"),
+        )
+        .expect("valid")
+        .render
+        .adaptive
+    };
+    assert_eq!(
+        scene("adaptive: (threshold: 0.05, max_depth: 4)"),
+        Some(AdaptiveDesc {
+            threshold: 0.05,
+            max_depth: 4
+        })
+    );
+    // The depth defaults to 3.
+    assert_eq!(
+        scene("samples: 16, adaptive: (threshold: 0)"),
+        Some(AdaptiveDesc {
+            threshold: 0.0,
+            max_depth: 3
+        })
+    );
 }

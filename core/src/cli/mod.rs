@@ -7,3 +7,4 @@ pub mod progress;
 pub mod render;
 pub mod shading;
 pub mod spd;
+pub mod sweep;

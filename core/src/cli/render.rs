@@ -15,12 +15,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// `--adaptive`: settings, or `None` for off.
+#[derive(Clone, Debug)]
+pub struct AdaptiveArg(pub Option<luxon_formats::AdaptiveDesc>);
+
 /// What the command line can change in a scene's render settings.
 #[derive(Default)]
 pub struct Overrides {
     pub output: Vec<PathBuf>,
     pub res: Option<(u32, u32)>,
     pub samples: Option<u32>,
+    pub adaptive: Option<AdaptiveArg>,
     pub threads: Option<u32>,
     pub stats: bool,
     /// `threads`, `mpi` or `hybrid`.
@@ -55,6 +60,9 @@ fn load(path: &Path, o: &Overrides) -> Result<SceneDesc, Error> {
             return Err(Error::Usage(format!("--samples {n}: expected 1..=65536")));
         }
         r.samples = n;
+    }
+    if let Some(a) = &o.adaptive {
+        r.adaptive = a.0;
     }
     if let Some(n) = o.threads {
         if n == 0 || n > 4096 {
@@ -270,6 +278,17 @@ fn print_stats(
         scene.planes.planes.len(),
         scene.customs.len()
     );
+    if let Some(a) = &set.adaptive {
+        let pixels = (set.width as u64 * set.height as u64).max(1);
+        eprintln!(
+            "  adaptive         threshold {}, max depth {}: {} base sample(s) per pixel, {:.2} on average, at most {}",
+            a.threshold,
+            a.max_depth,
+            luxon::adaptive::base_samples(set.samples),
+            c.primary as f64 / pixels as f64,
+            luxon::adaptive::max_samples(set.samples, a.max_depth)
+        );
+    }
     eprintln!("  effects          {}", scene.features);
     let mode = match (job, set.mode) {
         (Job::Local, ParallelMode::Threads) => "threads",

@@ -1,0 +1,73 @@
+//! `luxon sweep`: renders a scene at a range of settings and writes what each costs and how
+//! far it is from a reference (the work is [`luxon::sweep`]'s).
+
+use luxon::plugin::Registry;
+use luxon::sweep::{self, Curve, Options};
+use luxon::Error;
+use std::path::{Path, PathBuf};
+
+pub struct Args {
+    pub vary: Vec<String>,
+    pub reference: Option<PathBuf>,
+    pub reference_samples: Option<u32>,
+    pub samples: Option<u32>,
+    pub runs: u32,
+    pub res: Option<(u32, u32)>,
+    pub threads: Option<u32>,
+    pub out: PathBuf,
+}
+
+pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
+    let curves = a
+        .vary
+        .iter()
+        .map(|v| v.parse::<Curve>())
+        .collect::<Result<Vec<_>, _>>()?;
+    if a.runs == 0 || a.runs > 100 {
+        return Err(Error::Usage(format!("--runs {}: expected 1..=100", a.runs)));
+    }
+    if let Some(n) = a.reference_samples {
+        if n == 0 || n > 65536 {
+            return Err(Error::Usage(format!(
+                "--reference-samples {n}: expected 1..=65536"
+            )));
+        }
+    }
+    let mut desc = luxon_formats::load(path)?;
+    if let Some((w, h)) = a.res {
+        desc.render.width = w;
+        desc.render.height = h;
+    }
+    if let Some(n) = a.samples {
+        if n == 0 || n > 65536 {
+            return Err(Error::Usage(format!("--samples {n}: expected 1..=65536")));
+        }
+        desc.render.samples = n;
+    }
+    if let Some(n) = a.threads {
+        if n == 0 || n > 4096 {
+            return Err(Error::Usage(format!("--threads {n}: expected 1..=4096")));
+        }
+        desc.render.parallel.threads = Some(n);
+    }
+    // The sweep writes its own files, not the scene's outputs.
+    desc.render.outputs.clear();
+    let registry = Registry::discover(&desc.plugin_path);
+    let options = Options {
+        curves,
+        reference: a.reference.clone(),
+        reference_samples: a.reference_samples,
+        runs: a.runs,
+    };
+    let result = sweep::run(&desc, &registry, &options, &|what| {
+        eprintln!("luxon: rendering {what}")
+    })?;
+    let written = sweep::report::write(&result, &a.out)?;
+    print!("{}", sweep::report::markdown(&result));
+    eprintln!(
+        "luxon: wrote {} files to {} (sweep.md, sweep.csv, sweep.svg, contact.png, images)",
+        written.len(),
+        a.out.display()
+    );
+    Ok(())
+}
