@@ -3,7 +3,7 @@
 //! rays per second. `tests/stability.rs` runs the same check with fewer rays.
 //!
 //! ```sh
-//! cargo run --release --example watertight            # 10.6 M rays
+//! cargo run --release --example watertight            # 14.1 M rays
 //! cargo run --release --example watertight -- 40      # origins per mesh (default 40)
 //! ```
 

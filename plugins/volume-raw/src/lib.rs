@@ -301,11 +301,35 @@ fn open_error(path: &Path, e: std::io::Error) -> Error {
     }
 }
 
-impl VolumeReader for Raw {
-    type Params = RawParams;
+/// Where decoded blocks go: the host (through the plugin ABI) or, for tools, tests and the
+/// fuzz targets, anything else.
+pub trait Blocks {
+    fn begin(&mut self, info: &GridInfo) -> Result<(), Error>;
+    /// A dense block, x fastest.
+    fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error>;
+}
 
-    fn read(p: RawParams, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
-        let (layout, expected) = Layout::new(&p)?;
+impl Blocks for VolumeOut<'_> {
+    fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
+        VolumeOut::begin(self, info)
+    }
+
+    fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error> {
+        VolumeOut::dense(self, origin, dims, values)
+    }
+}
+
+/// Parameters checked, without the file: its expected size and the grid's map.
+struct Checked {
+    layout: Layout,
+    expected: u64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+}
+
+impl Checked {
+    fn new(p: &RawParams) -> Result<Checked, Error> {
+        let (layout, expected) = Layout::new(p)?;
         let spacing = finite("spacing", p.spacing)?;
         if spacing.iter().any(|&s| s <= 0.0) {
             return Err(invalid(format!(
@@ -318,6 +342,83 @@ impl VolumeReader for Raw {
                 "parameter `file` is empty; expected the path of a raw file",
             ));
         }
+        Ok(Checked {
+            layout,
+            expected,
+            spacing,
+            origin,
+        })
+    }
+
+    /// The size error, or nothing when `actual` is the expected size.
+    fn size(&self, path: &Path, actual: u64, magic: Option<[u8; 2]>) -> Result<(), Error> {
+        if actual == self.expected {
+            return Ok(());
+        }
+        let layout = &self.layout;
+        let mut message = format!(
+            "`{}`: expected {} bytes for {} {} voxels plus a {}-byte header, the file has {actual}",
+            path.display(),
+            self.expected,
+            dims_text(layout.dims),
+            layout.format.name(),
+            layout.header
+        );
+        if magic == Some([0x1f, 0x8b]) {
+            message.push_str(
+                "; it is gzip-compressed: decompress it first (e.g. `gzip -dk`), this reader \
+                 reads uncompressed files only",
+            );
+        }
+        Err(invalid(message))
+    }
+
+    /// Announces the grid and streams the voxels of `source` (of the expected size).
+    fn decode(
+        &self,
+        name: String,
+        source: &mut (impl Read + Seek),
+        path: &Path,
+        out: &mut impl Blocks,
+        budget: u64,
+    ) -> Result<(), Error> {
+        let (spacing, origin) = (self.spacing, self.origin);
+        out.begin(&GridInfo {
+            world_from_index: [
+                spacing[0], 0.0, 0.0, origin[0], //
+                0.0, spacing[1], 0.0, origin[1], //
+                0.0, 0.0, spacing[2], origin[2],
+            ],
+            background: 0.0,
+            index_min: [0; 3],
+            index_max: self.layout.dims.map(|n| (n - 1) as i64),
+            name,
+        })?;
+        stream(source, path, &self.layout, out, budget)
+    }
+}
+
+/// Reads a raw volume held in memory: `params` as in a scene (RON text; `file` only names the
+/// grid and messages), `bytes` the file's content. The reader's whole parsing without the
+/// plugin ABI or a file, for tools and fuzzing.
+pub fn read_bytes(params: &str, bytes: &[u8], out: &mut impl Blocks) -> Result<(), Error> {
+    let p: RawParams = luxon_plugin::parse_params(params)?;
+    let checked = Checked::new(&p)?;
+    let path = Path::new(&p.file);
+    checked.size(
+        path,
+        bytes.len() as u64,
+        bytes.get(..2).map(|m| [m[0], m[1]]),
+    )?;
+    let mut source = std::io::Cursor::new(bytes);
+    checked.decode(p.file.clone(), &mut source, path, out, BLOCK_VOXELS)
+}
+
+impl VolumeReader for Raw {
+    type Params = RawParams;
+
+    fn read(p: RawParams, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
+        let checked = Checked::new(&p)?;
         let path = ctx.resolve(&p.file);
         let mut file = File::open(&path).map_err(|e| open_error(&path, e))?;
         let meta = file
@@ -329,52 +430,23 @@ impl VolumeReader for Raw {
                 path.display()
             )));
         }
-        let actual = meta.len();
-        if actual != expected {
-            let mut message = format!(
-                "`{}`: expected {expected} bytes for {} {} voxels plus a {}-byte header, the \
-                 file has {actual}",
-                path.display(),
-                dims_text(layout.dims),
-                layout.format.name(),
-                layout.header
-            );
-            let mut magic = [0u8; 2];
-            if file.read_exact(&mut magic).is_ok() && magic == [0x1f, 0x8b] {
-                message.push_str(
-                    "; it is gzip-compressed: decompress it first (e.g. `gzip -dk`), this \
-                     reader reads uncompressed files only",
-                );
-            }
-            return Err(invalid(message));
-        }
-
-        let d = layout.dims;
+        let mut magic = [0u8; 2];
+        let magic = file.read_exact(&mut magic).is_ok().then_some(magic);
+        checked.size(&path, meta.len(), magic)?;
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_else(|| p.file.clone());
-        out.begin(&GridInfo {
-            world_from_index: [
-                spacing[0], 0.0, 0.0, origin[0], //
-                0.0, spacing[1], 0.0, origin[1], //
-                0.0, 0.0, spacing[2], origin[2],
-            ],
-            background: 0.0,
-            index_min: [0; 3],
-            index_max: d.map(|n| (n - 1) as i64),
-            name,
-        })?;
-        stream(&mut file, &path, &layout, out, BLOCK_VOXELS)
+        checked.decode(name, &mut file, &path, out, BLOCK_VOXELS)
     }
 }
 
 /// Reads the voxels block by block and hands each to the host.
 fn stream(
-    file: &mut File,
+    file: &mut (impl Read + Seek),
     path: &Path,
     layout: &Layout,
-    out: &mut VolumeOut,
+    out: &mut impl Blocks,
     budget: u64,
 ) -> Result<(), Error> {
     let [nx, ny, nz] = layout.dims;
@@ -794,6 +866,49 @@ mod tests {
             .blocks
             .iter()
             .all(|(_, d)| d[0] * d[1] * d[2] <= BLOCK_VOXELS));
+    }
+
+    /// Collects what `read_bytes` hands over.
+    #[derive(Default)]
+    struct Collect {
+        info: Option<GridInfo>,
+        values: Vec<f32>,
+    }
+
+    impl Blocks for Collect {
+        fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
+            self.info = Some(info.clone());
+            Ok(())
+        }
+        fn dense(&mut self, _: [i64; 3], _: [u64; 3], values: &[f32]) -> Result<(), Error> {
+            self.values.extend_from_slice(values);
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn read_bytes_decodes_without_a_file_or_the_abi() {
+        let params = r#"(file: "b.raw", dims: (3, 1, 1), format: "u16", endian: "big", header: 2)"#;
+        let bytes = [b'H', b'D', 0, 0, 0x80, 0x00, 0xff, 0xff];
+        let mut got = Collect::default();
+        read_bytes(params, &bytes, &mut got).unwrap();
+        assert_eq!(got.info.unwrap().index_max, [2, 0, 0]);
+        assert_eq!(got.values, [0.0, 32768.0 / 65535.0, 1.0]);
+        // The same checks as for a file: size, parameters.
+        let e = read_bytes(params, &bytes[..7], &mut Collect::default()).unwrap_err();
+        assert!(
+            e.message.contains("expected 8 bytes") && e.message.contains("has 7"),
+            "{}",
+            e.message
+        );
+        let e = read_bytes(
+            "(file: \"x\", dims: (0, 1, 1))",
+            &[],
+            &mut Collect::default(),
+        );
+        assert!(e.unwrap_err().message.contains("at least 1"));
+        let e = read_bytes("(dims: (1, 1, 1))", &[0], &mut Collect::default());
+        assert!(e.unwrap_err().message.contains("missing parameter `file`"));
     }
 
     #[test]
