@@ -209,13 +209,18 @@ impl Bvh {
 }
 
 /// Ray/box slab test; `t_max` is widened by 2·gamma(3) so rounding never culls a box the ray
-/// really touches (Ize 2013). Zero direction components give ±inf reciprocals, which work.
+/// really touches (Ize 2013). Zero direction components give ±inf reciprocals, which work,
+/// except when the origin lies exactly in a face plane on that axis: 0 · ∞ is NaN there, and
+/// the ray, parallel to the face and in its plane, is inside that slab for every t.
 #[inline(always)]
 fn slab(node: &Node, origin: Vec3A, inv: Vec3A, t_max: f32) -> bool {
     let t0 = (Vec3A::from(node.min) - origin) * inv;
     let t1 = (Vec3A::from(node.max) - origin) * inv;
-    let near = t0.min(t1).max_element().max(0.0);
-    let far = t0.max(t1).min_element().min(t_max) * (1.0 + 2.0 * gamma(3));
+    let defined = t0.cmpeq(t0) & t1.cmpeq(t1);
+    let lo = Vec3A::select(defined, t0.min(t1), Vec3A::NEG_INFINITY);
+    let hi = Vec3A::select(defined, t0.max(t1), Vec3A::INFINITY);
+    let near = lo.max_element().max(0.0);
+    let far = hi.min_element().min(t_max) * (1.0 + 2.0 * gamma(3));
     near <= far
 }
 
@@ -399,6 +404,40 @@ mod tests {
                 Aabb::new(c - 0.5, c + 0.5)
             })
             .collect()
+    }
+
+    /// Rays parallel to box faces, lying exactly in a face's plane: 0 · ∞ in the slab test
+    /// must not make the ray miss (or skip) the box.
+    #[test]
+    fn rays_in_the_plane_of_a_face_enter_the_box() {
+        let unit = Aabb::new(Vec3A::ZERO, Vec3A::ONE);
+        let flat = Aabb::new(Vec3A::new(0.0, 0.0, 0.0), Vec3A::new(1.0, 0.0, 1.0));
+        for b in [unit, flat] {
+            let (bvh, _) = Bvh::build(&[b]);
+            for (o, d) in [
+                ([-1.0, 0.0, 0.5], [1.0, 0.0, 0.0]),
+                ([-1.0, 0.0, 0.5], [1.0, -0.0, 0.0]),
+                ([2.0, 0.0, 0.5], [-1.0, -0.0, 0.0]),
+                ([-1.0, 0.0, 0.0], [1.0, 0.0, -0.0]),
+                ([0.5, 0.0, -1.0], [0.0, 0.0, 1.0]),
+                ([0.5, 0.0, -1.0], [-0.0, -0.0, 1.0]),
+            ] {
+                let (o, d) = (Vec3A::from(o), Vec3A::from(d));
+                let mut called = false;
+                bvh.intersect(o, d, f32::INFINITY, |_, _| {
+                    called = true;
+                    None
+                });
+                assert!(called, "closest-hit skipped {b:?} for {o} {d}");
+                assert!(
+                    bvh.any(o, d, f32::INFINITY, |_| true),
+                    "any-hit skipped {b:?}"
+                );
+            }
+            // Parallel, in neither face's plane and outside: culled.
+            let o = Vec3A::new(-1.0, 2.0, 0.5);
+            assert!(!bvh.any(o, Vec3A::X, f32::INFINITY, |_| true));
+        }
     }
 
     #[test]

@@ -9,6 +9,9 @@ pub mod set;
 pub mod sphere;
 pub mod triangle;
 
+#[cfg(test)]
+mod props;
+
 use crate::math::Vec3A;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -841,3 +841,84 @@ mod tests {
             .is_none());
     }
 }
+
+/// Property tests as the host calls the torus: an f32 render-space ray widened to f64, the hit
+/// kept in f32 with the host's error bound and left through the host's `luxon::ray::spawn`.
+#[cfg(test)]
+mod props {
+    use super::*;
+    use luxon::math::{gamma, Vec3A};
+    use proptest::prelude::*;
+
+    fn unit() -> impl Strategy<Value = Vec3A> {
+        (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
+            .prop_filter("not too short", |(x, y, z)| x * x + y * y + z * z > 0.01)
+            .prop_map(|(x, y, z)| Vec3A::new(x, y, z).normalize())
+    }
+
+    fn host_ray(r: &luxon::ray::Ray) -> Ray {
+        Ray {
+            origin: r.origin.as_dvec3().into(),
+            direction: r.dir.as_dvec3().into(),
+            tmin: 0.0,
+            tmax: f32::INFINITY as f64,
+            time: 0.0,
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+
+        /// The hit lies on the surface (relative to its magnitude in f32), the normal is unit
+        /// once normalised, and a ray leaving outward (away from the tube's centre line) does
+        /// not hit the torus again near its start: it can meet the far side of the ring, never
+        /// the surface it leaves.
+        #[test]
+        fn hit_on_surface_and_no_self_hit(e in -3i32..=4, far in prop_oneof![Just(0.0f32), 1.0f32..1e4],
+                                          at_dir in unit(), axis in unit(), minor in 0.05f64..0.9,
+                                          from in unit(), jitter in unit(), leave in unit()) {
+            let scale = 10f64.powi(e);
+            let pos = far * at_dir;
+            let t = Torus::new(&TorusParams {
+                center: pos.as_dvec3().into(),
+                axis: axis.as_dvec3().into(),
+                major: scale,
+                minor: minor * scale,
+            }).unwrap();
+            let o = pos + (4.0 * scale) as f32 * from;
+            let target = pos + jitter * scale as f32;
+            let r = luxon::ray::Ray::new(o, (target - o).normalize(), 0.0);
+            let Some(h) = t.intersect(0, &host_ray(&r)) else { return Ok(()); };
+            let p = r.at(h.t as f32);
+            let pd: V3 = p.as_dvec3().into();
+            let mag = pd.iter().fold(scale, |m, v| m.max(v.abs()));
+            let d = tests_distance(&t, pd);
+            prop_assert!(d.abs() <= mag / 65536.0, "{pd:?} is {d} off the surface");
+            let n = luxon::math::DVec3::from(h.normal).normalize_or_zero().as_vec3();
+            prop_assert!((n.length() - 1.0).abs() < 1e-5);
+            // Outward from the tube.
+            let rel = sub(pd, t.center);
+            let z = dot(rel, t.w);
+            let ring = sub(rel, mul(t.w, z));
+            let spine = mul(normalize(ring).unwrap(), t.major);
+            let out = Vec3A::from(luxon::math::DVec3::from(sub(rel, spine)).normalize().as_vec3());
+            let n = if Vec3A::from(n).dot(out) < 0.0 { -Vec3A::from(n) } else { Vec3A::from(n) };
+            let p_error = gamma(64) * (p.abs() + r.origin.abs());
+            let mut dir = if leave.dot(n) < 0.0 { leave - 2.0 * leave.dot(n) * n } else { leave };
+            dir = (dir + 0.05 * n).normalize();
+            let spawned = luxon::ray::spawn(p, p_error, n, dir, 0.0);
+            if let Some(again) = t.intersect(0, &host_ray(&spawned)) {
+                prop_assert!(again.t > 1e-3 * t.minor, "left {pd:?} along {dir}, hit again at {}", again.t);
+            }
+        }
+    }
+
+    /// Signed distance to the surface, independent of the solver.
+    fn tests_distance(t: &Torus, world: V3) -> f64 {
+        let rel = sub(world, t.center);
+        let z = dot(rel, t.w);
+        let ring = sub(rel, mul(t.w, z));
+        let rho = dot(ring, ring).sqrt();
+        (rho - t.major).hypot(z) - t.minor
+    }
+}

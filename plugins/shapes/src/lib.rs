@@ -625,6 +625,9 @@ impl Primitive for MeshEntry {
 mod cones;
 pub use cones::{Cone, Cylinder, Polycylinder, Ring};
 mod solids;
+
+#[cfg(test)]
+mod props;
 pub use solids::{BoxEntry, Heightfield, InfiniteCylinder, Quadric};
 
 luxon_plugin::export!(

@@ -69,6 +69,9 @@ use std::fs::File;
 use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::path::Path;
 
+/// The first bytes of every gzip stream.
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
 /// The most voxels read and converted at once (one dense block handed to the host).
 const BLOCK_VOXELS: u64 = 1 << 20;
 
@@ -311,11 +314,35 @@ fn open_error(path: &Path, e: std::io::Error) -> Error {
     }
 }
 
-impl VolumeReader for Raw {
-    type Params = RawParams;
+/// Where decoded blocks go: the host (through the plugin ABI) or, for tools, tests and the
+/// fuzz targets, anything else.
+pub trait Blocks {
+    fn begin(&mut self, info: &GridInfo) -> Result<(), Error>;
+    /// A dense block, x fastest.
+    fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error>;
+}
 
-    fn read(p: RawParams, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
-        let (layout, expected) = Layout::new(&p)?;
+impl Blocks for VolumeOut<'_> {
+    fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
+        VolumeOut::begin(self, info)
+    }
+
+    fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error> {
+        VolumeOut::dense(self, origin, dims, values)
+    }
+}
+
+/// Parameters checked, without the file: its expected size and the grid's map.
+struct Checked {
+    layout: Layout,
+    expected: u64,
+    spacing: [f64; 3],
+    origin: [f64; 3],
+}
+
+impl Checked {
+    fn new(p: &RawParams) -> Result<Checked, Error> {
+        let (layout, expected) = Layout::new(p)?;
         let spacing = finite("spacing", p.spacing)?;
         if spacing.iter().any(|&s| s <= 0.0) {
             return Err(invalid(format!(
@@ -328,6 +355,119 @@ impl VolumeReader for Raw {
                 "parameter `file` is empty; expected the path of a raw file",
             ));
         }
+        Ok(Checked {
+            layout,
+            expected,
+            spacing,
+            origin,
+        })
+    }
+
+    /// The size error, or nothing when `actual` is the expected size.
+    fn size(&self, path: &Path, actual: u64) -> Result<(), Error> {
+        if actual == self.expected {
+            return Ok(());
+        }
+        let layout = &self.layout;
+        Err(invalid(format!(
+            "`{}`: expected {} bytes for {} {} voxels plus a {}-byte header, the file has {actual}",
+            path.display(),
+            self.expected,
+            dims_text(layout.dims),
+            layout.format.name(),
+            layout.header
+        )))
+    }
+
+    /// The decompressed bytes of a gzip stream, which must be exactly the expected size
+    /// (checked without ever holding more than one byte beyond it).
+    fn gunzip(&self, source: impl Read, path: &Path) -> Result<Vec<u8>, Error> {
+        let (layout, expected) = (&self.layout, self.expected);
+        let mut bytes = Vec::new();
+        flate2::read::MultiGzDecoder::new(std::io::BufReader::new(source))
+            .take(expected.saturating_add(1))
+            .read_to_end(&mut bytes)
+            .map_err(|e| {
+                invalid(format!(
+                    "`{}` is gzip-compressed but cannot be decompressed: {e}",
+                    path.display()
+                ))
+            })?;
+        if bytes.len() as u64 != expected {
+            let actual = if bytes.len() as u64 > expected {
+                "more".to_string()
+            } else {
+                bytes.len().to_string()
+            };
+            return Err(invalid(format!(
+                "`{}` (gzip-compressed): expected {expected} decompressed bytes for {} {} voxels \
+                 plus a {}-byte header, it decompresses to {actual}",
+                path.display(),
+                dims_text(layout.dims),
+                layout.format.name(),
+                layout.header
+            )));
+        }
+        Ok(bytes)
+    }
+
+    /// Announces the grid and streams the voxels of `source` (of the expected size).
+    fn decode(
+        &self,
+        name: String,
+        source: &mut (impl Read + Seek),
+        path: &Path,
+        out: &mut impl Blocks,
+        budget: u64,
+    ) -> Result<(), Error> {
+        let (spacing, origin) = (self.spacing, self.origin);
+        out.begin(&GridInfo {
+            world_from_index: [
+                spacing[0], 0.0, 0.0, origin[0], //
+                0.0, spacing[1], 0.0, origin[1], //
+                0.0, 0.0, spacing[2], origin[2],
+            ],
+            background: 0.0,
+            index_min: [0; 3],
+            index_max: self.layout.dims.map(|n| (n - 1) as i64),
+            name,
+        })?;
+        stream(source, path, &self.layout, out, budget)
+    }
+}
+
+/// Reads a raw volume held in memory: `params` as in a scene (RON text; `file` only names the
+/// grid and messages), `bytes` the file's content. The reader's whole parsing without the
+/// plugin ABI or a file, for tools and fuzzing.
+pub fn read_bytes(params: &str, bytes: &[u8], out: &mut impl Blocks) -> Result<(), Error> {
+    let p: RawParams = luxon_plugin::parse_params(params)?;
+    let checked = Checked::new(&p)?;
+    let path = Path::new(&p.file);
+    if bytes.starts_with(&GZIP_MAGIC) {
+        let unzipped = checked.gunzip(bytes, path)?;
+        return checked.decode(
+            p.file.clone(),
+            &mut Cursor::new(unzipped),
+            path,
+            out,
+            BLOCK_VOXELS,
+        );
+    }
+    checked.size(path, bytes.len() as u64)?;
+    checked.decode(
+        p.file.clone(),
+        &mut Cursor::new(bytes),
+        path,
+        out,
+        BLOCK_VOXELS,
+    )
+}
+
+impl VolumeReader for Raw {
+    type Params = RawParams;
+
+    fn read(p: RawParams, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
+        let checked = Checked::new(&p)?;
         let path = ctx.resolve(&p.file);
         let mut file = File::open(&path).map_err(|e| open_error(&path, e))?;
         let meta = file
@@ -340,86 +480,29 @@ impl VolumeReader for Raw {
             )));
         }
         let mut magic = [0u8; 2];
-        let gzip = file.read_exact(&mut magic).is_ok() && magic == [0x1f, 0x8b];
+        let gzip = file.read_exact(&mut magic).is_ok() && magic == GZIP_MAGIC;
         file.seek(SeekFrom::Start(0))
             .map_err(|e| invalid(format!("cannot read `{}`: {e}", path.display())))?;
-        let unzipped = if gzip {
-            Some(gunzip(&mut file, &path, &layout, expected)?)
-        } else {
-            let actual = meta.len();
-            if actual != expected {
-                return Err(invalid(format!(
-                    "`{}`: expected {expected} bytes for {} {} voxels plus a {}-byte header, the \
-                     file has {actual}",
-                    path.display(),
-                    dims_text(layout.dims),
-                    layout.format.name(),
-                    layout.header
-                )));
-            }
-            None
-        };
-
-        let d = layout.dims;
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_else(|| p.file.clone());
-        out.begin(&GridInfo {
-            world_from_index: [
-                spacing[0], 0.0, 0.0, origin[0], //
-                0.0, spacing[1], 0.0, origin[1], //
-                0.0, 0.0, spacing[2], origin[2],
-            ],
-            background: 0.0,
-            index_min: [0; 3],
-            index_max: d.map(|n| (n - 1) as i64),
-            name,
-        })?;
-        match unzipped {
-            Some(bytes) => stream(&mut Cursor::new(bytes), &path, &layout, out, BLOCK_VOXELS),
-            None => stream(&mut file, &path, &layout, out, BLOCK_VOXELS),
+        if gzip {
+            let bytes = checked.gunzip(&mut file, &path)?;
+            checked.decode(name, &mut Cursor::new(bytes), &path, out, BLOCK_VOXELS)
+        } else {
+            checked.size(&path, meta.len())?;
+            checked.decode(name, &mut file, &path, out, BLOCK_VOXELS)
         }
     }
 }
 
-/// The decompressed bytes of a gzip file, which must be exactly `expected` long.
-fn gunzip(file: &mut File, path: &Path, layout: &Layout, expected: u64) -> Result<Vec<u8>, Error> {
-    let mut bytes = Vec::new();
-    // One byte more than expected is enough to tell that the file is too long.
-    flate2::read::MultiGzDecoder::new(std::io::BufReader::new(file))
-        .take(expected.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(|e| {
-            invalid(format!(
-                "`{}` is gzip-compressed but cannot be decompressed: {e}",
-                path.display()
-            ))
-        })?;
-    if bytes.len() as u64 != expected {
-        let actual = if bytes.len() as u64 > expected {
-            "more".to_string()
-        } else {
-            bytes.len().to_string()
-        };
-        return Err(invalid(format!(
-            "`{}` (gzip-compressed): expected {expected} decompressed bytes for {} {} voxels \
-             plus a {}-byte header, it decompresses to {actual}",
-            path.display(),
-            dims_text(layout.dims),
-            layout.format.name(),
-            layout.header
-        )));
-    }
-    Ok(bytes)
-}
-
 /// Reads the voxels block by block and hands each to the host.
-fn stream<R: Read + Seek>(
-    file: &mut R,
+fn stream(
+    file: &mut (impl Read + Seek),
     path: &Path,
     layout: &Layout,
-    out: &mut VolumeOut,
+    out: &mut impl Blocks,
     budget: u64,
 ) -> Result<(), Error> {
     let [nx, ny, nz] = layout.dims;
@@ -878,6 +961,49 @@ mod tests {
             .blocks
             .iter()
             .all(|(_, d)| d[0] * d[1] * d[2] <= BLOCK_VOXELS));
+    }
+
+    /// Collects what `read_bytes` hands over.
+    #[derive(Default)]
+    struct Collect {
+        info: Option<GridInfo>,
+        values: Vec<f32>,
+    }
+
+    impl Blocks for Collect {
+        fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
+            self.info = Some(info.clone());
+            Ok(())
+        }
+        fn dense(&mut self, _: [i64; 3], _: [u64; 3], values: &[f32]) -> Result<(), Error> {
+            self.values.extend_from_slice(values);
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn read_bytes_decodes_without_a_file_or_the_abi() {
+        let params = r#"(file: "b.raw", dims: (3, 1, 1), format: "u16", endian: "big", header: 2)"#;
+        let bytes = [b'H', b'D', 0, 0, 0x80, 0x00, 0xff, 0xff];
+        let mut got = Collect::default();
+        read_bytes(params, &bytes, &mut got).unwrap();
+        assert_eq!(got.info.unwrap().index_max, [2, 0, 0]);
+        assert_eq!(got.values, [0.0, 32768.0 / 65535.0, 1.0]);
+        // The same checks as for a file: size, parameters.
+        let e = read_bytes(params, &bytes[..7], &mut Collect::default()).unwrap_err();
+        assert!(
+            e.message.contains("expected 8 bytes") && e.message.contains("has 7"),
+            "{}",
+            e.message
+        );
+        let e = read_bytes(
+            "(file: \"x\", dims: (0, 1, 1))",
+            &[],
+            &mut Collect::default(),
+        );
+        assert!(e.unwrap_err().message.contains("at least 1"));
+        let e = read_bytes("(dims: (1, 1, 1))", &[0], &mut Collect::default());
+        assert!(e.unwrap_err().message.contains("missing parameter `file`"));
     }
 
     #[test]

@@ -1,0 +1,264 @@
+//! Property tests of every native intersection routine, through the same calls a render makes
+//! (`intersect`, then `surface`, then `ray::spawn`):
+//!
+//! - the hit point lies on the surface, within a bound relative to its magnitude;
+//! - the geometric and shading normals are unit length;
+//! - a ray spawned at the hit point and sent away from the surface (into the outward
+//!   hemisphere of a convex shape, either side of a flat one) does not hit it again.
+//!
+//! Shapes and rays span scales from 1e-3 to 1e4 and positions up to 1e4 away from the origin.
+
+use super::cone::Cone;
+use super::disc::Disc;
+use super::plane::Planes;
+use super::set::{Set, Shape};
+use super::sphere::Sphere;
+use super::triangle::{MeshInput, Triangles};
+use super::{Clips, Counters, Hit, Surface};
+use crate::math::{DVec3, Vec3A};
+use crate::ray::{spawn, Ray};
+use glam::Vec3;
+use proptest::prelude::*;
+
+/// Relative tolerance for "on the surface": f32 carries 2^-24; points are re-projected or
+/// interpolated with a few roundings, so 2^-16 of the magnitude is a generous, meaningful bound.
+const ON_SURFACE: f64 = 1.0 / 65536.0;
+
+fn cases() -> ProptestConfig {
+    ProptestConfig::with_cases(512)
+}
+
+fn unit() -> impl Strategy<Value = Vec3A> {
+    (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
+        .prop_filter("not too short", |(x, y, z)| x * x + y * y + z * z > 0.01)
+        .prop_map(|(x, y, z)| Vec3A::new(x, y, z).normalize())
+}
+
+/// A length scale and a far-away position: the scene's size and where it sits.
+fn placement() -> impl Strategy<Value = (f32, Vec3A)> {
+    (-3i32..=4, prop_oneof![Just(0.0f32), 1.0f32..1e4], unit()).prop_map(|(e, far, dir)| {
+        let scale = 10f32.powi(e);
+        (scale, far * dir)
+    })
+}
+
+/// Whether a shape of size `scale` at `pos` is resolved by f32 coordinates well enough that a
+/// ray aimed at its inside (with the aim point rounded to f32) must hit it.
+fn resolved(scale: f32, pos: Vec3A) -> bool {
+    scale > 1e-3 * pos.abs().max_element()
+}
+
+/// A ray from a point about `4 * scale` from `target`, aimed at `target + jitter`.
+fn ray_at(target: Vec3A, scale: f32, from: Vec3A, jitter: Vec3A) -> Ray {
+    let o = target + 4.0 * scale * from;
+    let aim = target + jitter * scale;
+    Ray::new(o, (aim - o).normalize(), 0.0)
+}
+
+/// Closest hit of a one-primitive set.
+fn first_hit<S: Shape>(set: &Set<S>, ray: &Ray) -> Option<Hit> {
+    let (mut t, mut hit) = (f32::INFINITY, None);
+    set.intersect(
+        ray,
+        &mut t,
+        &mut hit,
+        &Clips::default(),
+        &mut Counters::default(),
+    );
+    hit
+}
+
+/// A direction in the hemisphere around `n` (or its opposite), not grazing: what a reflected
+/// or refracted ray leaving the surface looks like.
+fn away(n: Vec3A, d: Vec3A, side: f32) -> Vec3A {
+    let n = n * side;
+    let d = if d.dot(n) < 0.0 {
+        d - 2.0 * d.dot(n) * n
+    } else {
+        d
+    };
+    (d + 0.05 * n).normalize()
+}
+
+fn check_normals(s: &Surface) -> Result<(), TestCaseError> {
+    prop_assert!(
+        (s.ng.length() - 1.0).abs() < 1e-5,
+        "|ng| = {}",
+        s.ng.length()
+    );
+    prop_assert!(
+        (s.ns.length() - 1.0).abs() < 1e-5,
+        "|ns| = {}",
+        s.ns.length()
+    );
+    prop_assert!(s.p.is_finite() && s.p_error.is_finite());
+    Ok(())
+}
+
+/// Checks the three properties of a hit on a one-primitive set. `distance(p)`: distance of a
+/// point from the surface (f64); `size`: the shape's magnitude (added to |p| for the bound);
+/// `convex`: leave only into the outward hemisphere of the normal (else either side).
+// One place for the three properties; the arguments are what differs between the shapes.
+#[allow(clippy::too_many_arguments)]
+fn check_hit<S: Shape>(
+    set: &Set<S>,
+    ray: &Ray,
+    surface: impl Fn(&Hit, &Ray) -> Surface,
+    distance: impl Fn(DVec3) -> f64,
+    size: f64,
+    convex: bool,
+    leave: Vec3A,
+    must_hit: bool,
+) -> Result<(), TestCaseError> {
+    let Some(hit) = first_hit(set, ray) else {
+        prop_assert!(!must_hit, "the ray missed");
+        return Ok(());
+    };
+    let s = surface(&hit, ray);
+    check_normals(&s)?;
+    let p = s.p.as_dvec3();
+    let bound = ON_SURFACE * (p.abs().max_element() + size);
+    let dist = distance(p);
+    prop_assert!(
+        dist <= bound,
+        "off the surface by {dist} (bound {bound}) at {p}"
+    );
+    for side in [1.0, -1.0] {
+        if convex && side < 0.0 {
+            continue;
+        }
+        let dir = away(s.ng, leave, side);
+        let r = spawn(s.p, s.p_error, s.ng, dir, 0.0);
+        let again = first_hit(set, &r);
+        prop_assert!(
+            again.is_none(),
+            "a ray leaving {p} along {dir} hit the surface again at t = {:?}",
+            again.map(|h| h.t)
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(cases())]
+
+    #[test]
+    fn sphere((scale, pos) in placement(), r in 0.1f32..2.0, from in unit(), jitter in unit(),
+              leave in unit(), k in 0.0f32..1.2) {
+        let radius = r * scale;
+        let mut set = Set::<Sphere>::default();
+        set.push(Sphere { center: pos.into(), radius }, 0);
+        set.build();
+        let ray = ray_at(pos, scale, from * (r + 1.0), jitter * k * r);
+        let (c, rd) = (pos.as_dvec3(), radius as f64);
+        check_hit(&set, &ray, |h, r| set.surface(h, r), |p| ((p - c).length() - rd).abs(),
+                  rd + c.abs().max_element(), true, leave, k < 0.9 && resolved(scale, pos))?;
+    }
+
+    #[test]
+    fn triangle((scale, pos) in placement(), a in unit(), b in unit(), c in unit(),
+                from in unit(), w in (0.0f32..1.0, 0.0f32..1.0), leave in unit()) {
+        let v = [pos + a * scale, pos + b * scale, pos + c * scale];
+        let e1 = (v[1] - v[0]).as_dvec3();
+        let e2 = (v[2] - v[0]).as_dvec3();
+        let n = e1.cross(e2);
+        prop_assume!(n.length() > 1e-3 * e1.length() * e2.length());
+        let positions: Vec<f64> = v.iter().flat_map(|p| p.to_array().map(f64::from)).collect();
+        let mut tris = Triangles::default();
+        let mesh = MeshInput {
+            positions: &positions, indices: &[0, 1, 2], normals: &[], colors: &[], uvs: &[],
+        };
+        prop_assert_eq!(tris.push_mesh(&mesh, DVec3::ZERO, 0).unwrap(), 0);
+        tris.set.build();
+        // Aim inside the triangle (barycentric weights folded into the triangle).
+        let (mut u, mut t) = w;
+        if u + t > 1.0 { (u, t) = (1.0 - u, 1.0 - t); }
+        let target = v[0] + u * (v[1] - v[0]) + t * (v[2] - v[0]);
+        let ray = ray_at(target, scale, from, Vec3A::ZERO);
+        let (p0, nn) = (v[0].as_dvec3(), n.normalize());
+        let size = v.iter().map(|p| p.abs().max_element()).fold(0.0, f32::max) as f64;
+        let inside = u > 0.05 && t > 0.05 && u + t < 0.95 && ray.dir.as_dvec3().dot(nn).abs() > 0.05
+            && resolved(scale, pos);
+        check_hit(&tris.set, &ray, |h, _| tris.surface(h), |p| (p - p0).dot(nn).abs(), size,
+                  false, leave, inside)?;
+    }
+
+    #[test]
+    fn cone_and_cylinder((scale, pos) in placement(), axis in unit(), len in 0.2f32..3.0,
+                         rb in 0.0f32..1.5, ra in 0.0f32..1.5, cylinder in any::<bool>(),
+                         from in unit(), s in 0.0f32..1.0, around in unit(), leave in unit()) {
+        prop_assume!(rb + ra > 0.1);
+        let ra = if cylinder { rb.max(0.1) } else { ra };
+        let rb = if cylinder { ra } else { rb };
+        let cone = Cone {
+            base: pos.into(), base_radius: rb * scale,
+            apex: (pos + axis * len * scale).into(), apex_radius: ra * scale,
+        };
+        let mut set = Set::<Cone>::default();
+        set.push(cone, 0);
+        set.build();
+        // Aim at a point of the surface: along the axis at s, out by the radius there.
+        let q = (around - around.dot(axis) * axis).normalize_or_zero();
+        prop_assume!(q != Vec3A::ZERO);
+        let target = pos + axis * (s * len * scale) + q * ((rb + s * (ra - rb)) * scale);
+        let ray = ray_at(target, scale, from, Vec3A::ZERO);
+        let (b, a) = (cone.base.as_dvec3(), cone.apex.as_dvec3());
+        let (rbd, rad) = (cone.base_radius as f64, cone.apex_radius as f64);
+        let distance = |p: DVec3| {
+            let h = (a - b).length();
+            let w = (a - b) / h;
+            let along = (p - b).dot(w);
+            let radial = ((p - b) - along * w).length();
+            let r = rbd + (rad - rbd) * along / h;
+            // Distance to the slanted line, measured across it.
+            (radial - r).abs() * h / (h * h + (rad - rbd).powi(2)).sqrt()
+        };
+        let size = (rbd.max(rad) + b.abs().max_element()).max(a.abs().max_element());
+        check_hit(&set, &ray, |h, r| set.surface(h, r), distance, size, true, leave, false)?;
+    }
+
+    #[test]
+    fn disc_and_ring((scale, pos) in placement(), n in unit(), inner in 0.0f32..0.8,
+                     width in 0.1f32..2.0, from in unit(), jitter in unit(), leave in unit()) {
+        let disc = Disc {
+            center: pos.into(), normal: n.into(),
+            inner: inner * scale, outer: (inner + width) * scale,
+        };
+        let mut set = Set::<Disc>::default();
+        set.push(disc, 0);
+        set.build();
+        let ray = ray_at(pos, scale, from, jitter * (inner + width));
+        let c = pos.as_dvec3();
+        let nd = Vec3::from(n).as_dvec3();
+        check_hit(&set, &ray, |h, r| set.surface(h, r), |p| (p - c).dot(nd).abs(),
+                  c.abs().max_element() + (disc.outer as f64), false, leave, false)?;
+    }
+
+    #[test]
+    fn plane((scale, pos) in placement(), n in unit(), from in unit(), jitter in unit(),
+             leave in unit(), len in 0.5f64..100.0) {
+        let mut planes = Planes::default();
+        let nn = n.as_dvec3() * len;
+        let p = pos.as_dvec3();
+        planes.push_world(0, [p.x, p.y, p.z, nn.x, nn.y, nn.z], DVec3::ZERO, 0).unwrap();
+        let ray = ray_at(pos, scale, from, jitter);
+        let hit_of = |r: &Ray| {
+            let (mut t, mut hit) = (f32::INFINITY, None);
+            planes.intersect(r, &mut t, &mut hit, &Clips::default(), &mut Counters::default());
+            hit
+        };
+        let Some(hit) = hit_of(&ray) else { return Ok(()); };
+        let s = planes.surface(&hit, &ray);
+        check_normals(&s)?;
+        let pn = planes.planes[0].normal.as_dvec3();
+        let point = planes.planes[0].point.as_dvec3();
+        let q = s.p.as_dvec3();
+        let bound = ON_SURFACE * (q.abs().max_element() + point.abs().max_element());
+        prop_assert!((q - point).dot(pn).abs() <= bound, "off the plane at {q}");
+        for side in [1.0, -1.0] {
+            let dir = away(s.ng, leave, side);
+            let again = hit_of(&spawn(s.p, s.p_error, s.ng, dir, 0.0));
+            prop_assert!(again.is_none(), "left {q} along {dir} and hit the plane again");
+        }
+    }
+}
