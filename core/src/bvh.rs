@@ -35,49 +35,114 @@ pub struct Bvh {
     nodes: Vec<Node>,
 }
 
-enum BuildNode {
-    Leaf {
-        bounds: Aabb,
-        start: usize,
-        count: usize,
-    },
-    Inner {
-        bounds: Aabb,
-        axis: u8,
-        children: Box<(BuildNode, BuildNode)>,
-    },
+/// 28 bytes (a million-triangle build holds one per triangle): the centroid is recomputed
+/// from the bounds where needed.
+#[derive(Clone, Copy)]
+struct BuildPrim {
+    min: [f32; 3],
+    max: [f32; 3],
+    index: u32,
 }
 
-struct BuildPrim {
-    bounds: Aabb,
-    centroid: Vec3A,
-    index: u32,
+impl BuildPrim {
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        Aabb::new(self.min.into(), self.max.into())
+    }
+
+    #[inline(always)]
+    fn centroid(&self, axis: usize) -> f32 {
+        (self.min[axis] + self.max[axis]) * 0.5
+    }
+
+    #[inline(always)]
+    fn center(&self) -> Vec3A {
+        self.bounds().centroid()
+    }
 }
 
 impl Bvh {
     /// Builds over the given primitive bounds; returns the BVH and the leaf order.
     pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<u32>) {
-        assert!(
-            bounds.len() < u32::MAX as usize,
-            "too many primitives for one BVH"
-        );
-        if bounds.is_empty() {
+        Bvh::build_with(bounds.len(), |i| bounds[i])
+    }
+
+    /// Builds over primitives `0..n` whose bounds `bound(i)` gives (no array of bounds is kept
+    /// alongside the build's own).
+    pub fn build_with(n: usize, bound: impl Fn(usize) -> Aabb + Sync) -> (Bvh, Vec<u32>) {
+        use rayon::prelude::*;
+        assert!(n < u32::MAX as usize, "too many primitives for one BVH");
+        if n == 0 {
             return (Bvh::default(), Vec::new());
         }
-        let mut prims: Vec<BuildPrim> = bounds
-            .iter()
-            .enumerate()
-            .map(|(i, b)| BuildPrim {
-                bounds: *b,
-                centroid: b.centroid(),
-                index: i as u32,
+        let mut prims: Vec<BuildPrim> = (0..n)
+            .into_par_iter()
+            .with_min_len(PARALLEL_CUTOFF)
+            .map(|i| {
+                let b = bound(i);
+                BuildPrim {
+                    min: b.min.into(),
+                    max: b.max.into(),
+                    index: i as u32,
+                }
             })
             .collect();
-        let root = build_node(&mut prims, 0, 0);
-        let mut nodes = Vec::with_capacity(2 * bounds.len() / MAX_LEAF.max(1) + 1);
-        flatten(&root, &mut nodes);
+        let mut nodes = Vec::new();
+        build_node(&mut prims, 0, 0, &mut nodes);
+        nodes.shrink_to_fit();
         let order = prims.iter().map(|p| p.index).collect();
         (Bvh { nodes }, order)
+    }
+
+    /// The nodes as little-endian-ready words, 8 per node (for the geometry cache).
+    pub(crate) fn to_words(&self, out: &mut impl FnMut(u32)) {
+        for n in &self.nodes {
+            n.min.iter().for_each(|x| out(x.to_bits()));
+            out(n.offset);
+            n.max.iter().for_each(|x| out(x.to_bits()));
+            out(n.count as u32 | (n.axis as u32) << 16);
+        }
+    }
+
+    /// Nodes read back from `to_words`, checked against `prims` primitives: every link and
+    /// leaf range in bounds, links pointing forward (so traversal ends), axes valid.
+    pub(crate) fn from_words(w: &[u32], prims: usize) -> Option<Bvh> {
+        if !w.len().is_multiple_of(8) || (w.is_empty() != (prims == 0)) {
+            return None;
+        }
+        let n = w.len() / 8;
+        let mut nodes = Vec::with_capacity(n);
+        // Depth of every node, so that traversal's fixed stack suffices.
+        let mut depth = vec![0u16; n];
+        for (i, c) in w.chunks_exact(8).enumerate() {
+            let f = |k: usize| f32::from_bits(c[k]);
+            let (count, axis) = (c[7] & 0xffff, c[7] >> 16);
+            let node = Node {
+                min: [f(0), f(1), f(2)],
+                offset: c[3],
+                max: [f(4), f(5), f(6)],
+                count: count as u16,
+                axis: axis as u8,
+                _pad: 0,
+            };
+            let ok = if count > 0 {
+                count as usize <= MAX_LEAF && node.offset as usize + count as usize <= prims
+            } else {
+                axis < 3
+                    && (node.offset as usize) > i + 1
+                    && (node.offset as usize) < n
+                    && i + 1 < n
+            };
+            if !ok || depth[i] as usize >= STACK - 1 {
+                return None;
+            }
+            if count == 0 {
+                depth[i + 1] = depth[i] + 1;
+                depth[node.offset as usize] = depth[i] + 1;
+            }
+            nodes.push(node);
+        }
+        Some(Bvh { nodes })
     }
 
     pub fn node_count(&self) -> usize {
@@ -194,17 +259,16 @@ fn slab(node: &Node, origin: Vec3A, inv: Vec3A, t_max: f32) -> bool {
     near <= far
 }
 
-fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+/// Builds the subtree over `prims` (the primitives `start..start + prims.len()` of the final
+/// order) depth-first into `out`: its root is the node pushed first, a node's first child
+/// follows it.
+fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec<Node>) {
+    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds()));
     let n = prims.len();
     if n <= 2 {
-        return BuildNode::Leaf {
-            bounds,
-            start,
-            count: n,
-        };
+        return leaf(out, bounds, start, n);
     }
-    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.center()));
     let extent = cb.max - cb.min;
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
@@ -215,7 +279,7 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode 
     };
     if extent[axis] <= 0.0 || !extent[axis].is_finite() || depth >= MAX_SAH_DEPTH {
         // All centroids coincide (or the tree is already deep): split by count.
-        return split_middle(prims, start, bounds, axis, n, depth);
+        return split_middle(prims, start, bounds, axis, n, depth, out);
     }
 
     // Bin centroids along the widest axis and sweep for the cheapest split.
@@ -225,8 +289,8 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode 
     let mut bin_bounds = [Aabb::EMPTY; BINS];
     let mut bin_count = [0usize; BINS];
     for p in prims.iter() {
-        let b = bin_of(p.centroid[axis]);
-        bin_bounds[b] = bin_bounds[b].union(p.bounds);
+        let b = bin_of(p.centroid(axis));
+        bin_bounds[b] = bin_bounds[b].union(p.bounds());
         bin_count[b] += 1;
     }
     let mut right_area = [0.0f32; BINS];
@@ -255,19 +319,15 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode 
     let split_cost = TRAVERSAL_COST + best.0 / bounds.half_area().max(f32::MIN_POSITIVE);
     if best.1 == 0 || (n <= MAX_LEAF && leaf_cost <= split_cost) {
         if n <= MAX_LEAF {
-            return BuildNode::Leaf {
-                bounds,
-                start,
-                count: n,
-            };
+            return leaf(out, bounds, start, n);
         }
-        return split_middle(prims, start, bounds, axis, n, depth);
+        return split_middle(prims, start, bounds, axis, n, depth, out);
     }
-    let mid = partition(prims, |p| bin_of(p.centroid[axis]) < best.1);
+    let mid = partition(prims, |p| bin_of(p.centroid(axis)) < best.1);
     if mid == 0 || mid == n {
-        return split_middle(prims, start, bounds, axis, n, depth);
+        return split_middle(prims, start, bounds, axis, n, depth, out);
     }
-    children(prims, start, bounds, axis, mid, depth)
+    children(prims, start, bounds, axis, mid, depth, out)
 }
 
 fn split_middle(
@@ -277,21 +337,18 @@ fn split_middle(
     axis: usize,
     n: usize,
     depth: usize,
-) -> BuildNode {
+    out: &mut Vec<Node>,
+) {
     if n <= MAX_LEAF {
-        return BuildNode::Leaf {
-            bounds,
-            start,
-            count: n,
-        };
+        return leaf(out, bounds, start, n);
     }
     let mid = n / 2;
     prims.select_nth_unstable_by(mid, |a, b| {
-        a.centroid[axis]
-            .total_cmp(&b.centroid[axis])
+        a.centroid(axis)
+            .total_cmp(&b.centroid(axis))
             .then(a.index.cmp(&b.index))
     });
-    children(prims, start, bounds, axis, mid, depth)
+    children(prims, start, bounds, axis, mid, depth, out)
 }
 
 fn children(
@@ -301,25 +358,50 @@ fn children(
     axis: usize,
     mid: usize,
     depth: usize,
-) -> BuildNode {
+    out: &mut Vec<Node>,
+) {
     let n = prims.len();
-    let (left, right) = prims.split_at_mut(mid);
-    let (l, r) = if n > PARALLEL_CUTOFF {
-        rayon::join(
-            || build_node(left, start, depth + 1),
-            || build_node(right, start + mid, depth + 1),
-        )
-    } else {
-        (
-            build_node(left, start, depth + 1),
-            build_node(right, start + mid, depth + 1),
-        )
-    };
-    BuildNode::Inner {
-        bounds,
+    let index = out.len();
+    out.push(Node {
+        min: bounds.min.into(),
+        offset: 0,
+        max: bounds.max.into(),
+        count: 0,
         axis: axis as u8,
-        children: Box::new((l, r)),
+        _pad: 0,
+    });
+    let (left, right) = prims.split_at_mut(mid);
+    if n > PARALLEL_CUTOFF {
+        // The second child builds into its own array, appended with its child links shifted.
+        let mut second = Vec::new();
+        rayon::join(
+            || build_node(left, start, depth + 1, out),
+            || build_node(right, start + mid, depth + 1, &mut second),
+        );
+        let base = out.len() as u32;
+        out[index].offset = base;
+        out.extend(second.into_iter().map(|mut node| {
+            if node.count == 0 {
+                node.offset += base;
+            }
+            node
+        }));
+    } else {
+        build_node(left, start, depth + 1, out);
+        out[index].offset = out.len() as u32;
+        build_node(right, start + mid, depth + 1, out);
     }
+}
+
+fn leaf(out: &mut Vec<Node>, bounds: Aabb, start: usize, count: usize) {
+    out.push(Node {
+        min: bounds.min.into(),
+        offset: start as u32,
+        max: bounds.max.into(),
+        count: count as u16,
+        axis: 0,
+        _pad: 0,
+    });
 }
 
 /// Stable-enough in-place partition (order within each side does not matter, but it must be
@@ -333,42 +415,6 @@ fn partition(prims: &mut [BuildPrim], pred: impl Fn(&BuildPrim) -> bool) -> usiz
         }
     }
     i
-}
-
-fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> usize {
-    let index = out.len();
-    match node {
-        BuildNode::Leaf {
-            bounds,
-            start,
-            count,
-        } => out.push(Node {
-            min: bounds.min.into(),
-            offset: *start as u32,
-            max: bounds.max.into(),
-            count: *count as u16,
-            axis: 0,
-            _pad: 0,
-        }),
-        BuildNode::Inner {
-            bounds,
-            axis,
-            children,
-        } => {
-            out.push(Node {
-                min: bounds.min.into(),
-                offset: 0,
-                max: bounds.max.into(),
-                count: 0,
-                axis: *axis,
-                _pad: 0,
-            });
-            flatten(&children.0, out);
-            let second = flatten(&children.1, out);
-            out[index].offset = second as u32;
-        }
-    }
-    index
 }
 
 #[cfg(test)]

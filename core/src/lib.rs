@@ -17,6 +17,7 @@
 //! ```
 
 pub mod bvh;
+pub mod cache;
 pub mod camera;
 pub mod error;
 pub mod framebuffer;
