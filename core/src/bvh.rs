@@ -30,18 +30,26 @@ const OFFSET_BITS: u32 = 48;
 const OFFSET_MASK: u64 = (1 << OFFSET_BITS) - 1;
 
 impl Node {
-    fn new(bounds: &Aabb, offset: usize, count: usize, axis: u8) -> Node {
-        debug_assert!((offset as u64) <= OFFSET_MASK && count <= MAX_LEAF);
+    fn new(bounds: &Aabb, offset: usize, count: usize, axis: usize) -> Node {
         Node {
             min: bounds.min.into(),
             max: bounds.max.into(),
-            link: offset as u64 | (count as u64) << OFFSET_BITS | (axis as u64) << 56,
+            link: Node::pack(offset, count, axis),
         }
+    }
+
+    fn pack(offset: usize, count: usize, axis: usize) -> u64 {
+        debug_assert!((offset as u64) <= OFFSET_MASK && count <= MAX_LEAF && axis < 3);
+        offset as u64 | (count as u64) << OFFSET_BITS | (axis as u64) << 56
     }
 
     #[inline(always)]
     fn offset(&self) -> usize {
         (self.link & OFFSET_MASK) as usize
+    }
+
+    fn set_offset(&mut self, offset: usize) {
+        self.link = Node::pack(offset, self.count(), self.axis());
     }
 
     #[inline(always)]
@@ -62,45 +70,108 @@ pub struct Bvh {
     nodes: Vec<Node>,
 }
 
-enum BuildNode {
-    Leaf {
-        bounds: Aabb,
-        start: usize,
-        count: usize,
-    },
-    Inner {
-        bounds: Aabb,
-        axis: u8,
-        children: Box<(BuildNode, BuildNode)>,
-    },
+/// 32 bytes (a million-triangle build holds one per triangle): the centroid is recomputed
+/// from the bounds where needed.
+#[derive(Clone, Copy)]
+struct BuildPrim {
+    min: [f32; 3],
+    max: [f32; 3],
+    index: u64,
 }
 
-struct BuildPrim {
-    bounds: Aabb,
-    centroid: Vec3A,
-    index: usize,
+impl BuildPrim {
+    #[inline(always)]
+    fn bounds(&self) -> Aabb {
+        Aabb::new(self.min.into(), self.max.into())
+    }
+
+    #[inline(always)]
+    fn centroid(&self, axis: usize) -> f32 {
+        (self.min[axis] + self.max[axis]) * 0.5
+    }
+
+    #[inline(always)]
+    fn center(&self) -> Vec3A {
+        self.bounds().centroid()
+    }
 }
 
 impl Bvh {
     /// Builds over the given primitive bounds; returns the BVH and the leaf order.
-    pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<usize>) {
-        if bounds.is_empty() {
+    pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<u64>) {
+        Bvh::build_with(bounds.len(), |i| bounds[i])
+    }
+
+    /// Builds over primitives `0..n` whose bounds `bound(i)` gives (no array of bounds is kept
+    /// alongside the build's own).
+    pub fn build_with(n: usize, bound: impl Fn(usize) -> Aabb + Sync) -> (Bvh, Vec<u64>) {
+        use rayon::prelude::*;
+        if n == 0 {
             return (Bvh::default(), Vec::new());
         }
-        let mut prims: Vec<BuildPrim> = bounds
-            .iter()
-            .enumerate()
-            .map(|(i, b)| BuildPrim {
-                bounds: *b,
-                centroid: b.centroid(),
-                index: i,
+        let mut prims: Vec<BuildPrim> = (0..n)
+            .into_par_iter()
+            .with_min_len(PARALLEL_CUTOFF)
+            .map(|i| {
+                let b = bound(i);
+                BuildPrim {
+                    min: b.min.into(),
+                    max: b.max.into(),
+                    index: i as u64,
+                }
             })
             .collect();
-        let root = build_node(&mut prims, 0, 0);
-        let mut nodes = Vec::with_capacity(2 * bounds.len() / MAX_LEAF.max(1) + 1);
-        flatten(&root, &mut nodes);
+        let mut nodes = Vec::new();
+        build_node(&mut prims, 0, 0, &mut nodes);
+        nodes.shrink_to_fit();
         let order = prims.iter().map(|p| p.index).collect();
         (Bvh { nodes }, order)
+    }
+
+    /// The nodes as little-endian-ready words, 8 per node (for the geometry cache).
+    pub(crate) fn to_words(&self, out: &mut impl FnMut(u32)) {
+        for n in &self.nodes {
+            n.min.iter().for_each(|x| out(x.to_bits()));
+            out(n.link as u32);
+            n.max.iter().for_each(|x| out(x.to_bits()));
+            out((n.link >> 32) as u32);
+        }
+    }
+
+    /// Nodes read back from `to_words`, checked against `prims` primitives: every link and
+    /// leaf range in bounds, links pointing forward (so traversal ends), axes valid.
+    pub(crate) fn from_words(w: &[u32], prims: usize) -> Option<Bvh> {
+        if !w.len().is_multiple_of(8) || (w.is_empty() != (prims == 0)) {
+            return None;
+        }
+        let n = w.len() / 8;
+        let mut nodes = Vec::with_capacity(n);
+        // Depth of every node, so that traversal's fixed stack suffices.
+        let mut depth = vec![0u16; n];
+        for (i, c) in w.chunks_exact(8).enumerate() {
+            let f = |k: usize| f32::from_bits(c[k]);
+            let node = Node {
+                min: [f(0), f(1), f(2)],
+                max: [f(4), f(5), f(6)],
+                link: u64::from(c[3]) | u64::from(c[7]) << 32,
+            };
+            let (count, axis, offset) = (node.count(), node.axis(), node.offset());
+            let ok = node.link >> 58 == 0
+                && if count > 0 {
+                    count <= MAX_LEAF && offset + count <= prims
+                } else {
+                    axis < 3 && offset > i + 1 && offset < n && i + 1 < n
+                };
+            if !ok || depth[i] as usize >= STACK - 1 {
+                return None;
+            }
+            if count == 0 {
+                depth[i + 1] = depth[i] + 1;
+                depth[offset] = depth[i] + 1;
+            }
+            nodes.push(node);
+        }
+        Some(Bvh { nodes })
     }
 
     pub fn node_count(&self) -> usize {
@@ -224,17 +295,16 @@ fn slab(node: &Node, origin: Vec3A, inv: Vec3A, t_max: f32) -> bool {
     near <= far
 }
 
-fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
+/// Builds the subtree over `prims` (the primitives `start..start + prims.len()` of the final
+/// order) depth-first into `out`: its root is the node pushed first, a node's first child
+/// follows it.
+fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec<Node>) {
+    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds()));
     let n = prims.len();
     if n <= 2 {
-        return BuildNode::Leaf {
-            bounds,
-            start,
-            count: n,
-        };
+        return leaf(out, bounds, start, n);
     }
-    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.center()));
     let extent = cb.max - cb.min;
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
@@ -245,7 +315,7 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode 
     };
     if extent[axis] <= 0.0 || !extent[axis].is_finite() || depth >= MAX_SAH_DEPTH {
         // All centroids coincide (or the tree is already deep): split by count.
-        return split_middle(prims, start, bounds, axis, n, depth);
+        return split_middle(prims, start, bounds, axis, n, depth, out);
     }
 
     // Bin centroids along the widest axis and sweep for the cheapest split.
@@ -255,8 +325,8 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode 
     let mut bin_bounds = [Aabb::EMPTY; BINS];
     let mut bin_count = [0usize; BINS];
     for p in prims.iter() {
-        let b = bin_of(p.centroid[axis]);
-        bin_bounds[b] = bin_bounds[b].union(p.bounds);
+        let b = bin_of(p.centroid(axis));
+        bin_bounds[b] = bin_bounds[b].union(p.bounds());
         bin_count[b] += 1;
     }
     let mut right_area = [0.0f32; BINS];
@@ -285,19 +355,15 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize) -> BuildNode 
     let split_cost = TRAVERSAL_COST + best.0 / bounds.half_area().max(f32::MIN_POSITIVE);
     if best.1 == 0 || (n <= MAX_LEAF && leaf_cost <= split_cost) {
         if n <= MAX_LEAF {
-            return BuildNode::Leaf {
-                bounds,
-                start,
-                count: n,
-            };
+            return leaf(out, bounds, start, n);
         }
-        return split_middle(prims, start, bounds, axis, n, depth);
+        return split_middle(prims, start, bounds, axis, n, depth, out);
     }
-    let mid = partition(prims, |p| bin_of(p.centroid[axis]) < best.1);
+    let mid = partition(prims, |p| bin_of(p.centroid(axis)) < best.1);
     if mid == 0 || mid == n {
-        return split_middle(prims, start, bounds, axis, n, depth);
+        return split_middle(prims, start, bounds, axis, n, depth, out);
     }
-    children(prims, start, bounds, axis, mid, depth)
+    children(prims, start, bounds, axis, mid, depth, out)
 }
 
 fn split_middle(
@@ -307,21 +373,18 @@ fn split_middle(
     axis: usize,
     n: usize,
     depth: usize,
-) -> BuildNode {
+    out: &mut Vec<Node>,
+) {
     if n <= MAX_LEAF {
-        return BuildNode::Leaf {
-            bounds,
-            start,
-            count: n,
-        };
+        return leaf(out, bounds, start, n);
     }
     let mid = n / 2;
     prims.select_nth_unstable_by(mid, |a, b| {
-        a.centroid[axis]
-            .total_cmp(&b.centroid[axis])
+        a.centroid(axis)
+            .total_cmp(&b.centroid(axis))
             .then(a.index.cmp(&b.index))
     });
-    children(prims, start, bounds, axis, mid, depth)
+    children(prims, start, bounds, axis, mid, depth, out)
 }
 
 fn children(
@@ -331,25 +394,37 @@ fn children(
     axis: usize,
     mid: usize,
     depth: usize,
-) -> BuildNode {
+    out: &mut Vec<Node>,
+) {
     let n = prims.len();
+    let index = out.len();
+    out.push(Node::new(&bounds, 0, 0, axis));
     let (left, right) = prims.split_at_mut(mid);
-    let (l, r) = if n > PARALLEL_CUTOFF {
+    if n > PARALLEL_CUTOFF {
+        // The second child builds into its own array, appended with its child links shifted.
+        let mut second = Vec::new();
         rayon::join(
-            || build_node(left, start, depth + 1),
-            || build_node(right, start + mid, depth + 1),
-        )
+            || build_node(left, start, depth + 1, out),
+            || build_node(right, start + mid, depth + 1, &mut second),
+        );
+        let base = out.len();
+        out[index].set_offset(base);
+        out.extend(second.into_iter().map(|mut node| {
+            if node.count() == 0 {
+                node.set_offset(node.offset() + base);
+            }
+            node
+        }));
     } else {
-        (
-            build_node(left, start, depth + 1),
-            build_node(right, start + mid, depth + 1),
-        )
-    };
-    BuildNode::Inner {
-        bounds,
-        axis: axis as u8,
-        children: Box::new((l, r)),
+        build_node(left, start, depth + 1, out);
+        let second = out.len();
+        out[index].set_offset(second);
+        build_node(right, start + mid, depth + 1, out);
     }
+}
+
+fn leaf(out: &mut Vec<Node>, bounds: Aabb, start: usize, count: usize) {
+    out.push(Node::new(&bounds, start, count, 0));
 }
 
 /// Stable-enough in-place partition (order within each side does not matter, but it must be
@@ -363,28 +438,6 @@ fn partition(prims: &mut [BuildPrim], pred: impl Fn(&BuildPrim) -> bool) -> usiz
         }
     }
     i
-}
-
-fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> usize {
-    let index = out.len();
-    match node {
-        BuildNode::Leaf {
-            bounds,
-            start,
-            count,
-        } => out.push(Node::new(bounds, *start, *count, 0)),
-        BuildNode::Inner {
-            bounds,
-            axis,
-            children,
-        } => {
-            out.push(Node::new(bounds, 0, 0, *axis));
-            flatten(&children.0, out);
-            let second = flatten(&children.1, out);
-            out[index] = Node::new(bounds, second, 0, *axis);
-        }
-    }
-    index
 }
 
 #[cfg(test)]
@@ -447,7 +500,8 @@ mod tests {
         // Past u32: a leaf 5 * 2^32 primitives in, and an inner node's second child.
         let leaf = Node::new(&b, 5 << 32 | 7, MAX_LEAF, 0);
         assert_eq!((leaf.offset(), leaf.count()), (5 << 32 | 7, MAX_LEAF));
-        let inner = Node::new(&b, (1 << 47) + 3, 0, 2);
+        let mut inner = Node::new(&b, 3, 0, 2);
+        inner.set_offset((1 << 47) + 3);
         assert_eq!(
             (inner.offset(), inner.count(), inner.axis()),
             ((1 << 47) + 3, 0, 2)
@@ -460,8 +514,8 @@ mod tests {
         let (bvh, order) = Bvh::build(&b);
         let mut seen = order.clone();
         seen.sort();
-        assert_eq!(seen, (0..10_000).collect::<Vec<usize>>());
-        let leaf_total: usize = bvh.nodes.iter().map(Node::count).sum();
+        assert_eq!(seen, (0..10_000).collect::<Vec<u64>>());
+        let leaf_total: usize = bvh.nodes.iter().map(|n| n.count()).sum();
         assert_eq!(leaf_total, 10_000);
         assert!(bvh.nodes.iter().all(|n| n.count() <= MAX_LEAF));
     }
@@ -486,7 +540,7 @@ mod tests {
                 .filter_map(|bx| hit_box(bx, o, d))
                 .fold(f32::INFINITY, f32::min);
             let got = bvh.intersect(o, d, f32::INFINITY, |p, tmax| {
-                hit_box(&b[order[p]], o, d).filter(|&t| t < tmax)
+                hit_box(&b[order[p] as usize], o, d).filter(|&t| t < tmax)
             });
             assert_eq!(got, brute, "ray {k}");
         }

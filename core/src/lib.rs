@@ -18,6 +18,7 @@
 
 pub mod adaptive;
 pub mod bvh;
+pub mod cache;
 pub mod camera;
 pub mod error;
 pub mod framebuffer;

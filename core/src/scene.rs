@@ -14,7 +14,8 @@ use crate::math::{DVec3, Vec3A};
 use crate::plugin::calls::{create_primitive, create_texture, GeometryBuilder, TextureInstance};
 use crate::plugin::{PluginKind, Registry};
 use crate::ray::Ray;
-use luxon_formats::{Highlight, LightDesc, OutputDesc, SceneDesc};
+use luxon_formats::{Highlight, InlineGeometry, LightDesc, OutputDesc, SceneDesc};
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -229,6 +230,8 @@ pub struct Scene {
     pub pixel_spread: f32,
     pub outputs: Vec<OutputDesc>,
     pub features: Features,
+    /// Per material: whether any object uses it.
+    pub used_materials: Vec<bool>,
     /// Objects per plugin name, in first-use order.
     pub object_counts: Vec<(String, usize)>,
     pub degenerate_triangles: u64,
@@ -243,6 +246,37 @@ fn v3(a: [f64; 3]) -> Vec3A {
 impl Scene {
     /// Resolves plugins, instantiates every object and builds the BVHs.
     pub fn build(desc: &SceneDesc, registry: &Registry) -> Result<Scene, Error> {
+        let groups = desc.inline.iter().map(Cow::Borrowed);
+        Scene::build_from(desc, Box::new(groups), None, registry)
+    }
+
+    /// Builds with the native geometry and BVHs of a geometry cache (`desc` holds the rest of
+    /// the scene and no inline geometry).
+    pub fn build_prebuilt(
+        desc: &SceneDesc,
+        geometry: crate::cache::Prebuilt,
+        registry: &Registry,
+    ) -> Result<Scene, Error> {
+        Scene::build_from(desc, Box::new(std::iter::empty()), Some(geometry), registry)
+    }
+
+    /// Like `build`, but takes the imported geometry (`desc.inline`) out of `desc` and frees
+    /// each group once it is stored, so a large import is not held twice while the BVHs are
+    /// built and the image rendered.
+    pub fn build_taking_geometry(
+        desc: &mut SceneDesc,
+        registry: &Registry,
+    ) -> Result<Scene, Error> {
+        let groups = std::mem::take(&mut desc.inline).into_iter().map(Cow::Owned);
+        Scene::build_from(desc, Box::new(groups), None, registry)
+    }
+
+    fn build_from<'g>(
+        desc: &SceneDesc,
+        inline: Box<dyn Iterator<Item = Cow<'g, InlineGeometry>> + 'g>,
+        prebuilt: Option<crate::cache::Prebuilt>,
+        registry: &Registry,
+    ) -> Result<Scene, Error> {
         let scene_dir = desc
             .source
             .parent()
@@ -413,7 +447,7 @@ impl Scene {
                 None => object_counts.push((entry.name.clone(), 1)),
             }
         }
-        for (k, g) in desc.inline.iter().enumerate() {
+        for (k, g) in inline.enumerate() {
             let at = || g.at.clone().unwrap_or_else(|| desc.camera.at.clone());
             let material = match &g.material {
                 Some(m) => material_names
@@ -453,15 +487,33 @@ impl Scene {
                 dropped += triangles.push_mesh(&input, world_offset, m).map_err(fail)?;
             }
         }
+        let native_built = prebuilt.is_some();
+        if let Some(p) = prebuilt {
+            if p.used.len() != materials.len() || p.world_offset != world_offset {
+                return Err(Error::Render(
+                    "the geometry cache does not match the scene".into(),
+                ));
+            }
+            spheres = p.spheres;
+            triangles = p.triangles;
+            cones = p.cones;
+            for (u, p) in used.iter_mut().zip(p.used) {
+                *u |= p;
+            }
+            dropped += p.degenerate;
+        }
         let plugin_time = t0.elapsed();
 
         let t1 = Instant::now();
+        let build_native = !native_built;
         let (_, custom_result) = rayon::join(
             || {
-                rayon::join(
-                    || rayon::join(|| spheres.build(), || triangles.set.build()),
-                    || rayon::join(|| cones.build(), || discs.build()),
-                )
+                if build_native {
+                    rayon::join(
+                        || rayon::join(|| spheres.build(), || triangles.set.build()),
+                        || rayon::join(|| cones.build(), || discs.build()),
+                    );
+                }
             },
             || customs.build(),
         );
@@ -636,6 +688,7 @@ impl Scene {
             settings,
             outputs: r.outputs.clone(),
             features,
+            used_materials: used,
             object_counts,
             degenerate_triangles: dropped,
             bvh_time,

@@ -3,6 +3,7 @@
 
 use super::job::Job;
 use super::progress::Progress;
+use luxon::cache::{self, Lookup};
 use luxon::output::stream::{is_ppm8, AsyncOutput};
 use luxon::output::Output;
 use luxon::plugin::Registry;
@@ -28,6 +29,10 @@ pub struct Overrides {
     pub adaptive: Option<AdaptiveArg>,
     pub threads: Option<u32>,
     pub stats: bool,
+    /// `--no-cache`: neither read nor write the geometry cache.
+    pub no_cache: bool,
+    /// `--cache`: write the geometry cache whatever the scene's size.
+    pub cache: bool,
     /// `threads`, `mpi` or `hybrid`.
     pub parallel: Option<String>,
     /// `pixel-cyclic`, `scanline-cyclic`, `block-cyclic` or `dynamic`.
@@ -47,8 +52,15 @@ pub fn cli_origin(what: &str) -> Origin {
     }
 }
 
-fn load(path: &Path, o: &Overrides) -> Result<SceneDesc, Error> {
-    let mut desc = luxon_formats::load(path)?;
+/// Scenes with fewer primitives load in well under a second without a cache.
+const CACHE_MIN_PRIMITIVES: usize = 100_000;
+
+/// Loads the scene; `skeleton`: the non-geometry lines of an NFF file from its geometry cache.
+fn load(path: &Path, o: &Overrides, skeleton: Option<&str>) -> Result<SceneDesc, Error> {
+    let mut desc = match skeleton {
+        Some(text) => luxon_formats::nff::parse_str(text, path)?.desc,
+        None => luxon_formats::load(path)?,
+    };
     o.shading.apply(&mut desc)?;
     let r = &mut desc.render;
     if let Some((w, h)) = o.res {
@@ -146,7 +158,19 @@ fn plan<'r>(scene: &Scene, outputs: Vec<Output<'r>>, job: &Job) -> Result<Plan<'
 pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let t0 = Instant::now();
     let job = Job::from_launcher()?;
-    let desc = load(path, o);
+    let use_cache = !o.no_cache && luxon_formats::nff::is_nff_path(path);
+    let mut cached = None;
+    if use_cache {
+        match cache::open(path) {
+            Lookup::Hit(c) => cached = Some(c),
+            Lookup::Miss => {}
+            Lookup::Corrupt(p, why) => eprintln!(
+                "luxon: warning: geometry cache {} is unusable ({why}); rebuilding it",
+                p.display()
+            ),
+        }
+    }
+    let desc = load(path, o, cached.as_ref().map(|c| c.skeleton.as_str()));
     let job = match &desc {
         Ok(d) => job.for_mode(d.render.parallel.mode)?,
         Err(_) => job,
@@ -154,8 +178,37 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let empty = Vec::new();
     let registry = Registry::discover(desc.as_ref().map_or(&empty, |d| &d.plugin_path));
     let load_time = t0.elapsed();
-    let ready = desc.and_then(|desc| {
-        let scene = Scene::build(&desc, &registry)?;
+    let mut cache_note = if use_cache { "not used" } else { "off" }.to_string();
+    let mut write_cache = false;
+    let ready = desc.and_then(|mut desc| {
+        let had_objects = !desc.objects.is_empty();
+        let from_cache = cached.is_some();
+        let prebuilt = match cached {
+            Some(c) => {
+                let cache::Cached { path, geometry, .. } = *c;
+                Scene::build_prebuilt(&desc, geometry, &registry)
+                    .ok()
+                    .map(|s| (s, path))
+            }
+            None => None,
+        };
+        let scene = match prebuilt {
+            Some((scene, from)) => {
+                cache_note = format!("read {}", from.display());
+                scene
+            }
+            None => {
+                if from_cache {
+                    // The cache's view of the scene did not fit: read the source itself.
+                    desc = load(path, o, None)?;
+                }
+                let scene = Scene::build_taking_geometry(&mut desc, &registry)?;
+                write_cache = use_cache
+                    && (o.cache || scene.primitive_count() >= CACHE_MIN_PRIMITIVES)
+                    && cache::cacheable(&scene, had_objects);
+                scene
+            }
+        };
         let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
         let plan = plan(&scene, outputs, &job)?;
         Ok((desc, scene, plan))
@@ -239,11 +292,30 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     }
     let write_time = tail + t_write.elapsed();
     let stats = RenderStats::of(ranks, render_time);
+    let total = t0.elapsed();
+    // After the image: writing the cache delays no picture.
+    let mut cache_written = None;
+    if write_cache {
+        let result = luxon_formats::nff::skeleton(path)
+            .map_err(|e| e.to_string())
+            .and_then(|sk| cache::write(path, &sk, &scene).map_err(|e| e.to_string()));
+        match result {
+            Ok(p) => {
+                cache_note = format!("written to {}", p.display());
+                cache_written = Some(p);
+            }
+            Err(e) => cache_note = format!("could not be written: {e}"),
+        }
+    }
     if o.stats {
-        print_stats(&scene, &job, &stats, load_time, write_time, t0.elapsed());
+        print_stats(&scene, &job, &stats, load_time, write_time, total);
+        eprintln!("  geometry cache   {cache_note}");
     }
     for w in written {
         eprintln!("luxon: wrote {}", w.display());
+    }
+    if let Some(p) = cache_written {
+        eprintln!("luxon: wrote geometry cache {}", p.display());
     }
     if stats.counters.nan_pixels > 0 {
         eprintln!(

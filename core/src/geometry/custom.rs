@@ -113,8 +113,8 @@ impl Customs {
             ));
         }
         let (bvh, order) = Bvh::build(&bounds);
-        self.refs = order.iter().map(|&i| self.refs[i]).collect();
-        self.material = order.iter().map(|&i| self.material[i]).collect();
+        self.refs = order.iter().map(|&i| self.refs[i as usize]).collect();
+        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
         self.bvh = bvh;
         Ok(())
     }

@@ -57,6 +57,20 @@ impl<S: Shape> Set<S> {
         self.data.is_empty()
     }
 
+    /// Primitives, packed materials and BVH, for the geometry cache.
+    pub(crate) fn parts(&self) -> (&[S], &[u32], &Bvh) {
+        (&self.data, &self.material, &self.bvh)
+    }
+
+    /// A set already built (read back from the geometry cache).
+    pub(crate) fn from_parts(data: Vec<S>, material: Vec<u32>, bvh: Bvh) -> Set<S> {
+        Set {
+            data,
+            material,
+            bvh,
+        }
+    }
+
     pub fn push(&mut self, shape: S, material: u32) {
         self.data.push(shape);
         self.material.push(material);
@@ -64,10 +78,10 @@ impl<S: Shape> Set<S> {
 
     /// Builds the BVH and stores the primitives in leaf order.
     pub fn build(&mut self) {
-        let bounds: Vec<Aabb> = self.data.iter().map(S::bounds).collect();
-        let (bvh, order) = Bvh::build(&bounds);
-        self.data = order.iter().map(|&i| self.data[i]).collect();
-        self.material = order.iter().map(|&i| self.material[i]).collect();
+        let data = &self.data;
+        let (bvh, order) = Bvh::build_with(data.len(), |i| data[i].bounds());
+        self.data = order.iter().map(|&i| self.data[i as usize]).collect();
+        self.material = order.iter().map(|&i| self.material[i as usize]).collect();
         self.bvh = bvh;
     }
 

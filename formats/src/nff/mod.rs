@@ -144,6 +144,55 @@ pub fn import(path: &Path) -> Result<Imported, SceneError> {
     }
 }
 
+/// The lines of an NFF file that are not geometry (the view, background, lights and `f`
+/// materials), in file order. Parsing them gives the file's scene without its primitives: the
+/// geometry cache stores those, built, and this text beside them.
+pub fn skeleton(path: &Path) -> Result<String, SceneError> {
+    const KEEP: [&str; 10] = [
+        "v",
+        "from",
+        "at",
+        "up",
+        "angle",
+        "hither",
+        "resolution",
+        "b",
+        "l",
+        "f",
+    ];
+    let io = |source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = File::open(path).map_err(io)?;
+    let mut reader = BufReader::with_capacity(1 << 16, file);
+    let gzip = reader.fill_buf().map_err(io)?.starts_with(&[0x1f, 0x8b]);
+    let mut text: Box<dyn BufRead> = if gzip {
+        Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(reader)))
+    } else {
+        Box::new(reader)
+    };
+    let mut out = String::new();
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        if text.read_until(b'\n', &mut line).map_err(io)? == 0 {
+            break;
+        }
+        let first = line
+            .split(|b| b.is_ascii_whitespace())
+            .find(|w| !w.is_empty())
+            .unwrap_or_default();
+        if KEEP.iter().any(|k| k.as_bytes() == first) {
+            out.push_str(&String::from_utf8_lossy(&line));
+            if !out.ends_with('\n') {
+                out.push('\n');
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Reads NFF text (not compressed) from `reader`; `path` names it in messages.
 pub fn import_reader(reader: impl Read + Send, path: &Path) -> Result<Imported, SceneError> {
     import_reader_blocks(reader, path, stream::BLOCK)
