@@ -4,7 +4,7 @@
 //! diffuse-only base; the base with mirror, glass, textured materials, textures and a volume
 //! reader defined but used by nothing; and the base with one effect switched on at a time
 //! (shadows, reflection, refraction, textures, ambient occlusion, fog, 4× antialiasing, depth of
-//! field, a rendered volume). Each variant runs `luxon render --stats` several times; the table
+//! field, a drawn volume). Each variant runs `luxon render --stats` several times; the table
 //! gives the median render time, its ratio to the base and the rays cast per kind.
 //!
 //! ```sh
@@ -31,11 +31,13 @@ struct Variant {
     camera: &'static str,
 }
 
-/// Defined, used by nothing: the scene's effects must not change.
+/// Defined, used by nothing: the scene's effects must not change. The volume is read but has
+/// no `render` settings, so nothing draws it.
 const UNUSED_TEXTURES: &str = r#"textures: {
         "marble": (plugin: "marble", params: (scale: 0.5)),
         "checks": (plugin: "checker", params: (scale: 1.0)),
-    },"#;
+    },
+    volumes: [(plugin: "phantom", name: "unused", params: (size: 32))],"#;
 const UNUSED_MATERIALS: &str = r#""mirror": (color: (0.9, 0.9, 0.9), reflect: 0.8),
         "glass": (color: (1, 1, 1), transmit: 0.9, ior: 1.5),
         "stone": (texture: "marble"),
@@ -58,7 +60,7 @@ fn variants() -> Vec<Variant> {
             ..base()
         },
         Variant {
-            name: "base + unused mirror/glass/textured materials and textures",
+            name: "base + unused mirror/glass/textured materials, textures, a volume",
             extra: UNUSED_TEXTURES.into(),
             more_materials: UNUSED_MATERIALS,
             ..base()
@@ -102,6 +104,13 @@ fn variants() -> Vec<Variant> {
         Variant {
             name: "antialiasing (4 samples)",
             samples: 4,
+            ..base()
+        },
+        Variant {
+            name: "volume (64³ vortex rings over the spheres)",
+            extra: r#"volumes: [(plugin: "vortex", name: "rings", params: (size: 64),
+                render: (transfer: (preset: "hot", range: (0.05, 1.0), opacity: 4), step: 0.02))],"#
+                .into(),
             ..base()
         },
         Variant {
@@ -149,7 +158,14 @@ fn scene(v: &Variant) -> String {
 }
 
 /// Render seconds and rays per kind from `--stats` (and instructions from `perf stat`).
-fn run(luxon: &Path, scene: &Path, out: &Path, threads: usize, perf: bool) -> Sample {
+fn run(
+    luxon: &Path,
+    scene: &Path,
+    out: &Path,
+    threads: usize,
+    perf: bool,
+    tiny: bool,
+) -> Sample {
     let counts = out.with_extension("perf");
     let mut cmd = if perf {
         let mut c = Command::new("perf");
@@ -168,6 +184,7 @@ fn run(luxon: &Path, scene: &Path, out: &Path, threads: usize, perf: bool) -> Sa
         .arg("--stats")
         .arg("--threads")
         .arg(threads.to_string())
+        .args(if tiny { &["--res", "1x1"][..] } else { &[] })
         .output()
         .expect("run luxon");
     let err = String::from_utf8_lossy(&o.stderr);
@@ -244,16 +261,27 @@ fn main() {
         std::fs::write(&path, scene(v)).unwrap();
         let out = dir.join(format!("v{k}.png"));
         // Warm-up (page cache, plugin loading).
-        run(&luxon, &path, &out, threads, false);
+        run(&luxon, &path, &out, threads, false, false);
         paths.push((path, out));
     }
     // Round robin: drift on a shared machine hits every variant alike.
     let mut times = vec![Vec::new(); all.len()];
     let mut rays = vec![[0; 5]; all.len()];
     let mut instructions = vec![Vec::new(); all.len()];
+    // The same scene at 1x1 pixel: everything but the render (loading, building, plugins), to
+    // subtract from the instruction counts so they measure the render alone.
+    let setup: Vec<Option<f64>> = paths
+        .iter()
+        .map(|(path, out)| {
+            let tiny = out.with_extension("tiny.png");
+            run(&luxon, path, &tiny, threads, perf, true)
+                .instructions
+                .map(|i| i as f64)
+        })
+        .collect();
     for round in 0..runs {
         for (k, (path, out)) in paths.iter().enumerate() {
-            let s = run(&luxon, path, out, threads, perf);
+            let s = run(&luxon, path, out, threads, perf, false);
             times[k].push(s.secs);
             rays[k] = s.rays;
             instructions[k].extend(s.instructions.map(|i| i as f64));
@@ -265,13 +293,17 @@ fn main() {
         .zip(times)
         .zip(rays)
         .zip(instructions)
-        .map(|(((v, t), r), i)| (v.name, median(t), r, (!i.is_empty()).then(|| median(i))))
+        .zip(setup)
+        .map(|((((v, t), r), i), setup)| {
+            let render = (!i.is_empty()).then(|| median(i) - setup.unwrap_or(0.0));
+            (v.name, median(t), r, render)
+        })
         .collect();
     let (base, base_instr) = (rows[0].1, rows[0].3);
     let mut table = String::new();
     writeln!(
         table,
-        "| variant | render (median of {runs}) | vs base | instructions vs base | primary | shadow | reflection | refraction | occlusion |"
+        "| variant | render (median of {runs}) | vs base | render instructions vs base | primary | shadow | reflection | refraction | occlusion |"
     )
     .unwrap();
     writeln!(table, "|---|---|---|---|---|---|---|---|---|").unwrap();
