@@ -158,14 +158,7 @@ fn scene(v: &Variant) -> String {
 }
 
 /// Render seconds and rays per kind from `--stats` (and instructions from `perf stat`).
-fn run(
-    luxon: &Path,
-    scene: &Path,
-    out: &Path,
-    threads: usize,
-    perf: bool,
-    tiny: bool,
-) -> Sample {
+fn run(luxon: &Path, scene: &Path, out: &Path, threads: usize, perf: bool, tiny: bool) -> Sample {
     let counts = out.with_extension("perf");
     let mut cmd = if perf {
         let mut c = Command::new("perf");
