@@ -97,25 +97,36 @@ pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError
         ignore_lines: true,
         ..Default::default()
     };
-    let loaded = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
-        let full = dir.join(mtl);
-        match tobj::load_mtl(&full) {
-            Ok(r) => Ok(r),
-            Err(e) => {
-                let why = match e {
-                    tobj::LoadError::OpenFileFailed => "cannot open it".to_string(),
-                    e => format!("cannot read it ({e})"),
-                };
-                warnings.borrow_mut().push(format!(
-                    "{}: material library `{}`: {why}; its materials are replaced by the \
+    // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): its panic
+    // becomes an error here, placed by our own scan of the faces.
+    let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
+            let full = dir.join(mtl);
+            match tobj::load_mtl(&full) {
+                Ok(r) => Ok(r),
+                Err(e) => {
+                    let why = match e {
+                        tobj::LoadError::OpenFileFailed => "cannot open it".to_string(),
+                        e => format!("cannot read it ({e})"),
+                    };
+                    warnings.borrow_mut().push(format!(
+                        "{}: material library `{}`: {why}; its materials are replaced by the \
                      default material",
-                    path.display(),
-                    full.display()
-                ));
-                Ok((Vec::new(), Default::default()))
+                        path.display(),
+                        full.display()
+                    ));
+                    Ok((Vec::new(), Default::default()))
+                }
             }
-        }
-    });
+        })
+    }))
+    .map_err(|_| {
+        let (line, detail) = find_bad_face(path).unwrap_or((
+            0,
+            "a face index is out of range; expected indices of defined vertices".to_string(),
+        ));
+        fail(line, detail)
+    })?;
     let (models, materials) = match loaded {
         Ok(l) => l,
         Err(e) => {
