@@ -14,7 +14,9 @@ fn case(name: &str) -> std::path::PathBuf {
 #[test]
 fn obj_face_index_overflow_in_tobj_is_an_error() {
     let path = case("obj-tobj-index-overflow.obj");
-    let e = load_obj(&path, None).expect_err("a malformed OBJ").to_string();
+    let e = load_obj(&path, None)
+        .expect_err("a malformed OBJ")
+        .to_string();
     assert!(e.contains("obj-tobj-index-overflow.obj"), "{e}");
     assert!(e.contains("index") || e.contains("cannot read"), "{e}");
 }
