@@ -97,8 +97,12 @@ pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError
         ignore_lines: true,
         ..Default::default()
     };
-    // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): its panic
-    // becomes an error here, placed by our own scan of the faces.
+    // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): faces are
+    // checked first by our own scan (one more pass over the file), and a panic in tobj all the
+    // same becomes an error.
+    if let Some((line, detail)) = find_bad_face(path) {
+        return Err(fail(line, detail));
+    }
     let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
             let full = dir.join(mtl);
@@ -314,7 +318,8 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 /// The first face with an index out of range: (line, message).
 fn find_bad_face(path: &Path) -> Option<(u32, String)> {
-    let text = std::fs::read_to_string(path).ok()?;
+    let bytes = std::fs::read(path).ok()?;
+    let text = String::from_utf8_lossy(&bytes);
     let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
     for (i, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
