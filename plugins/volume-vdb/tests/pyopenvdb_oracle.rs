@@ -72,6 +72,9 @@ fn every_fixture_matches_pyopenvdb_when_installed() {
             _ => panic!("unexpected oracle line {line}"),
         }
     }
-    assert!(grids >= 8 && voxels > 10_000, "{grids} grids, {voxels} voxels");
+    assert!(
+        grids >= 8 && voxels > 10_000,
+        "{grids} grids, {voxels} voxels"
+    );
     eprintln!("pyopenvdb oracle: {grids} grids, {voxels} voxels agree");
 }
