@@ -1,8 +1,10 @@
-//! Bounding volume hierarchy: binned SAH build in parallel (rayon), flattened depth-first into
-//! 32-byte nodes, and closure-based traversal so each primitive kind gets its own monomorphised
-//! loop with the intersection test inlined.
+//! Bounding volume hierarchy: binned SAH build in parallel (rayon) into a binary tree, which
+//! is then collapsed into 4-wide nodes (each holds its four children's boxes side by side, so
+//! one pass of vector arithmetic tests all four), and closure-based traversal so each primitive
+//! kind gets its own monomorphised loop with the intersection test inlined.
 
 use crate::math::{gamma, Aabb, Vec3A};
+use std::mem::MaybeUninit;
 
 /// Leaves hold at most this many primitives.
 const MAX_LEAF: usize = 8;
@@ -11,10 +13,14 @@ const BINS: usize = 16;
 const PARALLEL_CUTOFF: usize = 4096;
 /// SAH cost of a node traversal relative to one primitive test.
 const TRAVERSAL_COST: f32 = 1.0;
-/// Past this depth splits are by median, so the depth stays below `STACK` whatever the input.
+/// Past this depth splits are by median, so the depth stays bounded whatever the input.
 const MAX_SAH_DEPTH: usize = 64;
-const STACK: usize = MAX_SAH_DEPTH + 64;
+/// Deepest binary tree: median splits after `MAX_SAH_DEPTH` halve at least 2^48 primitives.
+const MAX_DEPTH: usize = MAX_SAH_DEPTH + 64;
+/// A wide node pushes at most three children, and no wide tree is deeper than the binary one.
+const STACK: usize = 3 * MAX_DEPTH + 1;
 
+/// A node of the binary build (and of the tree before it is collapsed).
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
 struct Node {
@@ -61,13 +67,183 @@ impl Node {
     fn axis(&self) -> usize {
         ((self.link >> 56) & 3) as usize
     }
+
+    fn bounds(&self) -> Aabb {
+        Aabb::new(self.min.into(), self.max.into())
+    }
+}
+
+/// A 4-wide node: the boxes of up to four children as rows min x, min y, min z, max x, max y,
+/// max z (one lane per child), and a link per child: a leaf (first primitive, count) packed as
+/// in `Node`, an inner node (its index, count 0), or `EMPTY` (its box is inverted, so no ray
+/// enters it). Two cache lines.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Wide {
+    b: [[f32; 4]; 6],
+    link: [u64; 4],
+}
+
+/// The root is never a child, so link 0 marks an unused slot.
+const EMPTY: u64 = 0;
+
+impl Wide {
+    const NONE: Wide = Wide {
+        b: [
+            [f32::INFINITY; 4],
+            [f32::INFINITY; 4],
+            [f32::INFINITY; 4],
+            [f32::NEG_INFINITY; 4],
+            [f32::NEG_INFINITY; 4],
+            [f32::NEG_INFINITY; 4],
+        ],
+        link: [EMPTY; 4],
+    };
+
+    fn set(&mut self, lane: usize, b: &Aabb, link: u64) {
+        for k in 0..3 {
+            self.b[k][lane] = b.min[k];
+            self.b[3 + k][lane] = b.max[k];
+        }
+        self.link[lane] = link;
+    }
+
+    fn bounds(&self) -> Aabb {
+        (0..4)
+            .filter(|&l| self.link[l] != EMPTY)
+            .fold(Aabb::EMPTY, |acc, l| {
+                acc.union(Aabb::new(
+                    Vec3A::new(self.b[0][l], self.b[1][l], self.b[2][l]),
+                    Vec3A::new(self.b[3][l], self.b[4][l], self.b[5][l]),
+                ))
+            })
+    }
+}
+
+#[inline(always)]
+fn count_of(link: u64) -> usize {
+    ((link >> OFFSET_BITS) & 0xff) as usize
+}
+
+#[inline(always)]
+fn offset_of(link: u64) -> usize {
+    (link & OFFSET_MASK) as usize
+}
+
+/// What a ray precomputes for the box tests: for each axis the row of the plane it meets
+/// first (min or max, by the sign of its direction) and the row of the other.
+struct BoxRay {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+/// `t_max` is widened by 2·gamma(3) so rounding never culls a box the ray really touches
+/// (Ize 2013).
+const WIDEN: f32 = 1.0 + 2.0 * gamma(3);
+
+impl BoxRay {
+    #[inline(always)]
+    fn new(origin: Vec3A, dir: Vec3A) -> BoxRay {
+        let inv = dir.recip();
+        let neg = |k: usize| usize::from(inv[k] < 0.0) * 3;
+        BoxRay {
+            origin: origin.into(),
+            inv: inv.into(),
+            near: [neg(0), 1 + neg(1), 2 + neg(2)],
+            far: [3 - neg(0), 4 - neg(1), 5 - neg(2)],
+        }
+    }
+
+    /// Which of the node's four boxes the ray meets in [0, t_max] (bit l for lane l), and the
+    /// entry distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
+    /// which is inside that slab for every t) are NaN and are skipped: max(t, acc) and
+    /// min(t, acc) keep `acc` when t is NaN (x86's maxps/minps return the second operand).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; 4]) {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE is part of the x86_64 baseline; each load reads one [f32; 4] row.
+        unsafe {
+            let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr());
+            let mut near = _mm_setzero_ps();
+            let mut far = _mm_set1_ps(t_max);
+            for k in 0..3 {
+                let o = _mm_set1_ps(self.origin[k]);
+                let inv = _mm_set1_ps(self.inv[k]);
+                let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
+                let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv);
+                near = _mm_max_ps(t0, near);
+                far = _mm_min_ps(t1, far);
+            }
+            let hit = _mm_cmple_ps(near, _mm_mul_ps(far, _mm_set1_ps(WIDEN)));
+            let mut t = [0.0; 4];
+            _mm_storeu_ps(t.as_mut_ptr(), near);
+            (_mm_movemask_ps(hit) as u32, t)
+        }
+    }
+
+    /// The same, lane by lane, for other targets.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; 4]) {
+        let mut near = [0.0f32; 4];
+        let mut far = [t_max; 4];
+        for k in 0..3 {
+            let (lo, hi) = (&node.b[self.near[k]], &node.b[self.far[k]]);
+            for l in 0..4 {
+                let t0 = (lo[l] - self.origin[k]) * self.inv[k];
+                let t1 = (hi[l] - self.origin[k]) * self.inv[k];
+                near[l] = if t0 > near[l] { t0 } else { near[l] };
+                far[l] = if t1 < far[l] { t1 } else { far[l] };
+            }
+        }
+        let mask = (0..4).fold(0, |m, l| m | u32::from(near[l] <= far[l] * WIDEN) << l);
+        (mask, near)
+    }
+}
+
+/// The traversal stack: links with their entry distances, never read before written (so not
+/// zeroed per ray, which cost a 6 KB memset).
+struct Stack {
+    entries: [MaybeUninit<(u64, f32)>; STACK],
+    len: usize,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new() -> Stack {
+        Stack {
+            entries: [const { MaybeUninit::uninit() }; STACK],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, link: u64, t: f32) {
+        // The depth bound (checked for cached trees too) keeps this in range.
+        self.entries[self.len] = MaybeUninit::new((link, t));
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u64, f32)> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: entries below `len` were written by `push`.
+        Some(unsafe { self.entries[self.len].assume_init() })
+    }
 }
 
 /// A BVH over primitives `0..n`. After building, primitive `order[i]` is the i-th in leaf order;
 /// owners reorder their arrays by `order` so leaves address contiguous ranges.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    /// Wide nodes depth first: a node's inner children come after it; the root is first.
+    nodes: Vec<Wide>,
 }
 
 /// 32 bytes (a million-triangle build holds one per triangle): the centroid is recomputed
@@ -96,6 +272,9 @@ impl BuildPrim {
     }
 }
 
+/// Words per wide node in `to_words`: 24 floats and 4 links of two words.
+const WORDS: usize = 32;
+
 impl Bvh {
     /// Builds over the given primitive bounds; returns the BVH and the leaf order.
     pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<u64>) {
@@ -121,53 +300,74 @@ impl Bvh {
                 }
             })
             .collect();
-        let mut nodes = Vec::new();
-        build_node(&mut prims, 0, 0, &mut nodes);
-        nodes.shrink_to_fit();
+        let mut binary = Vec::new();
+        build_node(&mut prims, 0, 0, &mut binary);
         let order = prims.iter().map(|p| p.index).collect();
-        (Bvh { nodes }, order)
+        drop(prims);
+        (Bvh::collapse(&binary), order)
     }
 
-    /// The nodes as little-endian-ready words, 8 per node (for the geometry cache).
+    /// The wide tree of a binary one: each wide node takes the two children of a binary node
+    /// and keeps opening the largest inner one among them until it has four.
+    fn collapse(binary: &[Node]) -> Bvh {
+        let mut nodes = Vec::with_capacity(binary.len() / 3 + 1);
+        if binary[0].count() > 0 {
+            let mut root = Wide::NONE;
+            root.set(0, &binary[0].bounds(), binary[0].link);
+            nodes.push(root);
+        } else {
+            collapse_node(binary, 0, &mut nodes);
+        }
+        Bvh { nodes }
+    }
+
+    /// The nodes as little-endian-ready words, `WORDS` per node (for the geometry cache).
     pub(crate) fn to_words(&self, out: &mut impl FnMut(u32)) {
         for n in &self.nodes {
-            n.min.iter().for_each(|x| out(x.to_bits()));
-            out(n.link as u32);
-            n.max.iter().for_each(|x| out(x.to_bits()));
-            out((n.link >> 32) as u32);
+            n.b.iter().flatten().for_each(|x| out(x.to_bits()));
+            for &l in &n.link {
+                out(l as u32);
+                out((l >> 32) as u32);
+            }
         }
     }
 
     /// Nodes read back from `to_words`, checked against `prims` primitives: every link and
-    /// leaf range in bounds, links pointing forward (so traversal ends), axes valid.
+    /// leaf range in bounds, links pointing forward (so traversal ends), empty slots with
+    /// inverted boxes, and no deeper than the traversal stack allows.
     pub(crate) fn from_words(w: &[u32], prims: usize) -> Option<Bvh> {
-        if !w.len().is_multiple_of(8) || (w.is_empty() != (prims == 0)) {
+        if !w.len().is_multiple_of(WORDS) || (w.is_empty() != (prims == 0)) {
             return None;
         }
-        let n = w.len() / 8;
+        let n = w.len() / WORDS;
         let mut nodes = Vec::with_capacity(n);
-        // Depth of every node, so that traversal's fixed stack suffices.
         let mut depth = vec![0u16; n];
-        for (i, c) in w.chunks_exact(8).enumerate() {
-            let f = |k: usize| f32::from_bits(c[k]);
-            let node = Node {
-                min: [f(0), f(1), f(2)],
-                max: [f(4), f(5), f(6)],
-                link: u64::from(c[3]) | u64::from(c[7]) << 32,
-            };
-            let (count, axis, offset) = (node.count(), node.axis(), node.offset());
-            let ok = node.link >> 58 == 0
-                && if count > 0 {
-                    count <= MAX_LEAF && offset + count <= prims
-                } else {
-                    axis < 3 && offset > i + 1 && offset < n && i + 1 < n
-                };
-            if !ok || depth[i] as usize >= STACK - 1 {
-                return None;
+        for (i, c) in w.chunks_exact(WORDS).enumerate() {
+            let mut node = Wide::NONE;
+            for (k, x) in node.b.iter_mut().flatten().enumerate() {
+                *x = f32::from_bits(c[k]);
             }
-            if count == 0 {
-                depth[i + 1] = depth[i] + 1;
-                depth[offset] = depth[i] + 1;
+            for l in 0..4 {
+                node.link[l] = u64::from(c[24 + 2 * l]) | u64::from(c[25 + 2 * l]) << 32;
+            }
+            for l in 0..4 {
+                let link = node.link[l];
+                let (count, offset) = (count_of(link), offset_of(link));
+                let ok = link >> 56 == 0
+                    && if link == EMPTY {
+                        // Inverted, so never entered (NaN would not compare).
+                        node.b[0][l] > node.b[3][l]
+                    } else if count > 0 {
+                        count <= MAX_LEAF && offset + count <= prims
+                    } else {
+                        offset > i && offset < n
+                    };
+                if !ok || depth[i] as usize >= MAX_DEPTH {
+                    return None;
+                }
+                if link != EMPTY && count == 0 {
+                    depth[offset] = depth[i] + 1;
+                }
             }
             nodes.push(node);
         }
@@ -180,7 +380,7 @@ impl Bvh {
 
     pub fn bounds(&self) -> Aabb {
         match self.nodes.first() {
-            Some(n) => Aabb::new(n.min.into(), n.max.into()),
+            Some(n) => n.bounds(),
             None => Aabb::EMPTY,
         }
     }
@@ -198,42 +398,51 @@ impl Bvh {
         if self.nodes.is_empty() {
             return t_max;
         }
-        let inv = dir.recip();
-        let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
-        let mut stack = [0usize; STACK];
-        let mut sp = 0usize;
+        let ray = BoxRay::new(origin, dir);
+        let mut stack = Stack::new();
         let mut i = 0usize;
         loop {
             let node = &self.nodes[i];
-            if slab(node, origin, inv, t_max) {
-                let count = node.count();
-                if count > 0 {
-                    let start = node.offset();
-                    for p in start..start + count {
-                        if let Some(t) = test(p, t_max) {
-                            t_max = t;
-                        }
+            let (mask, t) = ray.enter(node, t_max);
+            // Hit children, nearest last so it is taken first.
+            let mut hits = [(0u64, 0f32); 4];
+            let mut n = 0;
+            for (l, (&link, &t)) in node.link.iter().zip(&t).enumerate() {
+                if mask & 1 << l != 0 {
+                    let mut j = n;
+                    while j > 0 && hits[j - 1].1 < t {
+                        hits[j] = hits[j - 1];
+                        j -= 1;
                     }
-                } else {
-                    // Near child first.
-                    let (first, second) = if neg[node.axis()] {
-                        (node.offset(), i + 1)
-                    } else {
-                        (i + 1, node.offset())
-                    };
-                    stack[sp] = second;
-                    sp += 1;
-                    i = first;
-                    continue;
+                    hits[j] = (link, t);
+                    n += 1;
                 }
             }
-            if sp == 0 {
-                break;
+            for &(link, t) in &hits[..n] {
+                stack.push(link, t);
             }
-            sp -= 1;
-            i = stack[sp];
+            // Next: the nearest pending child still nearer than the closest hit; leaves are
+            // tested as they come off the stack.
+            loop {
+                let Some((link, t)) = stack.pop() else {
+                    return t_max;
+                };
+                if t > t_max {
+                    continue;
+                }
+                let count = count_of(link);
+                if count == 0 {
+                    i = offset_of(link);
+                    break;
+                }
+                let start = offset_of(link);
+                for p in start..start + count {
+                    if let Some(t) = test(p, t_max) {
+                        t_max = t;
+                    }
+                }
+            }
         }
-        t_max
     }
 
     /// Any-hit traversal: stops as soon as `test(prim)` returns true.
@@ -248,51 +457,60 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
-        let inv = dir.recip();
-        let mut stack = [0usize; STACK];
-        let mut sp = 0usize;
-        let mut i = 0usize;
-        loop {
-            let node = &self.nodes[i];
-            if slab(node, origin, inv, t_max) {
-                let count = node.count();
-                if count > 0 {
-                    let start = node.offset();
-                    for p in start..start + count {
-                        if test(p) {
-                            return true;
-                        }
-                    }
-                } else {
-                    stack[sp] = node.offset();
-                    sp += 1;
-                    i += 1;
-                    continue;
+        let ray = BoxRay::new(origin, dir);
+        let mut stack = Stack::new();
+        stack.push(0, 0.0);
+        while let Some((link, _)) = stack.pop() {
+            let count = count_of(link);
+            if count > 0 {
+                let start = offset_of(link);
+                if (start..start + count).any(&mut test) {
+                    return true;
+                }
+                continue;
+            }
+            let node = &self.nodes[offset_of(link)];
+            let (mask, _) = ray.enter(node, t_max);
+            for l in 0..4 {
+                if mask & 1 << l != 0 {
+                    stack.push(node.link[l], 0.0);
                 }
             }
-            if sp == 0 {
-                return false;
-            }
-            sp -= 1;
-            i = stack[sp];
         }
+        false
     }
 }
 
-/// Ray/box slab test; `t_max` is widened by 2·gamma(3) so rounding never culls a box the ray
-/// really touches (Ize 2013). Zero direction components give ±inf reciprocals, which work,
-/// except when the origin lies exactly in a face plane on that axis: 0 · ∞ is NaN there, and
-/// the ray, parallel to the face and in its plane, is inside that slab for every t.
-#[inline(always)]
-fn slab(node: &Node, origin: Vec3A, inv: Vec3A, t_max: f32) -> bool {
-    let t0 = (Vec3A::from(node.min) - origin) * inv;
-    let t1 = (Vec3A::from(node.max) - origin) * inv;
-    let defined = t0.cmpeq(t0) & t1.cmpeq(t1);
-    let lo = Vec3A::select(defined, t0.min(t1), Vec3A::NEG_INFINITY);
-    let hi = Vec3A::select(defined, t0.max(t1), Vec3A::INFINITY);
-    let near = lo.max_element().max(0.0);
-    let far = hi.min_element().min(t_max) * (1.0 + 2.0 * gamma(3));
-    near <= far
+/// Emits the wide node for binary inner node `i` and, after it, its inner descendants;
+/// returns its index.
+fn collapse_node(binary: &[Node], i: usize, out: &mut Vec<Wide>) -> usize {
+    let index = out.len();
+    out.push(Wide::NONE);
+    let mut kids = vec![i + 1, binary[i].offset()];
+    while kids.len() < 4 {
+        let widest = kids
+            .iter()
+            .enumerate()
+            .filter(|(_, &k)| binary[k].count() == 0)
+            .max_by(|a, b| {
+                let area = |k: usize| binary[k].bounds().half_area();
+                area(*a.1).total_cmp(&area(*b.1))
+            })
+            .map(|(slot, _)| slot);
+        let Some(slot) = widest else { break };
+        let k = kids[slot];
+        kids[slot] = k + 1;
+        kids.insert(slot + 1, binary[k].offset());
+    }
+    for (lane, &k) in kids.iter().enumerate() {
+        let link = if binary[k].count() > 0 {
+            binary[k].link & !(3 << 56)
+        } else {
+            collapse_node(binary, k, out) as u64
+        };
+        out[index].set(lane, &binary[k].bounds(), link);
+    }
+    index
 }
 
 /// Builds the subtree over `prims` (the primitives `start..start + prims.len()` of the final
@@ -444,6 +662,17 @@ fn partition(prims: &mut [BuildPrim], pred: impl Fn(&BuildPrim) -> bool) -> usiz
 mod tests {
     use super::*;
 
+    impl Bvh {
+        fn leaf_sizes(&self) -> impl Iterator<Item = usize> + '_ {
+            self.nodes
+                .iter()
+                .flat_map(|n| n.link)
+                .filter(|&l| l != EMPTY)
+                .map(count_of)
+                .filter(|&c| c > 0)
+        }
+    }
+
     fn boxes(n: usize) -> Vec<Aabb> {
         // Deterministic pseudo-random unit boxes.
         let mut s = 12345u32;
@@ -515,9 +744,16 @@ mod tests {
         let mut seen = order.clone();
         seen.sort();
         assert_eq!(seen, (0..10_000).collect::<Vec<u64>>());
-        let leaf_total: usize = bvh.nodes.iter().map(|n| n.count()).sum();
+        let leaf_total: usize = bvh.leaf_sizes().sum();
         assert_eq!(leaf_total, 10_000);
-        assert!(bvh.nodes.iter().all(|n| n.count() <= MAX_LEAF));
+        assert!(bvh.leaf_sizes().all(|c| c <= MAX_LEAF));
+        // Wide nodes hold more than two children on average.
+        let leaves = bvh.leaf_sizes().count();
+        assert!(
+            bvh.nodes.len() * 2 < leaves,
+            "{} nodes, {leaves} leaves",
+            bvh.nodes.len()
+        );
     }
 
     #[test]
@@ -566,6 +802,50 @@ mod tests {
     fn coincident_centroids_still_make_small_leaves() {
         let b = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 100];
         let (bvh, _) = Bvh::build(&b);
-        assert!(bvh.nodes.iter().all(|n| n.count() <= MAX_LEAF));
+        assert!(bvh.leaf_sizes().all(|c| c <= MAX_LEAF));
+        assert_eq!(bvh.leaf_sizes().sum::<usize>(), 100);
+    }
+
+    #[test]
+    fn wide_nodes_are_two_cache_lines() {
+        assert_eq!(std::mem::size_of::<Wide>(), 128);
+        assert_eq!(std::mem::align_of::<Wide>(), 64);
+    }
+
+    #[test]
+    fn words_round_trip_and_bad_links_are_refused() {
+        let b = boxes(3000);
+        let (bvh, _) = Bvh::build(&b);
+        let mut w = Vec::new();
+        bvh.to_words(&mut |x| w.push(x));
+        let back = Bvh::from_words(&w, 3000).expect("round trip");
+        assert_eq!(back.nodes.len(), bvh.nodes.len());
+        let mut w2 = Vec::new();
+        back.to_words(&mut |x| w2.push(x));
+        assert_eq!(w, w2);
+        // Too few primitives for the leaves, a link pointing backwards, a truncated node.
+        assert!(Bvh::from_words(&w, 2999).is_none());
+        let mut backwards = w.clone();
+        let inner = (0..4)
+            .find(|&l| {
+                let link = u64::from(w[24 + 2 * l]) | u64::from(w[25 + 2 * l]) << 32;
+                link != EMPTY && count_of(link) == 0
+            })
+            .unwrap();
+        let last = w.len() / WORDS - 1;
+        backwards[last * WORDS + 24 + 2 * inner] = 0;
+        backwards[last * WORDS + 25 + 2 * inner] = 0;
+        backwards[last * WORDS + 24] = 1;
+        assert!(Bvh::from_words(&backwards, 3000).is_none());
+        assert!(Bvh::from_words(&w[..w.len() - 1], 3000).is_none());
+    }
+
+    #[test]
+    fn a_single_leaf_tree_is_traversed() {
+        let b = boxes(3);
+        let (bvh, _) = Bvh::build(&b);
+        assert_eq!(bvh.nodes.len(), 1);
+        let o = b[0].centroid() - Vec3A::new(0.0, 0.0, 10.0);
+        assert!(bvh.any(o, Vec3A::Z, f32::INFINITY, |_| true));
     }
 }
