@@ -227,6 +227,19 @@ impl Stack {
         self.len += 1;
     }
 
+    /// Pushes keeping the entries above `base` in decreasing order of `t`.
+    #[inline(always)]
+    fn insert_sorted(&mut self, base: usize, link: u64, t: f32) {
+        let mut j = self.len;
+        // SAFETY: entries in base..len were written by `push` or here.
+        while j > base && unsafe { self.entries[j - 1].assume_init().1 } < t {
+            self.entries[j] = self.entries[j - 1];
+            j -= 1;
+        }
+        self.entries[j] = MaybeUninit::new((link, t));
+        self.len += 1;
+    }
+
     #[inline(always)]
     fn pop(&mut self) -> Option<(u64, f32)> {
         if self.len == 0 {
@@ -403,23 +416,13 @@ impl Bvh {
         let mut i = 0usize;
         loop {
             let node = &self.nodes[i];
-            let (mask, t) = ray.enter(node, t_max);
-            // Hit children, nearest last so it is taken first.
-            let mut hits = [(0u64, 0f32); 4];
-            let mut n = 0;
-            for (l, (&link, &t)) in node.link.iter().zip(&t).enumerate() {
-                if mask & 1 << l != 0 {
-                    let mut j = n;
-                    while j > 0 && hits[j - 1].1 < t {
-                        hits[j] = hits[j - 1];
-                        j -= 1;
-                    }
-                    hits[j] = (link, t);
-                    n += 1;
-                }
-            }
-            for &(link, t) in &hits[..n] {
-                stack.push(link, t);
+            let (mut mask, t) = ray.enter(node, t_max);
+            // Push the children hit, nearest last so it is taken first.
+            let base = stack.len;
+            while mask != 0 {
+                let l = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack.insert_sorted(base, node.link[l], t[l]);
             }
             // Next: the nearest pending child still nearer than the closest hit; leaves are
             // tested as they come off the stack.
@@ -470,11 +473,10 @@ impl Bvh {
                 continue;
             }
             let node = &self.nodes[offset_of(link)];
-            let (mask, _) = ray.enter(node, t_max);
-            for l in 0..4 {
-                if mask & 1 << l != 0 {
-                    stack.push(node.link[l], 0.0);
-                }
+            let (mut mask, _) = ray.enter(node, t_max);
+            while mask != 0 {
+                stack.push(node.link[mask.trailing_zeros() as usize], 0.0);
+                mask &= mask - 1;
             }
         }
         false

@@ -26,6 +26,7 @@ pub trait Shape: Copy + Send + Sync {
         t_max: f32,
     ) -> Option<(f32, f32, f32)>;
     /// How many times the ray crosses the surface in (0, t_max) (filtered shadows).
+    #[inline(always)]
     fn crossings(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> u32 {
         u32::from(self.hit(ray, prep, t_max).is_some())
     }
