@@ -127,8 +127,20 @@ fn sum_words(bytes: &[u8]) -> u64 {
 }
 
 fn sum_bytes(bytes: &[u8]) -> u64 {
+    sum_releasing(bytes, &|_, _| {})
+}
+
+/// `sum_bytes`, handing each block to `release` once summed.
+fn sum_releasing(bytes: &[u8], release: &Release<'_>) -> u64 {
     use rayon::prelude::*;
-    let blocks: Vec<u64> = bytes.par_chunks(SUM_BLOCK).map(sum_words).collect();
+    let blocks: Vec<u64> = bytes
+        .par_chunks(SUM_BLOCK)
+        .map(|block| {
+            let s = sum_words(block);
+            release(block.as_ptr() as usize, block.len());
+            s
+        })
+        .collect();
     let mut s = Sum::new();
     for b in blocks {
         s.add(b as u32);
@@ -361,7 +373,26 @@ pub fn open(source: &Path) -> Lookup {
             Ok(m) => m,
             Err(_) => continue,
         };
-        match read(&map, stamp) {
+        // Pages are given back as soon as they are checked or decoded, so the mapped file
+        // does not sit in memory beside the arrays decoded from it.
+        let base = map.as_ptr() as usize;
+        let release = |at: usize, len: usize| {
+            const PAGE: usize = 4096;
+            let start = (at - base).next_multiple_of(PAGE);
+            let end = (at - base + len) / PAGE * PAGE;
+            if end > start {
+                // SAFETY: a read-only private file mapping; dropped pages are read from the
+                // file again if touched (and the checksum has already been taken).
+                let _ = unsafe {
+                    map.unchecked_advise_range(
+                        memmap2::UncheckedAdvice::DontNeed,
+                        start,
+                        end - start,
+                    )
+                };
+            }
+        };
+        match read(&map, stamp, &release) {
             Ok(Some((skeleton, geometry))) => {
                 return Lookup::Hit(Box::new(Cached {
                     path,
@@ -376,10 +407,14 @@ pub fn open(source: &Path) -> Lookup {
     Lookup::Miss
 }
 
+/// Called with (address, length) of mapped bytes no longer needed.
+type Release<'a> = dyn Fn(usize, usize) + Sync + 'a;
+
 /// Little-endian reader over the mapped bytes; every read checked.
 struct In<'a> {
     b: &'a [u8],
     at: usize,
+    release: &'a Release<'a>,
 }
 
 impl<'a> In<'a> {
@@ -414,7 +449,7 @@ impl<'a> In<'a> {
         use rayon::prelude::*;
         let len = n.checked_mul(4 * k).ok_or("impossible length")?;
         let raw = self.bytes(len)?;
-        Ok(raw
+        let out = raw
             .par_chunks_exact(4 * k)
             .with_min_len(4096)
             .map(|c| {
@@ -424,7 +459,9 @@ impl<'a> In<'a> {
                 }
                 f(&words[..k])
             })
-            .collect())
+            .collect();
+        (self.release)(raw.as_ptr() as usize, raw.len());
+        Ok(out)
     }
 
     fn len(&mut self) -> Result<usize, String> {
@@ -443,8 +480,8 @@ fn v3(w: &[u32]) -> Vec3 {
 /// Ok(None): a cache of another version or source (stale); Err: corrupt.
 type Parsed = Result<Option<(String, Prebuilt)>, String>;
 
-fn read(b: &[u8], stamp: (u64, i64, u32)) -> Parsed {
-    let mut r = In { b, at: 0 };
+fn read<'a>(b: &'a [u8], stamp: (u64, i64, u32), release: &'a Release<'a>) -> Parsed {
+    let mut r = In { b, at: 0, release };
     if r.bytes(8).ok() != Some(&MAGIC[..]) {
         return Err("not a luxon geometry cache".into());
     }
@@ -476,7 +513,7 @@ fn read(b: &[u8], stamp: (u64, i64, u32)) -> Parsed {
         .checked_mul(4)
         .filter(|&l| l == (b.len() - r.at) as u64)
         .ok_or("length does not match the header (truncated?)")?;
-    if sum_bytes(&b[r.at..r.at + payload_len as usize]) != sum {
+    if sum_releasing(&b[r.at..r.at + payload_len as usize], release) != sum {
         return Err("payload checksum mismatch".into());
     }
 
