@@ -56,7 +56,7 @@
 
 mod lex;
 mod parse;
-mod polygon;
+pub(crate) mod polygon;
 mod stream;
 
 use std::collections::HashMap;

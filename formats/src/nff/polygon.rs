@@ -12,7 +12,12 @@ pub(crate) struct Triangulator {
     prev: Vec<u32>,
     next: Vec<u32>,
     reflex: Vec<bool>,
+    /// Per corner: `Some(diagonal length²)` when it is an ear.
+    ear: Vec<Option<f64>>,
 }
+
+/// Polygons up to this many corners get the best-ear triangulation.
+const BEST_EAR_MAX: usize = 2048;
 
 /// Newell's normal of a polygon (not normalised; zero when it has no area).
 pub(crate) fn newell_normal(v: &[[f64; 3]]) -> [f64; 3] {
@@ -36,6 +41,11 @@ impl Triangulator {
     /// Degenerate polygons (no area) get a fan: its triangles have no area either, and the
     /// renderer drops those.
     pub fn triangulate(&mut self, v: &[[f64; 3]], out: &mut Vec<[u32; 3]>) {
+        self.triangulate_up_to(v, out, BEST_EAR_MAX);
+    }
+
+    /// `triangulate`, cutting best ears in concave polygons of at most `best_ears` corners.
+    fn triangulate_up_to(&mut self, v: &[[f64; 3]], out: &mut Vec<[u32; 3]>, best_ears: usize) {
         let n = v.len();
         if n < 3 {
             return;
@@ -97,10 +107,82 @@ impl Triangulator {
             }
             return;
         }
-        self.ear_clip(out);
+        self.ear_clip(out, best_ears);
     }
 
-    fn ear_clip(&mut self, out: &mut Vec<[u32; 3]>) {
+    /// Cuts, each time, the ear with the shortest closing diagonal: the triangles come out
+    /// compact (a gear's teeth first, then its disc halved and halved again) instead of the
+    /// long slivers that cutting the first ear found leaves, which overlap in the BVH (the
+    /// SPD gears took 13.8 ray/triangle tests per ray with slivers). O(m²); larger polygons
+    /// take the first ear found.
+    fn ear_clip(&mut self, out: &mut Vec<[u32; 3]>, best_ears: usize) {
+        let m = self.pts.len();
+        if m > best_ears {
+            return self.first_ears(out);
+        }
+        self.prev.clear();
+        self.next.clear();
+        for i in 0..m {
+            self.prev.push(((i + m - 1) % m) as u32);
+            self.next.push(((i + 1) % m) as u32);
+        }
+        self.ear.clear();
+        for i in 0..m {
+            let e = self.ear_key(i);
+            self.ear.push(e);
+        }
+        let mut left = m;
+        let mut start = 0usize;
+        while left > 3 {
+            let mut best: Option<(f64, usize)> = None;
+            let mut k = start;
+            loop {
+                if let Some(key) = self.ear[k] {
+                    if best.is_none_or(|(b, _)| key < b) {
+                        best = Some((key, k));
+                    }
+                }
+                k = self.next[k] as usize;
+                if k == start {
+                    break;
+                }
+            }
+            // No ear: not simple (or rounding hides its ears); cut the flattest convex corner.
+            let cut = best.map_or_else(|| self.fallback_corner(start), |(_, k)| k);
+            let (p, nx) = (self.prev[cut] as usize, self.next[cut] as usize);
+            out.push([self.keep[p], self.keep[cut], self.keep[nx]]);
+            self.next[p] = nx as u32;
+            self.prev[nx] = p as u32;
+            left -= 1;
+            for k in [p, nx] {
+                let c = cross2(
+                    self.pts[self.prev[k] as usize],
+                    self.pts[k],
+                    self.pts[self.next[k] as usize],
+                );
+                self.reflex[k] = c < 0.0;
+            }
+            for k in [p, nx] {
+                self.ear[k] = self.ear_key(k);
+            }
+            start = p;
+        }
+        let (p, nx) = (self.prev[start] as usize, self.next[start] as usize);
+        out.push([self.keep[p], self.keep[start], self.keep[nx]]);
+    }
+
+    /// For an ear at corner `i`: the squared length of the diagonal that cuts it off.
+    fn ear_key(&self, i: usize) -> Option<f64> {
+        let (p, nx) = (self.prev[i] as usize, self.next[i] as usize);
+        if self.reflex[i] || !self.no_point_inside(p, i, nx) {
+            return None;
+        }
+        let (a, b) = (self.pts[p], self.pts[nx]);
+        Some((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2))
+    }
+
+    /// Ear clipping that cuts the first ear it meets (linear-ish time on huge polygons).
+    fn first_ears(&mut self, out: &mut Vec<[u32; 3]>) {
         let m = self.pts.len();
         self.prev.clear();
         self.next.clear();
@@ -265,6 +347,38 @@ mod tests {
         check_cover(&[[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 2.0], [0.0, 1.0]]);
         // Clockwise too.
         check_cover(&[[0.0, 1.0], [1.0, 2.0], [2.0, 1.0], [2.0, 0.0], [0.0, 0.0]]);
+    }
+
+    #[test]
+    fn gears_are_cut_into_compact_triangles() {
+        // A 36-tooth gear outline (144 corners, like the SPD gears).
+        let gear: Vec<[f64; 2]> = (0..144)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 144.0;
+                let r = if (i / 2) % 2 == 0 { 1.0 } else { 0.85 };
+                [r * a.cos(), r * a.sin()]
+            })
+            .collect();
+        let best = check_cover(&gear);
+        let longest = |tris: &[[u32; 3]]| -> f64 {
+            tris.iter()
+                .map(|t| {
+                    (0..3)
+                        .map(|k| {
+                            let (a, b) = (gear[t[k] as usize], gear[t[(k + 1) % 3] as usize]);
+                            (a[0] - b[0]).hypot(a[1] - b[1])
+                        })
+                        .fold(0.0, f64::max)
+                })
+                .sum()
+        };
+        // The same polygon cut at the first ears found.
+        let v: Vec<[f64; 3]> = gear.iter().map(|q| [q[0], q[1], 0.0]).collect();
+        let mut first = Vec::new();
+        Triangulator::default().triangulate_up_to(&v, &mut first, 0);
+        assert_eq!(first.len(), best.len());
+        let (b, f) = (longest(&best), longest(&first));
+        assert!(b < 0.5 * f, "longest edges: best ears {b}, first ears {f}");
     }
 
     #[test]

@@ -16,7 +16,7 @@
 use std::collections::HashMap;
 use std::io::{self, Write};
 
-use super::{cross, dot, push_g, sub, Counts, Fill, Sink, SpdScene, View, V3};
+use super::{push_g, Counts, Fill, Sink, SpdScene, View, V3};
 use crate::nff::{fov_of_angle, material_of_fill};
 
 /// Most primitives per object.
@@ -419,73 +419,11 @@ fn linear(c: f64) -> f64 {
     }
 }
 
-/// Triangles (indices into `v`) covering the planar polygon `v`: a fan when it is convex,
-/// otherwise ear clipping in the polygon's dominant projection plane.
+/// Triangles (indices into `v`) covering the planar polygon `v`: the NFF importer's
+/// triangulation (a fan when convex, otherwise best-ear clipping), so `.ron` and `.nff` output
+/// give the same triangles.
 pub(crate) fn triangulate(v: &[V3], out: &mut Vec<[u32; 3]>) {
-    let n = v.len();
-    // Newell's normal: robust for any planar polygon.
-    let mut normal = [0.0; 3];
-    for i in 0..n {
-        let (a, b) = (v[i], v[(i + 1) % n]);
-        normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    }
-    let convex = (0..n).all(|i| {
-        let (a, b, c) = (v[(i + n - 1) % n], v[i], v[(i + 1) % n]);
-        dot(cross(sub(b, a), sub(c, b)), normal) >= -1e-12 * dot(normal, normal).sqrt()
-    });
-    if convex || n == 3 {
-        out.extend((1..n as u32 - 1).map(|i| [0, i, i + 1]));
-        return;
-    }
-    // Project to 2-D, dropping the normal's largest component, counter-clockwise.
-    let k = (0..3)
-        .max_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))
-        .unwrap_or(2);
-    let (x, y) = ((k + 1) % 3, (k + 2) % 3);
-    let flip = normal[k] < 0.0;
-    let p: Vec<[f64; 2]> = v
-        .iter()
-        .map(|q| if flip { [q[y], q[x]] } else { [q[x], q[y]] })
-        .collect();
-    let cross2 = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
-        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-    };
-    let mut left: Vec<u32> = (0..n as u32).collect();
-    let mut guard = 0;
-    while left.len() > 3 && guard < 2 * n * n {
-        guard += 1;
-        let m = left.len();
-        let mut clipped = false;
-        for i in 0..m {
-            let (ia, ib, ic) = (left[(i + m - 1) % m], left[i], left[(i + 1) % m]);
-            let (a, b, c) = (p[ia as usize], p[ib as usize], p[ic as usize]);
-            if cross2(a, b, c) <= 0.0 {
-                continue;
-            }
-            let inside = left.iter().any(|&j| {
-                if j == ia || j == ib || j == ic {
-                    return false;
-                }
-                let q = p[j as usize];
-                cross2(a, b, q) >= 0.0 && cross2(b, c, q) >= 0.0 && cross2(c, a, q) >= 0.0
-            });
-            if !inside {
-                out.push([ia, ib, ic]);
-                left.remove(i);
-                clipped = true;
-                break;
-            }
-        }
-        if !clipped {
-            break;
-        }
-    }
-    // Whatever is left (3 corners, or a degenerate remainder) is fanned.
-    for i in 1..left.len().saturating_sub(1) {
-        out.push([left[0], left[i], left[i + 1]]);
-    }
+    crate::nff::polygon::Triangulator::default().triangulate(v, out);
 }
 
 #[cfg(test)]
