@@ -9,8 +9,9 @@
 //! gets three new ones in its other sub-quadrants, so no sample is wasted and a fully split cell
 //! is exactly a finer jittered grid. Splitting stops at the maximum depth.
 //!
-//! Every decision depends only on the pixel's own samples, whose positions come from the
-//! (pixel, cell, frame) hash: the image is identical for any thread count and decomposition.
+//! Every decision depends only on the pixel's own samples, whose jitter is one hash of the
+//! pixel's seed (the (pixel, frame) hash) and the cell: the image is identical for any thread
+//! count and decomposition.
 
 use crate::math::Vec3A;
 use crate::sampler::{hash, mix, to_unit};
