@@ -141,3 +141,31 @@ fn stats_count_adaptive_rays_and_bad_flags_are_refused() {
         assert!(stderr(&o).contains("--adaptive"), "{}", stderr(&o));
     }
 }
+
+/// The sampling pattern itself: the shipped ball-and-stick molecule rendered adaptively must
+/// match its committed picture (so a change of positions, splitting or averaging shows up here;
+/// bless with `LUXON_BLESS=1 cargo test --test adaptive` after looking at the new picture).
+#[test]
+fn ball_and_stick_matches_its_adaptive_golden_image() {
+    let fb = render_with(&root().join("scenes/ball-and-stick.ron"), |d| {
+        d.render.width = 128;
+        d.render.height = 96;
+        d.render.samples = 4;
+        d.render.adaptive = adaptive(0.05, 2);
+    });
+    let got = to_srgb8(&fb);
+    let golden = root().join("tests/golden/ball-and-stick-adaptive.png");
+    if std::env::var_os("LUXON_BLESS").is_some() {
+        image::save_buffer(&golden, &got, fb.width, fb.height, image::ColorType::Rgb8).unwrap();
+        return;
+    }
+    let want = image::open(&golden)
+        .unwrap_or_else(|e| panic!("{}: {e} (bless with LUXON_BLESS=1)", golden.display()))
+        .to_rgb8();
+    assert_eq!((want.width(), want.height()), (fb.width, fb.height));
+    let (mean, max) = diff(&got, want.as_raw());
+    // Same machine: identical. Elsewhere, libm's last bits may differ a little at edges.
+    assert!(mean < 0.5 && max < 64, "mean diff {mean:.3}, max {max}");
+    // Not a flat picture: the molecule is there, bright atoms on a dark background.
+    assert!(got.iter().any(|&c| c > 200) && got.iter().any(|&c| c < 90));
+}

@@ -56,6 +56,7 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     let n = s.samples.max(1);
     let inv_n = 1.0 / n as f32;
     let media = IorStack::default();
+    let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
     for span in spans {
         let y = span.y;
         for x in span.xs() {
@@ -70,8 +71,8 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
                     None => Vec3A::ZERO,
                 }
             };
-            let mut v = match &s.adaptive {
-                Some(a) => adaptive::pixel(x, y, s.frame, n, a, &mut shade),
+            let mut v = match &plan {
+                Some(p) => p.pixel(x, y, s.frame, &mut shade),
                 None => {
                     let mut sum = Vec3A::ZERO;
                     for i in 0..n {

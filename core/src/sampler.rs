@@ -3,7 +3,7 @@
 
 /// A 32-bit integer hash with good avalanche (lowbias32 by C. Wellons).
 #[inline(always)]
-pub fn mix(mut x: u32) -> u32 {
+pub const fn mix(mut x: u32) -> u32 {
     x ^= x >> 16;
     x = x.wrapping_mul(0x7feb_352d);
     x ^= x >> 15;

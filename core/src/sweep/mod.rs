@@ -378,6 +378,10 @@ pub fn run(
 
     let mut base: Option<Scene> = None;
     let mut rows = Vec::new();
+    // Settings of the shared built scene get their further runs round-robin after every
+    // setting has rendered once, so a change in the machine's load over the sweep (it is often
+    // shared) falls on all of them alike instead of on whichever ran then.
+    let mut later: Vec<(usize, Settings, Vec<Duration>)> = Vec::new();
     for curve in &options.curves {
         for setting in &curve.settings {
             let label = format!("{}={}", curve.param.name(), setting.label());
@@ -401,7 +405,11 @@ pub fn run(
                     scene.settings.samples > 1 || scene.settings.adaptive.is_some();
                 scene
             };
-            let (fb, rays, primary, time) = render_timed(scene, options.runs)?;
+            let runs = if setting.rebuilds() { options.runs } else { 1 };
+            let (fb, rays, primary, time) = render_timed(scene, runs)?;
+            if !setting.rebuilds() {
+                later.push((rows.len(), scene.settings.clone(), vec![time]));
+            }
             let rgb = to_rgb8(&fb);
             let rmse = crate::metrics::rmse(&rgb, &reference_rgb);
             let gray = crate::metrics::gray(&rgb);
@@ -417,6 +425,20 @@ pub fn run(
                 rgb,
             });
         }
+    }
+    if let Some(scene) = base.as_mut() {
+        for _ in 1..options.runs.max(1) {
+            for (_, settings, times) in &mut later {
+                scene.settings = settings.clone();
+                scene.features.antialiasing =
+                    scene.settings.samples > 1 || scene.settings.adaptive.is_some();
+                times.push(crate::render::render(scene, &|_, _| {})?.1.render_time);
+            }
+        }
+    }
+    for (row, _, mut times) in later {
+        times.sort();
+        rows[row].time = times[times.len() / 2];
     }
     Ok(Sweep {
         width: w,
