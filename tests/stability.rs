@@ -236,7 +236,8 @@ fn parallel_mirrors_end_at_the_depth_limit_in_bounded_time() {
         )"#
         )
     };
-    for depth in [20u32, 500] {
+    // 1024 is the largest max_depth a scene may ask for: the recursion must fit the stack.
+    for depth in [20u32, 1024] {
         let (fb, c) = render_counted(&format!("mirrors-{depth}"), &scene(depth));
         assert_eq!(c.nan_pixels, 0);
         assert_eq!(c.reflection, 64 * depth as u64);

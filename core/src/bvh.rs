@@ -400,7 +400,10 @@ impl Bvh {
 
     /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
     /// `t_max` (and records whatever it needs). Returns the final `t_max`.
-    #[inline]
+    // Not inlined: the traversal stack (6 KB) would otherwise sit in every frame of the
+    // recursive integrator, and deep reflections (max_depth in the hundreds) overflow the
+    // thread's stack. The primitive test is still inlined here.
+    #[inline(never)]
     pub fn intersect<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
         origin: Vec3A,
@@ -449,7 +452,7 @@ impl Bvh {
     }
 
     /// Any-hit traversal: stops as soon as `test(prim)` returns true.
-    #[inline]
+    #[inline(never)]
     pub fn any<F: FnMut(usize) -> bool>(
         &self,
         origin: Vec3A,

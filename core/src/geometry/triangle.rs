@@ -111,7 +111,23 @@ pub fn intersect_triangle(v: &[Vec3; 3], r: &TriRay, t_max: f32) -> Option<(f32,
         return None;
     }
     let inv = 1.0 / det;
-    Some((t_scaled * inv, vv * inv, w * inv))
+    let t = t_scaled * inv;
+    // A hit closer than the rounding error of t could be the surface a ray just left: reject
+    // it (the bound of Pharr, Jakob & Humphreys, PBR 3rd ed., 3.9.6). Only computed for hits.
+    let z = [sz * a[kz], sz * b[kz], sz * c[kz]];
+    let max_z = z.map(f32::abs).into_iter().fold(0.0, f32::max);
+    let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+    let max_y = ay.abs().max(by.abs()).max(cy.abs());
+    let delta_z = gamma(3) * max_z;
+    let delta_x = gamma(5) * (max_x + max_z);
+    let delta_y = gamma(5) * (max_y + max_z);
+    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    let max_e = u.abs().max(vv.abs()).max(w.abs());
+    let delta_t = 3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv.abs();
+    if t <= delta_t {
+        return None;
+    }
+    Some((t, vv * inv, w * inv))
 }
 
 /// A mesh as plugins and importers give it: flat f64/f32 arrays, optional ones empty.

@@ -107,6 +107,9 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, Error> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .thread_name(|i| format!("luxon-render-{i}"))
+        // The integrator recurses once per bounce, up to max_depth 1024: room to spare (only
+        // the pages touched are ever committed).
+        .stack_size(32 << 20)
         .build()
         .map_err(|e| Error::Render(format!("cannot start {threads} render threads: {e}")))
 }
