@@ -420,12 +420,28 @@ impl Bvh {
         loop {
             let node = &self.nodes[i];
             let (mut mask, t) = ray.enter(node, t_max);
-            // Push the children hit, nearest last so it is taken first.
-            let base = stack.len;
-            while mask != 0 {
-                let l = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                stack.insert_sorted(base, node.link[l], t[l]);
+            if mask.is_power_of_two() {
+                // One child hit: enter or test it without going through the stack.
+                let link = node.link[mask.trailing_zeros() as usize];
+                let count = count_of(link);
+                if count == 0 {
+                    i = offset_of(link);
+                    continue;
+                }
+                let start = offset_of(link);
+                for p in start..start + count {
+                    if let Some(t) = test(p, t_max) {
+                        t_max = t;
+                    }
+                }
+            } else {
+                // Push the children hit, nearest last so it is taken first.
+                let base = stack.len;
+                while mask != 0 {
+                    let l = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack.insert_sorted(base, node.link[l], t[l]);
+                }
             }
             // Next: the nearest pending child still nearer than the closest hit; leaves are
             // tested as they come off the stack.
@@ -465,24 +481,36 @@ impl Bvh {
         }
         let ray = BoxRay::new(origin, dir);
         let mut stack = Stack::new();
-        stack.push(0, 0.0);
-        while let Some((link, _)) = stack.pop() {
+        // The root (an inner node, or the wide node holding a lone leaf).
+        let mut link = 0u64;
+        loop {
             let count = count_of(link);
             if count > 0 {
                 let start = offset_of(link);
                 if (start..start + count).any(&mut test) {
                     return true;
                 }
-                continue;
+            } else {
+                let node = &self.nodes[offset_of(link)];
+                let (mut mask, _) = ray.enter(node, t_max);
+                if mask != 0 {
+                    // The last child hit is taken now, the others pushed (so the order is
+                    // the stack's, whatever the count).
+                    let last = 31 - mask.leading_zeros() as usize;
+                    mask &= !(1 << last);
+                    while mask != 0 {
+                        stack.push(node.link[mask.trailing_zeros() as usize], 0.0);
+                        mask &= mask - 1;
+                    }
+                    link = node.link[last];
+                    continue;
+                }
             }
-            let node = &self.nodes[offset_of(link)];
-            let (mut mask, _) = ray.enter(node, t_max);
-            while mask != 0 {
-                stack.push(node.link[mask.trailing_zeros() as usize], 0.0);
-                mask &= mask - 1;
+            match stack.pop() {
+                Some((next, _)) => link = next,
+                None => return false,
             }
         }
-        false
     }
 }
 
