@@ -37,6 +37,9 @@ pub struct Set<S> {
     /// Material and clip group, packed (see `pack`).
     pub material: Vec<u32>,
     bvh: Bvh,
+    /// Some primitive belongs to a clip group (set when built): without, tests skip the
+    /// packed-material load.
+    clipped: bool,
 }
 
 impl<S> Default for Set<S> {
@@ -45,6 +48,7 @@ impl<S> Default for Set<S> {
             data: Vec::new(),
             material: Vec::new(),
             bvh: Bvh::default(),
+            clipped: false,
         }
     }
 }
@@ -65,10 +69,12 @@ impl<S: Shape> Set<S> {
 
     /// A set already built (read back from the geometry cache).
     pub(crate) fn from_parts(data: Vec<S>, material: Vec<u32>, bvh: Bvh) -> Set<S> {
+        let clipped = material.iter().any(|&m| clip_of(m) != 0);
         Set {
             data,
             material,
             bvh,
+            clipped,
         }
     }
 
@@ -84,6 +90,7 @@ impl<S: Shape> Set<S> {
         self.data = order.iter().map(|&i| self.data[i as usize]).collect();
         self.material = order.iter().map(|&i| self.material[i as usize]).collect();
         self.bvh = bvh;
+        self.clipped = self.material.iter().any(|&m| clip_of(m) != 0);
     }
 
     /// The nearest hit of primitive `i` in (0, t_max) that its clip group keeps.
@@ -96,8 +103,11 @@ impl<S: Shape> Set<S> {
         t_max: f32,
         clips: &Clips,
     ) -> Option<(f32, f32, f32)> {
-        let clip = clip_of(self.material[i]);
         let shape = &self.data[i];
+        if !self.clipped {
+            return shape.hit(ray, prep, t_max);
+        }
+        let clip = clip_of(self.material[i]);
         if clip == 0 {
             return shape.hit(ray, prep, t_max);
         }
@@ -152,6 +162,10 @@ impl<S: Shape> Set<S> {
         let prep = S::prep(ray);
         self.bvh.any(ray.origin, ray.dir, t_max, |i| {
             c.tests += 1;
+            if !self.clipped {
+                let n = self.data[i].crossings(ray, &prep, t_max);
+                return n > 0 && on_hit(material_of(self.material[i]), n);
+            }
             let packed = self.material[i];
             let n = if clip_of(packed) == 0 {
                 self.data[i].crossings(ray, &prep, t_max)
