@@ -389,7 +389,7 @@ fn main() {
                 };
                 match r {
                     Renderer::Luxon | Renderer::LuxonCached => {
-                        run.load = after(&text, "load + plugins")
+                        run.load = after(&text, "load + objects")
                             .unwrap_or_else(|| missing("load"))
                             + after(&text, "BVH build").unwrap_or_else(|| missing("BVH build"));
                         run.render = after(&text, "render  ").unwrap_or_else(|| missing("render"));

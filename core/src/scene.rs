@@ -236,6 +236,8 @@ pub struct Scene {
     pub object_counts: Vec<(String, usize)>,
     pub degenerate_triangles: u64,
     pub bvh_time: Duration,
+    /// Instantiating the objects through their plugins and storing all geometry natively
+    /// (after reading the scene, before the BVH build).
     pub plugin_time: Duration,
 }
 

@@ -426,7 +426,7 @@ fn print_stats(
     }
     eprintln!("  NaN pixels       {}", c.nan_pixels);
     eprintln!(
-        "  load + plugins   {:.3} s (plugins {:.3} s)",
+        "  load + objects   {:.3} s (objects and geometry {:.3} s)",
         load.as_secs_f64() + scene.plugin_time.as_secs_f64(),
         scene.plugin_time.as_secs_f64()
     );
