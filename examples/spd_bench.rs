@@ -282,24 +282,27 @@ fn main() {
         scenes.push((scene.clone(), nff, has_pov.then_some(pov), reference));
     }
 
+    // `luxon render NFF -o OUT --threads N`.
+    let luxon_render = |nff: &Path, out: &Path| {
+        vec![
+            bin.display().to_string(),
+            s("render"),
+            nff.display().to_string(),
+            s("-o"),
+            out.display().to_string(),
+            s("--threads"),
+            threads.clone(),
+        ]
+    };
+
     // Warm-up for the cached rows: the first cached render writes the cache.
     if cached {
         for (scene, nff, _, _) in &scenes {
             eprintln!("spd_bench: writing the geometry cache of {scene}");
             let out = a.work.join(format!("{scene}-warm.png"));
-            measure(
-                &[
-                    bin.display().to_string(),
-                    s("render"),
-                    nff.display().to_string(),
-                    s("-o"),
-                    out.display().to_string(),
-                    s("--threads"),
-                    threads.clone(),
-                    s("--cache"),
-                ],
-                &a.work,
-            );
+            let mut cmd = luxon_render(nff, &out);
+            cmd.push(s("--cache"));
+            measure(&cmd, &a.work);
         }
     }
 
@@ -324,16 +327,8 @@ fn main() {
                         let out = a
                             .work
                             .join(format!("{scene}-{}.png", r.label().replace(' ', "")));
-                        let mut cmd = vec![
-                            bin.display().to_string(),
-                            s("render"),
-                            nff.display().to_string(),
-                            s("-o"),
-                            out.display().to_string(),
-                            s("--threads"),
-                            threads.clone(),
-                            s("--stats"),
-                        ];
+                        let mut cmd = luxon_render(nff, &out);
+                        cmd.push(s("--stats"));
                         if r == Renderer::Luxon && has_cache {
                             cmd.push(s("--no-cache"));
                         }

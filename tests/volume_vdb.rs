@@ -4,44 +4,10 @@
 mod common;
 use common::*;
 
-use luxon::plugin::{PluginKind, Registry};
-use luxon::volume::{read_volume, Volume};
-use luxon_formats::{Origin, SceneDesc};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
     root().join("plugins/volume-vdb/tests/fixtures").join(name)
-}
-
-/// Writes `scene.ron` with `volumes` (RON list items) into `dir` and loads it.
-fn scene(dir: &Path, volumes: &str) -> SceneDesc {
-    let text = format!(
-        "(\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    volumes: [\n{volumes}\n    ],\n)\n"
-    );
-    let path = dir.join("scene.ron");
-    std::fs::write(&path, text).unwrap();
-    luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn read(desc: &SceneDesc, reg: &Registry, i: usize) -> Result<Volume, (Origin, String)> {
-    let call = &desc.volumes[i].value.call;
-    let entry = reg
-        .get(&call.plugin.value, PluginKind::VolumeReader)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let name = desc.volumes[i]
-        .value
-        .name
-        .as_ref()
-        .map(|n| n.value.clone())
-        .unwrap_or_else(|| format!("volume {i}"));
-    read_volume(
-        reg,
-        entry,
-        &call.params,
-        &call.params_at,
-        desc.source.parent().unwrap(),
-        &name,
-    )
 }
 
 /// The host's volume holds, voxel for voxel, what the parser reads (which the plugin's own tests
@@ -52,7 +18,7 @@ fn vdb_volumes_match_the_parser_voxel_by_voxel() {
     for f in ["fog_sphere.vdb", "half.vdb", "level_set.vdb", "masks.vdb"] {
         std::fs::copy(fixture(f), dir.join(f)).unwrap();
     }
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         r#"        (plugin: "vdb", name: "fog", params: (file: "fog_sphere.vdb")),
         (plugin: "vdb", params: (file: "half.vdb", grid: "density")),
@@ -69,7 +35,7 @@ fn vdb_volumes_match_the_parser_voxel_by_voxel() {
     .into_iter()
     .enumerate()
     {
-        let v = read(&desc, &reg, i).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
+        let v = read_volume_of(&desc, &reg, i).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
         let bytes = std::fs::read(fixture(file)).unwrap();
         let g = luxon_volume_vdb::read_grid(&bytes, grid).unwrap();
         assert_eq!(v.plugin, "vdb");
@@ -90,7 +56,7 @@ fn vdb_volumes_match_the_parser_voxel_by_voxel() {
         }
     }
     // The level set: minus the background inside (index centre 16, 16, 16), plus outside.
-    let v = read(&desc, &reg, 2).unwrap();
+    let v = read_volume_of(&desc, &reg, 2).unwrap();
     assert_eq!(v.name, "surface");
     assert_eq!(v.background, 0.75);
     assert_eq!(v.value([16, 16, 16]), -0.75);
@@ -103,7 +69,7 @@ fn luxon_check_describes_a_vdb_volume() {
     let dir = temp_dir("vdb-check");
     std::fs::create_dir_all(dir.join("volumes")).unwrap();
     std::fs::copy(fixture("fog_sphere.vdb"), dir.join("volumes/fog.vdb")).unwrap();
-    scene(
+    volume_scene(
         &dir,
         &format!(
             r#"        (plugin: "vdb", name: "smoke", params: (file: "volumes/fog.vdb", grid: "density")),
@@ -134,7 +100,7 @@ fn vdb_errors_point_at_the_params() {
         std::fs::copy(fixture(f), dir.join(f)).unwrap();
     }
     std::fs::write(dir.join("fake.vdb"), b"not a volume at all").unwrap();
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         r#"        (plugin: "vdb", params: (file: "multi.vdb", grid: "smoke")),
         (plugin: "vdb", params: (file: "vec3.vdb")),
@@ -145,7 +111,7 @@ fn vdb_errors_point_at_the_params() {
     );
     let reg = registry(&desc);
     let err = |i: usize| {
-        let (at, m) = read(&desc, &reg, i).unwrap_err();
+        let (at, m) = read_volume_of(&desc, &reg, i).unwrap_err();
         assert_eq!(at.line, 4 + i as u32, "{m}");
         m
     };

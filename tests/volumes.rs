@@ -4,35 +4,10 @@
 mod common;
 use common::*;
 
-use luxon::plugin::{PluginKind, Registry};
-use luxon::volume::{read_volume, Volume};
-use luxon_formats::{Origin, SceneDesc, Spanned, VolumeDescEntry};
+use luxon::plugin::PluginKind;
+use luxon::volume::read_volume;
+
 use std::path::{Path, PathBuf};
-
-/// Writes `scene.ron` with `volumes` (RON list items) into `dir` and loads it.
-fn scene(dir: &Path, volumes: &str) -> SceneDesc {
-    let text = format!(
-        "(\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    volumes: [\n{volumes}\n    ],\n)\n"
-    );
-    let path = dir.join("scene.ron");
-    std::fs::write(&path, text).unwrap();
-    luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Reads volume `i` of the scene as `Scene::build` does.
-fn read(desc: &SceneDesc, reg: &Registry, i: usize) -> Result<Volume, (Origin, String)> {
-    let v: &Spanned<VolumeDescEntry> = &desc.volumes[i];
-    let call = &v.value.call;
-    let entry = reg
-        .get(&call.plugin.value, PluginKind::VolumeReader)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let name = match &v.value.name {
-        Some(n) => n.value.clone(),
-        None => format!("volume {i}"),
-    };
-    let dir = desc.source.parent().unwrap();
-    read_volume(reg, entry, &call.params, &call.params_at, dir, &name)
-}
 
 /// The known value of voxel (x, y, z) in the 10x7x5 test grid.
 fn known(x: i64, y: i64, z: i64) -> u16 {
@@ -58,13 +33,13 @@ fn write_grid(dir: &Path) -> PathBuf {
 fn raw_u16_big_endian_values_across_bricks() {
     let dir = temp_dir("volume-u16");
     write_grid(&dir);
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         r#"        (plugin: "raw", name: "grid", params: (file: "grid.raw", dims: (10, 7, 5), format: "u16", endian: "big", normalize: false, spacing: (0.5, 0.5, 2), origin: (1, 2, 3))),
         (plugin: "raw", params: (file: "grid.raw", dims: (10, 7, 5), format: "u16", endian: "big")),"#,
     );
     let reg = registry(&desc);
-    let v = read(&desc, &reg, 0).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
+    let v = read_volume_of(&desc, &reg, 0).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
 
     assert_eq!(v.name, "grid");
     assert_eq!(v.grid_name, "grid.raw");
@@ -121,7 +96,7 @@ fn raw_u16_big_endian_values_across_bricks() {
     assert!(v.memory_bytes() >= 2 * 512 * 4, "{}", v.memory_bytes());
 
     // The second volume: normalised by default, unnamed, default transform.
-    let w = read(&desc, &reg, 1).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
+    let w = read_volume_of(&desc, &reg, 1).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
     assert_eq!(w.name, "volume 1");
     assert_eq!(w.value([9, 6, 4]), f32::from(known(9, 6, 4)) / 65535.0);
     assert_eq!(
@@ -138,12 +113,12 @@ fn size_mismatch_is_reported_at_the_params() {
     let mut bytes = std::fs::read(&path).unwrap();
     bytes.pop();
     std::fs::write(&path, bytes).unwrap();
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         "        (plugin: \"raw\",\n         params: (file: \"grid.raw\", dims: (10, 7, 5), format: \"u16\")),",
     );
     let reg = registry(&desc);
-    let (at, message) = read(&desc, &reg, 0).unwrap_err();
+    let (at, message) = read_volume_of(&desc, &reg, 0).unwrap_err();
     // The params start on line 5, column 18 of scene.ron.
     assert_eq!(*at.file, dir.join("scene.ron"));
     assert_eq!((at.line, at.col), (5, 18));
@@ -169,12 +144,12 @@ fn size_mismatch_is_reported_at_the_params() {
 fn plugin_errors_inside_params_point_into_the_scene() {
     let dir = temp_dir("volume-params");
     write_grid(&dir);
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         "        (plugin: \"raw\", params: (\n            file: \"grid.raw\",\n            dims: (10, 7, 5),\n            format: \"u32\",\n        )),",
     );
     let reg = registry(&desc);
-    let (at, message) = read(&desc, &reg, 0).unwrap_err();
+    let (at, message) = read_volume_of(&desc, &reg, 0).unwrap_err();
     // `format: "u32"` is on line 7 of scene.ron (line 4 of the params text).
     assert_eq!(at.line, 7, "{at}: {message}");
     assert!(
@@ -183,11 +158,11 @@ fn plugin_errors_inside_params_point_into_the_scene() {
     );
 
     // A missing file names the path it resolved to (against the scene's directory).
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         "        (plugin: \"raw\", params: (file: \"sub/missing.raw\", dims: (1, 1, 1))),",
     );
-    let (_, message) = read(&desc, &reg, 0).unwrap_err();
+    let (_, message) = read_volume_of(&desc, &reg, 0).unwrap_err();
     assert!(
         message.contains(&format!(
             "volume file `{}` does not exist",
@@ -201,7 +176,7 @@ fn plugin_errors_inside_params_point_into_the_scene() {
 #[test]
 fn only_volume_readers_are_called() {
     let dir = temp_dir("volume-kind");
-    let desc = scene(&dir, "        (plugin: \"sphere\"),");
+    let desc = volume_scene(&dir, "        (plugin: \"sphere\"),");
     let reg = registry(&desc);
     let call = &desc.volumes[0].value.call;
     let e = reg
@@ -248,12 +223,12 @@ fn real_mri_head() {
     let bytes = std::fs::read(&raw).unwrap();
     assert_eq!(bytes.len(), 256 * 256 * 109);
 
-    let desc = scene(
+    let desc = volume_scene(
         &dir,
         r#"        (plugin: "raw", name: "head", params: (file: "head.raw", dims: (256, 256, 109), spacing: (1, 1, 2))),"#,
     );
     let reg = registry(&desc);
-    let v = read(&desc, &reg, 0).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
+    let v = read_volume_of(&desc, &reg, 0).unwrap_or_else(|(at, m)| panic!("{at}: {m}"));
     assert_eq!(v.voxel_count(), 256 * 256 * 109);
     assert_eq!(v.index_max, [255, 255, 108]);
     assert_eq!(v.min_max(), (0.0, 1.0));

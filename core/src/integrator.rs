@@ -328,10 +328,6 @@ fn square(seed: u32, i: u32, n: u32) -> (f32, f32) {
     pixel_sample(seed, mix(seed), i, n, 0)
 }
 
-fn attenuate(a: &[f32; 3], d: f32) -> f32 {
-    1.0 / (a[0] + a[1] * d + a[2] * d * d)
-}
-
 impl Whitted<'_> {
     /// Light from one source reaching a shading point: diffuse and highlight, times what the
     /// shadow rays let through. Area lights average `samples` points on the light.
@@ -386,7 +382,7 @@ impl Whitted<'_> {
         let from_point = |q: Vec3A, color: Vec3A, a: &[f32; 3], c: &mut Counters| {
             let d = q - sh.p;
             let dist = d.length();
-            one(Some(q), d / dist, color * attenuate(a, dist), c)
+            one(Some(q), d / dist, color * Light::attenuate(a, dist), c)
         };
         match light {
             Light::Directional {
@@ -411,18 +407,8 @@ impl Whitted<'_> {
                 if cos <= *cos_outer {
                     return Vec3A::ZERO;
                 }
-                // Smoothstep across the fall-off band: no visible edge.
-                let x = if cos >= *cos_inner {
-                    1.0
-                } else {
-                    (cos - cos_outer) / (cos_inner - cos_outer)
-                };
-                from_point(
-                    *position,
-                    *color * (x * x * (3.0 - 2.0 * x)),
-                    attenuation,
-                    c,
-                )
+                let w = Light::spot_weight(cos, *cos_inner, *cos_outer);
+                from_point(*position, *color * w, attenuation, c)
             }
             Light::Sphere {
                 center,

@@ -91,6 +91,29 @@ pub enum Light {
 }
 
 impl Light {
+    /// The fraction of light at distance `d` for attenuation coefficients (constant, linear,
+    /// quadratic).
+    #[inline]
+    pub fn attenuate(a: &[f32; 3], d: f32) -> f32 {
+        1.0 / (a[0] + a[1] * d + a[2] * d * d)
+    }
+
+    /// A spot light's weight where the direction from it makes cosine `cos` with its axis:
+    /// 1 inside the inner cone, 0 outside the outer one, and a smoothstep across the band
+    /// between them (no visible edge).
+    #[inline]
+    pub fn spot_weight(cos: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+        if cos <= cos_outer {
+            return 0.0;
+        }
+        let x = if cos >= cos_inner {
+            1.0
+        } else {
+            (cos - cos_outer) / (cos_inner - cos_outer)
+        };
+        x * x * (3.0 - 2.0 * x)
+    }
+
     pub fn casts_shadows(&self) -> bool {
         match self {
             Light::Point { shadows, .. }

@@ -530,7 +530,7 @@ fn toward(light: &Light, p: Vec3A) -> Option<(Vec3A, f32, Vec3A)> {
         let d = q - p;
         let dist = d.length();
         (dist > 0.0).then(|| {
-            let att = 1.0 / (a[0] + a[1] * dist + a[2] * dist * dist);
+            let att = Light::attenuate(a, dist);
             (d / dist, dist, color * att)
         })
     };
@@ -557,12 +557,8 @@ fn toward(light: &Light, p: Vec3A) -> Option<(Vec3A, f32, Vec3A)> {
             if cos <= *cos_outer {
                 return None;
             }
-            let x = if cos >= *cos_inner {
-                1.0
-            } else {
-                (cos - cos_outer) / (cos_inner - cos_outer)
-            };
-            point(*position, *color * (x * x * (3.0 - 2.0 * x)), attenuation)
+            let w = Light::spot_weight(cos, *cos_inner, *cos_outer);
+            point(*position, *color * w, attenuation)
         }
         Light::Sphere {
             center,

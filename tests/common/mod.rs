@@ -96,3 +96,32 @@ pub fn diff(a: &[u8], b: &[u8]) -> (f64, u8) {
     }
     (sum as f64 / a.len() as f64, max)
 }
+
+/// Writes `scene.ron` with `volumes` (RON list items) into `dir` and loads it.
+pub fn volume_scene(dir: &Path, volumes: &str) -> SceneDesc {
+    let text = format!(
+        "(\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    volumes: [\n{volumes}\n    ],\n)\n"
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Reads volume `i` of the scene as `Scene::build` does.
+pub fn read_volume_of(
+    desc: &SceneDesc,
+    reg: &Registry,
+    i: usize,
+) -> Result<luxon::volume::Volume, (luxon_formats::Origin, String)> {
+    let v = &desc.volumes[i];
+    let call = &v.value.call;
+    let entry = reg
+        .get(&call.plugin.value, luxon::plugin::PluginKind::VolumeReader)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let name = match &v.value.name {
+        Some(n) => n.value.clone(),
+        None => format!("volume {i}"),
+    };
+    let dir = desc.source.parent().unwrap();
+    luxon::volume::read_volume(reg, entry, &call.params, &call.params_at, dir, &name)
+}

@@ -21,27 +21,53 @@ use std::time::{Duration, Instant};
 pub struct AdaptiveArg(pub Option<luxon_formats::AdaptiveDesc>);
 
 /// What the command line can change in a scene's render settings.
-#[derive(Default)]
+#[derive(clap::Args, Default)]
 pub struct Overrides {
+    /// Output file(s); the writer is chosen by extension. Replaces the scene's outputs.
+    #[arg(short, long = "output")]
     pub output: Vec<PathBuf>,
+    /// Resolution as WIDTHxHEIGHT.
+    #[arg(long, value_parser = super::parse_res)]
     pub res: Option<(u32, u32)>,
+    /// Samples per pixel.
+    #[arg(long)]
     pub samples: Option<u32>,
+    /// Adaptive supersampling: split the pixel cells whose samples differ by more than
+    /// THRESHOLD (colour, 0..1), at most DEPTH times (default 3); `off` turns a scene's off.
+    #[arg(long, value_name = "THRESHOLD[:DEPTH]", value_parser = parse_adaptive)]
     pub adaptive: Option<AdaptiveArg>,
+    /// Render threads per process (default: every CPU; with MPI, the rank's share of them).
+    #[arg(long)]
     pub threads: Option<u32>,
+    /// Print rays cast per kind, intersection tests, timings and the work of every rank and
+    /// thread.
+    #[arg(long)]
     pub stats: bool,
-    /// `--no-cache`: neither read nor write the geometry cache.
+    /// Neither read nor write the binary geometry cache of an NFF scene.
+    #[arg(long, conflicts_with = "cache")]
     pub no_cache: bool,
-    /// `--cache`: write the geometry cache whatever the scene's size.
+    /// Write the geometry cache of an NFF scene whatever its size (by default only scenes
+    /// of 100,000 primitives or more get one).
+    #[arg(long)]
     pub cache: bool,
-    /// `threads`, `mpi` or `hybrid`.
+    /// Parallel mode: threads in one process, MPI ranks (one thread each), or both.
+    #[arg(long, value_parser = ["threads", "mpi", "hybrid"])]
     pub parallel: Option<String>,
-    /// `pixel-cyclic`, `scanline-cyclic`, `block-cyclic` or `dynamic`.
+    /// How pixels are dealt to threads and ranks.
+    #[arg(long, value_parser = ["pixel-cyclic", "scanline-cyclic", "block-cyclic", "dynamic"])]
     pub decomposition: Option<String>,
+    /// Edge in pixels of dynamic tiles and block-cyclic blocks.
+    #[arg(long = "block-size", alias = "tile-size")]
     pub block_size: Option<u32>,
-    /// `async`, `sync` or `mpi-io`.
+    /// Output: written while rendering, after it, or by every MPI rank (8-bit PPM).
+    #[arg(long, value_parser = ["async", "sync", "mpi-io"])]
     pub io: Option<String>,
-    /// `--shade`, `--max-depth`, `--no-shadows`, `--ao`.
+    #[command(flatten)]
     pub shading: super::shading::ShadingArgs,
+}
+
+fn parse_adaptive(s: &str) -> Result<AdaptiveArg, String> {
+    luxon::adaptive::parse(s, 3).map(AdaptiveArg)
 }
 
 pub fn cli_origin(what: &str) -> Origin {

@@ -6,14 +6,36 @@ use luxon::sweep::{self, Curve, Options};
 use luxon::Error;
 use std::path::{Path, PathBuf};
 
+#[derive(clap::Args)]
 pub struct Args {
+    /// PARAMETER=VALUE,VALUE,...: samples=1,4,16,64; max_depth=1,2,4,8;
+    /// texture_filter=nearest,bilinear,mip; adaptive=off,0.1,0.05:3 (THRESHOLD[:DEPTH]);
+    /// volume_step=... (not supported by this build).
+    #[arg(long, required = true)]
     pub vary: Vec<String>,
+    /// Compare with this image (same resolution); default: a reference rendered with many
+    /// samples and every varied parameter at its most accurate value.
+    #[arg(long)]
     pub reference: Option<PathBuf>,
+    /// Samples per pixel of the rendered reference (default: 4x the most any setting
+    /// gives a pixel, 64..=1024).
+    #[arg(long = "reference-samples")]
     pub reference_samples: Option<u32>,
+    /// Samples per pixel for every curve but a `samples` one (also adaptive sampling's
+    /// base); default: the scene's.
+    #[arg(long)]
     pub samples: Option<u32>,
+    /// Renders per setting; the median time is reported.
+    #[arg(long, default_value_t = 3)]
     pub runs: u32,
+    /// Resolution as WIDTHxHEIGHT.
+    #[arg(long, value_parser = super::parse_res)]
     pub res: Option<(u32, u32)>,
+    /// Render threads (default: every CPU).
+    #[arg(long)]
     pub threads: Option<u32>,
+    /// Directory for the report.
+    #[arg(short, long = "output", value_name = "OUTPUT")]
     pub out: PathBuf,
 }
 

@@ -64,21 +64,24 @@ fn fmt_ssim(s: Option<f64>) -> String {
     s.map_or("n/a".into(), |s| format!("{s:.4}"))
 }
 
+/// A row's cells; `digits`: decimals of the time, samples per pixel and RMSE.
+fn cells(r: &Row, [time, spp, rmse]: [usize; 3]) -> [String; 8] {
+    [
+        r.param.name().to_string(),
+        r.value.to_string(),
+        format!("{:.time$}", r.time.as_secs_f64()),
+        r.rays.to_string(),
+        format!("{:.spp$}", r.samples_per_pixel),
+        format!("{:.rmse$}", r.rmse),
+        fmt_psnr(r.psnr),
+        fmt_ssim(r.ssim),
+    ]
+}
+
 pub fn csv(s: &Sweep) -> String {
     let mut out = String::from("parameter,value,time_s,rays,samples_per_pixel,rmse,psnr_db,ssim\n");
     for r in &s.rows {
-        let _ = writeln!(
-            out,
-            "{},{},{:.6},{},{:.3},{:.6},{},{}",
-            r.param.name(),
-            r.value,
-            r.time.as_secs_f64(),
-            r.rays,
-            r.samples_per_pixel,
-            r.rmse,
-            fmt_psnr(r.psnr),
-            fmt_ssim(r.ssim)
-        );
+        let _ = writeln!(out, "{}", cells(r, [6, 3, 6]).join(","));
     }
     out
 }
@@ -94,18 +97,7 @@ pub fn markdown(s: &Sweep) -> String {
     );
     out.push_str("|---|---|---:|---:|---:|---:|---:|---:|\n");
     for r in &s.rows {
-        let _ = writeln!(
-            out,
-            "| {} | {} | {:.3} | {} | {:.2} | {:.5} | {} | {} |",
-            r.param.name(),
-            r.value,
-            r.time.as_secs_f64(),
-            r.rays,
-            r.samples_per_pixel,
-            r.rmse,
-            fmt_psnr(r.psnr),
-            fmt_ssim(r.ssim)
-        );
+        let _ = writeln!(out, "| {} |", cells(r, [3, 2, 5]).join(" | "));
     }
     out
 }
