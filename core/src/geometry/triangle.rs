@@ -38,11 +38,14 @@ pub struct Triangles {
 }
 
 /// What a ray precomputes once for the watertight test (Woop, Benthin & Wald 2013): the axis
-/// along which it travels most and the shear that maps it onto +z.
+/// along which it travels most and the shear that maps it onto +z; the origin is kept in that
+/// axis order so the test reads each vertex coordinate straight from memory.
 #[derive(Clone, Copy)]
 pub struct TriRay {
-    o: Vec3A,
+    /// Coordinate indices (x', y', z'), each in 0..3.
     k: [usize; 3],
+    /// The origin in (x', y', z') order.
+    o: [f32; 3],
     s: [f32; 3],
 }
 
@@ -63,11 +66,20 @@ impl TriRay {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let o = ray.origin;
         TriRay {
-            o: ray.origin,
             k: [kx, ky, kz],
+            o: [o[kx], o[ky], o[kz]],
             s: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
         }
+    }
+
+    /// Coordinate `k[i]` of `v`.
+    #[inline(always)]
+    fn coord(&self, v: &Vec3, i: usize) -> f32 {
+        let v: &[f32; 3] = v.as_ref();
+        // SAFETY: `new` only stores indices 0, 1 and 2.
+        unsafe { *v.get_unchecked(self.k[i]) }
     }
 }
 
@@ -75,14 +87,16 @@ impl TriRay {
 /// triangles that meet there. Returns (t, b1, b2) with t in (0, t_max).
 #[inline(always)]
 pub fn intersect_triangle(v: &[Vec3; 3], r: &TriRay, t_max: f32) -> Option<(f32, f32, f32)> {
-    let [kx, ky, kz] = r.k;
     let [sx, sy, sz] = r.s;
-    let a = Vec3A::from(v[0]) - r.o;
-    let b = Vec3A::from(v[1]) - r.o;
-    let c = Vec3A::from(v[2]) - r.o;
-    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+    let [ox, oy, oz] = r.o;
+    // Each vertex relative to the origin, sheared so the ray runs along +z.
+    let shear = |p: &Vec3| {
+        let z = r.coord(p, 2) - oz;
+        (r.coord(p, 0) - ox - sx * z, r.coord(p, 1) - oy - sy * z, z)
+    };
+    let (ax, ay, az) = shear(&v[0]);
+    let (bx, by, bz) = shear(&v[1]);
+    let (cx, cy, cz) = shear(&v[2]);
     let mut u = cx * by - cy * bx;
     let mut vv = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
@@ -102,7 +116,8 @@ pub fn intersect_triangle(v: &[Vec3; 3], r: &TriRay, t_max: f32) -> Option<(f32,
     if det == 0.0 {
         return None;
     }
-    let t_scaled = u * (sz * a[kz]) + vv * (sz * b[kz]) + w * (sz * c[kz]);
+    let z = [sz * az, sz * bz, sz * cz];
+    let t_scaled = u * z[0] + vv * z[1] + w * z[2];
     if det > 0.0 {
         if t_scaled <= 0.0 || t_scaled >= t_max * det {
             return None;
@@ -114,7 +129,6 @@ pub fn intersect_triangle(v: &[Vec3; 3], r: &TriRay, t_max: f32) -> Option<(f32,
     let t = t_scaled * inv;
     // A hit closer than the rounding error of t could be the surface a ray just left: reject
     // it (the bound of Pharr, Jakob & Humphreys, PBR 3rd ed., 3.9.6). Only computed for hits.
-    let z = [sz * a[kz], sz * b[kz], sz * c[kz]];
     let max_z = z.map(f32::abs).into_iter().fold(0.0, f32::max);
     let max_x = ax.abs().max(bx.abs()).max(cx.abs());
     let max_y = ay.abs().max(by.abs()).max(cy.abs());
