@@ -1,7 +1,8 @@
 //! Bounding volume hierarchy: binned SAH build in parallel (rayon) into a binary tree, which
-//! is then collapsed into 4-wide nodes (each holds its four children's boxes side by side, so
-//! one pass of vector arithmetic tests all four), and closure-based traversal so each primitive
-//! kind gets its own monomorphised loop with the intersection test inlined.
+//! is then collapsed into 8-wide nodes (each holds its eight children's boxes side by side, so
+//! one pass of vector arithmetic tests all eight: one AVX pass where the CPU has AVX, checked
+//! at run time, else two SSE passes), and closure-based traversal so each primitive kind gets
+//! its own monomorphised loop with the intersection test inlined.
 
 use crate::math::{gamma, Aabb, Vec3A};
 use std::mem::MaybeUninit;
@@ -17,8 +18,11 @@ const TRAVERSAL_COST: f32 = 1.0;
 const MAX_SAH_DEPTH: usize = 64;
 /// Deepest binary tree: median splits after `MAX_SAH_DEPTH` halve at least 2^48 primitives.
 const MAX_DEPTH: usize = MAX_SAH_DEPTH + 64;
-/// A wide node pushes at most three children, and no wide tree is deeper than the binary one.
-const STACK: usize = 3 * MAX_DEPTH + 1;
+/// Children per wide node.
+const LANES: usize = 8;
+/// A wide node pushes at most `LANES - 1` children, and no wide tree is deeper than the
+/// binary one.
+const STACK: usize = (LANES - 1) * MAX_DEPTH + 1;
 
 /// A node of the binary build (and of the tree before it is collapsed).
 #[derive(Clone, Copy, Debug)]
@@ -73,15 +77,15 @@ impl Node {
     }
 }
 
-/// A 4-wide node: the boxes of up to four children as rows min x, min y, min z, max x, max y,
+/// A wide node: the boxes of up to `LANES` children as rows min x, min y, min z, max x, max y,
 /// max z (one lane per child), and a link per child: a leaf (first primitive, count) packed as
 /// in `Node`, an inner node (its index, count 0), or `EMPTY` (its box is inverted, so no ray
-/// enters it). Two cache lines.
+/// enters it). Four cache lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Wide {
-    b: [[f32; 4]; 6],
-    link: [u64; 4],
+    b: [[f32; LANES]; 6],
+    link: [u64; LANES],
 }
 
 /// The root is never a child, so link 0 marks an unused slot.
@@ -90,14 +94,14 @@ const EMPTY: u64 = 0;
 impl Wide {
     const NONE: Wide = Wide {
         b: [
-            [f32::INFINITY; 4],
-            [f32::INFINITY; 4],
-            [f32::INFINITY; 4],
-            [f32::NEG_INFINITY; 4],
-            [f32::NEG_INFINITY; 4],
-            [f32::NEG_INFINITY; 4],
+            [f32::INFINITY; LANES],
+            [f32::INFINITY; LANES],
+            [f32::INFINITY; LANES],
+            [f32::NEG_INFINITY; LANES],
+            [f32::NEG_INFINITY; LANES],
+            [f32::NEG_INFINITY; LANES],
         ],
-        link: [EMPTY; 4],
+        link: [EMPTY; LANES],
     };
 
     fn set(&mut self, lane: usize, b: &Aabb, link: u64) {
@@ -109,7 +113,7 @@ impl Wide {
     }
 
     fn bounds(&self) -> Aabb {
-        (0..4)
+        (0..LANES)
             .filter(|&l| self.link[l] != EMPTY)
             .fold(Aabb::EMPTY, |acc, l| {
                 acc.union(Aabb::new(
@@ -156,52 +160,101 @@ impl BoxRay {
         }
     }
 
-    /// Which of the node's four boxes the ray meets in [0, t_max] (bit l for lane l), and the
-    /// entry distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
+    /// Which of the node's boxes the ray meets in [0, t_max] (bit l for lane l), and the entry
+    /// distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
     /// which is inside that slab for every t) are NaN and are skipped: max(t, acc) and
     /// min(t, acc) keep `acc` when t is NaN (x86's maxps/minps return the second operand).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; 4]) {
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
         use std::arch::x86_64::*;
-        // SAFETY: SSE is part of the x86_64 baseline; each load reads one [f32; 4] row.
-        unsafe {
-            let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr());
-            let mut near = _mm_setzero_ps();
-            let mut far = _mm_set1_ps(t_max);
-            for k in 0..3 {
-                let o = _mm_set1_ps(self.origin[k]);
-                let inv = _mm_set1_ps(self.inv[k]);
-                let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
-                let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv);
-                near = _mm_max_ps(t0, near);
-                far = _mm_min_ps(t1, far);
+        let mut t = [0.0; LANES];
+        let mut mask = 0;
+        for h in 0..LANES / 4 {
+            // SAFETY: SSE is part of the x86_64 baseline; each load reads four floats of a row.
+            unsafe {
+                let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr().add(4 * h));
+                let mut near = _mm_setzero_ps();
+                let mut far = _mm_set1_ps(t_max);
+                for k in 0..3 {
+                    let o = _mm_set1_ps(self.origin[k]);
+                    let inv = _mm_set1_ps(self.inv[k]);
+                    let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv);
+                    near = _mm_max_ps(t0, near);
+                    far = _mm_min_ps(t1, far);
+                }
+                let hit = _mm_cmple_ps(near, _mm_mul_ps(far, _mm_set1_ps(WIDEN)));
+                _mm_storeu_ps(t.as_mut_ptr().add(4 * h), near);
+                mask |= (_mm_movemask_ps(hit) as u32) << (4 * h);
             }
-            let hit = _mm_cmple_ps(near, _mm_mul_ps(far, _mm_set1_ps(WIDEN)));
-            let mut t = [0.0; 4];
-            _mm_storeu_ps(t.as_mut_ptr(), near);
-            (_mm_movemask_ps(hit) as u32, t)
         }
+        (mask, t)
+    }
+
+    /// The same with AVX: all eight lanes in one pass (bitwise the same results).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn enter_avx(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        use std::arch::x86_64::*;
+        let row = |r: usize| {
+            // SAFETY: reads one row of eight floats.
+            unsafe { _mm256_loadu_ps(node.b[r].as_ptr()) }
+        };
+        let mut near = _mm256_setzero_ps();
+        let mut far = _mm256_set1_ps(t_max);
+        for k in 0..3 {
+            let o = _mm256_set1_ps(self.origin[k]);
+            let inv = _mm256_set1_ps(self.inv[k]);
+            let t0 = _mm256_mul_ps(_mm256_sub_ps(row(self.near[k]), o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(row(self.far[k]), o), inv);
+            near = _mm256_max_ps(t0, near);
+            far = _mm256_min_ps(t1, far);
+        }
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_mul_ps(far, _mm256_set1_ps(WIDEN)));
+        let mut t = [0.0; LANES];
+        // SAFETY: writes eight floats.
+        unsafe { _mm256_storeu_ps(t.as_mut_ptr(), near) };
+        (_mm256_movemask_ps(hit) as u32, t)
+    }
+
+    /// The box test of the traversal compiled for `avx` (see `Bvh::intersect`).
+    #[inline(always)]
+    fn enter_with<const AVX: bool>(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: only the AVX instantiations call this, after checking the CPU.
+            return unsafe { self.enter_avx(node, t_max) };
+        }
+        self.enter(node, t_max)
     }
 
     /// The same, lane by lane, for other targets.
     #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
-    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; 4]) {
-        let mut near = [0.0f32; 4];
-        let mut far = [t_max; 4];
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        let mut near = [0.0f32; LANES];
+        let mut far = [t_max; LANES];
         for k in 0..3 {
             let (lo, hi) = (&node.b[self.near[k]], &node.b[self.far[k]]);
-            for l in 0..4 {
+            for l in 0..LANES {
                 let t0 = (lo[l] - self.origin[k]) * self.inv[k];
                 let t1 = (hi[l] - self.origin[k]) * self.inv[k];
                 near[l] = if t0 > near[l] { t0 } else { near[l] };
                 far[l] = if t1 < far[l] { t1 } else { far[l] };
             }
         }
-        let mask = (0..4).fold(0, |m, l| m | u32::from(near[l] <= far[l] * WIDEN) << l);
+        let mask = (0..LANES).fold(0, |m, l| m | u32::from(near[l] <= far[l] * WIDEN) << l);
         (mask, near)
     }
+}
+
+/// Whether this CPU has AVX (8-wide box tests); the check is a cached load.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn avx() -> bool {
+    std::arch::is_x86_feature_detected!("avx")
 }
 
 /// The traversal stack: links with their entry distances, never read before written (so not
@@ -285,8 +338,10 @@ impl BuildPrim {
     }
 }
 
-/// Words per wide node in `to_words`: 24 floats and 4 links of two words.
-const WORDS: usize = 32;
+/// Words per wide node in `to_words`: the box rows, then a link of two words per lane.
+const WORDS: usize = 8 * LANES;
+/// Where the links start among a node's words.
+const LINK_WORDS: usize = 6 * LANES;
 
 impl Bvh {
     /// Builds over the given primitive bounds; returns the BVH and the leaf order.
@@ -321,7 +376,7 @@ impl Bvh {
     }
 
     /// The wide tree of a binary one: each wide node takes the two children of a binary node
-    /// and keeps opening the largest inner one among them until it has four.
+    /// and keeps opening the largest inner one among them until it has `LANES`.
     fn collapse(binary: &[Node]) -> Bvh {
         let mut nodes = Vec::with_capacity(binary.len() / 3 + 1);
         if binary[0].count() > 0 {
@@ -360,10 +415,11 @@ impl Bvh {
             for (k, x) in node.b.iter_mut().flatten().enumerate() {
                 *x = f32::from_bits(c[k]);
             }
-            for l in 0..4 {
-                node.link[l] = u64::from(c[24 + 2 * l]) | u64::from(c[25 + 2 * l]) << 32;
+            for l in 0..LANES {
+                node.link[l] =
+                    u64::from(c[LINK_WORDS + 2 * l]) | u64::from(c[LINK_WORDS + 1 + 2 * l]) << 32;
             }
-            for l in 0..4 {
+            for l in 0..LANES {
                 let link = node.link[l];
                 let (count, offset) = (count_of(link), offset_of(link));
                 let ok = link >> 56 == 0
@@ -403,8 +459,48 @@ impl Bvh {
     // Not inlined: the traversal stack (6 KB) would otherwise sit in every frame of the
     // recursive integrator, and deep reflections (max_depth in the hundreds) overflow the
     // thread's stack. The primitive test is still inlined here.
-    #[inline(never)]
+    #[inline]
     pub fn intersect<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        if avx() {
+            // SAFETY: the CPU has AVX.
+            return unsafe { self.intersect_avx(origin, dir, t_max, test) };
+        }
+        self.intersect_base(origin, dir, t_max, test)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline(never)]
+    fn intersect_avx<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        self.closest::<true, F>(origin, dir, t_max, test)
+    }
+
+    #[inline(never)]
+    fn intersect_base<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        self.closest::<false, F>(origin, dir, t_max, test)
+    }
+
+    #[inline(always)]
+    fn closest<const AVX: bool, F: FnMut(usize, f32) -> Option<f32>>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
@@ -419,7 +515,7 @@ impl Bvh {
         let mut i = 0usize;
         loop {
             let node = &self.nodes[i];
-            let (mut mask, t) = ray.enter(node, t_max);
+            let (mut mask, t) = ray.enter_with::<AVX>(node, t_max);
             if mask.is_power_of_two() {
                 // One child hit: enter or test it without going through the stack.
                 let link = node.link[mask.trailing_zeros() as usize];
@@ -468,8 +564,48 @@ impl Bvh {
     }
 
     /// Any-hit traversal: stops as soon as `test(prim)` returns true.
-    #[inline(never)]
+    #[inline]
     pub fn any<F: FnMut(usize) -> bool>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if avx() {
+            // SAFETY: the CPU has AVX.
+            return unsafe { self.any_avx(origin, dir, t_max, test) };
+        }
+        self.any_base(origin, dir, t_max, test)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline(never)]
+    fn any_avx<F: FnMut(usize) -> bool>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> bool {
+        self.first::<true, F>(origin, dir, t_max, test)
+    }
+
+    #[inline(never)]
+    fn any_base<F: FnMut(usize) -> bool>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> bool {
+        self.first::<false, F>(origin, dir, t_max, test)
+    }
+
+    #[inline(always)]
+    fn first<const AVX: bool, F: FnMut(usize) -> bool>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
@@ -492,7 +628,7 @@ impl Bvh {
                 }
             } else {
                 let node = &self.nodes[offset_of(link)];
-                let (mut mask, _) = ray.enter(node, t_max);
+                let (mut mask, _) = ray.enter_with::<AVX>(node, t_max);
                 if mask != 0 {
                     // The last child hit is taken now, the others pushed (so the order is
                     // the stack's, whatever the count).
@@ -520,7 +656,7 @@ fn collapse_node(binary: &[Node], i: usize, out: &mut Vec<Wide>) -> usize {
     let index = out.len();
     out.push(Wide::NONE);
     let mut kids = vec![i + 1, binary[i].offset()];
-    while kids.len() < 4 {
+    while kids.len() < LANES {
         let widest = kids
             .iter()
             .enumerate()
@@ -744,20 +880,32 @@ mod tests {
                 ([0.5, 0.0, -1.0], [-0.0, -0.0, 1.0]),
             ] {
                 let (o, d) = (Vec3A::from(o), Vec3A::from(d));
-                let mut called = false;
-                bvh.intersect(o, d, f32::INFINITY, |_, _| {
-                    called = true;
-                    None
-                });
-                assert!(called, "closest-hit skipped {b:?} for {o} {d}");
+                for base in [false, true] {
+                    let mut called = false;
+                    let test = |_, _| {
+                        called = true;
+                        None
+                    };
+                    if base {
+                        bvh.intersect_base(o, d, f32::INFINITY, test);
+                    } else {
+                        bvh.intersect(o, d, f32::INFINITY, test);
+                    }
+                    assert!(called, "closest-hit skipped {b:?} for {o} {d}");
+                }
                 assert!(
                     bvh.any(o, d, f32::INFINITY, |_| true),
                     "any-hit skipped {b:?}"
+                );
+                assert!(
+                    bvh.any_base(o, d, f32::INFINITY, |_| true),
+                    "baseline any-hit skipped {b:?}"
                 );
             }
             // Parallel, in neither face's plane and outside: culled.
             let o = Vec3A::new(-1.0, 2.0, 0.5);
             assert!(!bvh.any(o, Vec3A::X, f32::INFINITY, |_| true));
+            assert!(!bvh.any_base(o, Vec3A::X, f32::INFINITY, |_| true));
         }
     }
 
@@ -814,11 +962,74 @@ mod tests {
                 .iter()
                 .filter_map(|bx| hit_box(bx, o, d))
                 .fold(f32::INFINITY, f32::min);
-            let got = bvh.intersect(o, d, f32::INFINITY, |p, tmax| {
-                hit_box(&b[order[p] as usize], o, d).filter(|&t| t < tmax)
-            });
-            assert_eq!(got, brute, "ray {k}");
+            let test =
+                |p: usize, tmax: f32| hit_box(&b[order[p] as usize], o, d).filter(|&t| t < tmax);
+            // The dispatched traversal (AVX where the CPU has it) and the baseline one.
+            assert_eq!(bvh.intersect(o, d, f32::INFINITY, test), brute, "ray {k}");
+            assert_eq!(
+                bvh.intersect_base(o, d, f32::INFINITY, test),
+                brute,
+                "ray {k}"
+            );
         }
+    }
+
+    /// The AVX and baseline traversals open the same boxes in the same order, rays parallel to
+    /// the axes (NaN slab distances) included.
+    #[test]
+    fn every_traversal_visits_the_same_leaves() {
+        let b = boxes(5000);
+        let (bvh, _) = Bvh::build(&b);
+        let mut seed = 7u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        let mut tested = 0;
+        for k in 0..500 {
+            let o = Vec3A::new(next(), next(), next()) * 120.0 - 10.0;
+            let mut d = Vec3A::new(next(), next(), next()) - 0.5;
+            // Every third ray lies parallel to one or two axes.
+            if k % 3 == 0 {
+                d[k % 2] = 0.0;
+                d[2 - k % 2] *= (k % 4) as f32;
+            }
+            let d = d.normalize_or(Vec3A::Z);
+            let visits = |base: bool| {
+                let mut seen = Vec::new();
+                let test = |p: usize, _| {
+                    seen.push(p);
+                    None
+                };
+                if base {
+                    bvh.intersect_base(o, d, 1e3, test);
+                } else {
+                    bvh.intersect(o, d, 1e3, test);
+                }
+                seen
+            };
+            let v = visits(false);
+            assert_eq!(v, visits(true), "ray {k}");
+            tested += v.len();
+            let leaves = |base: bool| {
+                let mut seen = Vec::new();
+                let test = |p: usize| {
+                    seen.push(p);
+                    false
+                };
+                if base {
+                    bvh.any_base(o, d, 1e3, test);
+                } else {
+                    bvh.any(o, d, 1e3, test);
+                }
+                seen
+            };
+            assert_eq!(leaves(false), leaves(true), "ray {k}");
+        }
+        assert!(
+            tested > 500,
+            "the rays should meet many boxes, met {tested}"
+        );
     }
 
     #[test]
@@ -846,8 +1057,8 @@ mod tests {
     }
 
     #[test]
-    fn wide_nodes_are_two_cache_lines() {
-        assert_eq!(std::mem::size_of::<Wide>(), 128);
+    fn wide_nodes_are_four_cache_lines() {
+        assert_eq!(std::mem::size_of::<Wide>(), 256);
         assert_eq!(std::mem::align_of::<Wide>(), 64);
     }
 
@@ -865,16 +1076,17 @@ mod tests {
         // Too few primitives for the leaves, a link pointing backwards, a truncated node.
         assert!(Bvh::from_words(&w, 2999).is_none());
         let mut backwards = w.clone();
-        let inner = (0..4)
+        let inner = (0..LANES)
             .find(|&l| {
-                let link = u64::from(w[24 + 2 * l]) | u64::from(w[25 + 2 * l]) << 32;
+                let link =
+                    u64::from(w[LINK_WORDS + 2 * l]) | u64::from(w[LINK_WORDS + 1 + 2 * l]) << 32;
                 link != EMPTY && count_of(link) == 0
             })
             .unwrap();
         let last = w.len() / WORDS - 1;
-        backwards[last * WORDS + 24 + 2 * inner] = 0;
-        backwards[last * WORDS + 25 + 2 * inner] = 0;
-        backwards[last * WORDS + 24] = 1;
+        backwards[last * WORDS + LINK_WORDS + 2 * inner] = 0;
+        backwards[last * WORDS + LINK_WORDS + 1 + 2 * inner] = 0;
+        backwards[last * WORDS + LINK_WORDS] = 1;
         assert!(Bvh::from_words(&backwards, 3000).is_none());
         assert!(Bvh::from_words(&w[..w.len() - 1], 3000).is_none());
     }

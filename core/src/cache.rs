@@ -31,7 +31,7 @@ use std::time::UNIX_EPOCH;
 
 const MAGIC: &[u8; 8] = b"LUXGEOC\0";
 /// Raise when the layout changes.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 const LUXON_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// A scene's native geometry, built, as the cache gives it back.
