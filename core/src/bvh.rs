@@ -623,8 +623,10 @@ impl Bvh {
             let count = count_of(link);
             if count > 0 {
                 let start = offset_of(link);
-                if (start..start + count).any(&mut test) {
-                    return true;
+                for p in start..start + count {
+                    if test(p) {
+                        return true;
+                    }
                 }
             } else {
                 let node = &self.nodes[offset_of(link)];

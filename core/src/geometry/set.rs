@@ -134,15 +134,21 @@ impl<S: Shape> Set<S> {
             return;
         }
         let prep = S::prep(ray);
-        *t_max = self.bvh.intersect(ray.origin, ray.dir, *t_max, |i, tm| {
-            c.tests += 1;
-            let (t, b1, b2) = self.kept_hit(i, ray, &prep, tm, clips)?;
-            let mut h = Hit::new(t, S::KIND, i);
-            h.b1 = b1;
-            h.b2 = b2;
-            *hit = Some(h);
-            Some(t)
-        });
+        *t_max = self.bvh.intersect(
+            ray.origin,
+            ray.dir,
+            *t_max,
+            #[inline(always)]
+            |i, tm| {
+                c.tests += 1;
+                let (t, b1, b2) = self.kept_hit(i, ray, &prep, tm, clips)?;
+                let mut h = Hit::new(t, S::KIND, i);
+                h.b1 = b1;
+                h.b2 = b2;
+                *hit = Some(h);
+                Some(t)
+            },
+        );
     }
 
     /// Calls `on_hit(material, crossings)` for primitives the ray crosses in (0, t_max) until it
@@ -160,25 +166,31 @@ impl<S: Shape> Set<S> {
             return false;
         }
         let prep = S::prep(ray);
-        self.bvh.any(ray.origin, ray.dir, t_max, |i| {
-            c.tests += 1;
-            if !self.clipped {
-                let n = self.data[i].crossings(ray, &prep, t_max);
-                return n > 0 && on_hit(material_of(self.material[i]), n);
-            }
-            let packed = self.material[i];
-            let n = if clip_of(packed) == 0 {
-                self.data[i].crossings(ray, &prep, t_max)
-            } else {
-                // Count only the crossings the clip group keeps.
-                let (mut n, mut lo) = (0, 0.0);
-                while let Some(h) = self.data[i].hit_after(ray, &prep, lo, t_max) {
-                    n += u32::from(!clips.cut(clip_of(packed), ray.at(h.0)));
-                    lo = h.0;
+        self.bvh.any(
+            ray.origin,
+            ray.dir,
+            t_max,
+            #[inline(always)]
+            |i| {
+                c.tests += 1;
+                if !self.clipped {
+                    let n = self.data[i].crossings(ray, &prep, t_max);
+                    return n > 0 && on_hit(material_of(self.material[i]), n);
                 }
-                n
-            };
-            n > 0 && on_hit(material_of(packed), n)
-        })
+                let packed = self.material[i];
+                let n = if clip_of(packed) == 0 {
+                    self.data[i].crossings(ray, &prep, t_max)
+                } else {
+                    // Count only the crossings the clip group keeps.
+                    let (mut n, mut lo) = (0, 0.0);
+                    while let Some(h) = self.data[i].hit_after(ray, &prep, lo, t_max) {
+                        n += u32::from(!clips.cut(clip_of(packed), ray.at(h.0)));
+                        lo = h.0;
+                    }
+                    n
+                };
+                n > 0 && on_hit(material_of(packed), n)
+            },
+        )
     }
 }
