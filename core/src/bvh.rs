@@ -275,8 +275,10 @@ impl Stack {
 
     #[inline(always)]
     fn push(&mut self, link: u64, t: f32) {
-        // The depth bound (checked for cached trees too) keeps this in range.
-        self.entries[self.len] = MaybeUninit::new((link, t));
+        debug_assert!(self.len < STACK);
+        // SAFETY: a traversal holds at most `LANES - 1` entries per level of the tree plus one,
+        // and no tree is deeper than `MAX_DEPTH` (built so, and checked for cached trees).
+        unsafe { *self.entries.get_unchecked_mut(self.len) = MaybeUninit::new((link, t)) };
         self.len += 1;
     }
 
@@ -284,12 +286,16 @@ impl Stack {
     #[inline(always)]
     fn insert_sorted(&mut self, base: usize, link: u64, t: f32) {
         let mut j = self.len;
-        // SAFETY: entries in base..len were written by `push` or here.
-        while j > base && unsafe { self.entries[j - 1].assume_init().1 } < t {
-            self.entries[j] = self.entries[j - 1];
-            j -= 1;
+        debug_assert!(j < STACK);
+        // SAFETY: entries in base..len were written by `push` or here, and len stays in range
+        // as in `push`.
+        unsafe {
+            while j > base && self.entries.get_unchecked(j - 1).assume_init().1 < t {
+                *self.entries.get_unchecked_mut(j) = *self.entries.get_unchecked(j - 1);
+                j -= 1;
+            }
+            *self.entries.get_unchecked_mut(j) = MaybeUninit::new((link, t));
         }
-        self.entries[j] = MaybeUninit::new((link, t));
         self.len += 1;
     }
 
@@ -300,7 +306,7 @@ impl Stack {
         }
         self.len -= 1;
         // SAFETY: entries below `len` were written by `push`.
-        Some(unsafe { self.entries[self.len].assume_init() })
+        Some(unsafe { self.entries.get_unchecked(self.len).assume_init() })
     }
 }
 
@@ -443,6 +449,15 @@ impl Bvh {
         Some(Bvh { nodes })
     }
 
+    /// Node `i` of a link. Links come from `collapse` or passed `from_words`, so they are in
+    /// range; the traversal loops skip the check.
+    #[inline(always)]
+    fn node(&self, i: usize) -> &Wide {
+        debug_assert!(i < self.nodes.len());
+        // SAFETY: see above; the root (0) exists whenever a traversal starts.
+        unsafe { self.nodes.get_unchecked(i) }
+    }
+
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
@@ -514,7 +529,7 @@ impl Bvh {
         let mut stack = Stack::new();
         let mut i = 0usize;
         loop {
-            let node = &self.nodes[i];
+            let node = self.node(i);
             let (mut mask, t) = ray.enter_with::<AVX>(node, t_max);
             if mask.is_power_of_two() {
                 // One child hit: enter or test it without going through the stack.
@@ -629,7 +644,7 @@ impl Bvh {
                     }
                 }
             } else {
-                let node = &self.nodes[offset_of(link)];
+                let node = self.node(offset_of(link));
                 let (mut mask, _) = ray.enter_with::<AVX>(node, t_max);
                 if mask != 0 {
                     // The last child hit is taken now, the others pushed (so the order is
