@@ -124,6 +124,13 @@ impl Wide {
     }
 }
 
+/// The lowest lane set in a non-empty hit mask (the mask has a bit per lane, so the `&` only
+/// spares the bounds check).
+#[inline(always)]
+fn first_lane(mask: u32) -> usize {
+    mask.trailing_zeros() as usize & (LANES - 1)
+}
+
 #[inline(always)]
 fn count_of(link: u64) -> usize {
     ((link >> OFFSET_BITS) & 0xff) as usize
@@ -150,13 +157,13 @@ const WIDEN: f32 = 1.0 + 2.0 * gamma(3);
 impl BoxRay {
     #[inline(always)]
     fn new(origin: Vec3A, dir: Vec3A) -> BoxRay {
-        let inv = dir.recip();
-        let neg = |k: usize| usize::from(inv[k] < 0.0) * 3;
+        let inv: [f32; 3] = dir.recip().into();
+        let neg = inv.map(|x| usize::from(x < 0.0) * 3);
         BoxRay {
             origin: origin.into(),
-            inv: inv.into(),
-            near: [neg(0), 1 + neg(1), 2 + neg(2)],
-            far: [3 - neg(0), 4 - neg(1), 5 - neg(2)],
+            inv,
+            near: [neg[0], 1 + neg[1], 2 + neg[2]],
+            far: [3 - neg[0], 4 - neg[1], 5 - neg[2]],
         }
     }
 
@@ -533,7 +540,7 @@ impl Bvh {
             let (mut mask, t) = ray.enter_with::<AVX>(node, t_max);
             if mask.is_power_of_two() {
                 // One child hit: enter or test it without going through the stack.
-                let link = node.link[mask.trailing_zeros() as usize];
+                let link = node.link[first_lane(mask)];
                 let count = count_of(link);
                 if count == 0 {
                     i = offset_of(link);
@@ -549,7 +556,7 @@ impl Bvh {
                 // Push the children hit, nearest last so it is taken first.
                 let base = stack.len;
                 while mask != 0 {
-                    let l = mask.trailing_zeros() as usize;
+                    let l = first_lane(mask);
                     mask &= mask - 1;
                     stack.insert_sorted(base, node.link[l], t[l]);
                 }
@@ -649,10 +656,10 @@ impl Bvh {
                 if mask != 0 {
                     // The last child hit is taken now, the others pushed (so the order is
                     // the stack's, whatever the count).
-                    let last = 31 - mask.leading_zeros() as usize;
+                    let last = (31 - mask.leading_zeros() as usize) & (LANES - 1);
                     mask &= !(1 << last);
                     while mask != 0 {
-                        stack.push(node.link[mask.trailing_zeros() as usize], 0.0);
+                        stack.push(node.link[first_lane(mask)], 0.0);
                         mask &= mask - 1;
                     }
                     link = node.link[last];

@@ -50,23 +50,25 @@ pub struct TriRay {
 }
 
 impl TriRay {
+    #[inline]
     pub fn new(ray: &Ray) -> TriRay {
-        let d = ray.dir;
-        let a = d.abs();
-        let kz = if a.x > a.y && a.x > a.z {
+        let d: [f32; 3] = ray.dir.into();
+        let a = d.map(f32::abs);
+        let kz = if a[0] > a[1] && a[0] > a[2] {
             0
-        } else if a.y > a.z {
+        } else if a[1] > a[2] {
             1
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Keep the winding so the sign test below means the same for every ray.
+        // The next two axes in cyclic order; swapped for a negative z' to keep the winding so
+        // the sign test below means the same for every ray.
+        const NEXT: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
+        let [mut kx, mut ky] = NEXT[kz];
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let o = ray.origin;
+        let o: [f32; 3] = ray.origin.into();
         TriRay {
             k: [kx, ky, kz],
             o: [o[kx], o[ky], o[kz]],
