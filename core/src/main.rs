@@ -71,7 +71,27 @@ fn keep_large_blocks_returnable() {
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
 fn keep_large_blocks_returnable() {}
 
+/// This build uses x86-64-v3 instructions (`.cargo/config.toml`): on an older CPU, say so and
+/// how to rebuild rather than die on an illegal instruction. Out of line and first in `main`, so
+/// nothing built for v3 runs before it (the detection itself is in the standard library).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline(never)]
+fn check_cpu() {
+    let v3 = std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi2");
+    if !v3 {
+        eprintln!(
+            "luxon: error: this build needs an x86-64-v3 CPU (AVX2, FMA, BMI2), which this one is \
+             not; rebuild for any x86-64 with RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release"
+        );
+        std::process::exit(2);
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    check_cpu();
     keep_large_blocks_returnable();
     let cli = Cli::parse();
     let result = match cli.command {
