@@ -174,6 +174,7 @@ impl Camera {
 
     /// The ray through image position (`x`, `y`) in pixels from the top-left corner, or `None`
     /// outside a fisheye's image circle (Tachyon draws those pixels black).
+    #[inline]
     pub fn primary(&self, x: f32, y: f32, width: u32, height: u32, time: f32) -> Option<Ray> {
         // Which eye, and the position in its half of the image.
         let (mut w, mut h) = (width as f32, height as f32);
