@@ -744,7 +744,7 @@ impl Scene {
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         match hit.kind {
             Kind::Sphere => self.spheres.surface(hit, ray),
-            Kind::Triangle => self.triangles.surface(hit),
+            Kind::Triangle => self.triangles.surface(hit, self.features.textures),
             Kind::Plane => self.planes.surface(hit, ray),
             Kind::Cone => self.cones.surface(hit, ray),
             Kind::Disc => self.discs.surface(hit, ray),

@@ -290,7 +290,8 @@ impl Triangles {
         Ok(dropped)
     }
 
-    pub fn surface(&self, hit: &Hit) -> Surface {
+    /// `textured`: the scene looks textures up, so the uvs and their scale are needed.
+    pub fn surface(&self, hit: &Hit, textured: bool) -> Surface {
         let i = hit.index as usize;
         let Triangle { v, attr: a } = self.set.data[i];
         let (b1, b2) = (hit.b1, hit.b2);
@@ -333,6 +334,9 @@ impl Triangles {
                         + b1 * Vec3A::from(va[1].c)
                         + b2 * Vec3A::from(va[2].c),
                 );
+            }
+            if !textured {
+                return s;
             }
             let uv = |k: usize| b0 * va[0].uv[k] + b1 * va[1].uv[k] + b2 * va[2].uv[k];
             s.uv = [uv(0), uv(1)];
