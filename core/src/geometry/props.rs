@@ -179,7 +179,7 @@ proptest! {
         let size = v.iter().map(|p| p.abs().max_element()).fold(0.0, f32::max) as f64;
         let inside = u > 0.05 && t > 0.05 && u + t < 0.95 && ray.dir.as_dvec3().dot(nn).abs() > 0.05
             && resolved(scale, pos);
-        check_hit(&tris.set, &ray, |h, _| tris.surface(h), |p| (p - p0).dot(nn).abs(), size,
+        check_hit(&tris.set, &ray, |h, _| tris.surface(h, true), |p| (p - p0).dot(nn).abs(), size,
                   false, leave, inside)?;
     }
 
