@@ -265,7 +265,7 @@ fn avx() -> bool {
 }
 
 /// The traversal stack: links with their entry distances, never read before written (so not
-/// zeroed per ray, which cost a 6 KB memset).
+/// zeroed per ray, which cost a memset of the whole stack).
 struct Stack {
     entries: [MaybeUninit<(u64, f32)>; STACK],
     len: usize,
@@ -478,9 +478,10 @@ impl Bvh {
 
     /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
     /// `t_max` (and records whatever it needs). Returns the final `t_max`.
-    // Not inlined: the traversal stack (6 KB) would otherwise sit in every frame of the
-    // recursive integrator, and deep reflections (max_depth in the hundreds) overflow the
-    // thread's stack. The primitive test is still inlined here.
+    // Only this dispatch is inlined; the loops (`intersect_avx`, `intersect_base`) are not, or
+    // their 14 KB stack would sit in every frame of the recursive integrator, and deep
+    // reflections (max_depth in the hundreds) would overflow the thread's stack. The primitive
+    // test is inlined into the loops.
     #[inline]
     pub fn intersect<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
