@@ -413,9 +413,9 @@ fn main() {
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "| scene | renderer | wall s | load s | render s | peak MB | render / tachyon | wall / tachyon | SSIM vs POV-Ray |"
+        "| scene | renderer | wall s | load s | render s | peak MB | render / tachyon | per round | wall / tachyon | SSIM vs POV-Ray |"
     );
-    let _ = writeln!(t, "|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(t, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     let num = |x: f64, digits: usize| {
         if x.is_nan() {
             "–".to_string()
@@ -438,19 +438,36 @@ fn main() {
                 }
                 num(med(r, f) / med(Renderer::Tachyon, f), 3)
             };
+            // The same ratio within each round (both renderers ran minutes apart at most):
+            // its range shows how much the machine's load moved the median.
+            let spread = |f: fn(&Run) -> f64| {
+                let (Some(mine), Some(theirs)) =
+                    (runs.get(&(k, r)), runs.get(&(k, Renderer::Tachyon)))
+                else {
+                    return "–".to_string();
+                };
+                if matches!(r, Renderer::Tachyon) {
+                    return "1".to_string();
+                }
+                let ratios: Vec<f64> = mine.iter().zip(theirs).map(|(a, b)| f(a) / f(b)).collect();
+                let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                format!("{}–{}", num(lo, 2), num(hi, 2))
+            };
             let similarity = images
                 .get(&(k, r))
                 .and_then(|img| ssim_against(img, reference))
                 .map_or("–".to_string(), |x| format!("{x:.3}"));
             let _ = writeln!(
                 t,
-                "| {scene} | {} | {} | {} | {} | {} | {} | {} | {similarity} |",
+                "| {scene} | {} | {} | {} | {} | {} | {} | {} | {} | {similarity} |",
                 r.label(),
                 num(med(r, |x| x.wall), 3),
                 num(med(r, |x| x.load), 3),
                 num(med(r, |x| x.render), 3),
                 num(med(r, |x| x.peak_mb), 0),
                 ratio(|x| x.render),
+                spread(|x| x.render),
                 ratio(|x| x.wall),
             );
         }
