@@ -289,6 +289,9 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         let rendered = job.render(&scene, &threads, gather, keep, &sink);
         let render_end = Instant::now();
         drop(tx);
+        if let Some(w) = &writer {
+            w.thread().unpark();
+        }
         let streamed = writer.map(|w| {
             w.join()
                 .unwrap_or_else(|_| Err(Error::Render("the writer thread panicked".into())))
