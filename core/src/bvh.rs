@@ -146,12 +146,15 @@ fn offset_of(link: u64) -> usize {
 struct BoxRay {
     origin: [f32; 3],
     inv: [f32; 3],
+    /// `inv` times [`WIDEN`], for the far planes.
+    inv_far: [f32; 3],
     near: [usize; 3],
     far: [usize; 3],
 }
 
-/// `t_max` is widened by 2·gamma(3) so rounding never culls a box the ray really touches
-/// (Ize 2013).
+/// Far-plane distances and `t_max` are widened by 2·gamma(3) so rounding never culls a box the
+/// ray really touches (Ize 2013). The far planes get it through their reciprocals: as many
+/// roundings as widening each result, and a multiply less on the path from one node to the next.
 const WIDEN: f32 = 1.0 + 2.0 * gamma(3);
 
 impl BoxRay {
@@ -162,6 +165,7 @@ impl BoxRay {
         BoxRay {
             origin: origin.into(),
             inv,
+            inv_far: inv.map(|x| x * WIDEN),
             near: [neg[0], 1 + neg[1], 2 + neg[2]],
             far: [3 - neg[0], 4 - neg[1], 5 - neg[2]],
         }
@@ -182,16 +186,17 @@ impl BoxRay {
             unsafe {
                 let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr().add(4 * h));
                 let mut near = _mm_setzero_ps();
-                let mut far = _mm_set1_ps(t_max);
+                let mut far = _mm_set1_ps(t_max * WIDEN);
                 for k in 0..3 {
                     let o = _mm_set1_ps(self.origin[k]);
                     let inv = _mm_set1_ps(self.inv[k]);
+                    let inv_far = _mm_set1_ps(self.inv_far[k]);
                     let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
-                    let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv_far);
                     near = _mm_max_ps(t0, near);
                     far = _mm_min_ps(t1, far);
                 }
-                let hit = _mm_cmple_ps(near, _mm_mul_ps(far, _mm_set1_ps(WIDEN)));
+                let hit = _mm_cmple_ps(near, far);
                 _mm_storeu_ps(t.as_mut_ptr().add(4 * h), near);
                 mask |= (_mm_movemask_ps(hit) as u32) << (4 * h);
             }
@@ -210,16 +215,17 @@ impl BoxRay {
             unsafe { _mm256_loadu_ps(node.b[r].as_ptr()) }
         };
         let mut near = _mm256_setzero_ps();
-        let mut far = _mm256_set1_ps(t_max);
+        let mut far = _mm256_set1_ps(t_max * WIDEN);
         for k in 0..3 {
             let o = _mm256_set1_ps(self.origin[k]);
             let inv = _mm256_set1_ps(self.inv[k]);
+            let inv_far = _mm256_set1_ps(self.inv_far[k]);
             let t0 = _mm256_mul_ps(_mm256_sub_ps(row(self.near[k]), o), inv);
-            let t1 = _mm256_mul_ps(_mm256_sub_ps(row(self.far[k]), o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(row(self.far[k]), o), inv_far);
             near = _mm256_max_ps(t0, near);
             far = _mm256_min_ps(t1, far);
         }
-        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_mul_ps(far, _mm256_set1_ps(WIDEN)));
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(near, far);
         let mut t = [0.0; LANES];
         // SAFETY: writes eight floats.
         unsafe { _mm256_storeu_ps(t.as_mut_ptr(), near) };
@@ -242,17 +248,17 @@ impl BoxRay {
     #[inline(always)]
     fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
         let mut near = [0.0f32; LANES];
-        let mut far = [t_max; LANES];
+        let mut far = [t_max * WIDEN; LANES];
         for k in 0..3 {
             let (lo, hi) = (&node.b[self.near[k]], &node.b[self.far[k]]);
             for l in 0..LANES {
                 let t0 = (lo[l] - self.origin[k]) * self.inv[k];
-                let t1 = (hi[l] - self.origin[k]) * self.inv[k];
+                let t1 = (hi[l] - self.origin[k]) * self.inv_far[k];
                 near[l] = if t0 > near[l] { t0 } else { near[l] };
                 far[l] = if t1 < far[l] { t1 } else { far[l] };
             }
         }
-        let mask = (0..LANES).fold(0, |m, l| m | u32::from(near[l] <= far[l] * WIDEN) << l);
+        let mask = (0..LANES).fold(0, |m, l| m | u32::from(near[l] <= far[l]) << l);
         (mask, near)
     }
 }
@@ -264,31 +270,48 @@ fn avx() -> bool {
     std::arch::is_x86_feature_detected!("avx")
 }
 
-/// The traversal stack: links with their entry distances, never read before written (so not
-/// zeroed per ray, which cost a memset of the whole stack).
-struct Stack {
-    entries: [MaybeUninit<(u64, f32)>; STACK],
+/// The traversal stack: links (with their entry distances for closest-hit), never read before
+/// written (so not zeroed per ray, which cost a memset of the whole stack). The entries live in
+/// a separate local the stack borrows: with `len` beside them in one struct, the compiler
+/// reloaded `len` from memory after every store to an entry.
+struct Stack<'a, T> {
+    entries: &'a mut [MaybeUninit<T>; STACK],
     len: usize,
 }
 
-impl Stack {
+/// The storage of a [`Stack`].
+#[inline(always)]
+fn stack_space<T: Copy>() -> [MaybeUninit<T>; STACK] {
+    [const { MaybeUninit::uninit() }; STACK]
+}
+
+impl<'a, T: Copy> Stack<'a, T> {
     #[inline(always)]
-    fn new() -> Stack {
-        Stack {
-            entries: [const { MaybeUninit::uninit() }; STACK],
-            len: 0,
-        }
+    fn new(entries: &'a mut [MaybeUninit<T>; STACK]) -> Self {
+        Stack { entries, len: 0 }
     }
 
     #[inline(always)]
-    fn push(&mut self, link: u64, t: f32) {
+    fn push(&mut self, entry: T) {
         debug_assert!(self.len < STACK);
         // SAFETY: a traversal holds at most `LANES - 1` entries per level of the tree plus one,
         // and no tree is deeper than `MAX_DEPTH` (built so, and checked for cached trees).
-        unsafe { *self.entries.get_unchecked_mut(self.len) = MaybeUninit::new((link, t)) };
+        unsafe { *self.entries.get_unchecked_mut(self.len) = MaybeUninit::new(entry) };
         self.len += 1;
     }
 
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: entries below `len` were written by `push`.
+        Some(unsafe { self.entries.get_unchecked(self.len).assume_init() })
+    }
+}
+
+impl Stack<'_, (u64, f32)> {
     /// Pushes keeping the entries above `base` in decreasing order of `t`.
     #[inline(always)]
     fn insert_sorted(&mut self, base: usize, link: u64, t: f32) {
@@ -304,16 +327,6 @@ impl Stack {
             *self.entries.get_unchecked_mut(j) = MaybeUninit::new((link, t));
         }
         self.len += 1;
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<(u64, f32)> {
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        // SAFETY: entries below `len` were written by `push`.
-        Some(unsafe { self.entries.get_unchecked(self.len).assume_init() })
     }
 }
 
@@ -343,11 +356,6 @@ impl BuildPrim {
     #[inline(always)]
     fn centroid(&self, axis: usize) -> f32 {
         (self.min[axis] + self.max[axis]) * 0.5
-    }
-
-    #[inline(always)]
-    fn center(&self) -> Vec3A {
-        self.bounds().centroid()
     }
 }
 
@@ -534,7 +542,8 @@ impl Bvh {
             return t_max;
         }
         let ray = BoxRay::new(origin, dir);
-        let mut stack = Stack::new();
+        let mut space = stack_space::<(u64, f32)>();
+        let mut stack = Stack::new(&mut space);
         let mut i = 0usize;
         loop {
             let node = self.node(i);
@@ -639,7 +648,8 @@ impl Bvh {
             return false;
         }
         let ray = BoxRay::new(origin, dir);
-        let mut stack = Stack::new();
+        let mut space = stack_space::<u64>();
+        let mut stack = Stack::new(&mut space);
         // The root (an inner node, or the wide node holding a lone leaf).
         let mut link = 0u64;
         loop {
@@ -660,7 +670,7 @@ impl Bvh {
                     let last = (31 - mask.leading_zeros() as usize) & (LANES - 1);
                     mask &= !(1 << last);
                     while mask != 0 {
-                        stack.push(node.link[first_lane(mask)], 0.0);
+                        stack.push(node.link[first_lane(mask)]);
                         mask &= mask - 1;
                     }
                     link = node.link[last];
@@ -668,7 +678,7 @@ impl Bvh {
                 }
             }
             match stack.pop() {
-                Some((next, _)) => link = next,
+                Some(next) => link = next,
                 None => return false,
             }
         }
@@ -677,28 +687,54 @@ impl Bvh {
 
 /// Emits the wide node for binary inner node `i` and, after it, its inner descendants;
 /// returns its index.
+/// The children of the wide node for binary inner node `i`: its two children, then the widest
+/// inner one replaced by its own two (the first of equals) until there are `LANES`.
+fn open_kids(binary: &[Node], i: usize) -> ([usize; LANES], usize) {
+    let mut kids = [0usize; LANES];
+    // Half areas of the inner children; -1 for leaves, which are never opened.
+    let mut area = [0.0f32; LANES];
+    let area_of = |k: usize| {
+        if binary[k].count() == 0 {
+            binary[k].bounds().half_area()
+        } else {
+            -1.0
+        }
+    };
+    let mut len = 2;
+    (kids[0], kids[1]) = (i + 1, binary[i].offset());
+    (area[0], area[1]) = (area_of(kids[0]), area_of(kids[1]));
+    while len < LANES {
+        let mut slot = None;
+        for s in 0..len {
+            if area[s] >= 0.0 && slot.is_none_or(|b: usize| area[s] > area[b]) {
+                slot = Some(s);
+            }
+        }
+        let Some(slot) = slot else { break };
+        let k = kids[slot];
+        kids.copy_within(slot + 1..len, slot + 2);
+        area.copy_within(slot + 1..len, slot + 2);
+        (kids[slot], kids[slot + 1]) = (k + 1, binary[k].offset());
+        (area[slot], area[slot + 1]) = (area_of(kids[slot]), area_of(kids[slot + 1]));
+        len += 1;
+    }
+    (kids, len)
+}
+
+/// A leaf's link in a wide node (the binary node's split axis bits cleared).
+fn leaf_link(node: &Node) -> u64 {
+    node.link & !(3 << 56)
+}
+
+/// Emits the wide node for binary inner node `i` and, after it, its inner descendants;
+/// returns its index.
 fn collapse_node(binary: &[Node], i: usize, out: &mut Vec<Wide>) -> usize {
     let index = out.len();
     out.push(Wide::NONE);
-    let mut kids = vec![i + 1, binary[i].offset()];
-    while kids.len() < LANES {
-        let widest = kids
-            .iter()
-            .enumerate()
-            .filter(|(_, &k)| binary[k].count() == 0)
-            .max_by(|a, b| {
-                let area = |k: usize| binary[k].bounds().half_area();
-                area(*a.1).total_cmp(&area(*b.1))
-            })
-            .map(|(slot, _)| slot);
-        let Some(slot) = widest else { break };
-        let k = kids[slot];
-        kids[slot] = k + 1;
-        kids.insert(slot + 1, binary[k].offset());
-    }
-    for (lane, &k) in kids.iter().enumerate() {
+    let (kids, len) = open_kids(binary, i);
+    for (lane, &k) in kids[..len].iter().enumerate() {
         let link = if binary[k].count() > 0 {
-            binary[k].link & !(3 << 56)
+            leaf_link(&binary[k])
         } else {
             collapse_node(binary, k, out) as u64
         };
@@ -710,13 +746,77 @@ fn collapse_node(binary: &[Node], i: usize, out: &mut Vec<Wide>) -> usize {
 /// Builds the subtree over `prims` (the primitives `start..start + prims.len()` of the final
 /// order) depth-first into `out`: its root is the node pushed first, a node's first child
 /// follows it.
+/// Nodes with more primitives than this are summed up and binned on every thread (the top of
+/// the tree would otherwise run on one).
+const PARALLEL_BINNING: usize = 1 << 16;
+
+/// The bounds of the primitives and of their centroids, in one pass.
+fn summarize(prims: &[BuildPrim]) -> (Aabb, Aabb) {
+    use rayon::prelude::*;
+    let one = |prims: &[BuildPrim]| {
+        prims.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), p| {
+            let pb = p.bounds();
+            (b.union(pb), c.grow(pb.centroid()))
+        })
+    };
+    if prims.len() <= PARALLEL_BINNING {
+        return one(prims);
+    }
+    prims.par_chunks(PARALLEL_BINNING / 4).map(one).reduce(
+        || (Aabb::EMPTY, Aabb::EMPTY),
+        |a, b| (a.0.union(b.0), a.1.union(b.1)),
+    )
+}
+
+/// Primitive bounds and counts per centroid bin, for each axis.
+type Bins = ([[Aabb; BINS]; 3], [[usize; BINS]; 3]);
+
+/// Bins the primitives' centroids: bin `((c - lo) * scale)` clamped to `[0, bins - 1]` on each
+/// axis, the arithmetic `build_node`'s partition repeats.
+fn bin(prims: &[BuildPrim], lo: Vec3A, scale: Vec3A, bins: usize) -> Bins {
+    use rayon::prelude::*;
+    let one = |prims: &[BuildPrim]| {
+        let mut bin_bounds = [[Aabb::EMPTY; BINS]; 3];
+        let mut bin_count = [[0usize; BINS]; 3];
+        let top = Vec3A::splat((bins - 1) as f32);
+        for p in prims {
+            let b = p.bounds();
+            let x: [f32; 3] = ((b.centroid() - lo) * scale)
+                .max(Vec3A::ZERO)
+                .min(top)
+                .into();
+            for a in 0..3 {
+                // SAFETY: x[a] is finite and in [0, bins - 1] (max maps NaN to 0).
+                let i = unsafe { x[a].to_int_unchecked::<u32>() } as usize;
+                bin_bounds[a][i] = bin_bounds[a][i].union(b);
+                bin_count[a][i] += 1;
+            }
+        }
+        (bin_bounds, bin_count)
+    };
+    if prims.len() <= PARALLEL_BINNING {
+        return one(prims);
+    }
+    prims.par_chunks(PARALLEL_BINNING / 4).map(one).reduce(
+        || ([[Aabb::EMPTY; BINS]; 3], [[0; BINS]; 3]),
+        |mut a, b| {
+            for k in 0..3 {
+                for i in 0..BINS {
+                    a.0[k][i] = a.0[k][i].union(b.0[k][i]);
+                    a.1[k][i] += b.1[k][i];
+                }
+            }
+            a
+        },
+    )
+}
+
 fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec<Node>) {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds()));
+    let (bounds, cb) = summarize(prims);
     let n = prims.len();
     if n <= 2 {
         return leaf(out, bounds, start, n);
     }
-    let cb = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.center()));
     let extent = cb.max - cb.min;
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
@@ -730,45 +830,57 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec
         return split_middle(prims, start, bounds, axis, n, depth, out);
     }
 
-    // Bin centroids along the widest axis and sweep for the cheapest split.
-    let scale = BINS as f32 / extent[axis];
-    let lo = cb.min[axis];
-    let bin_of = |c: f32| {
+    // Bin centroids along every axis in one pass over the primitives, and sweep each for the
+    // cheapest split.
+    let lo = cb.min;
+    // No more bins than primitives: small nodes, most of the tree, sweep fewer.
+    let bins = BINS.min(n);
+    let scale = extent.map(|e| {
+        if e > 0.0 && e.is_finite() {
+            bins as f32 / e
+        } else {
+            0.0
+        }
+    });
+    let bin_of = |axis: usize, c: f32| {
         // Clamped first (max maps NaN to 0), so the cheap truncating conversion is exact; Rust's
         // saturating `as` cost a fifth of the build.
-        let x = ((c - lo) * scale).max(0.0).min((BINS - 1) as f32);
-        // SAFETY: x is finite and in [0, BINS - 1].
+        let x = ((c - lo[axis]) * scale[axis])
+            .max(0.0)
+            .min((bins - 1) as f32);
+        // SAFETY: x is finite and in [0, bins - 1].
         unsafe { x.to_int_unchecked::<u32>() as usize }
     };
-    let mut bin_bounds = [Aabb::EMPTY; BINS];
-    let mut bin_count = [0usize; BINS];
-    for p in prims.iter() {
-        let b = bin_of(p.centroid(axis));
-        bin_bounds[b] = bin_bounds[b].union(p.bounds());
-        bin_count[b] += 1;
-    }
-    let mut right_area = [0.0f32; BINS];
-    let mut right_count = [0usize; BINS];
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    for i in (1..BINS).rev() {
-        acc = acc.union(bin_bounds[i]);
-        cnt += bin_count[i];
-        right_area[i] = acc.half_area();
-        right_count[i] = cnt;
-    }
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    let mut best = (f32::INFINITY, 0usize);
-    for i in 1..BINS {
-        acc = acc.union(bin_bounds[i - 1]);
-        cnt += bin_count[i - 1];
-        if cnt == 0 || right_count[i] == 0 {
+    let (bin_bounds, bin_count) = bin(prims, lo, scale, bins);
+    let mut best = (f32::INFINITY, 0usize, axis);
+    for a in 0..3 {
+        if scale[a] == 0.0 {
             continue;
         }
-        let cost = acc.half_area() * cnt as f32 + right_area[i] * right_count[i] as f32;
-        if cost < best.0 {
-            best = (cost, i);
+        let (bin_bounds, bin_count) = (&bin_bounds[a], &bin_count[a]);
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0usize; BINS];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in (1..bins).rev() {
+            acc = acc.union(bin_bounds[i]);
+            cnt += bin_count[i];
+            right_area[i] = acc.half_area();
+            right_count[i] = cnt;
+        }
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in 1..bins {
+            acc = acc.union(bin_bounds[i - 1]);
+            cnt += bin_count[i - 1];
+            if cnt == 0 || right_count[i] == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * cnt as f32 + right_area[i] * right_count[i] as f32;
+            if cost < best.0 {
+                best = (cost, i, a);
+            }
         }
     }
+    let axis = best.2;
     let leaf_cost = n as f32;
     let split_cost = TRAVERSAL_COST + best.0 / bounds.half_area().max(f32::MIN_POSITIVE);
     if best.1 == 0 || (n <= MAX_LEAF && leaf_cost <= split_cost) {
@@ -777,7 +889,7 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec
         }
         return split_middle(prims, start, bounds, axis, n, depth, out);
     }
-    let mid = partition(prims, |p| bin_of(p.centroid(axis)) < best.1);
+    let mid = partition(prims, |p| bin_of(axis, p.centroid(axis)) < best.1);
     if mid == 0 || mid == n {
         return split_middle(prims, start, bounds, axis, n, depth, out);
     }
@@ -996,6 +1108,34 @@ mod tests {
                 brute,
                 "ray {k}"
             );
+        }
+    }
+
+    /// The SAH weighs every axis, not only the one the centroids spread widest along: two
+    /// long thin rows of boxes, 100 apart in y and each 400 long in x, split between the rows.
+    #[test]
+    fn the_sah_splits_along_the_cheapest_axis() {
+        let b: Vec<Aabb> = (0..400)
+            .map(|i| {
+                let c = Vec3A::new((i / 2) as f32 * 2.0, (i % 2) as f32 * 100.0, 0.0);
+                Aabb::new(c - 0.5, c + 0.5)
+            })
+            .collect();
+        let mut prims: Vec<BuildPrim> = b
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BuildPrim {
+                min: b.min.into(),
+                max: b.max.into(),
+                index: i as u64,
+            })
+            .collect();
+        let mut binary = Vec::new();
+        build_node(&mut prims, 0, 0, &mut binary);
+        assert_eq!(binary[0].axis(), 1, "the root splits across the rows");
+        for child in [1, binary[0].offset()] {
+            let b = binary[child].bounds();
+            assert!(b.max.y - b.min.y <= 1.0, "one row per side: {b:?}");
         }
     }
 

@@ -30,8 +30,9 @@ use std::path::{Path, PathBuf};
 use std::time::UNIX_EPOCH;
 
 const MAGIC: &[u8; 8] = b"LUXGEOC\0";
-/// Raise when the layout changes.
-pub const FORMAT_VERSION: u32 = 4;
+/// Raise when the layout changes, or when a new build makes better trees than the cached ones
+/// (5: the SAH looks at all three axes).
+pub const FORMAT_VERSION: u32 = 5;
 const LUXON_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// A scene's native geometry, built, as the cache gives it back.
