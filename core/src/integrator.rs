@@ -64,6 +64,22 @@ impl IorStack {
 
 pub struct Whitted<'a> {
     pub scene: &'a Scene,
+    /// Some light or occlusion draws random numbers (more than one sample): only then is a
+    /// shading point's seed worth hashing.
+    draws: bool,
+}
+
+impl<'a> Whitted<'a> {
+    pub fn new(scene: &'a Scene) -> Whitted<'a> {
+        let sampled = |l: &Light| match l {
+            Light::Sphere { samples, .. } | Light::Rect { samples, .. } => *samples > 1,
+            _ => false,
+        };
+        let draws = scene.features.ambient_occlusion
+            && scene.ao.as_ref().is_some_and(|a| a.samples > 1)
+            || scene.lights.iter().any(sampled);
+        Whitted { scene, draws }
+    }
 }
 
 impl Whitted<'_> {
@@ -207,7 +223,7 @@ impl Whitted<'_> {
         let mut color = mat.ambient * shade_opacity * base;
         // Random numbers for area lights and occlusion, from the ray itself: deterministic for
         // any thread count or decomposition, different for every path.
-        let seed = ray_seed(ray);
+        let seed = if self.draws { ray_seed(ray) } else { 0 };
         // Light and occlusion rays leave smooth meshes from the curved surface, not the facet.
         let (light_p, light_error) = if entering && s.lift != Vec3A::ZERO {
             let q = s.p + s.lift;

@@ -50,7 +50,7 @@ pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
 /// Renders the pixels of `spans`, returning their RGBA values span after span.
 pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
     let s = &scene.settings;
-    let integrator = Whitted { scene };
+    let integrator = Whitted::new(scene);
     let count: usize = spans.iter().map(|s| s.count as usize).sum();
     let mut out = Vec::with_capacity(count * 4);
     let n = s.samples.max(1);

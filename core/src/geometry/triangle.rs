@@ -72,7 +72,8 @@ impl TriRay {
         TriRay {
             k: [kx, ky, kz],
             o: [o[kx], o[ky], o[kz]],
-            s: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
+            // One vector division, lane for lane the three scalar ones.
+            s: (Vec3A::new(d[kx], d[ky], 1.0) / Vec3A::splat(d[kz])).into(),
         }
     }
 
