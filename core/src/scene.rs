@@ -728,7 +728,6 @@ impl Scene {
         self.spheres
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         self.triangles
-            .set
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         self.planes
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);

@@ -134,6 +134,21 @@ impl<S: Shape> Set<S> {
         clips: &Clips,
         c: &mut Counters,
     ) {
+        self.intersect_noting(ray, t_max, hit, clips, c, |_| {});
+    }
+
+    /// [`Set::intersect`], calling `noted(prim)` for every closer hit found on the way (for
+    /// prefetching what shading that primitive will read).
+    #[inline]
+    pub fn intersect_noting(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        clips: &Clips,
+        c: &mut Counters,
+        noted: impl Fn(usize),
+    ) {
         if self.data.is_empty() {
             return;
         }
@@ -150,6 +165,7 @@ impl<S: Shape> Set<S> {
                 h.b1 = b1;
                 h.b2 = b2;
                 *hit = Some(h);
+                noted(i);
                 Some(t)
             },
         );

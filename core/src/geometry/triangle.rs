@@ -291,6 +291,31 @@ impl Triangles {
         Ok(dropped)
     }
 
+    /// The nearest hit, as [`Set::intersect`]; each closer hit found on the way starts loading
+    /// the vertex attributes `surface` will read, while the traversal goes on.
+    #[inline]
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        clips: &super::Clips,
+        c: &mut super::Counters,
+    ) {
+        self.set.intersect_noting(ray, t_max, hit, clips, c, |i| {
+            let a = self.set.data[i].attr;
+            if a != NO_ATTR {
+                if let Some(corner) = self.corners.get(a as usize) {
+                    for &v in corner {
+                        if let Some(va) = self.vertex_attrs.get(v as usize) {
+                            prefetch(va);
+                        }
+                    }
+                }
+            }
+        });
+    }
+
     /// `textured`: the scene looks textures up, so the uvs and their scale are needed.
     pub fn surface(&self, hit: &Hit, textured: bool) -> Surface {
         let i = hit.index as usize;
@@ -366,6 +391,18 @@ fn terminator_lift(p: Vec3A, v: [Vec3A; 3], b: [f32; 3], va: &[VertexAttr; 3], s
         lift -= b[k] * below * n;
     }
     lift
+}
+
+/// Asks for the cache line holding `x`; a hint only.
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing and cannot fault.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        )
+    };
 }
 
 #[cfg(test)]
