@@ -768,47 +768,108 @@ fn summarize(prims: &[BuildPrim]) -> (Aabb, Aabb) {
     )
 }
 
-/// Primitive bounds and counts per centroid bin, for each axis.
-type Bins = ([[Aabb; BINS]; 3], [[usize; BINS]; 3]);
+/// Primitive bounds and counts per centroid bin, for each axis (`K` bins at most).
+type Bins<const K: usize> = ([[Aabb; K]; 3], [[usize; K]; 3]);
 
-/// Bins the primitives' centroids: bin `((c - lo) * scale)` clamped to `[0, bins - 1]` on each
-/// axis, the arithmetic `build_node`'s partition repeats.
-fn bin(prims: &[BuildPrim], lo: Vec3A, scale: Vec3A, bins: usize) -> Bins {
-    use rayon::prelude::*;
-    let one = |prims: &[BuildPrim]| {
-        let mut bin_bounds = [[Aabb::EMPTY; BINS]; 3];
-        let mut bin_count = [[0usize; BINS]; 3];
-        let top = Vec3A::splat((bins - 1) as f32);
-        for p in prims {
-            let b = p.bounds();
-            let x: [f32; 3] = ((b.centroid() - lo) * scale)
-                .max(Vec3A::ZERO)
-                .min(top)
-                .into();
-            for a in 0..3 {
-                // SAFETY: x[a] is finite and in [0, bins - 1] (max maps NaN to 0).
-                let i = unsafe { x[a].to_int_unchecked::<u32>() } as usize;
-                bin_bounds[a][i] = bin_bounds[a][i].union(b);
-                bin_count[a][i] += 1;
-            }
+/// Adds the primitives to `bins` by centroid: bin `((c - lo) * scale)` clamped to
+/// `[0, bins - 1]` on each axis, the arithmetic `build_node`'s partition repeats.
+fn bin_into<const K: usize>(
+    prims: &[BuildPrim],
+    lo: Vec3A,
+    scale: Vec3A,
+    bins: usize,
+    (bin_bounds, bin_count): &mut Bins<K>,
+) {
+    let top = Vec3A::splat((bins - 1) as f32);
+    for p in prims {
+        let b = p.bounds();
+        let x: [f32; 3] = ((b.centroid() - lo) * scale)
+            .max(Vec3A::ZERO)
+            .min(top)
+            .into();
+        for a in 0..3 {
+            // SAFETY: x[a] is finite and in [0, bins - 1] (max maps NaN to 0), bins <= K.
+            let i = unsafe { x[a].to_int_unchecked::<u32>() } as usize;
+            bin_bounds[a][i] = bin_bounds[a][i].union(b);
+            bin_count[a][i] += 1;
         }
-        (bin_bounds, bin_count)
-    };
-    if prims.len() <= PARALLEL_BINNING {
-        return one(prims);
     }
-    prims.par_chunks(PARALLEL_BINNING / 4).map(one).reduce(
-        || ([[Aabb::EMPTY; BINS]; 3], [[0; BINS]; 3]),
-        |mut a, b| {
+}
+
+/// [`bin_into`] for a large node, on every thread.
+fn bin_parallel<const K: usize>(
+    prims: &[BuildPrim],
+    lo: Vec3A,
+    scale: Vec3A,
+    bins: usize,
+) -> Bins<K> {
+    use rayon::prelude::*;
+    let empty = || ([[Aabb::EMPTY; K]; 3], [[0; K]; 3]);
+    prims
+        .par_chunks(PARALLEL_BINNING / 4)
+        .map(|chunk| {
+            let mut b = empty();
+            bin_into(chunk, lo, scale, bins, &mut b);
+            b
+        })
+        .reduce(empty, |mut a, b| {
             for k in 0..3 {
-                for i in 0..BINS {
+                for i in 0..K {
                     a.0[k][i] = a.0[k][i].union(b.0[k][i]);
                     a.1[k][i] += b.1[k][i];
                 }
             }
             a
-        },
-    )
+        })
+}
+
+/// The cheapest binned SAH split over the axes whose `scale` is not 0: (cost, bin, axis), bin 0
+/// when there is none. `K` (at least `bins`) sizes the arrays: small nodes, most of the tree,
+/// neither clear nor sweep sixteen bins.
+fn best_split<const K: usize>(
+    prims: &[BuildPrim],
+    lo: Vec3A,
+    scale: Vec3A,
+    bins: usize,
+    axis: usize,
+) -> (f32, usize, usize) {
+    // Filled in place: returned, the arrays cost a copy per node.
+    let mut binned = ([[Aabb::EMPTY; K]; 3], [[0; K]; 3]);
+    if prims.len() <= PARALLEL_BINNING {
+        bin_into(prims, lo, scale, bins, &mut binned);
+    } else {
+        binned = bin_parallel(prims, lo, scale, bins);
+    }
+    let (bin_bounds, bin_count) = &binned;
+    let mut best = (f32::INFINITY, 0usize, axis);
+    for a in 0..3 {
+        if scale[a] == 0.0 {
+            continue;
+        }
+        let (bin_bounds, bin_count) = (&bin_bounds[a], &bin_count[a]);
+        let mut right_area = [0.0f32; K];
+        let mut right_count = [0usize; K];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in (1..bins).rev() {
+            acc = acc.union(bin_bounds[i]);
+            cnt += bin_count[i];
+            right_area[i] = acc.half_area();
+            right_count[i] = cnt;
+        }
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in 1..bins {
+            acc = acc.union(bin_bounds[i - 1]);
+            cnt += bin_count[i - 1];
+            if cnt == 0 || right_count[i] == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * cnt as f32 + right_area[i] * right_count[i] as f32;
+            if cost < best.0 {
+                best = (cost, i, a);
+            }
+        }
+    }
+    best
 }
 
 fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec<Node>) {
@@ -851,35 +912,13 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec
         // SAFETY: x is finite and in [0, bins - 1].
         unsafe { x.to_int_unchecked::<u32>() as usize }
     };
-    let (bin_bounds, bin_count) = bin(prims, lo, scale, bins);
-    let mut best = (f32::INFINITY, 0usize, axis);
-    for a in 0..3 {
-        if scale[a] == 0.0 {
-            continue;
-        }
-        let (bin_bounds, bin_count) = (&bin_bounds[a], &bin_count[a]);
-        let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0usize; BINS];
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-        for i in (1..bins).rev() {
-            acc = acc.union(bin_bounds[i]);
-            cnt += bin_count[i];
-            right_area[i] = acc.half_area();
-            right_count[i] = cnt;
-        }
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-        for i in 1..bins {
-            acc = acc.union(bin_bounds[i - 1]);
-            cnt += bin_count[i - 1];
-            if cnt == 0 || right_count[i] == 0 {
-                continue;
-            }
-            let cost = acc.half_area() * cnt as f32 + right_area[i] * right_count[i] as f32;
-            if cost < best.0 {
-                best = (cost, i, a);
-            }
-        }
-    }
+    let best = if n <= 4 {
+        best_split::<4>(prims, lo, scale, bins, axis)
+    } else if n <= 8 {
+        best_split::<8>(prims, lo, scale, bins, axis)
+    } else {
+        best_split::<BINS>(prims, lo, scale, bins, axis)
+    };
     let axis = best.2;
     let leaf_cost = n as f32;
     let split_cost = TRAVERSAL_COST + best.0 / bounds.half_area().max(f32::MIN_POSITIVE);
