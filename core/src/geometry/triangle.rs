@@ -382,11 +382,12 @@ impl Triangles {
 
 /// Hanika's shadow-terminator fix ("Hacking the shadow terminator", Ray Tracing Gems II): the
 /// offset from `p` to the barycentric blend of `p` projected onto each vertex's tangent plane,
-/// for the planes `p` lies below. Zero on concave parts and on flat facets.
+/// for the planes `p` lies below. Zero on concave parts and on flat facets. Vertex normals are
+/// stored unit length or zero (`push_mesh` normalizes them), so they are used as they are.
 fn terminator_lift(p: Vec3A, v: [Vec3A; 3], b: [f32; 3], va: &[VertexAttr; 3], side: f32) -> Vec3A {
     let mut lift = Vec3A::ZERO;
     for k in 0..3 {
-        let n = side * Vec3A::from(va[k].n).normalize_or_zero();
+        let n = side * Vec3A::from(va[k].n);
         let below = (p - v[k]).dot(n).min(0.0);
         lift -= b[k] * below * n;
     }
