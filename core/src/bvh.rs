@@ -348,6 +348,14 @@ struct BuildPrim {
 }
 
 impl BuildPrim {
+    fn new(b: Aabb, index: usize) -> BuildPrim {
+        BuildPrim {
+            min: b.min.into(),
+            max: b.max.into(),
+            index: index as u64,
+        }
+    }
+
     #[inline(always)]
     fn bounds(&self) -> Aabb {
         Aabb::new(self.min.into(), self.max.into())
@@ -380,14 +388,7 @@ impl Bvh {
         let mut prims: Vec<BuildPrim> = (0..n)
             .into_par_iter()
             .with_min_len(PARALLEL_CUTOFF)
-            .map(|i| {
-                let b = bound(i);
-                BuildPrim {
-                    min: b.min.into(),
-                    max: b.max.into(),
-                    index: i as u64,
-                }
-            })
+            .map(|i| BuildPrim::new(bound(i), i))
             .collect();
         let mut binary = Vec::new();
         build_node(&mut prims, 0, 0, &mut binary);
@@ -685,8 +686,6 @@ impl Bvh {
     }
 }
 
-/// Emits the wide node for binary inner node `i` and, after it, its inner descendants;
-/// returns its index.
 /// The children of the wide node for binary inner node `i`: its two children, then the widest
 /// inner one replaced by its own two (the first of equals) until there are `LANES`.
 fn open_kids(binary: &[Node], i: usize) -> ([usize; LANES], usize) {
@@ -771,8 +770,21 @@ fn summarize(prims: &[BuildPrim]) -> (Aabb, Aabb) {
 /// Primitive bounds and counts per centroid bin, for each axis (`K` bins at most).
 type Bins<const K: usize> = ([[Aabb; K]; 3], [[usize; K]; 3]);
 
-/// Adds the primitives to `bins` by centroid: bin `((c - lo) * scale)` clamped to
-/// `[0, bins - 1]` on each axis, the arithmetic `build_node`'s partition repeats.
+/// The bin of centroid `c` on each axis: `(c - lo) * scale` clamped to `[0, bins - 1]`. The
+/// binning and the partition that follows it both call this, so they agree on every primitive.
+#[inline(always)]
+fn bin_of(c: Vec3A, lo: Vec3A, scale: Vec3A, bins: usize) -> [usize; 3] {
+    // Clamped first (max maps NaN to 0), so the cheap truncating conversion is exact; Rust's
+    // saturating `as` cost a fifth of the build.
+    let x: [f32; 3] = ((c - lo) * scale)
+        .max(Vec3A::ZERO)
+        .min(Vec3A::splat((bins - 1) as f32))
+        .into();
+    // SAFETY: each x is finite and in [0, bins - 1].
+    x.map(|x| unsafe { x.to_int_unchecked::<u32>() } as usize)
+}
+
+/// Adds the primitives to `bins` by centroid ([`bin_of`]).
 fn bin_into<const K: usize>(
     prims: &[BuildPrim],
     lo: Vec3A,
@@ -780,16 +792,13 @@ fn bin_into<const K: usize>(
     bins: usize,
     (bin_bounds, bin_count): &mut Bins<K>,
 ) {
-    let top = Vec3A::splat((bins - 1) as f32);
     for p in prims {
         let b = p.bounds();
-        let x: [f32; 3] = ((b.centroid() - lo) * scale)
-            .max(Vec3A::ZERO)
-            .min(top)
-            .into();
-        for a in 0..3 {
-            // SAFETY: x[a] is finite and in [0, bins - 1] (max maps NaN to 0), bins <= K.
-            let i = unsafe { x[a].to_int_unchecked::<u32>() } as usize;
+        for (a, i) in bin_of(b.centroid(), lo, scale, bins)
+            .into_iter()
+            .enumerate()
+        {
+            // bins <= K, so i < K.
             bin_bounds[a][i] = bin_bounds[a][i].union(b);
             bin_count[a][i] += 1;
         }
@@ -903,15 +912,6 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec
             0.0
         }
     });
-    let bin_of = |axis: usize, c: f32| {
-        // Clamped first (max maps NaN to 0), so the cheap truncating conversion is exact; Rust's
-        // saturating `as` cost a fifth of the build.
-        let x = ((c - lo[axis]) * scale[axis])
-            .max(0.0)
-            .min((bins - 1) as f32);
-        // SAFETY: x is finite and in [0, bins - 1].
-        unsafe { x.to_int_unchecked::<u32>() as usize }
-    };
     let best = if n <= 4 {
         best_split::<4>(prims, lo, scale, bins, axis)
     } else if n <= 8 {
@@ -928,7 +928,9 @@ fn build_node(prims: &mut [BuildPrim], start: usize, depth: usize, out: &mut Vec
         }
         return split_middle(prims, start, bounds, axis, n, depth, out);
     }
-    let mid = partition(prims, |p| bin_of(axis, p.centroid(axis)) < best.1);
+    let mid = partition(prims, |p| {
+        bin_of(p.bounds().centroid(), lo, scale, bins)[axis] < best.1
+    });
     if mid == 0 || mid == n {
         return split_middle(prims, start, bounds, axis, n, depth, out);
     }
@@ -1160,15 +1162,7 @@ mod tests {
                 Aabb::new(c - 0.5, c + 0.5)
             })
             .collect();
-        let mut prims: Vec<BuildPrim> = b
-            .iter()
-            .enumerate()
-            .map(|(i, b)| BuildPrim {
-                min: b.min.into(),
-                max: b.max.into(),
-                index: i as u64,
-            })
-            .collect();
+        let mut prims: Vec<BuildPrim> = (0..b.len()).map(|i| BuildPrim::new(b[i], i)).collect();
         let mut binary = Vec::new();
         build_node(&mut prims, 0, 0, &mut binary);
         assert_eq!(binary[0].axis(), 1, "the root splits across the rows");

@@ -64,8 +64,8 @@ impl IorStack {
 
 pub struct Whitted<'a> {
     pub scene: &'a Scene,
-    /// Some light or occlusion draws random numbers (more than one sample): only then is a
-    /// shading point's seed worth hashing.
+    /// Some light or occlusion draws random numbers (more than one sample; `square` ignores
+    /// the seed for one): only then is a shading point's seed worth hashing.
     draws: bool,
 }
 

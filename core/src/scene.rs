@@ -728,7 +728,10 @@ impl Scene {
         self.spheres
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         self.triangles
-            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+            .set
+            .intersect_noting(ray, &mut t_max, &mut hit, &self.clips, c, |i| {
+                self.triangles.prefetch_shading(i)
+            });
         self.planes
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         self.cones

@@ -6,6 +6,7 @@ use super::{clip_of, material_of, Clips, Counters, Hit, Kind};
 use crate::bvh::Bvh;
 use crate::math::Aabb;
 use crate::ray::Ray;
+use rayon::prelude::*;
 
 pub trait Shape: Copy + Send + Sync {
     const KIND: Kind;
@@ -87,7 +88,6 @@ impl<S: Shape> Set<S> {
     pub fn build(&mut self) {
         let data = &self.data;
         let (bvh, order) = Bvh::build_with(data.len(), |i| data[i].bounds());
-        use rayon::prelude::*;
         self.data = order.par_iter().map(|&i| self.data[i as usize]).collect();
         self.material = order
             .par_iter()

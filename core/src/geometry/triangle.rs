@@ -291,29 +291,21 @@ impl Triangles {
         Ok(dropped)
     }
 
-    /// The nearest hit, as [`Set::intersect`]; each closer hit found on the way starts loading
-    /// the vertex attributes `surface` will read, while the traversal goes on.
-    #[inline]
-    pub fn intersect(
-        &self,
-        ray: &Ray,
-        t_max: &mut f32,
-        hit: &mut Option<Hit>,
-        clips: &super::Clips,
-        c: &mut super::Counters,
-    ) {
-        self.set.intersect_noting(ray, t_max, hit, clips, c, |i| {
-            let a = self.set.data[i].attr;
-            if a != NO_ATTR {
-                if let Some(corner) = self.corners.get(a as usize) {
-                    for &v in corner {
-                        if let Some(va) = self.vertex_attrs.get(v as usize) {
-                            prefetch(va);
-                        }
-                    }
+    /// Starts loading the vertex attributes `surface` will read for triangle `i`: called for
+    /// each closer hit found during traversal, which goes on while they arrive.
+    #[inline(always)]
+    pub fn prefetch_shading(&self, i: usize) {
+        let a = self.set.data[i].attr;
+        if a == NO_ATTR {
+            return;
+        }
+        if let Some(corner) = self.corners.get(a as usize) {
+            for &v in corner {
+                if let Some(va) = self.vertex_attrs.get(v as usize) {
+                    prefetch(va);
                 }
             }
-        });
+        }
     }
 
     /// `textured`: the scene looks textures up, so the uvs and their scale are needed.

@@ -156,7 +156,8 @@ impl<'r> AsyncOutput<'r> {
     }
 
     /// Takes chunks until every sender is gone, then finishes every file; returns the paths
-    /// written. Unpark its thread after dropping the last sender, or the end waits up to [`POLL`]. Incomplete rows (a failed render) leave no file behind.
+    /// written. Incomplete rows (a failed render) leave no file behind. Unpark the thread
+    /// running this after dropping the last sender, or the end waits up to [`POLL`].
     pub fn run(
         mut self,
         chunks: Receiver<Chunk>,
