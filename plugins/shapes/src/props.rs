@@ -3,7 +3,8 @@
 //! f64, the hit point taken back to f32 with the host's error bound and left through the
 //! host's own `luxon::ray::spawn`.
 //!
-//! - the hit point lies on the surface, within a bound relative to its magnitude;
+//! - the hit point lies on the surface, within a bound relative to its magnitude and within
+//!   the host's error bound along the normal (the offset spawned rays start at);
 //! - the normal is finite and non-zero, and unit length once the host normalises it;
 //! - a ray leaving the hit point into the outward hemisphere of a convex shape never hits it
 //!   again; a ray leaving a heightfield upward hits it again only where it really crosses
@@ -22,8 +23,10 @@ type V3 = [f64; 3];
 /// Relative tolerance for "on the surface" (the host keeps hit points in f32).
 const ON_SURFACE: f64 = 1.0 / 65536.0;
 
+/// 512 cases, or `PROPTEST_CASES` (which `with_cases` would override) for longer runs.
 fn cases() -> ProptestConfig {
-    ProptestConfig::with_cases(512)
+    let cases = std::env::var("PROPTEST_CASES").ok();
+    ProptestConfig::with_cases(cases.and_then(|v| v.parse().ok()).unwrap_or(512))
 }
 
 fn unit() -> impl Strategy<Value = Vec3A> {
@@ -104,6 +107,12 @@ fn check<S: CustomShape>(
     let mag = pd.iter().fold(size, |m, v| m.max(v.abs()));
     let dist = distance(pd);
     prop_assert!(dist <= ON_SURFACE * mag, "{pd:?} is {dist} off the surface");
+    // The host spawns rays this far off along the normal: the surface must lie within it.
+    let bound = n.abs().dot(p_error) as f64;
+    prop_assert!(
+        dist <= bound,
+        "{pd:?} is {dist} off the surface, beyond its error bound {bound}"
+    );
     let n = outward(pd, n);
     let dir = away(n, leave);
     let spawned = host_ray(&luxon::ray::spawn(p, p_error, n, dir, 0.0));
@@ -179,55 +188,7 @@ proptest! {
     #[test]
     fn convex_quadrics((scale, pos) in placement(), axes in (0.2f64..2.0, 0.2f64..2.0, 0.2f64..2.0),
                        paraboloid in any::<bool>(), from in unit(), jitter in unit(), leave in unit()) {
-        // An ellipsoid (x/a)² + (y/b)² + (z/c)² = 1, or a paraboloid (x/a)² + (z/c)² = y/b,
-        // around `pos`, in a clipping box that holds all of the ellipsoid.
-        let c = v3(pos);
-        let (a, b, cc) = (axes.0 * scale, axes.1 * scale, axes.2 * scale);
-        let (ka, kb, kc) = (1.0 / (a * a), 1.0 / (b * b), 1.0 / (cc * cc));
-        let k: [f64; 10] = if paraboloid {
-            // ka (x - cx)² + kc (z - cz)² - (y - cy) / b
-            [ka, 0.0, kc, 0.0, 0.0, 0.0, -2.0 * ka * c[0], -1.0 / b, -2.0 * kc * c[2],
-             ka * c[0] * c[0] + kc * c[2] * c[2] + c[1] / b]
-        } else {
-            [ka, kb, kc, 0.0, 0.0, 0.0, -2.0 * ka * c[0], -2.0 * kb * c[1], -2.0 * kc * c[2],
-             ka * c[0] * c[0] + kb * c[1] * c[1] + kc * c[2] * c[2] - 1.0]
-        };
-        let m = 2.5 * scale;
-        let (min, max) = ([c[0] - m, c[1] - m, c[2] - m], [c[0] + m, c[1] + m, c[2] + m]);
-        let coefficients = k.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", ");
-        let q = ClippedQuadric::new(&parse_params(&format!(
-            "(coefficients: ({coefficients}), min: {}, max: {})", text(min), text(max))).unwrap()).unwrap();
-        let r = aimed(pos + jitter * scale as f32, 2.0 * scale, from);
-        // First-order distance |f| / |∇f|, in coordinates relative to the centre.
-        let distance = |p: V3| {
-            let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-            let (f, g) = if paraboloid {
-                (ka * d[0] * d[0] + kc * d[2] * d[2] - d[1] / b,
-                 [2.0 * ka * d[0], -1.0 / b, 2.0 * kc * d[2]])
-            } else {
-                (ka * d[0] * d[0] + kb * d[1] * d[1] + kc * d[2] * d[2] - 1.0,
-                 [2.0 * ka * d[0], 2.0 * kb * d[1], 2.0 * kc * d[2]])
-            };
-            f.abs() / (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt()
-        };
-        // Only hits inside the clipping box count; the box's faces cut the paraboloid open,
-        // so leaving outward from near a cut may still cross the surface: skip those.
-        let inner = |p: V3| (0..3).all(|k| p[k] > min[k] + 0.2 * m && p[k] < max[k] - 0.2 * m);
-        let outward = |p: V3, n: Vec3A| {
-            let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-            let g = if paraboloid {
-                [2.0 * ka * d[0], -1.0 / b, 2.0 * kc * d[2]]
-            } else {
-                [2.0 * ka * d[0], 2.0 * kb * d[1], 2.0 * kc * d[2]]
-            };
-            if n.as_dvec3().dot(g.into()) < 0.0 { -n } else { n }
-        };
-        let size = c.iter().map(|v| v.abs()).fold(m, f64::max);
-        if let Some(h) = q.intersect(0, &host_ray(&r)) {
-            let p: V3 = r.at(h.t as f32).as_dvec3().into();
-            let cut_nearby = !inner(p);
-            check(&q, &r, distance, size, outward, leave, |_, _| cut_nearby)?;
-        }
+        quadric_case(scale, pos, axes, paraboloid, from, jitter, leave)?;
     }
 
     #[test]
@@ -236,6 +197,121 @@ proptest! {
                    from in unit(), jitter in (0.0f32..1.0, 0.0f32..1.0), leave in unit()) {
         heightfield_case(scale, pos, n, &heights, from, jitter, leave)?;
     }
+}
+
+/// The quadric property for one input: an ellipsoid (x/a)² + (y/b)² + (z/c)² = 1, or a
+/// paraboloid (x/a)² + (z/c)² = y/b, with axes `axes * scale` around `pos`, in a clipping box
+/// that holds all of the ellipsoid; a ray aimed near `pos` from the direction `from`.
+fn quadric_case(
+    scale: f64,
+    pos: Vec3A,
+    axes: (f64, f64, f64),
+    paraboloid: bool,
+    from: Vec3A,
+    jitter: Vec3A,
+    leave: Vec3A,
+) -> Result<Option<Leaving>, TestCaseError> {
+    let c = v3(pos);
+    let (a, b, cc) = (axes.0 * scale, axes.1 * scale, axes.2 * scale);
+    let (ka, kb, kc) = (1.0 / (a * a), 1.0 / (b * b), 1.0 / (cc * cc));
+    #[rustfmt::skip]
+    let k: [f64; 10] = if paraboloid {
+        // ka (x - cx)² + kc (z - cz)² - (y - cy) / b
+        [ka, 0.0, kc, 0.0, 0.0, 0.0, -2.0 * ka * c[0], -1.0 / b, -2.0 * kc * c[2],
+         ka * c[0] * c[0] + kc * c[2] * c[2] + c[1] / b]
+    } else {
+        [ka, kb, kc, 0.0, 0.0, 0.0, -2.0 * ka * c[0], -2.0 * kb * c[1], -2.0 * kc * c[2],
+         ka * c[0] * c[0] + kb * c[1] * c[1] + kc * c[2] * c[2] - 1.0]
+    };
+    let m = 2.5 * scale;
+    let (min, max) = (
+        [c[0] - m, c[1] - m, c[2] - m],
+        [c[0] + m, c[1] + m, c[2] + m],
+    );
+    let coefficients = k
+        .iter()
+        .map(|v| format!("{v:?}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let q = ClippedQuadric::new(
+        &parse_params(&format!(
+            "(coefficients: ({coefficients}), min: {}, max: {})",
+            text(min),
+            text(max)
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    let r = aimed(pos + jitter * scale as f32, 2.0 * scale, from);
+    // The exact distance, in coordinates relative to the centre (not |f| / |∇f|: a shape
+    // smaller than f32's spacing at its position may have its hit rounded to the centre,
+    // where ∇f = 0).
+    let distance = |p: V3| {
+        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        if paraboloid {
+            quadric_distance(d, [ka, 0.0, kc], [0.0, -1.0 / b, 0.0], 0.0)
+        } else {
+            quadric_distance(d, [ka, kb, kc], [0.0; 3], -1.0)
+        }
+    };
+    // Only hits inside the clipping box count; the box's faces cut the paraboloid open,
+    // so leaving outward from near a cut may still cross the surface: skip those.
+    let inner = |p: V3| (0..3).all(|k| p[k] > min[k] + 0.2 * m && p[k] < max[k] - 0.2 * m);
+    let outward = |p: V3, n: Vec3A| {
+        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let g = if paraboloid {
+            [2.0 * ka * d[0], -1.0 / b, 2.0 * kc * d[2]]
+        } else {
+            [2.0 * ka * d[0], 2.0 * kb * d[1], 2.0 * kc * d[2]]
+        };
+        // g = 0 at the centre, where only a shape far smaller than the spawn offset (~100 f32
+        // steps) can have its hit rounded to: every side leads out of it.
+        if n.as_dvec3().dot(g.into()) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    };
+    let size = c.iter().map(|v| v.abs()).fold(m, f64::max);
+    let Some(h) = q.intersect(0, &host_ray(&r)) else {
+        return Ok(None);
+    };
+    let p: V3 = r.at(h.t as f32).as_dvec3().into();
+    let cut_nearby = !inner(p);
+    check(&q, &r, distance, size, outward, leave, |_, _| cut_nearby)
+}
+
+/// Distance from `d` to the surface `f(x) = Σ k_i x_i² + l_i x_i + c0 = 0` (`k_i >= 0`, not all
+/// 0; `f` takes both signs), as the maximum over `μ` of the Lagrangian dual
+/// `φ(μ) = min_x |x - d|² + μ f(x)`: exact for one quadratic constraint (the S-lemma), concave,
+/// with `φ'(μ) = f(x(μ))` at the minimiser `x_i(μ) = (d_i - μ l_i / 2) / (1 + μ k_i)`, defined
+/// for `1 + μ k_i > 0`. No gradient in a denominator, so the centre of an ellipsoid is fine (its
+/// maximum is then at the end of that range, which bisection approaches).
+fn quadric_distance(d: V3, k: V3, l: V3, c0: f64) -> f64 {
+    let x = |mu: f64| -> Option<V3> {
+        let w = [0, 1, 2].map(|i| 1.0 + mu * k[i]);
+        w.iter()
+            .all(|&w| w > 0.0)
+            .then(|| [0, 1, 2].map(|i| (d[i] - 0.5 * mu * l[i]) / w[i]))
+    };
+    let f = |x: V3| (0..3).map(|i| x[i] * (k[i] * x[i] + l[i])).sum::<f64>() + c0;
+    let k_max = k.iter().fold(0.0, |m: f64, &v| m.max(v));
+    // The maximum lies in [lo, hi]: x is undefined below lo, and φ'(hi) <= 0.
+    let mut lo = -1.0 / k_max;
+    let mut hi = 1.0 / k_max;
+    while x(hi).is_some_and(|x| f(x) > 0.0) {
+        hi *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        match x(mid) {
+            Some(x) if f(x) <= 0.0 => hi = mid,
+            _ => lo = mid,
+        }
+    }
+    let x = x(hi).expect("1 + hi k_i > 0");
+    let phi = dot(sub(x, d), sub(x, d)) + hi * f(x);
+    phi.max(0.0).sqrt()
 }
 
 /// f64 rounding of a point's distance from a plane, relative to the coordinates involved
@@ -499,4 +575,75 @@ fn heightfield_leaving_across_a_concave_fold() {
     assert!(q[0] < 2.0);
     // The same point as a hit of the start facet is not on it: the check has teeth.
     assert_eq!(terrain.facet_at(q, start, hit.normal), None);
+}
+
+/// `quadric_distance` against closed forms, including the centre of an ellipsoid (the nearest
+/// points are the ends of its shortest axis) and points on a paraboloid's axis.
+#[test]
+fn quadric_distance_is_exact() {
+    let ellipsoid = |d: V3, r: V3| quadric_distance(d, r.map(|r| 1.0 / (r * r)), [0.0; 3], -1.0);
+    let close = |got: f64, want: f64| (got - want).abs() <= 1e-12 * want.max(1.0);
+    for (d, want) in [
+        ([0.0, 0.0, 0.0], 2.0),
+        ([3.0, 0.0, 0.0], 1.0),
+        ([0.0, 0.0, 9.0], 7.0),
+        // Off-centre on a longer axis: nearest at y = 0.5 · 9 / (9 - 4), z² = 4 (1 - y² / 9).
+        ([0.0, 0.5, 0.0], 3.8f64.sqrt()),
+        ([1e-300, 0.0, 0.0], 2.0),
+        ([0.0, 3.0 * 0.6, 2.0 * 0.8], 0.0), // on the surface
+    ] {
+        let got = ellipsoid(d, [4.0, 3.0, 2.0]);
+        assert!(close(got, want), "{d:?}: {got} != {want}");
+    }
+    // A sphere: | |d| - r |, at any scale.
+    for (s, d) in [(1e-4, [1e-4, -2e-4, 0.5e-4]), (1e4, [3e4, 1e4, -2e4])] {
+        let got = ellipsoid(d, [s; 3]);
+        let want = (dot(d, d).sqrt() - s).abs();
+        assert!((got - want).abs() <= 1e-12 * s, "{got} != {want}");
+    }
+    // y = x² + z²: from (0, h, 0), the apex while h <= 1/2 (the radius of curvature there),
+    // else the circle where 2 x² = 2 h - 1, at distance √(h - 1/4).
+    let paraboloid = |d: V3| quadric_distance(d, [1.0, 0.0, 1.0], [0.0, -1.0, 0.0], 0.0);
+    for (h, want) in [
+        (-2.0, 2.0f64),
+        (0.25, 0.25),
+        (0.5, 0.5),
+        (3.0, 2.75f64.sqrt()),
+    ] {
+        let got = paraboloid([0.0, h, 0.0]);
+        assert!(close(got, want), "h = {h}: {got} != {want}");
+    }
+}
+
+/// The case proptest once shrank a failure to (also in `proptest-regressions/props.txt`): a
+/// sphere of radius 2e-4 around (3217.5, -3742.8, 5472.8), where f32's spacing is 2.4e-4 in x
+/// and y and 4.9e-4 in z. The plugin's f64 hit lies on the surface, and rounding it to f32
+/// lands on the centre: 2e-4 off, far inside its error bound (0.025 to 0.042 per axis) but
+/// where ∇f = 0, so the old first-order distance |f| / |∇f| was infinite.
+#[test]
+fn quadric_smaller_than_f32_spacing() {
+    let (scale, pos) = (0.001, Vec3A::new(3217.4993, -3742.8179, 5472.7993));
+    let (from, jitter) = (
+        Vec3A::new(0.5031121, 0.26987594, 0.82100254),
+        Vec3A::new(0.5730141, 0.3569052, 0.737749),
+    );
+    let leaving = quadric_case(scale, pos, (0.2, 0.2, 0.2), false, from, jitter, Vec3A::Z);
+    let Leaving { hit, ray, again } = leaving.unwrap().expect("the ray hits the sphere");
+    let r = aimed(pos + jitter * scale as f32, 2.0 * scale, from);
+    // The f64 hit: on the sphere to within the rounding of the coefficients, which hold
+    // |centre|² / r² ≈ 1.4e15 (spacing 0.25, over |∇f| = 2 / r: 2.5e-5 in radius).
+    let exact = sub(at(&host_ray(&r), hit.t), v3(pos));
+    assert!(
+        (dot(exact, exact).sqrt() - 2e-4).abs() < 2.5e-5,
+        "{exact:?}"
+    );
+    // The host's point is the centre, 2e-4 from the surface, inside its error bound.
+    let (p, p_error, n) = host_surface(&r, &hit);
+    assert_eq!(p, pos);
+    assert!(p_error.min_element() > 100.0 * 2e-4, "{p_error:?}");
+    assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-6);
+    // The spawned ray starts well outside and does not come back.
+    let o = sub(ray.origin, v3(pos));
+    assert!(dot(o, o).sqrt() > 100.0 * 2e-4, "{o:?}");
+    assert!(again.is_none());
 }
