@@ -24,8 +24,10 @@ use proptest::prelude::*;
 /// interpolated with a few roundings, so 2^-16 of the magnitude is a generous, meaningful bound.
 const ON_SURFACE: f64 = 1.0 / 65536.0;
 
+/// 512 cases, or `PROPTEST_CASES` (which `with_cases` would override) for longer runs.
 fn cases() -> ProptestConfig {
-    ProptestConfig::with_cases(512)
+    let cases = std::env::var("PROPTEST_CASES").ok();
+    ProptestConfig::with_cases(cases.and_then(|v| v.parse().ok()).unwrap_or(512))
 }
 
 fn unit() -> impl Strategy<Value = Vec3A> {

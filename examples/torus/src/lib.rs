@@ -867,7 +867,10 @@ mod props {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig::with_cases(512))]
+        // 512 cases, or `PROPTEST_CASES` (which `with_cases` would override) for longer runs.
+        #![proptest_config(ProptestConfig::with_cases(
+            std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(512)
+        ))]
 
         /// The hit lies on the surface (relative to its magnitude in f32), the normal is unit
         /// once normalised, and a ray leaving outward (away from the tube's centre line) does
