@@ -14,7 +14,7 @@
 //! zero in the slab test).
 
 use super::solids::{ClippedQuadric, Cuboid, HeightGrid, LineCylinder};
-use luxon::math::{gamma, Vec3A};
+use luxon::math::{gamma, DVec3, Vec3A};
 use luxon_plugin::{parse_params, CustomShape, Hit, Ray};
 use proptest::prelude::*;
 
@@ -61,9 +61,7 @@ fn aimed(target: Vec3A, scale: f64, from: Vec3A) -> luxon::ray::Ray {
 fn host_surface(r: &luxon::ray::Ray, h: &Hit) -> (Vec3A, Vec3A, Vec3A) {
     let p = r.at(h.t as f32);
     let p_error = gamma(64) * (p.abs() + r.origin.abs());
-    let n = luxon::math::DVec3::from(h.normal)
-        .normalize_or_zero()
-        .as_vec3();
+    let n = DVec3::from(h.normal).normalize_or_zero().as_vec3();
     (p, p_error, Vec3A::from(n))
 }
 
@@ -310,7 +308,7 @@ fn quadric_distance(d: V3, k: V3, l: V3, c0: f64) -> f64 {
         }
     }
     let x = x(hi).expect("1 + hi k_i > 0");
-    let phi = dot(sub(x, d), sub(x, d)) + hi * f(x);
+    let phi = DVec3::from(x).distance_squared(d.into()) + hi * f(x);
     phi.max(0.0).sqrt()
 }
 
@@ -411,7 +409,7 @@ impl Terrain {
     /// `FOOTPRINT` of its footprint. `None`: `q` is not a point of such a facet.
     fn facet_at(&self, q: V3, from: V3, normal: V3) -> Option<(usize, usize, usize)> {
         let (gx, gz) = self.grid_xz(q);
-        let len = |v: V3| dot(v, v).sqrt();
+        let (q, from, normal) = (DVec3::from(q), DVec3::from(from), DVec3::from(normal));
         for j in 0..self.n - 1 {
             for i in 0..self.n - 1 {
                 for k in 0..2 {
@@ -421,18 +419,16 @@ impl Terrain {
                     if lo < -FOOTPRINT || lo > hi + FOOTPRINT || hi > 1.0 + FOOTPRINT {
                         continue;
                     }
-                    let [a, b, c] = self.triangle(i, j, k);
-                    let m = cross(sub(b, a), sub(c, a));
+                    let [a, b, c] = self.triangle(i, j, k).map(DVec3::from);
+                    let m = (b - a).cross(c - a);
                     // Only picks the facet: random neighbours' normals differ by far more,
                     // and equal normals on one plane are the same surface.
-                    if len(cross(m, normal)) > 1e-6 * len(m) * len(normal) {
+                    if m.cross(normal).length() > 1e-6 * m.length() * normal.length() {
                         continue;
                     }
-                    let m = [m[0] / len(m), m[1] / len(m), m[2] / len(m)];
-                    let scale: f64 = (0..3)
-                        .map(|k| m[k].abs() * (q[k].abs() + a[k].abs() + from[k].abs()))
-                        .sum();
-                    if dot(m, sub(q, a)).abs() <= ROUNDING * scale {
+                    let m = m / m.length();
+                    let scale = (m.abs() * (q.abs() + a.abs() + from.abs())).element_sum();
+                    if m.dot(q - a).abs() <= ROUNDING * scale {
                         return Some((i, j, k));
                     }
                 }
@@ -440,22 +436,6 @@ impl Terrain {
         }
         None
     }
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn at(r: &Ray, t: f64) -> V3 {
@@ -559,10 +539,11 @@ fn heightfield_leaving_across_a_concave_fold() {
     assert!(start[0] > 2.0 && start[0] < 2.001, "{start:?}");
     assert_eq!(terrain.facet_at(start, start, hit.normal), None); // lifted off its plane
     let [a, b, c] = terrain.triangle(2, 1, 1);
-    let m = cross(sub(b, a), sub(c, a));
-    assert!(dot(m, sub(start, a)) > 0.0 && dot(m, ray.direction) > 0.0);
+    let [a, b, c] = [a, b, c].map(DVec3::from);
+    let m = (b - a).cross(c - a);
+    assert!(m.dot(DVec3::from(start) - a) > 0.0 && m.dot(ray.direction.into()) > 0.0);
     // ... whose plane the western neighbour rises above: the fold is concave.
-    assert!(dot(m, sub(terrain.corner(1, 1), a)) > 0.5 * dot(m, m).sqrt());
+    assert!(m.dot(DVec3::from(terrain.corner(1, 1)) - a) > 0.5 * m.length());
     // The ray heads west and down into cell (1, 1)'s triangle (1, 1)-(2, 2)-(2, 1).
     let again = again.expect("the leaving ray crosses the neighbouring facet");
     assert!(
@@ -598,7 +579,7 @@ fn quadric_distance_is_exact() {
     // A sphere: | |d| - r |, at any scale.
     for (s, d) in [(1e-4, [1e-4, -2e-4, 0.5e-4]), (1e4, [3e4, 1e4, -2e4])] {
         let got = ellipsoid(d, [s; 3]);
-        let want = (dot(d, d).sqrt() - s).abs();
+        let want = (DVec3::from(d).length() - s).abs();
         assert!((got - want).abs() <= 1e-12 * s, "{got} != {want}");
     }
     // y = x² + z²: from (0, h, 0), the apex while h <= 1/2 (the radius of curvature there),
@@ -632,18 +613,15 @@ fn quadric_smaller_than_f32_spacing() {
     let r = aimed(pos + jitter * scale as f32, 2.0 * scale, from);
     // The f64 hit: on the sphere to within the rounding of the coefficients, which hold
     // |centre|² / r² ≈ 1.4e15 (spacing 0.25, over |∇f| = 2 / r: 2.5e-5 in radius).
-    let exact = sub(at(&host_ray(&r), hit.t), v3(pos));
-    assert!(
-        (dot(exact, exact).sqrt() - 2e-4).abs() < 2.5e-5,
-        "{exact:?}"
-    );
+    let exact = DVec3::from(at(&host_ray(&r), hit.t)) - DVec3::from(v3(pos));
+    assert!((exact.length() - 2e-4).abs() < 2.5e-5, "{exact:?}");
     // The host's point is the centre, 2e-4 from the surface, inside its error bound.
     let (p, p_error, n) = host_surface(&r, &hit);
     assert_eq!(p, pos);
     assert!(p_error.min_element() > 100.0 * 2e-4, "{p_error:?}");
     assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-6);
     // The spawned ray starts well outside and does not come back.
-    let o = sub(ray.origin, v3(pos));
-    assert!(dot(o, o).sqrt() > 100.0 * 2e-4, "{o:?}");
+    let o = DVec3::from(ray.origin) - DVec3::from(v3(pos));
+    assert!(o.length() > 100.0 * 2e-4, "{o:?}");
     assert!(again.is_none());
 }
