@@ -62,11 +62,21 @@ pub fn fail(message: &str) -> ! {
                 std::thread::sleep(Duration::from_millis(5));
             }
         }
-        eprintln!("luxon: error: rank {rank}: {message}");
+        say(&format!("luxon: error: rank {rank}: {message}"));
     } else {
-        eprintln!("luxon: error: {message}");
+        say(&format!("luxon: error: {message}"));
     }
     abort_job()
+}
+
+/// Prints one line to stderr in a single `write`. `eprintln!` writes its pieces one by
+/// one, and mpirun, which forwards every rank's stderr, can print its own abort banner
+/// between them.
+pub(super) fn say(line: &str) {
+    use std::io::Write;
+    let mut stderr = std::io::stderr().lock();
+    let _ = stderr.write_all(format!("{line}\n").as_bytes());
+    let _ = stderr.flush();
 }
 
 pub(super) fn abort_job() -> ! {
