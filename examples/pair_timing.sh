@@ -11,7 +11,7 @@
 # target/release/). Renders use one thread each, no geometry cache, and `--stats`' render time.
 set -euo pipefail
 if [ $# -lt 3 ]; then
-    sed -n '2,10p' "$0" >&2
+    sed -n '2,11p' "$0" >&2
     exit 2
 fi
 a=$1 b=$2 scene=$3 rounds=${4:-20}
