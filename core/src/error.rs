@@ -32,3 +32,12 @@ impl Error {
         }
     }
 }
+
+/// Prints `luxon: error: {message}` to stderr in a single write. `eprintln!` writes its pieces
+/// one by one, and under mpirun, which forwards every rank's stderr and adds messages of its
+/// own (its abort banner), a line written in pieces can come out split.
+pub fn print_error(message: &str) {
+    use std::io::Write;
+    let line = format!("luxon: error: {message}\n");
+    let _ = std::io::stderr().lock().write_all(line.as_bytes());
+}

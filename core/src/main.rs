@@ -109,10 +109,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            // In one write: under mpirun, which forwards every rank's stderr and adds its own
-            // messages, a line written in pieces can come out split.
-            let line = format!("luxon: error: {e}\n");
-            let _ = std::io::Write::write_all(&mut std::io::stderr().lock(), line.as_bytes());
+            luxon::error::print_error(&e.to_string());
             ExitCode::FAILURE
         }
     }

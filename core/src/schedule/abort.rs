@@ -1,6 +1,7 @@
 //! Ending an MPI job on failure (feature `mpi`): an error or panic on any rank, from any
 //! thread, reaches rank 0's stderr and ends every rank (`MPI_Abort`) within seconds.
 
+use crate::error::print_error;
 use mpi::ffi;
 use std::os::raw::{c_int, c_void};
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
@@ -62,21 +63,11 @@ pub fn fail(message: &str) -> ! {
                 std::thread::sleep(Duration::from_millis(5));
             }
         }
-        say(&format!("luxon: error: rank {rank}: {message}"));
+        print_error(&format!("rank {rank}: {message}"));
     } else {
-        say(&format!("luxon: error: {message}"));
+        print_error(message);
     }
     abort_job()
-}
-
-/// Prints one line to stderr in a single `write`. `eprintln!` writes its pieces one by
-/// one, and mpirun, which forwards every rank's stderr, can print its own abort banner
-/// between them.
-pub(super) fn say(line: &str) {
-    use std::io::Write;
-    let mut stderr = std::io::stderr().lock();
-    let _ = stderr.write_all(format!("{line}\n").as_bytes());
-    let _ = stderr.flush();
 }
 
 pub(super) fn abort_job() -> ! {
