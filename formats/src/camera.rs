@@ -10,7 +10,7 @@ use crate::raw;
 use crate::spans::Node;
 use crate::validate::Checker;
 
-type Result<T> = std::result::Result<T, crate::SceneError>;
+type Result<T> = std::result::Result<T, crate::error::SceneError>;
 
 impl Checker<'_> {
     pub(crate) fn camera(&self, c: raw::Camera, node: &Node) -> Result<Spanned<CameraDesc>> {

@@ -35,7 +35,7 @@ pub(crate) struct MeshRef {
     pub material: Option<Spanned<String>>,
 }
 
-type Result<T> = std::result::Result<T, crate::SceneError>;
+type Result<T> = std::result::Result<T, crate::error::SceneError>;
 
 impl Checker<'_> {
     /// Converts everything but `include`, which the loader follows.

@@ -4,28 +4,9 @@
 //! Coordinates stay `f64` here: the core re-centres the world before storing `f32`.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
-/// A position in a source file (1-based line and column, in characters).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Origin {
-    pub file: Arc<PathBuf>,
-    pub line: u32,
-    pub col: u32,
-}
-
-impl std::fmt::Display for Origin {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}:{}:{}", self.file.display(), self.line, self.col)
-    }
-}
-
-/// A value and where it was written.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Spanned<T> {
-    pub value: T,
-    pub at: Origin,
-}
+use crate::geometry::InlineGeometry;
+pub use crate::origin::{Origin, Spanned};
 
 /// A plugin named in a scene and the RON text of its `params` subtree.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,7 +38,7 @@ pub struct SceneDesc {
     pub clip_groups: Vec<(String, Spanned<Vec<ClipPlaneDesc>>)>,
     pub objects: Vec<Spanned<ObjectDesc>>,
     /// Native geometry from importers (NFF, OBJ...), stored by the core without plugins.
-    pub inline: Vec<crate::geometry::InlineGeometry>,
+    pub inline: Vec<InlineGeometry>,
     /// Volumes read by volume-reader plugins, in file order (includes first).
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
     pub render: RenderDesc,

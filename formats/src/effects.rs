@@ -5,7 +5,7 @@ use crate::raw;
 use crate::spans::Node;
 use crate::validate::Checker;
 
-type Result<T> = std::result::Result<T, crate::SceneError>;
+type Result<T> = std::result::Result<T, crate::error::SceneError>;
 
 fn length(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()

@@ -1,8 +1,8 @@
-//! The one error type of the crate, and the "did you mean" helper its messages use.
+//! The error every loader returns (`SceneError`), and the "did you mean" helper its messages use.
 
 use std::path::PathBuf;
 
-use crate::desc::Origin;
+use crate::origin::Origin;
 
 /// Why a scene could not be loaded. `At` messages are written to follow `file:line:col: `.
 #[derive(Debug, thiserror::Error)]

@@ -1,9 +1,9 @@
-//! Inline native geometry: what importers of fixed formats (NFF, OBJ, Tachyon) hand the core
-//! directly. A million triangles must not round-trip through RON text to reach a plugin, so an
-//! importer fills these arrays and the core stores them as it stores a primitive plugin's output
-//! (same validation, same native types). World coordinates, f64.
+//! Inline native geometry: what the NFF and OBJ importers (and a RON scene's `meshes:`) hand
+//! the core directly. A million triangles must not round-trip through RON text to reach a
+//! plugin, so an importer fills these arrays and the core stores them as it stores a primitive
+//! plugin's output (same validation, same native types). World coordinates, f64.
 
-use crate::desc::{Origin, Spanned};
+use crate::origin::{Origin, Spanned};
 
 /// A run of primitives sharing one material.
 #[derive(Clone, Debug, Default, PartialEq)]

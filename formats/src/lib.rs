@@ -1,8 +1,23 @@
 //! # luxon-formats: scene files into `SceneDesc`
 //!
-//! Reads Luxon's RON scene format (and, later, importers such as NFF and OBJ) into a
-//! [`SceneDesc`]: plain data with the source position of everything, so that every error names
-//! `file:line:col` and what was expected. Depends on no renderer code and knows no plugins.
+//! Reads Luxon's RON scene format and the NFF and OBJ importers into a [`SceneDesc`]: plain
+//! data with the source position of everything, so that every error names `file:line:col` and
+//! what was expected. [`spd`] generates Eric Haines' SPD test scenes as NFF or RON. Depends on
+//! no renderer code and knows no plugins.
+//!
+//! Modules import only modules of lower layers (bottom first; `tests/layers.rs` keeps this):
+//!
+//! | layer       | modules                                          |
+//! |-------------|--------------------------------------------------|
+//! | origin      | `origin`                                         |
+//! | leaves      | `error`, `geometry`, `spans`, `raw`              |
+//! | description | `desc`                                           |
+//! | scanner     | `scanner`                                        |
+//! | checks      | `validate`, `ron_error`                          |
+//! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
+//! | importers   | `nff`, `obj`                                     |
+//! | formats     | `ron_scene`, `spd`                               |
+//! | front door  | `load`                                           |
 
 mod camera;
 mod convert;
@@ -10,8 +25,10 @@ pub mod desc;
 mod effects;
 mod error;
 pub mod geometry;
+mod load;
 pub mod nff;
 pub mod obj;
+mod origin;
 mod raw;
 mod ron_error;
 mod ron_scene;
@@ -21,41 +38,8 @@ pub mod spd;
 mod validate;
 mod volume_render;
 
-use std::path::Path;
-
 pub use desc::*;
 pub use error::{suggest, SceneError};
 pub use geometry::{InlineGeometry, InlineMesh};
+pub use load::load;
 pub use ron_scene::load_ron_str;
-
-/// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
-/// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
-/// any case).
-pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
-    if nff::is_nff_path(path) {
-        return nff::load(path);
-    }
-    if obj::is_obj_path(path) {
-        return obj::load(path);
-    }
-    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if !extension.eq_ignore_ascii_case("ron") {
-        let found = match extension {
-            "" => "a scene file name without an extension".to_string(),
-            e => format!("unsupported scene file extension `.{e}`"),
-        };
-        let message = format!(
-            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`",
-            ron_scene::supported_extensions()
-        );
-        return Err(SceneError::Io {
-            path: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::Unsupported, message),
-        });
-    }
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    load_ron_str(&text, path)
-}

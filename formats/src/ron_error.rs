@@ -3,14 +3,16 @@
 use ron::error::SpannedError;
 
 use crate::error::{suggest, unknown_name, SceneError};
-use crate::spans::{scan, SourceMap};
+use crate::scanner::{scan, skip_blank};
+use crate::spans::SourceMap;
 
 /// ron's error, with "did you mean" for names.
 pub(crate) fn ron_error(e: &SpannedError, src: &SourceMap) -> SceneError {
     // ron's span may start on the blank before the culprit; point at the culprit.
     let start = src.byte(e.span.start.line, e.span.start.col);
     let end = src.byte(e.span.end.line, e.span.end.col);
-    let mut at = src.skip_blank(start, end.max(start));
+    let to = end.max(start).min(src.text.len());
+    let mut at = skip_blank(&src.text[..to], start);
     // These are reported at the closing bracket; the value's start reads better.
     if matches!(
         e.code,

@@ -10,7 +10,8 @@ use crate::error::{quoted_list, unknown_name, SceneError};
 use crate::obj::{is_obj_path, load_obj};
 use crate::raw;
 use crate::ron_error::ron_error;
-use crate::spans::{scan, SourceMap};
+use crate::scanner::scan;
+use crate::spans::SourceMap;
 use crate::validate::{references, Checker};
 
 /// Loads a scene from RON text; `path` names it in messages and anchors relative paths.

@@ -445,6 +445,40 @@ pub(crate) fn skip_blank(src: &str, from: usize) -> usize {
 mod tests {
     use super::*;
 
+    fn text<'a>(src: &'a str, node: &Node) -> &'a str {
+        &src[node.start..node.end]
+    }
+
+    #[test]
+    fn finds_fields_items_and_entries() {
+        let src = r#"#![enable(implicit_some)]
+// comment with ( and "
+Scene( /* nested /* block */ comment */
+    objects: [ (plugin: "sphere", params: Foo(a: [1, 2], b: {"x": -1e-3}), m: Some("r")) ],
+    materials: { "a\"b": (c: 'x'), r"raw": (c: '\n') },
+    n: -inf, h: 0x1F, t: true,
+)"#;
+        let root = scan(src).unwrap();
+        let object = root.field("objects").unwrap().item(0).unwrap();
+        assert!(text(src, object).starts_with("(plugin"));
+        assert_eq!(text(src, object.field("plugin").unwrap()), "\"sphere\"");
+        assert_eq!(
+            text(src, object.raw_field("params").unwrap()),
+            r#"Foo(a: [1, 2], b: {"x": -1e-3})"#
+        );
+        assert_eq!(text(src, object.field("m").unwrap()), "\"r\"");
+        let (key, value) = root.field("materials").unwrap().entry(1).unwrap();
+        assert_eq!(text(src, key), "r\"raw\"");
+        assert_eq!(text(src, value.field("c").unwrap()), "'\\n'");
+        let mut numbers = Vec::new();
+        root.each_number(&mut |n| {
+            numbers.push(text(src, n).to_string());
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+        assert_eq!(numbers, ["1", "2", "-1e-3", "-inf", "0x1F"]);
+    }
+
     #[test]
     fn reports_unclosed_things() {
         assert_eq!(scan("(a: \"x)").unwrap_err().at, 4);

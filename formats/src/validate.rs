@@ -1,4 +1,6 @@
-//! Checks that serde cannot express: ranges, geometry and names, each reported at the value.
+//! Checks that serde cannot express, each reported at the value: `Checker` (one file's
+//! positions and errors; finite numbers, ranges, colours, plugin names; the conversion modules
+//! add their parts to it) and `references` (names used but never defined, after merging).
 
 use crate::desc::{Origin, SceneDesc, Spanned};
 use crate::error::{unknown_name, SceneError};

@@ -7,7 +7,7 @@ use crate::raw;
 use crate::spans::Node;
 use crate::validate::Checker;
 
-type Result<T> = std::result::Result<T, crate::SceneError>;
+type Result<T> = std::result::Result<T, crate::error::SceneError>;
 
 impl Checker<'_> {
     pub(crate) fn volume_render(

@@ -185,7 +185,7 @@ pub fn scene(name: &str) -> Result<&'static SpdScene, SpdError> {
         .find(|s| s.name == name)
         .ok_or_else(|| SpdError::UnknownName {
             name: name.to_string(),
-            suggestion: crate::suggest(&name.to_ascii_lowercase(), names()),
+            suggestion: crate::error::suggest(&name.to_ascii_lowercase(), names()),
         })
 }
 

@@ -1,0 +1,39 @@
+//! The front door: a scene file of any supported format, chosen by its extension.
+
+use std::path::Path;
+
+use crate::desc::SceneDesc;
+use crate::error::SceneError;
+use crate::{nff, obj, ron_scene};
+
+/// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
+/// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
+/// any case).
+pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
+    if nff::is_nff_path(path) {
+        return nff::load(path);
+    }
+    if obj::is_obj_path(path) {
+        return obj::load(path);
+    }
+    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !extension.eq_ignore_ascii_case("ron") {
+        let found = match extension {
+            "" => "a scene file name without an extension".to_string(),
+            e => format!("unsupported scene file extension `.{e}`"),
+        };
+        let message = format!(
+            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`",
+            ron_scene::supported_extensions()
+        );
+        return Err(SceneError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::Unsupported, message),
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    ron_scene::load_ron_str(&text, path)
+}
