@@ -13,147 +13,96 @@ fn length(v: [f64; 3]) -> f64 {
 
 impl Checker<'_> {
     pub(crate) fn light(&self, light: raw::Light, node: &Node) -> Result<Spanned<LightDesc>> {
-        let field = |name: &'static str| node.field(name).unwrap_or(node);
-        let colour =
-            |c: Option<[f64; 3]>| self.colour(field("color"), "color", c.unwrap_or([1.0; 3]));
-        let intensity = |i: Option<f64>| {
-            self.range(
-                field("intensity"),
-                "intensity",
-                i.unwrap_or(1.0),
-                0.0,
-                f64::INFINITY,
-            )
-        };
-        let attenuation = |a: Option<[f64; 3]>| -> Result<Attenuation> {
-            let Some(a) = a else {
-                return Ok(Attenuation::default());
-            };
-            let at = field("attenuation");
-            if a.iter().any(|&k| k < 0.0) || a.iter().all(|&k| k == 0.0) {
-                return Err(self.error(
-                    at,
-                    format!("`attenuation` is {a:?}; expected (constant, linear, quadratic) >= 0, not all 0"),
-                ));
-            }
-            Ok(Attenuation {
-                constant: a[0],
-                linear: a[1],
-                quadratic: a[2],
-            })
-        };
-        let direction = |name: &'static str, d: [f64; 3]| -> Result<[f64; 3]> {
-            if length(d) == 0.0 {
-                return Err(self.error(
-                    field(name),
-                    format!("the light's `{name}` has zero length; expected a non-zero vector"),
-                ));
-            }
-            Ok(d)
-        };
-        let samples = |n: Option<f64>| match n {
-            Some(n) => self.whole(field("samples"), "samples", n, 1, 4096),
-            None => Ok(16),
-        };
+        let f = LightFields { check: self, node };
         let light = match light {
             raw::Light::Point {
                 position,
                 color,
-                intensity: i,
+                intensity,
                 shadows,
-                attenuation: a,
+                attenuation,
             } => LightDesc::Point {
                 position,
-                color: colour(color)?,
-                intensity: intensity(i)?,
+                color: f.colour(color)?,
+                intensity: f.intensity(intensity)?,
                 shadows: shadows.unwrap_or(true),
-                attenuation: attenuation(a)?,
+                attenuation: f.attenuation(attenuation)?,
             },
             raw::Light::Directional {
-                direction: d,
+                direction,
                 color,
-                intensity: i,
+                intensity,
                 shadows,
             } => LightDesc::Directional {
-                direction: direction("direction", d)?,
-                color: colour(color)?,
-                intensity: intensity(i)?,
+                direction: f.direction("direction", direction)?,
+                color: f.colour(color)?,
+                intensity: f.intensity(intensity)?,
                 shadows: shadows.unwrap_or(true),
             },
             raw::Light::Spot {
                 position,
-                direction: d,
+                direction,
                 angle,
                 falloff,
                 color,
-                intensity: i,
+                intensity,
                 shadows,
-                attenuation: a,
+                attenuation,
             } => {
-                let cone = self.range(field("angle"), "angle", angle, f64::MIN_POSITIVE, 179.0)?;
+                let cone =
+                    self.range(f.field("angle"), "angle", angle, f64::MIN_POSITIVE, 179.0)?;
                 let falloff = match falloff {
-                    Some(f) => self.range(field("falloff"), "falloff", f, 0.0, cone)?,
+                    Some(v) => self.range(f.field("falloff"), "falloff", v, 0.0, cone)?,
                     None => 0.0,
                 };
                 LightDesc::Spot {
                     position,
-                    direction: direction("direction", d)?,
+                    direction: f.direction("direction", direction)?,
                     cone_deg: cone,
                     falloff_deg: falloff,
-                    color: colour(color)?,
-                    intensity: intensity(i)?,
+                    color: f.colour(color)?,
+                    intensity: f.intensity(intensity)?,
                     shadows: shadows.unwrap_or(true),
-                    attenuation: attenuation(a)?,
+                    attenuation: f.attenuation(attenuation)?,
                 }
             }
             raw::Light::SphereLight {
                 center,
                 radius,
-                samples: n,
+                samples,
                 color,
-                intensity: i,
+                intensity,
                 shadows,
-                attenuation: a,
+                attenuation,
             } => LightDesc::Sphere {
                 center,
-                radius: self.positive(field("radius"), "radius", radius)?,
-                samples: samples(n)?,
-                color: colour(color)?,
-                intensity: intensity(i)?,
+                radius: self.positive(f.field("radius"), "radius", radius)?,
+                samples: f.samples(samples)?,
+                color: f.colour(color)?,
+                intensity: f.intensity(intensity)?,
                 shadows: shadows.unwrap_or(true),
-                attenuation: attenuation(a)?,
+                attenuation: f.attenuation(attenuation)?,
             },
             raw::Light::RectLight {
                 corner,
                 edge1,
                 edge2,
-                samples: n,
+                samples,
                 color,
-                intensity: i,
+                intensity,
                 shadows,
-                attenuation: a,
+                attenuation,
             } => {
-                let (e1, e2) = (direction("edge1", edge1)?, direction("edge2", edge2)?);
-                let cross = [
-                    e1[1] * e2[2] - e1[2] * e2[1],
-                    e1[2] * e2[0] - e1[0] * e2[2],
-                    e1[0] * e2[1] - e1[1] * e2[0],
-                ];
-                if length(cross) == 0.0 {
-                    return Err(self.error(
-                        field("edge2"),
-                        "`edge1` and `edge2` are parallel; expected the two sides of a rectangle",
-                    ));
-                }
+                let (edge1, edge2) = f.rectangle(edge1, edge2)?;
                 LightDesc::Rect {
                     corner,
-                    edge1: e1,
-                    edge2: e2,
-                    samples: samples(n)?,
-                    color: colour(color)?,
-                    intensity: intensity(i)?,
+                    edge1,
+                    edge2,
+                    samples: f.samples(samples)?,
+                    color: f.colour(color)?,
+                    intensity: f.intensity(intensity)?,
                     shadows: shadows.unwrap_or(true),
-                    attenuation: attenuation(a)?,
+                    attenuation: f.attenuation(attenuation)?,
                 }
             }
         };
@@ -210,5 +159,90 @@ impl Checker<'_> {
                 None => 1.0,
             },
         })
+    }
+}
+
+/// The checks the kinds of light share, each reported at its field of the light `node`.
+struct LightFields<'a> {
+    check: &'a Checker<'a>,
+    node: &'a Node,
+}
+
+impl LightFields<'_> {
+    fn field(&self, name: &str) -> &Node {
+        self.node.field(name).unwrap_or(self.node)
+    }
+
+    fn colour(&self, c: Option<[f64; 3]>) -> Result<[f64; 3]> {
+        self.check
+            .colour(self.field("color"), "color", c.unwrap_or([1.0; 3]))
+    }
+
+    fn intensity(&self, i: Option<f64>) -> Result<f64> {
+        self.check.range(
+            self.field("intensity"),
+            "intensity",
+            i.unwrap_or(1.0),
+            0.0,
+            f64::INFINITY,
+        )
+    }
+
+    fn attenuation(&self, a: Option<[f64; 3]>) -> Result<Attenuation> {
+        let Some(a) = a else {
+            return Ok(Attenuation::default());
+        };
+        if a.iter().any(|&k| k < 0.0) || a.iter().all(|&k| k == 0.0) {
+            return Err(self.check.error(
+                self.field("attenuation"),
+                format!("`attenuation` is {a:?}; expected (constant, linear, quadratic) >= 0, not all 0"),
+            ));
+        }
+        Ok(Attenuation {
+            constant: a[0],
+            linear: a[1],
+            quadratic: a[2],
+        })
+    }
+
+    /// A non-zero vector, field `name`.
+    fn direction(&self, name: &str, d: [f64; 3]) -> Result<[f64; 3]> {
+        if length(d) == 0.0 {
+            return Err(self.check.error(
+                self.field(name),
+                format!("the light's `{name}` has zero length; expected a non-zero vector"),
+            ));
+        }
+        Ok(d)
+    }
+
+    /// A rectangle light's two sides: non-zero and not parallel.
+    fn rectangle(&self, edge1: [f64; 3], edge2: [f64; 3]) -> Result<([f64; 3], [f64; 3])> {
+        let (e1, e2) = (
+            self.direction("edge1", edge1)?,
+            self.direction("edge2", edge2)?,
+        );
+        let cross = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        if length(cross) == 0.0 {
+            return Err(self.check.error(
+                self.field("edge2"),
+                "`edge1` and `edge2` are parallel; expected the two sides of a rectangle",
+            ));
+        }
+        Ok((e1, e2))
+    }
+
+    /// Shadow rays per shading point of an area light (default 16).
+    fn samples(&self, n: Option<f64>) -> Result<u32> {
+        match n {
+            Some(n) => self
+                .check
+                .whole(self.field("samples"), "samples", n, 1, 4096),
+            None => Ok(16),
+        }
     }
 }

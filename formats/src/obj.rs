@@ -54,117 +54,178 @@ pub fn is_obj_path(path: &Path) -> bool {
 /// reported there (naming the OBJ file and line in the message) and the geometry and
 /// materials carry it as their origin. Without it, the OBJ file itself is the origin.
 pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError> {
-    let file_origin = |line: u32| Origin {
-        file: Arc::new(path.to_path_buf()),
-        line,
-        col: 1,
+    let file = ObjFile {
+        path,
+        at: at.as_ref(),
     };
-    // An error at `line` of the OBJ file (0: no line known).
-    let fail = |line: u32, message: String| match &at {
-        Some(at) => SceneError::at(
-            at.clone(),
-            if line > 0 {
-                format!("in mesh file {}:{line}: {message}", path.display())
-            } else {
-                format!("mesh file `{}`: {message}", path.display())
-            },
-        ),
-        None => SceneError::at(file_origin(line.max(1)), message),
-    };
-    let file = File::open(path).map_err(|e| match &at {
-        Some(_) => fail(
-            0,
-            format!("cannot read it: {e}; expected a Wavefront .obj file"),
-        ),
-        None => SceneError::Io {
-            path: path.to_path_buf(),
-            source: e,
-        },
-    })?;
-    let mut reader = Counting {
-        inner: BufReader::with_capacity(1 << 16, file),
-        newlines: 0,
-        last: b'\n',
-    };
-    let warnings = RefCell::new(Vec::new());
-    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    // The update fills the fields tobj's optional features (merging, reordering) add.
-    #[allow(clippy::needless_update)]
-    let options = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
-    // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): faces are
-    // checked first by our own scan (one more pass over the file), and a panic in tobj all the
-    // same becomes an error.
-    if let Some((line, detail)) = find_bad_face(path) {
-        return Err(fail(line, detail));
-    }
-    let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
-            let full = dir.join(mtl);
-            match tobj::load_mtl(&full) {
-                Ok(r) => Ok(r),
-                Err(e) => {
-                    let why = match e {
-                        tobj::LoadError::OpenFileFailed => "cannot open it".to_string(),
-                        e => format!("cannot read it ({e})"),
-                    };
-                    warnings.borrow_mut().push(format!(
-                        "{}: material library `{}`: {why}; its materials are replaced by the \
-                     default material",
-                        path.display(),
-                        full.display()
-                    ));
-                    Ok((Vec::new(), Default::default()))
-                }
-            }
-        })
-    }))
-    .map_err(|_| {
-        let (line, detail) = find_bad_face(path).unwrap_or((
-            0,
-            "a face index is out of range; expected indices of defined vertices".to_string(),
-        ));
-        fail(line, detail)
-    })?;
-    let (models, materials) = match loaded {
-        Ok(l) => l,
-        Err(e) => {
-            let line = reader.line();
-            return Err(match e {
-                tobj::LoadError::FaceVertexOutOfBounds
-                | tobj::LoadError::FaceTexCoordOutOfBounds
-                | tobj::LoadError::FaceNormalOutOfBounds
-                | tobj::LoadError::FaceColorOutOfBounds => {
-                    // tobj finds these when a group ends: look for the face ourselves.
-                    let (line, detail) = find_bad_face(path).unwrap_or((0, e.to_string()));
-                    fail(line, detail)
-                }
-                tobj::LoadError::ReadError => fail(0, "cannot read it (not UTF-8 text?)".into()),
-                e => fail(
-                    line,
-                    format!("{e}; expected OBJ statements such as `v x y z`, `f 1 2 3`"),
-                ),
-            });
-        }
-    };
-    let materials = materials.unwrap_or_default();
-    let mut warnings = warnings.into_inner();
+    let Parsed {
+        models,
+        materials,
+        mut warnings,
+    } = file.parse()?;
+    let origin = file.origin();
+    let (names, materials) = named_materials(path, &materials, &origin);
+    let geometry = models
+        .into_iter()
+        .filter_map(|model| mesh_of_model(model, &names, &origin, path, &mut warnings))
+        .collect();
+    Ok(ObjImport {
+        materials,
+        geometry,
+        warnings,
+    })
+}
 
+/// What tobj read: the models, the MTL materials and warnings about MTL files that could not
+/// be read.
+struct Parsed {
+    models: Vec<tobj::Model>,
+    materials: Vec<tobj::Material>,
+    warnings: Vec<String>,
+}
+
+/// The OBJ file being read and where a scene names it (if one does): places its errors.
+struct ObjFile<'a> {
+    path: &'a Path,
+    at: Option<&'a Origin>,
+}
+
+impl ObjFile<'_> {
+    /// Line `line` of the OBJ file itself.
+    fn line_origin(&self, line: u32) -> Origin {
+        Origin {
+            file: Arc::new(self.path.to_path_buf()),
+            line,
+            col: 1,
+        }
+    }
+
+    /// What the imported geometry and materials name as their origin.
+    fn origin(&self) -> Origin {
+        self.at.cloned().unwrap_or_else(|| self.line_origin(1))
+    }
+
+    /// An error at `line` of the OBJ file (0: no line known).
+    fn fail(&self, line: u32, message: String) -> SceneError {
+        match self.at {
+            Some(at) => SceneError::at(
+                at.clone(),
+                if line > 0 {
+                    format!("in mesh file {}:{line}: {message}", self.path.display())
+                } else {
+                    format!("mesh file `{}`: {message}", self.path.display())
+                },
+            ),
+            None => SceneError::at(self.line_origin(line.max(1)), message),
+        }
+    }
+
+    /// The file through tobj.
+    fn parse(&self) -> Result<Parsed, SceneError> {
+        let file = File::open(self.path).map_err(|e| match self.at {
+            Some(_) => self.fail(
+                0,
+                format!("cannot read it: {e}; expected a Wavefront .obj file"),
+            ),
+            None => SceneError::Io {
+                path: self.path.to_path_buf(),
+                source: e,
+            },
+        })?;
+        let mut reader = Counting {
+            inner: BufReader::with_capacity(1 << 16, file),
+            newlines: 0,
+            last: b'\n',
+        };
+        let warnings = RefCell::new(Vec::new());
+        let dir = self.path.parent().unwrap_or(Path::new("")).to_path_buf();
+        // The update fills the fields tobj's optional features (merging, reordering) add.
+        #[allow(clippy::needless_update)]
+        let options = tobj::LoadOptions {
+            single_index: true,
+            triangulate: true,
+            ignore_points: true,
+            ignore_lines: true,
+            ..Default::default()
+        };
+        // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): faces
+        // are checked first by our own scan (one more pass over the file), and a panic in tobj
+        // all the same becomes an error.
+        if let Some((line, detail)) = find_bad_face(self.path) {
+            return Err(self.fail(line, detail));
+        }
+        let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
+                let full = dir.join(mtl);
+                match tobj::load_mtl(&full) {
+                    Ok(r) => Ok(r),
+                    Err(e) => {
+                        let why = match e {
+                            tobj::LoadError::OpenFileFailed => "cannot open it".to_string(),
+                            e => format!("cannot read it ({e})"),
+                        };
+                        warnings.borrow_mut().push(format!(
+                            "{}: material library `{}`: {why}; its materials are replaced by the \
+                     default material",
+                            self.path.display(),
+                            full.display()
+                        ));
+                        Ok((Vec::new(), Default::default()))
+                    }
+                }
+            })
+        }))
+        .map_err(|_| {
+            let (line, detail) = find_bad_face(self.path).unwrap_or((
+                0,
+                "a face index is out of range; expected indices of defined vertices".to_string(),
+            ));
+            self.fail(line, detail)
+        })?;
+        let (models, materials) = loaded.map_err(|e| self.tobj_error(e, reader.line()))?;
+        Ok(Parsed {
+            models,
+            materials: materials.unwrap_or_default(),
+            warnings: warnings.into_inner(),
+        })
+    }
+
+    /// tobj's error, found while reading line `line`, as ours.
+    fn tobj_error(&self, e: tobj::LoadError, line: u32) -> SceneError {
+        match e {
+            tobj::LoadError::FaceVertexOutOfBounds
+            | tobj::LoadError::FaceTexCoordOutOfBounds
+            | tobj::LoadError::FaceNormalOutOfBounds
+            | tobj::LoadError::FaceColorOutOfBounds => {
+                // tobj finds these when a group ends: look for the face ourselves.
+                let (line, detail) = find_bad_face(self.path).unwrap_or((0, e.to_string()));
+                self.fail(line, detail)
+            }
+            tobj::LoadError::ReadError => self.fail(0, "cannot read it (not UTF-8 text?)".into()),
+            e => self.fail(
+                line,
+                format!("{e}; expected OBJ statements such as `v x y z`, `f 1 2 3`"),
+            ),
+        }
+    }
+}
+
+/// The MTL materials as Luxon materials named `obj:<file stem>:<mtl name>`, with those names
+/// in MTL order (a model's `material_id` indexes them).
+fn named_materials(
+    path: &Path,
+    materials: &[tobj::Material],
+    origin: &Origin,
+) -> (Vec<String>, Vec<(String, Spanned<MaterialDesc>)>) {
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let origin = at.clone().unwrap_or_else(|| file_origin(1));
     let names: Vec<String> = materials
         .iter()
         .map(|m| format!("obj:{stem}:{}", m.name))
         .collect();
-    let out_materials = materials
+    let out = materials
         .iter()
         .zip(&names)
         .map(|(m, name)| {
@@ -177,64 +238,67 @@ pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError
             )
         })
         .collect();
+    (names, out)
+}
 
-    let mut geometry = Vec::new();
-    for model in models {
-        let m = model.mesh;
-        if m.indices.len() < 3 {
-            continue;
-        }
-        let positions: Vec<[f64; 3]> = m
-            .positions
-            .chunks_exact(3)
-            .map(|p| [p[0], p[1], p[2]])
-            .collect();
-        let indices: Vec<[u64; 3]> = m
-            .indices
-            .chunks_exact(3)
-            .map(|t| [t[0] as u64, t[1] as u64, t[2] as u64])
-            .collect();
-        let normals = if m.normals.len() == m.positions.len() {
-            m.normals
-                .chunks_exact(3)
-                .map(|n| [n[0], n[1], n[2]])
-                .collect()
-        } else {
-            if !m.normals.is_empty() {
-                warnings.push(format!(
-                    "{}: object `{}` gives normals for some vertices only; computed smooth \
-                     normals for all",
-                    path.display(),
-                    model.name
-                ));
-            }
-            smooth_normals(&positions, &indices)
-        };
-        let uvs = if m.texcoords.len() / 2 == positions.len() {
-            m.texcoords.chunks_exact(2).map(|t| [t[0], t[1]]).collect()
-        } else {
-            Vec::new()
-        };
-        let material = m.material_id.and_then(|i| names.get(i)).map(|n| Spanned {
-            value: n.clone(),
-            at: origin.clone(),
-        });
-        geometry.push(InlineGeometry {
-            material,
-            at: Some(origin.clone()),
-            mesh: InlineMesh {
-                positions,
-                normals,
-                indices,
-                uvs,
-            },
-            ..InlineGeometry::default()
-        });
+/// One tobj model as a triangle mesh (`None`: it has no triangle), with smooth normals where
+/// the file gives none or too few (the latter with a warning).
+fn mesh_of_model(
+    model: tobj::Model,
+    names: &[String],
+    origin: &Origin,
+    path: &Path,
+    warnings: &mut Vec<String>,
+) -> Option<InlineGeometry> {
+    let m = model.mesh;
+    if m.indices.len() < 3 {
+        return None;
     }
-    Ok(ObjImport {
-        materials: out_materials,
-        geometry,
-        warnings,
+    let positions: Vec<[f64; 3]> = m
+        .positions
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    let indices: Vec<[u64; 3]> = m
+        .indices
+        .chunks_exact(3)
+        .map(|t| [t[0] as u64, t[1] as u64, t[2] as u64])
+        .collect();
+    let normals = if m.normals.len() == m.positions.len() {
+        m.normals
+            .chunks_exact(3)
+            .map(|n| [n[0], n[1], n[2]])
+            .collect()
+    } else {
+        if !m.normals.is_empty() {
+            warnings.push(format!(
+                "{}: object `{}` gives normals for some vertices only; computed smooth \
+                 normals for all",
+                path.display(),
+                model.name
+            ));
+        }
+        smooth_normals(&positions, &indices)
+    };
+    let uvs = if m.texcoords.len() / 2 == positions.len() {
+        m.texcoords.chunks_exact(2).map(|t| [t[0], t[1]]).collect()
+    } else {
+        Vec::new()
+    };
+    let material = m.material_id.and_then(|i| names.get(i)).map(|n| Spanned {
+        value: n.clone(),
+        at: origin.clone(),
+    });
+    Some(InlineGeometry {
+        material,
+        at: Some(origin.clone()),
+        mesh: InlineMesh {
+            positions,
+            normals,
+            indices,
+            uvs,
+        },
+        ..InlineGeometry::default()
     })
 }
 

@@ -616,10 +616,14 @@ impl<'a> Parser<'a> {
                 ),
             );
         }
-        let (mut from, mut look, mut up, mut angle) = (None, None, None, None);
-        let mut hither = None;
-        let mut resolution = None;
-        let mut up_col = (0, 0);
+        let view = self.view_lines()?.into_view(at)?;
+        self.out.directives.push((Directive::View(view), at));
+        Ok(())
+    }
+
+    /// The lines after `v`, up to the next entity (which is left `pending`).
+    fn view_lines(&mut self) -> Result<ViewLines> {
+        let mut v = ViewLines::default();
         while self.l.advance() {
             let key = self.l.tok(0);
             let Some(k) = VIEW_KEYS.iter().position(|v| v.as_bytes() == key) else {
@@ -632,12 +636,12 @@ impl<'a> Parser<'a> {
             };
             let name = VIEW_KEYS[k];
             let seen = match k {
-                0 => from.is_some(),
-                1 => look.is_some(),
-                2 => up.is_some(),
-                3 => angle.is_some(),
-                4 => hither.is_some(),
-                _ => resolution.is_some(),
+                0 => v.from.is_some(),
+                1 => v.look.is_some(),
+                2 => v.up.is_some(),
+                3 => v.angle.is_some(),
+                4 => v.hither.is_some(),
+                _ => v.resolution.is_some(),
             };
             if seen {
                 return self.err(
@@ -646,65 +650,96 @@ impl<'a> Parser<'a> {
                 );
             }
             match k {
-                0 => from = Some(self.numbers::<3>(1, "`from`", "x y z")?),
-                1 => look = Some(self.numbers::<3>(1, "`at`", "x y z")?),
+                0 => v.from = Some(self.numbers::<3>(1, "`from`", "x y z")?),
+                1 => v.look = Some(self.numbers::<3>(1, "`at`", "x y z")?),
                 2 => {
-                    up = Some(self.numbers::<3>(1, "`up`", "x y z")?);
-                    up_col = (self.l.line, self.l.col(1));
+                    v.up = Some(self.numbers::<3>(1, "`up`", "x y z")?);
+                    v.up_at = Loc {
+                        line: self.l.line,
+                        col: self.l.col(1),
+                    };
                 }
-                3 => {
-                    let [a] = self.numbers::<1>(1, "`angle`", "full field of view in degrees")?;
-                    if !(a > 0.0 && a < 180.0) {
-                        return self.err(
-                            self.l.col(1),
-                            format!("`angle` is {a}; expected a field of view in (0, 180) degrees"),
-                        );
-                    }
-                    angle = Some(a);
-                }
+                3 => v.angle = Some(self.view_angle()?),
                 // Read and checked, then ignored: Luxon has no near clipping plane.
-                4 => hither = Some(self.numbers::<1>(1, "`hither`", "near distance")?[0]),
-                _ => {
-                    if self.l.toks.len() != 3 {
-                        return self.err(
-                            self.l.col(self.l.toks.len().min(3)),
-                            format!(
-                                "`resolution` takes 2 whole numbers (width height), found {}",
-                                self.l.toks.len() - 1
-                            ),
-                        );
-                    }
-                    let mut r = [0u32; 2];
-                    for i in 0..2 {
-                        r[i] = match parse_u32(self.l.tok(i + 1)) {
-                            Some(v) if (1..=65536).contains(&v) => v,
-                            _ => {
-                                return self.err(
-                                    self.l.col(i + 1),
-                                    format!(
-                                        "expected a whole number of pixels in 1..=65536 for the {}, found `{}`",
-                                        ["width", "height"][i],
-                                        show(self.l.tok(i + 1))
-                                    ),
-                                )
-                            }
-                        };
-                    }
-                    resolution = Some((r[0], r[1]));
-                }
+                4 => v.hither = Some(self.numbers::<1>(1, "`hither`", "near distance")?[0]),
+                _ => v.resolution = Some(self.view_resolution()?),
             }
         }
+        Ok(v)
+    }
+
+    /// `angle a`: the full field of view in degrees.
+    fn view_angle(&self) -> Result<f64> {
+        let [a] = self.numbers::<1>(1, "`angle`", "full field of view in degrees")?;
+        if !(a > 0.0 && a < 180.0) {
+            return self.err(
+                self.l.col(1),
+                format!("`angle` is {a}; expected a field of view in (0, 180) degrees"),
+            );
+        }
+        Ok(a)
+    }
+
+    /// `resolution w h`: the image size in pixels.
+    fn view_resolution(&self) -> Result<(u32, u32)> {
+        if self.l.toks.len() != 3 {
+            return self.err(
+                self.l.col(self.l.toks.len().min(3)),
+                format!(
+                    "`resolution` takes 2 whole numbers (width height), found {}",
+                    self.l.toks.len() - 1
+                ),
+            );
+        }
+        let mut r = [0u32; 2];
+        for i in 0..2 {
+            r[i] = match parse_u32(self.l.tok(i + 1)) {
+                Some(v) if (1..=65536).contains(&v) => v,
+                _ => {
+                    return self.err(
+                        self.l.col(i + 1),
+                        format!(
+                            "expected a whole number of pixels in 1..=65536 for the {}, found `{}`",
+                            ["width", "height"][i],
+                            show(self.l.tok(i + 1))
+                        ),
+                    )
+                }
+            };
+        }
+        Ok((r[0], r[1]))
+    }
+}
+
+/// The lines of one `v` view, as read.
+#[derive(Default)]
+struct ViewLines {
+    from: Option<[f64; 3]>,
+    look: Option<[f64; 3]>,
+    up: Option<[f64; 3]>,
+    angle: Option<f64>,
+    hither: Option<f64>,
+    resolution: Option<(u32, u32)>,
+    /// Where the `up` vector was given, for its error.
+    up_at: Loc,
+}
+
+impl ViewLines {
+    /// The view, if it is complete and `from`, `at` and `up` make a frame; `at` is the `v`.
+    fn into_view(self, at: Loc) -> Result<View> {
         let missing: Vec<&str> = [
-            ("from", from.is_none()),
-            ("at", look.is_none()),
-            ("up", up.is_none()),
-            ("angle", angle.is_none()),
+            ("from", self.from.is_none()),
+            ("at", self.look.is_none()),
+            ("up", self.up.is_none()),
+            ("angle", self.angle.is_none()),
         ]
         .iter()
         .filter(|m| m.1)
         .map(|m| m.0)
         .collect();
-        if !missing.is_empty() {
+        let (Some(from), Some(look), Some(up), Some(angle)) =
+            (self.from, self.look, self.up, self.angle)
+        else {
             return Err(ChunkError {
                 at,
                 message: format!(
@@ -717,8 +752,7 @@ impl<'a> Parser<'a> {
                         .join(", ")
                 ),
             });
-        }
-        let (from, look, up, angle) = (from.unwrap(), look.unwrap(), up.unwrap(), angle.unwrap());
+        };
         let dir = [look[0] - from[0], look[1] - from[1], look[2] - from[2]];
         if dir == [0.0; 3] {
             return Err(ChunkError {
@@ -734,23 +768,16 @@ impl<'a> Parser<'a> {
         let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         if norm(cross) <= 1e-9 * norm(dir) * norm(up) {
             return Err(ChunkError {
-                at: Loc {
-                    line: up_col.0,
-                    col: up_col.1,
-                },
+                at: self.up_at,
                 message: "`up` is zero or parallel to the viewing direction (from -> at); expected a vector across it".into(),
             });
         }
-        self.out.directives.push((
-            Directive::View(View {
-                from,
-                at: look,
-                up,
-                angle,
-                resolution,
-            }),
-            at,
-        ));
-        Ok(())
+        Ok(View {
+            from,
+            at: look,
+            up,
+            angle,
+            resolution: self.resolution,
+        })
     }
 }
