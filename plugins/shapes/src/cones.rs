@@ -1,7 +1,8 @@
 //! Cylinders, cones, rings and polycylinders: native cones and discs the core intersects itself.
 
-use crate::{finite, invalid, length, positive, scale, sub};
-use luxon_plugin::{Context, Describe, Error, Geometry, Primitive};
+use crate::params::positive;
+use crate::vector::{length, scale, sub};
+use luxon_plugin::{finite, invalid, Context, Describe, Error, Geometry, Primitive};
 use serde::Deserialize;
 
 fn non_negative(name: &str, x: f64) -> Result<f64, Error> {

@@ -13,7 +13,10 @@
 //! Also: rays exactly parallel to the box's faces and lying in a face's plane (division by
 //! zero in the slab test).
 
-use super::solids::{ClippedQuadric, Cuboid, HeightGrid, LineCylinder};
+use super::boxes::Cuboid;
+use super::heightfield::HeightGrid;
+use super::infinite_cylinder::LineCylinder;
+use super::quadric::ClippedQuadric;
 use luxon::math::{gamma, DVec3, Vec3A};
 use luxon_plugin::{parse_params, CustomShape, Hit, Ray};
 use proptest::prelude::*;
