@@ -1,0 +1,85 @@
+//! `tga`: Truevision TGA, sRGB-encoded, 8 bits per channel, RGB or RGBA.
+
+use std::io::Write;
+
+use crate::encode::{check_image, encode_error, srgb8};
+use image::codecs::tga::TgaEncoder;
+use image::{ExtendedColorType, ImageEncoder};
+use luxon_plugin::{Context, Describe, Error, Image, Writer};
+use serde::Deserialize;
+
+pub struct Tga;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TgaParams {
+    #[serde(default)]
+    alpha: bool,
+}
+
+impl Describe for Tga {
+    const NAME: &'static str = "tga";
+    const DESCRIPTION: &'static str =
+        "Truevision TGA, sRGB-encoded, 8 bits per channel, RGB or RGBA.";
+    const PARAMS: &'static str =
+        "alpha: bool = false  write an alpha channel (RGBA instead of RGB)";
+}
+
+impl Writer for Tga {
+    const EXTENSIONS: &'static str = "tga";
+    type Params = TgaParams;
+
+    fn write(
+        params: TgaParams,
+        _ctx: &Context,
+        image: &Image,
+        out: &mut dyn Write,
+    ) -> Result<(), Error> {
+        check_image(image)?;
+        let color = if params.alpha {
+            ExtendedColorType::Rgba8
+        } else {
+            ExtendedColorType::Rgb8
+        };
+        let mut bytes = Vec::new();
+        TgaEncoder::new(&mut bytes)
+            .write_image(
+                &srgb8(image, params.alpha),
+                image.width,
+                image.height,
+                color,
+            )
+            .map_err(|e| encode_error("TGA", e))?;
+        out.write_all(&bytes)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{decode, encode, gradient, srgb8_of, H, W};
+
+    #[test]
+    fn tga_roundtrip() {
+        let rgba = gradient();
+        let img = match decode(
+            &encode::<Tga>("()", &rgba).unwrap(),
+            image::ImageFormat::Tga,
+        ) {
+            image::DynamicImage::ImageRgb8(i) => i,
+            other => panic!("expected RGB8, got {:?}", other.color()),
+        };
+        assert_eq!(img.dimensions(), (W, H));
+        assert_eq!(img.get_pixel(0, 0).0, [0, 188, srgb8_of(0.25)]);
+        assert_eq!(img.get_pixel(W - 1, 1).0, [255, 188, 255]);
+
+        let bytes = encode::<Tga>("(alpha: true)", &rgba).unwrap();
+        let img = match decode(&bytes, image::ImageFormat::Tga) {
+            image::DynamicImage::ImageRgba8(i) => i,
+            other => panic!("expected RGBA8, got {:?}", other.color()),
+        };
+        assert_eq!(img.get_pixel(0, 0).0, [0, 188, srgb8_of(0.25), 0]);
+        assert_eq!(img.get_pixel(5, 2).0[3], 170);
+    }
+}
