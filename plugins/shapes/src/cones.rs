@@ -1,4 +1,5 @@
-//! Cylinders, cones, rings and polycylinders: native cones and discs the core intersects itself.
+//! `cylinder`, `cone`, `ring` and `polycylinder`: native cones and discs (and a polycylinder's
+//! joint spheres) the core intersects itself.
 
 use crate::params::positive;
 use crate::vector::{length, scale, sub};
