@@ -277,7 +277,7 @@ fn write_to(
     skeleton: &str,
     scene: &Scene,
 ) -> std::io::Result<()> {
-    let tmp = crate::output::temp_path(path, std::process::id())
+    let tmp = crate::files::temp_path(path, std::process::id())
         .map_err(|e| std::io::Error::other(e.to_string()))?;
     let result = (|| {
         let file = std::fs::File::create(&tmp)?;

@@ -2,7 +2,7 @@
 //! the `mpi` feature). Hides the feature from the rest of the command.
 
 #[cfg(feature = "mpi")]
-use luxon::output::temp_path;
+use luxon::files::temp_path;
 use luxon::schedule::{launched_ranks, render_local, threads_for, Chunk, RankStats, Sink};
 use luxon::{Error, Scene};
 use luxon_formats::ParallelMode;

@@ -165,7 +165,7 @@ impl Cluster {
     /// the header).
     pub fn write_ppm(&self, tmp: &std::path::Path, width: u32, height: u32, mine: &[Chunk]) {
         let header = if self.rank == 0 {
-            crate::output::stream::ppm_header(width, height)
+            crate::ppm::ppm_header(width, height)
         } else {
             Vec::new()
         };
