@@ -3,6 +3,11 @@
 //! reflection, transparency with filtered shadows. Effects the scene does not call for (see
 //! `Features`) are skipped before any ray is spawned for them.
 
+pub mod march;
+mod pixels;
+
+pub use pixels::render_spans;
+
 use crate::geometry::Counters;
 use crate::math::{gamma, reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
@@ -134,7 +139,7 @@ impl Whitted<'_> {
         // Volumes in front of the first surface (or the background), composited over it.
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         let cutoff = scene.settings.min_weight / weight.max(f32::MIN_POSITIVE);
-        let (color, through) = crate::volume_render::march(scene, ray, t_hit, cutoff, c);
+        let (color, through) = march::march(scene, ray, t_hit, cutoff, c);
         if through < cutoff {
             // Early ray termination: what lies behind cannot show.
             return color;
@@ -376,7 +381,7 @@ impl Whitted<'_> {
                     };
                     arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
                     if scene.features.volumes && arriving != Vec3A::ZERO {
-                        arriving *= crate::volume_render::transmittance(scene, &sray, t_max, c);
+                        arriving *= march::transmittance(scene, &sray, t_max, c);
                     }
                     if arriving == Vec3A::ZERO {
                         return Vec3A::ZERO;

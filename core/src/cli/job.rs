@@ -3,7 +3,8 @@
 
 #[cfg(feature = "mpi")]
 use luxon::files::temp_path;
-use luxon::schedule::{launched_ranks, render_local, threads_for, Chunk, RankStats, Sink};
+use luxon::framebuffer::Chunk;
+use luxon::schedule::{launched_ranks, render_local, threads_for, RankStats, Sink};
 use luxon::{Error, Scene};
 use luxon_formats::ParallelMode;
 use std::path::Path;

@@ -8,7 +8,7 @@ use luxon::output::stream::{is_ppm8, AsyncOutput};
 use luxon::output::Output;
 use luxon::plugin::Registry;
 use luxon::render::RenderStats;
-use luxon::schedule::Chunk;
+use luxon::framebuffer::Chunk;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{Decomposition, Origin, OutputDesc, OutputIo, ParallelMode, SceneDesc};
 use std::path::{Path, PathBuf};

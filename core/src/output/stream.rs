@@ -6,10 +6,10 @@
 use super::{write_all, Output};
 use crate::error::Error;
 use crate::files::{pending, temp_path};
+use crate::framebuffer::Chunk;
 use crate::framebuffer::Framebuffer;
 use crate::plugin::Registry;
 use crate::ppm::{ppm_header, srgb8};
-use crate::schedule::Chunk;
 use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};

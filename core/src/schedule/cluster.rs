@@ -14,8 +14,9 @@
 
 use super::abort::{abort_job, fail, Injected, TAG_ERROR};
 use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
-use super::{decompose, run_share, wire, Chunk, RankStats, Share, Sink};
+use super::{decompose, run_share, wire, RankStats, Share, Sink};
 use crate::error::Error;
+use crate::framebuffer::Chunk;
 use crate::scene::Scene;
 use luxon_formats::{Decomposition, ParallelMode};
 use mpi::topology::SimpleCommunicator;

@@ -2,7 +2,7 @@
 //! straight into one shared PPM file with a single collective `MPI_File_write_at_all`, its file
 //! view listing where its pixels go. rsmpi has no safe MPI-IO, hence the raw calls.
 
-use super::Chunk;
+use crate::framebuffer::Chunk;
 use crate::ppm::srgb8;
 use mpi::ffi;
 use std::ffi::CString;
@@ -141,7 +141,7 @@ fn ffi_len(n: u64) -> Result<c_int, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::schedule::Span;
+    use crate::framebuffer::Span;
 
     #[test]
     fn runs_are_sorted_and_merged() {
