@@ -4,7 +4,7 @@
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::framebuffer::Framebuffer;
-use crate::plugin::calls::encode_image;
+use crate::plugin::writer::encode_image;
 use crate::plugin::{Entry, PluginKind, Registry};
 use luxon_formats::OutputDesc;
 use std::path::{Path, PathBuf};

@@ -11,8 +11,9 @@ use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::{MeshInput, Triangles};
 use crate::geometry::{pack, Clips, Counters, Hit, Kind, Surface, MAX_CLIP_GROUPS, MAX_MATERIALS};
 use crate::math::{DVec3, Vec3A};
-use crate::plugin::calls::{create_primitive, create_texture, GeometryBuilder, TextureInstance};
-use crate::plugin::{PluginKind, Registry};
+use crate::plugin::primitive::{create_primitive, GeometryBuilder};
+use crate::plugin::texture::{create_texture, TextureInstance};
+use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::ray::Ray;
 use luxon_formats::{Highlight, InlineGeometry, LightDesc, OutputDesc, SceneDesc};
 use std::borrow::Cow;
@@ -340,7 +341,7 @@ impl Scene {
                 Some(n) => n.value.clone(),
                 None => format!("volume {i}"),
             };
-            let volume = crate::volume::read_volume(
+            let volume = read_volume(
                 registry,
                 entry,
                 &call.params,
