@@ -265,6 +265,18 @@ pub struct Scene {
     pub plugin_time: Duration,
 }
 
+/// A scene's native geometry with its BVHs built, as a geometry cache gives it back
+/// ([`crate::cache`]).
+pub struct Prebuilt {
+    pub world_offset: DVec3,
+    /// Per material of the scene (index 0: the default): whether any primitive uses it.
+    pub used: Vec<bool>,
+    pub degenerate: u64,
+    pub spheres: Spheres,
+    pub triangles: Triangles,
+    pub cones: Cones,
+}
+
 fn v3(a: [f64; 3]) -> Vec3A {
     Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
 }
@@ -280,7 +292,7 @@ impl Scene {
     /// the scene and no inline geometry).
     pub fn build_prebuilt(
         desc: &SceneDesc,
-        geometry: crate::cache::Prebuilt,
+        geometry: Prebuilt,
         registry: &Registry,
     ) -> Result<Scene, Error> {
         Scene::build_from(desc, Box::new(std::iter::empty()), Some(geometry), registry)
@@ -300,7 +312,7 @@ impl Scene {
     fn build_from<'g>(
         desc: &SceneDesc,
         inline: Box<dyn Iterator<Item = Cow<'g, InlineGeometry>> + 'g>,
-        prebuilt: Option<crate::cache::Prebuilt>,
+        prebuilt: Option<Prebuilt>,
         registry: &Registry,
     ) -> Result<Scene, Error> {
         let scene_dir = desc
