@@ -107,9 +107,7 @@ pub fn check(src_dir: &Path, layers: &[(&str, &[&str])]) -> Vec<String> {
             let line = text.lines().nth(r.line - 1).unwrap_or("").trim();
             let at = format!("{}:{}: `{}` ({line})", rel.display(), r.line, r.path);
             let Some(&to) = layer_of.get(&target) else {
-                problems.push(format!(
-                    "{at}: `{target}` is no module of the layer table"
-                ));
+                problems.push(format!("{at}: `{target}` is no module of the layer table"));
                 continue;
             };
             if to > from {
@@ -469,10 +467,8 @@ mod checker {
 
     impl Src {
         fn new(name: &str, files: &[(&str, &str)]) -> Src {
-            let dir = std::env::temp_dir().join(format!(
-                "luxon-layers-{name}-{}",
-                std::process::id()
-            ));
+            let dir =
+                std::env::temp_dir().join(format!("luxon-layers-{name}-{}", std::process::id()));
             let _ = std::fs::remove_dir_all(&dir);
             for (path, text) in files {
                 let p = dir.join(path);
@@ -556,7 +552,10 @@ mod checker {
         let src = Src::new(
             "same",
             &[
-                ("lib.rs", "pub mod a;\npub mod b;\npub mod c;\npub use c::Top;\n"),
+                (
+                    "lib.rs",
+                    "pub mod a;\npub mod b;\npub mod c;\npub use c::Top;\n",
+                ),
                 ("a.rs", "use crate::b::B;\nuse crate::Top;\n"),
                 ("b.rs", "pub struct B;\n"),
                 ("c.rs", "pub struct Top;\n"),
