@@ -4,8 +4,8 @@
 mod common;
 use common::*;
 
+use luxon::plugin::read_volume;
 use luxon::plugin::PluginKind;
-use luxon::volume::read_volume;
 
 use std::path::{Path, PathBuf};
 

@@ -23,7 +23,7 @@ use crate::geometry::sphere::{Sphere, Spheres};
 use crate::geometry::triangle::{Triangle, Triangles, VertexAttr, NO_ATTR};
 use crate::geometry::{clip_of, material_of};
 use crate::math::DVec3;
-use crate::scene::Scene;
+use crate::scene::{Prebuilt, Scene};
 use glam::Vec3;
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
@@ -34,17 +34,6 @@ const MAGIC: &[u8; 8] = b"LUXGEOC\0";
 /// (5: the SAH looks at all three axes).
 pub const FORMAT_VERSION: u32 = 5;
 const LUXON_VERSION: &str = env!("CARGO_PKG_VERSION");
-
-/// A scene's native geometry, built, as the cache gives it back.
-pub struct Prebuilt {
-    pub world_offset: DVec3,
-    /// Per material of the scene (index 0: the default): whether any primitive uses it.
-    pub used: Vec<bool>,
-    pub degenerate: u64,
-    pub spheres: Spheres,
-    pub triangles: Triangles,
-    pub cones: Cones,
-}
 
 /// A cache found valid for its source.
 pub struct Cached {
@@ -277,7 +266,7 @@ fn write_to(
     skeleton: &str,
     scene: &Scene,
 ) -> std::io::Result<()> {
-    let tmp = crate::output::temp_path(path, std::process::id())
+    let tmp = crate::files::temp_path(path, std::process::id())
         .map_err(|e| std::io::Error::other(e.to_string()))?;
     let result = (|| {
         let file = std::fs::File::create(&tmp)?;

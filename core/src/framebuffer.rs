@@ -1,4 +1,5 @@
-//! The image being rendered: linear RGBA f32, rows top to bottom.
+//! The image being rendered: linear RGBA f32, rows top to bottom; and the pieces it arrives in
+//! from the render threads (spans of pixels, and chunks: spans with their values).
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Framebuffer {
@@ -37,7 +38,7 @@ impl Framebuffer {
     }
 
     /// Copies rendered pixels to where their spans say.
-    pub fn put_chunk(&mut self, c: &crate::schedule::Chunk) {
+    pub fn put_chunk(&mut self, c: &Chunk) {
         let mut src = c.rgba.chunks_exact(4);
         for s in &c.spans {
             let row = s.y as usize * self.width as usize;
@@ -48,5 +49,33 @@ impl Framebuffer {
                 }
             }
         }
+    }
+}
+
+/// Pixels `x0, x0 + step, ...` (`count` of them) of row `y`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Span {
+    pub y: u32,
+    pub x0: u32,
+    pub step: u32,
+    pub count: u32,
+}
+
+impl Span {
+    pub fn xs(self) -> impl Iterator<Item = u32> {
+        (0..self.count).map(move |k| self.x0 + k * self.step)
+    }
+}
+
+/// Rendered pixels: spans and their linear RGBA values, span after span.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chunk {
+    pub spans: Vec<Span>,
+    pub rgba: Vec<f32>,
+}
+
+impl Chunk {
+    pub fn pixels(&self) -> u64 {
+        self.spans.iter().map(|s| s.count as u64).sum()
     }
 }

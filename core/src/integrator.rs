@@ -3,7 +3,12 @@
 //! reflection, transparency with filtered shadows. Effects the scene does not call for (see
 //! `Features`) are skipped before any ray is spawned for them.
 
-use crate::geometry::Counters;
+pub mod march;
+mod pixels;
+
+pub use pixels::render_spans;
+
+use crate::geometry::{Counters, Hit, Surface};
 use crate::math::{gamma, reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
 use crate::sampler::{mix, pixel_sample};
@@ -134,7 +139,7 @@ impl Whitted<'_> {
         // Volumes in front of the first surface (or the background), composited over it.
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         let cutoff = scene.settings.min_weight / weight.max(f32::MIN_POSITIVE);
-        let (color, through) = crate::volume_render::march(scene, ray, t_hit, cutoff, c);
+        let (color, through) = march::march(scene, ray, t_hit, cutoff, c);
         if through < cutoff {
             // Early ray termination: what lies behind cannot show.
             return color;
@@ -146,12 +151,13 @@ impl Whitted<'_> {
         color + through * behind
     }
 
-    /// The colour a surface hit shows along `ray` (lighting, reflection, refraction).
+    /// The colour a surface hit shows along `ray`: the material at the hit, its lighting, fog,
+    /// then reflection and refraction (each a named step below).
     #[allow(clippy::too_many_arguments)]
     fn shade(
         &self,
         ray: &Ray,
-        hit: &crate::geometry::Hit,
+        hit: &Hit,
         depth: u32,
         weight: f32,
         media: &IorStack,
@@ -163,28 +169,69 @@ impl Whitted<'_> {
         let s = scene.surface(&hit, ray);
         let mat = &scene.materials[s.material as usize];
         let features = scene.features;
-        let settings = &scene.settings;
         let footprint = width + scene.pixel_spread * hit.t;
+        let side = Side::of(&s, ray);
+        let (base, kr, kt) = self.material_at(&s, mat, side.n, footprint, ray.time);
+        let transparency = scene.settings.transparency;
+        let kt = self.transparency(kt, ray, side.n, media);
+        let post = transparency.mode == TransparencyMode::PostMultiplied;
 
-        // Orient normals toward the viewer; remember which side was hit for media changes.
-        let entering = s.ng.dot(ray.dir) < 0.0;
-        let ng = if entering { s.ng } else { -s.ng };
-        let mut n = if s.ns.dot(ng) < 0.0 { -s.ns } else { s.ns };
-        if n.dot(ray.dir) > 0.0 {
-            // Interpolated normals can face away at silhouettes; fall back to the true one.
-            n = ng;
+        let opacity = 1.0 - kt;
+        // Post-multiplied: shade as if opaque, then scale everything by the opacity.
+        let shade_opacity = if post { 1.0 } else { opacity };
+        let mut color = mat.ambient * shade_opacity * base;
+        color += self.lighting(ray, &s, &side, mat, base, shade_opacity, c);
+        if post {
+            color *= opacity;
+        }
+        let filter = if post { Vec3A::ONE } else { base };
+        if depth == 0 {
+            self.fog(&mut color, ray, hit.t);
         }
 
+        let next = depth + 1;
+        if features.reflection && kr > 0.0 {
+            let bounce = Bounce {
+                depth: next,
+                weight: weight * kr,
+                footprint,
+            };
+            self.reflection(&mut color, ray, &s, &side, kr, &bounce, media, c);
+        }
+        if features.transmission && kt > 0.0 {
+            let bounce = Bounce {
+                depth: next,
+                weight: weight * kt,
+                footprint,
+            };
+            let filter = kt * filter;
+            self.transmission(&mut color, ray, &s, &side, mat, filter, &bounce, media, c);
+        }
+        color
+    }
+
+    /// The material's colour and reflect and transmit coefficients at a surface point, with
+    /// its textures (looked up along shading normal `n`) and vertex colour applied.
+    #[inline]
+    fn material_at(
+        &self,
+        s: &Surface,
+        mat: &Material,
+        n: Vec3A,
+        footprint: f32,
+        time: f32,
+    ) -> (Vec3A, f32, f32) {
+        let scene = self.scene;
         let mut base = mat.color;
         let (mut kr, mut kt) = (mat.reflect, mat.transmit);
-        if features.textures {
+        if scene.features.textures {
             let q = TexQuery {
                 p: (s.p.as_dvec3() + scene.world_offset).into(),
                 n: n.into(),
                 uv: s.uv,
                 footprint,
                 uv_footprint: footprint * s.uv_scale,
-                time: ray.time,
+                time,
             };
             let mean = |c: [f32; 4]| (c[0] + c[1] + c[2]) / 3.0;
             if let Some(t) = mat.texture {
@@ -201,7 +248,15 @@ impl Whitted<'_> {
         if let Some(vc) = s.color {
             base *= vc;
         }
-        let transparency = settings.transparency;
+        (base, kr, kt)
+    }
+
+    /// The transmit coefficient after the scene's transparency rules: none past the most
+    /// transparent surfaces a path may cross, thicker at grazing angles when angle-modulated.
+    #[inline]
+    fn transparency(&self, kt: f32, ray: &Ray, n: Vec3A, media: &IorStack) -> f32 {
+        let transparency = self.scene.settings.transparency;
+        let mut kt = kt;
         if kt > 0.0 {
             if transparency
                 .max_surfaces
@@ -214,18 +269,28 @@ impl Whitted<'_> {
                 kt = kt.powf(1.0 / cos);
             }
         }
-        let post = transparency.mode == TransparencyMode::PostMultiplied;
+        kt
+    }
 
-        let opacity = 1.0 - kt;
-        // Post-multiplied: shade as if opaque, then scale everything by the opacity.
-        let shade_opacity = if post { 1.0 } else { opacity };
-        let view = -ray.dir;
-        let mut color = mat.ambient * shade_opacity * base;
+    /// The light sources' and the sky's (ambient occlusion) light a surface point reflects.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn lighting(
+        &self,
+        ray: &Ray,
+        s: &Surface,
+        side: &Side,
+        mat: &Material,
+        base: Vec3A,
+        opacity: f32,
+        c: &mut Counters,
+    ) -> Vec3A {
+        let scene = self.scene;
         // Random numbers for area lights and occlusion, from the ray itself: deterministic for
         // any thread count or decomposition, different for every path.
         let seed = if self.draws { ray_seed(ray) } else { 0 };
         // Light and occlusion rays leave smooth meshes from the curved surface, not the facet.
-        let (light_p, light_error) = if entering && s.lift != Vec3A::ZERO {
+        let (light_p, light_error) = if side.entering && s.lift != Vec3A::ZERO {
             let q = s.p + s.lift;
             (q, s.p_error + gamma(4) * (s.lift.abs() + q.abs()))
         } else {
@@ -234,82 +299,141 @@ impl Whitted<'_> {
         let shade = Shade {
             p: light_p,
             p_error: light_error,
-            n,
-            ng,
-            view,
+            n: side.n,
+            ng: side.ng,
+            view: -ray.dir,
             base,
-            opacity: shade_opacity,
+            opacity,
             time: ray.time,
         };
         let mut lit = Vec3A::ZERO;
         for (k, light) in scene.lights.iter().enumerate() {
             lit += self.direct(&shade, mat, light, mix(seed ^ k as u32), c);
         }
-        if let (true, Some(ao)) = (features.ambient_occlusion, &scene.ao) {
+        if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
             lit *= ao.direct;
-            lit +=
-                mat.diffuse * shade_opacity * base * ao.sky * self.unoccluded(&shade, ao, seed, c);
+            lit += mat.diffuse * opacity * base * ao.sky * self.unoccluded(&shade, ao, seed, c);
         }
-        color += lit;
-        if post {
-            color *= opacity;
-        }
-        let filter = if post { Vec3A::ONE } else { base };
-        if depth == 0 {
-            if let (true, Some(fog)) = (features.fog, &scene.fog) {
-                let d = if fog.planar {
-                    hit.t * ray.dir.dot(scene.camera.forward)
-                } else {
-                    hit.t
-                };
-                let v = fog.visibility(d);
-                color = color * v + fog.color * (1.0 - v);
-            }
-        }
-
-        let next = depth + 1;
-        if features.reflection && kr > 0.0 {
-            let w = weight * kr;
-            if next > settings.max_depth {
-                color += kr * scene.background;
-            } else if w >= settings.min_weight {
-                c.reflection += 1;
-                let r = spawn(s.p, s.p_error, ng, reflect(ray.dir, n), ray.time);
-                color += kr * self.trace(&r, next, w, media, footprint, c);
-            }
-        }
-
-        if features.transmission && kt > 0.0 {
-            let w = weight * kt;
-            if next > settings.max_depth {
-                color += kt * filter * scene.background;
-            } else if w >= settings.min_weight {
-                // Which media are on each side of the surface.
-                let mut inside = *media;
-                inside.surfaces += 1;
-                let (n1, n2) = if entering {
-                    let n1 = media.current();
-                    inside.push(s.material, mat.ior);
-                    (n1, mat.ior)
-                } else {
-                    inside.remove(s.material);
-                    (mat.ior, inside.current())
-                };
-                let (dir, through) = match refract(ray.dir, n, n1 / n2) {
-                    Some(t) => (t, true),
-                    // Total internal reflection: the light stays on this side.
-                    None => (reflect(ray.dir, n), false),
-                };
-                c.refraction += 1;
-                let r = spawn(s.p, s.p_error, ng, dir, ray.time);
-                let mut outside = *media;
-                outside.surfaces += 1;
-                let stack = if through { &inside } else { &outside };
-                color += kt * filter * self.trace(&r, next, w, stack, footprint, c);
-            }
-        }
-        color
+        lit
     }
+
+    /// Fog over the distance `t` a camera ray travelled to its hit.
+    #[inline]
+    fn fog(&self, color: &mut Vec3A, ray: &Ray, t: f32) {
+        let scene = self.scene;
+        if let (true, Some(fog)) = (scene.features.fog, &scene.fog) {
+            let d = if fog.planar {
+                t * ray.dir.dot(scene.camera.forward)
+            } else {
+                t
+            };
+            let v = fog.visibility(d);
+            *color = *color * v + fog.color * (1.0 - v);
+        }
+    }
+
+    /// Adds the mirror reflection, scaled by `kr`, to `color`: the background past the maximum
+    /// depth, nothing below the minimum weight.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn reflection(
+        &self,
+        color: &mut Vec3A,
+        ray: &Ray,
+        s: &Surface,
+        side: &Side,
+        kr: f32,
+        bounce: &Bounce,
+        media: &IorStack,
+        c: &mut Counters,
+    ) {
+        let settings = &self.scene.settings;
+        if bounce.depth > settings.max_depth {
+            *color += kr * self.scene.background;
+        } else if bounce.weight >= settings.min_weight {
+            c.reflection += 1;
+            let r = spawn(s.p, s.p_error, side.ng, reflect(ray.dir, side.n), ray.time);
+            *color += kr * self.trace(&r, bounce.depth, bounce.weight, media, bounce.footprint, c);
+        }
+    }
+
+    /// Adds the light coming through the surface (refracted, or totally internally reflected),
+    /// scaled by `filter`, to `color`, keeping track of the media the ray is in.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn transmission(
+        &self,
+        color: &mut Vec3A,
+        ray: &Ray,
+        s: &Surface,
+        side: &Side,
+        mat: &Material,
+        filter: Vec3A,
+        bounce: &Bounce,
+        media: &IorStack,
+        c: &mut Counters,
+    ) {
+        let settings = &self.scene.settings;
+        if bounce.depth > settings.max_depth {
+            *color += filter * self.scene.background;
+        } else if bounce.weight >= settings.min_weight {
+            // Which media are on each side of the surface.
+            let mut inside = *media;
+            inside.surfaces += 1;
+            let (n1, n2) = if side.entering {
+                let n1 = media.current();
+                inside.push(s.material, mat.ior);
+                (n1, mat.ior)
+            } else {
+                inside.remove(s.material);
+                (mat.ior, inside.current())
+            };
+            let (dir, through) = match refract(ray.dir, side.n, n1 / n2) {
+                Some(t) => (t, true),
+                // Total internal reflection: the light stays on this side.
+                None => (reflect(ray.dir, side.n), false),
+            };
+            c.refraction += 1;
+            let r = spawn(s.p, s.p_error, side.ng, dir, ray.time);
+            let mut outside = *media;
+            outside.surfaces += 1;
+            let stack = if through { &inside } else { &outside };
+            let (depth, weight) = (bounce.depth, bounce.weight);
+            *color += filter * self.trace(&r, depth, weight, stack, bounce.footprint, c);
+        }
+    }
+}
+
+/// Which side of a surface a ray hit, and the normals facing it.
+struct Side {
+    /// The ray arrived against the geometric normal (entering a closed shape).
+    entering: bool,
+    /// Geometric and shading normal, both toward the viewer.
+    ng: Vec3A,
+    n: Vec3A,
+}
+
+impl Side {
+    /// Orients the normals toward the viewer; remembers which side was hit for media changes.
+    #[inline]
+    fn of(s: &Surface, ray: &Ray) -> Side {
+        let entering = s.ng.dot(ray.dir) < 0.0;
+        let ng = if entering { s.ng } else { -s.ng };
+        let mut n = if s.ns.dot(ng) < 0.0 { -s.ns } else { s.ns };
+        if n.dot(ray.dir) > 0.0 {
+            // Interpolated normals can face away at silhouettes; fall back to the true one.
+            n = ng;
+        }
+        Side { entering, ng, n }
+    }
+}
+
+/// The ray a reflection or refraction spawns: its depth, its weight (the most it can add to the
+/// pixel), and the width of its footprint at its origin.
+struct Bounce {
+    depth: u32,
+    weight: f32,
+    footprint: f32,
 }
 
 /// What lighting needs to know about a shading point.
@@ -376,7 +500,7 @@ impl Whitted<'_> {
                     };
                     arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
                     if scene.features.volumes && arriving != Vec3A::ZERO {
-                        arriving *= crate::volume_render::transmittance(scene, &sray, t_max, c);
+                        arriving *= march::transmittance(scene, &sray, t_max, c);
                     }
                     if arriving == Vec3A::ZERO {
                         return Vec3A::ZERO;

@@ -15,12 +15,38 @@
 //! luxon::output::write_all(&outputs, &image, &registry, ".".as_ref())?;
 //! # Ok::<(), luxon::Error>(())
 //! ```
+//!
+//! ## Layers
+//!
+//! The modules form layers (listed from the top down); a module imports only modules of lower
+//! layers, never one of its own layer or above, so nothing runs in a circle (`tests/layers.rs`
+//! keeps this). A new module goes in the lowest layer that has everything it needs.
+//!
+//! | layer | modules | what they hold |
+//! |---|---|---|
+//! | cli | `main.rs`, `cli` (the binary) | the command line |
+//! | output | [`output`], [`sweep`] | writer plugins, asynchronous PPM output; accuracy sweeps |
+//! | render | [`render`] | a whole image in this process |
+//! | schedule | [`schedule`] | which thread or MPI rank renders which pixels |
+//! | integrator | [`integrator`] | a pixel's value: Whitted shading, volume marching, the pixel kernel |
+//! | cache | [`cache`] | the scene's built geometry on disk |
+//! | scene | [`scene`] | the built scene and its build stages; hit, surface and shadow queries |
+//! | plugin | [`plugin`] | the plugin host: loading, calls, the sinks that fill geometry and volumes |
+//! | volume_render | [`volume_render`] | volumes prepared for ray casting (transfer functions, skip cells) |
+//! | volume | [`volume`] | sparse voxel grids |
+//! | geometry | [`geometry`] | primitives and their sets, each with its BVH |
+//! | bvh | [`bvh`] | the wide BVH over boxes |
+//! | camera | [`camera`], [`adaptive`] | camera rays; where a pixel's samples go |
+//! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks; PPM bytes; image error measures; files written whole |
+//! | ray | [`ray`] | rays and robust ray spawning |
+//! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
 
 pub mod adaptive;
 pub mod bvh;
 pub mod cache;
 pub mod camera;
 pub mod error;
+pub mod files;
 pub mod framebuffer;
 pub mod geometry;
 pub mod integrator;
@@ -28,6 +54,7 @@ pub mod math;
 pub mod metrics;
 pub mod output;
 pub mod plugin;
+pub mod ppm;
 pub mod ray;
 pub mod render;
 pub mod sampler;

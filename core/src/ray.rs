@@ -25,6 +25,7 @@ impl Ray {
 /// rounding error (`p_error`, per component) projected on the geometric normal, then rounds away
 /// from the surface. No fixed epsilon: the offset scales with the point's magnitude, so scenes
 /// work at any scale and far from the origin (Wächter & Binder, Ray Tracing Gems ch. 6; pbrt-v4).
+#[inline]
 pub fn offset_origin(p: Vec3A, p_error: Vec3A, ng: Vec3A, w: Vec3A) -> Vec3A {
     let d = ng.abs().dot(p_error);
     let mut offset = d * ng;
@@ -43,12 +44,14 @@ pub fn offset_origin(p: Vec3A, p_error: Vec3A, ng: Vec3A, w: Vec3A) -> Vec3A {
 }
 
 /// A ray leaving a surface point in direction `dir`.
+#[inline]
 pub fn spawn(p: Vec3A, p_error: Vec3A, ng: Vec3A, dir: Vec3A, time: f32) -> Ray {
     Ray::new(offset_origin(p, p_error, ng, dir), dir, time)
 }
 
 /// A ray from a surface point toward `target`; returns the ray and the distance to just short
 /// of the target (for shadow rays toward point lights).
+#[inline]
 pub fn spawn_to(p: Vec3A, p_error: Vec3A, ng: Vec3A, target: Vec3A, time: f32) -> (Ray, f32) {
     let d = target - p;
     let o = offset_origin(p, p_error, ng, d);

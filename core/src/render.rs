@@ -1,16 +1,13 @@
-//! Rendering pixels, and a whole scene into a framebuffer in this process. Which thread renders
-//! which pixels is [`crate::schedule`]'s business; every pixel's samples come from its own
-//! deterministic sequence, so the result does not depend on it.
+//! Rendering a whole scene into a framebuffer in this process. Which thread renders which
+//! pixels is [`crate::schedule`]'s business, and a pixel's value the integrator's
+//! ([`render_spans`](crate::integrator::render_spans)); every pixel's samples come from its own
+//! deterministic sequence, so the result does not depend on the threads.
 
-use crate::adaptive;
 use crate::error::Error;
-use crate::framebuffer::Framebuffer;
+use crate::framebuffer::{Chunk, Framebuffer};
 use crate::geometry::Counters;
-use crate::integrator::{IorStack, Whitted};
-use crate::math::Vec3A;
-use crate::sampler::pixel_sample;
 use crate::scene::Scene;
-use crate::schedule::{render_local, threads_for, Chunk, RankStats, Span};
+use crate::schedule::{render_local, threads_for, RankStats, WorkerStats};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -30,7 +27,7 @@ pub struct RenderStats {
 
 impl RenderStats {
     pub fn of(ranks: Vec<RankStats>, render_time: Duration) -> RenderStats {
-        let mut total = crate::schedule::WorkerStats::default();
+        let mut total = WorkerStats::default();
         for r in &ranks {
             total.add(&r.total());
         }
@@ -46,52 +43,6 @@ impl RenderStats {
 
 /// Called with (pixels done, pixels in all); may be called from any thread.
 pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
-
-/// Renders the pixels of `spans`, returning their RGBA values span after span.
-pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
-    let s = &scene.settings;
-    let integrator = Whitted::new(scene);
-    let count: usize = spans.iter().map(|s| s.count as usize).sum();
-    let mut out = Vec::with_capacity(count * 4);
-    let n = s.samples.max(1);
-    let inv_n = 1.0 / n as f32;
-    let media = IorStack::default();
-    let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
-    for span in spans {
-        let y = span.y;
-        for x in span.xs() {
-            let mut shade = |jx: f32, jy: f32| {
-                let (px, py) = (x as f32 + jx, y as f32 + jy);
-                // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
-                match scene.camera.primary(px, py, s.width, s.height, s.time) {
-                    Some(ray) => {
-                        c.primary += 1;
-                        integrator.radiance(&ray, 0, 1.0, &media, c)
-                    }
-                    None => Vec3A::ZERO,
-                }
-            };
-            let mut v = match &plan {
-                Some(p) => p.pixel(x, y, s.frame, &mut shade),
-                None => {
-                    let mut sum = Vec3A::ZERO;
-                    for i in 0..n {
-                        let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
-                        sum += shade(jx, jy);
-                    }
-                    sum * inv_n
-                }
-            };
-            if !v.is_finite() {
-                // A NaN never aborts a render: count it and clamp the pixel.
-                c.nan_pixels += 1;
-                v = Vec3A::ZERO;
-            }
-            out.extend_from_slice(&[v.x, v.y, v.z, 1.0]);
-        }
-    }
-    out
-}
 
 /// Renders `scene` in this process with its settings (threads, decomposition). `progress` is
 /// told about finished pixels.

@@ -13,12 +13,8 @@
 //! allocated). The first error stops the volume: later calls fail, and the read fails even if
 //! the plugin ignores the error.
 
-use crate::plugin::calls::{plugin_label, read_volume_into};
-use crate::plugin::{Entry, Registry};
-use luxon_formats::Origin;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
-use std::path::Path;
 
 /// Edge length of a brick in voxels.
 pub const BRICK_SIZE: i64 = 8;
@@ -234,35 +230,6 @@ fn local_index(ijk: [i64; 3]) -> usize {
     let mask = BRICK_SIZE - 1;
     ((ijk[0] & mask) + ((ijk[1] & mask) << BRICK_SHIFT) + ((ijk[2] & mask) << (2 * BRICK_SHIFT)))
         as usize
-}
-
-/// Reads one volume with a volume-reader plugin. `instance` is the scene's name for the volume
-/// (it becomes [`Volume::name`] and is passed to the plugin for its messages). Errors carry the
-/// scene position: inside `params` when the plugin reports one, otherwise `params_at`.
-pub fn read_volume(
-    registry: &Registry,
-    entry: &Entry,
-    params: &str,
-    params_at: &Origin,
-    scene_dir: &Path,
-    instance: &str,
-) -> Result<Volume, (Origin, String)> {
-    let mut builder = VolumeBuilder::new(instance, &entry.name);
-    read_volume_into(
-        registry,
-        entry,
-        params,
-        params_at,
-        scene_dir,
-        instance,
-        &mut builder,
-    )?;
-    builder.finish().map_err(|m| {
-        (
-            params_at.clone(),
-            format!("{} {m}", plugin_label(registry, entry)),
-        )
-    })
 }
 
 /// Collects what a reader sends and checks it (the host side of `VolumeSink`).
@@ -673,8 +640,6 @@ fn store(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plugin::PluginKind;
-    use luxon_plugin::abi;
 
     const IDENTITY: [f64; 12] = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
 
@@ -826,110 +791,6 @@ mod tests {
         assert!(b
             .begin(IDENTITY, 0.0, [0; 3], [2047, 2047, 4096], "g")
             .is_err());
-    }
-
-    /// A reader that misbehaves in the way its params say, through the real sink callbacks.
-    extern "C" fn sloppy_read(
-        params: abi::Str,
-        _ctx: *const abi::CallContext,
-        sink: *const abi::VolumeSink,
-        err: *const abi::ErrorSink,
-    ) -> abi::Status {
-        let s = unsafe { &*sink };
-        let desc = abi::VolumeDesc {
-            world_from_index: IDENTITY,
-            background: 0.5,
-            index_min: [0; 3],
-            index_max: [3; 3],
-            grid_name: abi::Str::new("sloppy"),
-        };
-        let origin = [2i64, 2, 2];
-        let dims = [2u64, 2, 3];
-        let values = [1.0f32; 12];
-        match unsafe { params.as_str() }.unwrap() {
-            // Data before `begin`, passing the host's error on.
-            "early" => (s.add_tile)(s.ctx, &origin, &[1; 3], 1.0, err),
-            // A block outside the box, its error ignored.
-            "ignore" => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &dims, values.as_ptr(), err);
-                abi::STATUS_OK
-            }
-            "nobegin" => abi::STATUS_OK,
-            "null" => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &[2; 3], std::ptr::null(), err)
-            }
-            "huge" => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &[u64::MAX; 3], values.as_ptr(), err)
-            }
-            _ => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &[2; 3], values.as_ptr(), err)
-            }
-        }
-    }
-
-    static SLOPPY: abi::VolumeReaderVTable = abi::VolumeReaderVTable { read: sloppy_read };
-
-    fn sloppy_registry() -> Registry {
-        let mut r = Registry::default();
-        r.libraries.push(crate::plugin::Library {
-            path: "/plugins/libluxon_sloppy.so".into(),
-            name: "sloppy".into(),
-            sdk_version: luxon_plugin::SDK_VERSION.into(),
-            abi_version: abi::ABI_VERSION,
-        });
-        r.entries.push(Entry {
-            kind: PluginKind::VolumeReader,
-            name: "sloppy".into(),
-            description: String::new(),
-            params_doc: String::new(),
-            extensions: Vec::new(),
-            library: 0,
-            vtable: &SLOPPY as *const abi::VolumeReaderVTable as *const std::ffi::c_void,
-            shadowed: false,
-        });
-        r
-    }
-
-    #[test]
-    fn sink_errors_reach_the_scene_position_and_stick() {
-        let reg = sloppy_registry();
-        let entry = &reg.entries[0];
-        let at = Origin {
-            file: std::sync::Arc::new("scene.ron".into()),
-            line: 4,
-            col: 9,
-        };
-        let read = |params: &str| read_volume(&reg, entry, params, &at, Path::new("."), "v");
-
-        let v = read("ok").unwrap();
-        assert_eq!((v.value([3, 3, 3]), v.value([1, 1, 1])), (1.0, 0.5));
-        assert_eq!((v.grid_name.as_str(), v.voxel_count()), ("sloppy", 8));
-
-        let (o, m) = read("early").unwrap_err();
-        assert_eq!(o, at);
-        assert_eq!(
-            m,
-            "plugin `sloppy` (libluxon_sloppy.so) failed: tile at [2, 2, 2] of 1x1x1 voxels: \
-             `add_tile` was called before `begin`; a reader must describe the grid first"
-        );
-        let (o, m) = read("ignore").unwrap_err();
-        assert_eq!(o, at);
-        assert!(
-            m.starts_with("plugin `sloppy` (libluxon_sloppy.so) ignored an error")
-                && m.contains("dense block at [2, 2, 2] of 2x2x3 voxels reaches from")
-                && m.contains("outside the grid's index box [0, 0, 0] to [3, 3, 3]"),
-            "{m}"
-        );
-        let (_, m) = read("nobegin").unwrap_err();
-        assert!(m.contains("never called `begin`"), "{m}");
-        let (_, m) = read("null").unwrap_err();
-        assert!(m.contains("no values (a null pointer)"), "{m}");
-        let (_, m) = read("huge").unwrap_err();
-        assert!(m.contains("too many voxels"), "{m}");
     }
 
     #[test]

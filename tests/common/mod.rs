@@ -123,5 +123,5 @@ pub fn read_volume_of(
         None => format!("volume {i}"),
     };
     let dir = desc.source.parent().unwrap();
-    luxon::volume::read_volume(reg, entry, &call.params, &call.params_at, dir, &name)
+    luxon::plugin::read_volume(reg, entry, &call.params, &call.params_at, dir, &name)
 }

@@ -2,8 +2,9 @@
 //! the `mpi` feature). Hides the feature from the rest of the command.
 
 #[cfg(feature = "mpi")]
-use luxon::output::temp_path;
-use luxon::schedule::{launched_ranks, render_local, threads_for, Chunk, RankStats, Sink};
+use luxon::files::temp_path;
+use luxon::framebuffer::Chunk;
+use luxon::schedule::{launched_ranks, render_local, threads_for, RankStats, Sink};
 use luxon::{Error, Scene};
 use luxon_formats::ParallelMode;
 use std::path::Path;

@@ -4,11 +4,12 @@
 use super::job::Job;
 use super::progress::Progress;
 use luxon::cache::{self, Lookup};
+use luxon::framebuffer::Chunk;
 use luxon::output::stream::{is_ppm8, AsyncOutput};
 use luxon::output::Output;
 use luxon::plugin::Registry;
 use luxon::render::RenderStats;
-use luxon::schedule::Chunk;
+use luxon::schedule::RankStats;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{Decomposition, Origin, OutputDesc, OutputIo, ParallelMode, SceneDesc};
 use std::path::{Path, PathBuf};
@@ -181,21 +182,12 @@ fn plan<'r>(scene: &Scene, outputs: Vec<Output<'r>>, job: &Job) -> Result<Plan<'
     })
 }
 
+/// `luxon render`: the stages below, in order. Every rank runs them; only rank 0 reports.
 pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let t0 = Instant::now();
     let job = Job::from_launcher()?;
-    let use_cache = !o.no_cache && luxon_formats::nff::is_nff_path(path);
-    let mut cached = None;
-    if use_cache {
-        match cache::open(path) {
-            Lookup::Hit(c) => cached = Some(c),
-            Lookup::Miss => {}
-            Lookup::Corrupt(p, why) => eprintln!(
-                "luxon: warning: geometry cache {} is unusable ({why}); rebuilding it",
-                p.display()
-            ),
-        }
-    }
+    let mut cache = CacheUse::new(path, o);
+    let cached = cache.open(path);
     let desc = load(path, o, cached.as_ref().map(|c| c.skeleton.as_str()));
     let job = match &desc {
         Ok(d) => job.for_mode(d.render.parallel.mode)?,
@@ -204,41 +196,7 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let empty = Vec::new();
     let registry = Registry::discover(desc.as_ref().map_or(&empty, |d| &d.plugin_path));
     let load_time = t0.elapsed();
-    let mut cache_note = if use_cache { "not used" } else { "off" }.to_string();
-    let mut write_cache = false;
-    let ready = desc.and_then(|mut desc| {
-        let had_objects = !desc.objects.is_empty();
-        let from_cache = cached.is_some();
-        let prebuilt = match cached {
-            Some(c) => {
-                let cache::Cached { path, geometry, .. } = *c;
-                Scene::build_prebuilt(&desc, geometry, &registry)
-                    .ok()
-                    .map(|s| (s, path))
-            }
-            None => None,
-        };
-        let scene = match prebuilt {
-            Some((scene, from)) => {
-                cache_note = format!("read {}", from.display());
-                scene
-            }
-            None => {
-                if from_cache {
-                    // The cache's view of the scene did not fit: read the source itself.
-                    desc = load(path, o, None)?;
-                }
-                let scene = Scene::build_taking_geometry(&mut desc, &registry)?;
-                write_cache = use_cache
-                    && (o.cache || scene.primitive_count() >= CACHE_MIN_PRIMITIVES)
-                    && cache::cacheable(&scene, had_objects);
-                scene
-            }
-        };
-        let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
-        let plan = plan(&scene, outputs, &job)?;
-        Ok((desc, scene, plan))
-    });
+    let ready = desc.and_then(|desc| prepare(path, o, desc, cached, &registry, &job, &mut cache));
     let (ready, status) = match ready {
         Ok(r) => {
             let threads = job.threads(&r.1);
@@ -256,89 +214,45 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     };
     let s = &scene.settings;
     let scene_dir = desc.source.parent().unwrap_or(Path::new("."));
+    let Plan {
+        written_by_root,
+        concurrent,
+        streams,
+    } = plan;
+    let gather = !written_by_root.is_empty();
+    let keep = !concurrent.is_empty();
+    let shares = Shares {
+        threads: &threads,
+        gather,
+        keep,
+    };
+    let r = render(&scene, &job, &shares, streams, &registry, scene_dir)?;
 
-    let bar = Progress::new();
-    let total = s.width as u64 * s.height as u64;
-    let done = AtomicU64::new(0);
-    let sync = s.io == OutputIo::Sync && job.rank() == 0;
-    let sync_fb = Mutex::new(Framebuffer::new(0, 0));
-    if sync {
-        *sync_fb.lock().unwrap_or_else(|e| e.into_inner()) = Framebuffer::new(s.width, s.height);
-    }
-    let gather = !plan.written_by_root.is_empty();
-    let keep = !plan.concurrent.is_empty();
-    let (tx, rx) = mpsc::channel::<Chunk>();
-    let start = Instant::now();
-    let (rendered, streamed, tail) = std::thread::scope(|sc| {
-        let writer = plan
-            .streams
-            .map(|streams| sc.spawn(|| streams.run(rx, &registry, scene_dir)));
-        let streaming = writer.is_some();
-        let sink = |c: Chunk| {
-            let n = c.pixels();
-            if streaming {
-                let _ = tx.send(c);
-            } else if sync {
-                sync_fb
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .put_chunk(&c);
-            }
-            bar.tick(done.fetch_add(n, Ordering::Relaxed) + n, total);
-        };
-        let rendered = job.render(&scene, &threads, gather, keep, &sink);
-        let render_end = Instant::now();
-        drop(tx);
-        if let Some(w) = &writer {
-            w.thread().unpark();
-        }
-        let streamed = writer.map(|w| {
-            w.join()
-                .unwrap_or_else(|_| Err(Error::Render("the writer thread panicked".into())))
-        });
-        (rendered, streamed, render_end.elapsed())
-    });
-    let render_time = start.elapsed() - tail;
-    bar.finish();
-    let (ranks, kept) = rendered?;
     let t_write = Instant::now();
-    let mut written = streamed.transpose()?.unwrap_or_default();
-    for out in &plan.concurrent {
-        job.write_concurrent(&out.desc.path, s.width, s.height, &kept)?;
+    let mut written = r.written;
+    for out in &concurrent {
+        job.write_concurrent(&out.desc.path, s.width, s.height, &r.kept)?;
         written.push(out.desc.path.clone());
     }
     if job.rank() != 0 {
         return Ok(());
     }
-    if sync {
-        let fb = sync_fb.into_inner().unwrap_or_else(|e| e.into_inner());
+    if let Some(fb) = r.sync_fb {
         written.extend(luxon::output::write_all(
-            &plan.written_by_root,
+            &written_by_root,
             &fb,
             &registry,
             scene_dir,
         )?);
     }
-    let write_time = tail + t_write.elapsed();
-    let stats = RenderStats::of(ranks, render_time);
+    let write_time = r.tail + t_write.elapsed();
+    let stats = RenderStats::of(r.ranks, r.render_time);
     let total = t0.elapsed();
     // After the image: writing the cache delays no picture.
-    let mut cache_written = None;
-    if write_cache {
-        let result = luxon_formats::nff::skeleton(path)
-            .map_err(|e| e.to_string())
-            .and_then(|sk| cache::write(path, &sk, &scene).map_err(|e| e.to_string()));
-        match result {
-            Ok(p) => {
-                cache_note = format!("written to {}", p.display());
-                cache_written = Some(p);
-            }
-            Err(e) => cache_note = format!("could not be written: {e}"),
-        }
-    }
+    let cache_written = cache.write_after(path, &scene);
     if o.stats {
         print_stats(&scene, &job, &stats, load_time, write_time, total);
-        eprintln!("  geometry cache   {cache_note}");
+        eprintln!("  geometry cache   {}", cache.note);
     }
     for w in written {
         eprintln!("luxon: wrote {}", w.display());
@@ -353,6 +267,189 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// The geometry cache of an NFF scene during one render: whether it is used, what became of it
+/// (for `--stats`), and whether to write it once the image is out.
+struct CacheUse {
+    on: bool,
+    note: String,
+    write: bool,
+}
+
+impl CacheUse {
+    fn new(path: &Path, o: &Overrides) -> CacheUse {
+        let on = !o.no_cache && luxon_formats::nff::is_nff_path(path);
+        CacheUse {
+            on,
+            note: if on { "not used" } else { "off" }.to_string(),
+            write: false,
+        }
+    }
+
+    /// The scene's cache when it is valid; warns about a corrupt one (it is rebuilt).
+    fn open(&self, path: &Path) -> Option<Box<cache::Cached>> {
+        if !self.on {
+            return None;
+        }
+        match cache::open(path) {
+            Lookup::Hit(c) => Some(c),
+            Lookup::Miss => None,
+            Lookup::Corrupt(p, why) => {
+                eprintln!(
+                    "luxon: warning: geometry cache {} is unusable ({why}); rebuilding it",
+                    p.display()
+                );
+                None
+            }
+        }
+    }
+
+    /// Writes the cache when the build asked for it; the file written.
+    fn write_after(&mut self, path: &Path, scene: &Scene) -> Option<PathBuf> {
+        if !self.write {
+            return None;
+        }
+        let result = luxon_formats::nff::skeleton(path)
+            .map_err(|e| e.to_string())
+            .and_then(|sk| cache::write(path, &sk, scene).map_err(|e| e.to_string()));
+        match result {
+            Ok(p) => {
+                self.note = format!("written to {}", p.display());
+                Some(p)
+            }
+            Err(e) => {
+                self.note = format!("could not be written: {e}");
+                None
+            }
+        }
+    }
+}
+
+/// Builds the scene (from the geometry cache when it fits the scene, else from the source),
+/// resolves its outputs and plans who writes them.
+fn prepare<'r>(
+    path: &Path,
+    o: &Overrides,
+    mut desc: SceneDesc,
+    cached: Option<Box<cache::Cached>>,
+    registry: &'r Registry,
+    job: &Job,
+    cache: &mut CacheUse,
+) -> Result<(SceneDesc, Scene, Plan<'r>), Error> {
+    let had_objects = !desc.objects.is_empty();
+    let from_cache = cached.is_some();
+    let prebuilt = match cached {
+        Some(c) => {
+            let cache::Cached { path, geometry, .. } = *c;
+            Scene::build_prebuilt(&desc, geometry, registry)
+                .ok()
+                .map(|s| (s, path))
+        }
+        None => None,
+    };
+    let scene = match prebuilt {
+        Some((scene, from)) => {
+            cache.note = format!("read {}", from.display());
+            scene
+        }
+        None => {
+            if from_cache {
+                // The cache's view of the scene did not fit: read the source itself.
+                desc = load(path, o, None)?;
+            }
+            let scene = Scene::build_taking_geometry(&mut desc, registry)?;
+            cache.write = cache.on
+                && (o.cache || scene.primitive_count() >= CACHE_MIN_PRIMITIVES)
+                && cache::cacheable(&scene, had_objects);
+            scene
+        }
+    };
+    let outputs = luxon::output::resolve(&scene.outputs, registry)?;
+    let plan = plan(&scene, outputs, job)?;
+    Ok((desc, scene, plan))
+}
+
+/// How the ranks share the render: threads per rank, whether rank 0 gathers every rank's
+/// pixels, whether each rank keeps its own (for concurrent output).
+struct Shares<'a> {
+    threads: &'a [usize],
+    gather: bool,
+    keep: bool,
+}
+
+/// What the render phase leaves: every rank's work (on rank 0), this rank's chunks when kept,
+/// the files the writer thread finished, the image for a synchronous write, and how long the
+/// render took and the writer went on after it.
+struct Rendered {
+    ranks: Vec<RankStats>,
+    kept: Vec<Chunk>,
+    written: Vec<PathBuf>,
+    sync_fb: Option<Framebuffer>,
+    render_time: Duration,
+    tail: Duration,
+}
+
+/// Renders this rank's share with a progress bar, handing finished chunks to the writer thread
+/// (asynchronous output), to a framebuffer (synchronous output, rank 0), or to nobody.
+fn render(
+    scene: &Scene,
+    job: &Job,
+    shares: &Shares,
+    streams: Option<AsyncOutput>,
+    registry: &Registry,
+    scene_dir: &Path,
+) -> Result<Rendered, Error> {
+    let s = &scene.settings;
+    let bar = Progress::new();
+    let total = s.width as u64 * s.height as u64;
+    let done = AtomicU64::new(0);
+    let sync = s.io == OutputIo::Sync && job.rank() == 0;
+    let sync_fb = Mutex::new(Framebuffer::new(0, 0));
+    if sync {
+        *sync_fb.lock().unwrap_or_else(|e| e.into_inner()) = Framebuffer::new(s.width, s.height);
+    }
+    let (tx, rx) = mpsc::channel::<Chunk>();
+    let start = Instant::now();
+    let (rendered, streamed, tail) = std::thread::scope(|sc| {
+        let writer = streams.map(|streams| sc.spawn(|| streams.run(rx, registry, scene_dir)));
+        let streaming = writer.is_some();
+        let sink = |c: Chunk| {
+            let n = c.pixels();
+            if streaming {
+                let _ = tx.send(c);
+            } else if sync {
+                sync_fb
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .put_chunk(&c);
+            }
+            bar.tick(done.fetch_add(n, Ordering::Relaxed) + n, total);
+        };
+        let rendered = job.render(scene, shares.threads, shares.gather, shares.keep, &sink);
+        let render_end = Instant::now();
+        drop(tx);
+        if let Some(w) = &writer {
+            w.thread().unpark();
+        }
+        let streamed = writer.map(|w| {
+            w.join()
+                .unwrap_or_else(|_| Err(Error::Render("the writer thread panicked".into())))
+        });
+        (rendered, streamed, render_end.elapsed())
+    });
+    let render_time = start.elapsed() - tail;
+    bar.finish();
+    let (ranks, kept) = rendered?;
+    let written = streamed.transpose()?.unwrap_or_default();
+    Ok(Rendered {
+        ranks,
+        kept,
+        written,
+        sync_fb: sync.then(|| sync_fb.into_inner().unwrap_or_else(|e| e.into_inner())),
+        render_time,
+        tail,
+    })
 }
 
 fn print_stats(

@@ -35,7 +35,7 @@ pub fn run(name: Option<&str>, size: Option<u32>, output: Option<&Path>) -> Resu
             output.display()
         ))
     })?;
-    let tmp = luxon::output::temp_path(output, std::process::id())?;
+    let tmp = luxon::files::temp_path(output, std::process::id())?;
     let result = (|| -> Result<spd::Counts, spd::SpdError> {
         let mut file = std::fs::File::create(&tmp)?;
         let counts = spd::generate_as(scene.name, size, format, &mut file)?;

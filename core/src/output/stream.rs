@@ -3,58 +3,23 @@
 //! into their temporary files while rendering goes on. Other formats are encoded from the
 //! assembled image at the end. Every file appears atomically (temporary file + rename).
 
-use super::{temp_path, write_all, Output};
+use super::{write_all, Output};
 use crate::error::Error;
+use crate::files::{pending, temp_path};
+use crate::framebuffer::Chunk;
 use crate::framebuffer::Framebuffer;
 use crate::plugin::Registry;
-use crate::schedule::Chunk;
+use crate::ppm::{ppm_header, srgb8};
 use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError};
-use std::sync::Mutex;
 use std::time::Duration;
-
-/// Appends the 8-bit sRGB RGB bytes of linear RGBA pixels, exactly as the `ppm` writer does.
-pub fn srgb8(rgba: &[f32], out: &mut Vec<u8>) {
-    for px in rgba.chunks_exact(4) {
-        out.extend(
-            px[..3]
-                .iter()
-                .map(|&c| (luxon_plugin::linear_to_srgb(c) * 255.0).round() as u8),
-        );
-    }
-}
-
-pub fn ppm_header(width: u32, height: u32) -> Vec<u8> {
-    format!("P6\n{width} {height}\n255\n").into_bytes()
-}
 
 /// An output the core writes itself, row by row: the `ppm` writer with 8 bits per channel.
 pub fn is_ppm8(o: &Output) -> bool {
     let params: String = o.desc.params.split_whitespace().collect();
     o.writer.name == "ppm" && (params == "()" || params == "(bits:8)")
-}
-
-/// Temporary files being written, removed by [`discard_temp_files`] when the process must end
-/// at once.
-static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-
-/// Removes the temporary files of unfinished outputs (before an abort that runs no destructor).
-pub fn discard_temp_files() {
-    if let Ok(files) = PENDING.try_lock() {
-        for f in files.iter() {
-            let _ = std::fs::remove_file(f);
-        }
-    }
-}
-
-fn pending(tmp: &Path, add: bool) {
-    let mut files = PENDING.lock().unwrap_or_else(|e| e.into_inner());
-    files.retain(|f| f != tmp);
-    if add {
-        files.push(tmp.to_path_buf());
-    }
 }
 
 /// A PPM written row by row into its temporary file.
@@ -157,7 +122,7 @@ impl<'r> AsyncOutput<'r> {
 
     /// Takes chunks until every sender is gone, then finishes every file; returns the paths
     /// written. Incomplete rows (a failed render) leave no file behind. Unpark the thread
-    /// running this after dropping the last sender, or the end waits up to [`POLL`].
+    /// running this after dropping the last sender, or the end waits up to `POLL` (20 ms).
     pub fn run(
         mut self,
         chunks: Receiver<Chunk>,

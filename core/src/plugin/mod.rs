@@ -1,6 +1,13 @@
-//! The plugin host: discovery and handshake (`registry`), calls and sinks (`calls`).
+//! The plugin host: discovery and handshake (`registry`), one call with its errors mapped to the
+//! scene (`calls`), and per kind of plugin the call and the host side of its sink: primitives
+//! filling the scene's geometry, textures, volume readers filling volumes, writers.
 
 pub mod calls;
+pub mod primitive;
 pub mod registry;
+pub mod texture;
+pub mod volume_reader;
+pub mod writer;
 
 pub use registry::{Entry, Library, LookupError, PluginKind, Problem, Registry};
+pub use volume_reader::read_volume;

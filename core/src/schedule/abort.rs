@@ -71,7 +71,7 @@ pub fn fail(message: &str) -> ! {
 }
 
 pub(super) fn abort_job() -> ! {
-    crate::output::stream::discard_temp_files();
+    crate::files::discard_temp_files();
     // SAFETY: plain FFI call on the world communicator.
     unsafe {
         ffi::MPI_Abort(ffi::RSMPI_COMM_WORLD, 1);

@@ -14,8 +14,9 @@
 
 use super::abort::{abort_job, fail, Injected, TAG_ERROR};
 use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
-use super::{decompose, run_share, wire, Chunk, RankStats, Share, Sink};
+use super::{decompose, run_share, wire, RankStats, Share, Sink};
 use crate::error::Error;
+use crate::framebuffer::Chunk;
 use crate::scene::Scene;
 use luxon_formats::{Decomposition, ParallelMode};
 use mpi::topology::SimpleCommunicator;
@@ -165,7 +166,7 @@ impl Cluster {
     /// the header).
     pub fn write_ppm(&self, tmp: &std::path::Path, width: u32, height: u32, mine: &[Chunk]) {
         let header = if self.rank == 0 {
-            crate::output::stream::ppm_header(width, height)
+            crate::ppm::ppm_header(width, height)
         } else {
             Vec::new()
         };

@@ -2,22 +2,8 @@
 //! block-cyclic) deal units round-robin to `workers` workers numbered across every rank; the
 //! dynamic one cuts the image into tiles that are handed out on demand.
 
+use crate::framebuffer::Span;
 use luxon_formats::Decomposition;
-
-/// Pixels `x0, x0 + step, ...` (`count` of them) of row `y`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Span {
-    pub y: u32,
-    pub x0: u32,
-    pub step: u32,
-    pub count: u32,
-}
-
-impl Span {
-    pub fn xs(self) -> impl Iterator<Item = u32> {
-        (0..self.count).map(move |k| self.x0 + k * self.step)
-    }
-}
 
 /// A rectangle of pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

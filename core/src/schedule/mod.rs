@@ -15,27 +15,15 @@ mod mailbox;
 mod mpi_io;
 
 use crate::error::Error;
+use crate::framebuffer::{Chunk, Span};
 use crate::geometry::Counters;
-use crate::render::render_spans;
+use crate::integrator::render_spans;
 use crate::scene::Scene;
-pub use decompose::{Rect, Span};
+pub use decompose::Rect;
 use luxon_formats::Decomposition;
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
-
-/// Rendered pixels: spans and their linear RGBA values, span after span.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Chunk {
-    pub spans: Vec<Span>,
-    pub rgba: Vec<f32>,
-}
-
-impl Chunk {
-    pub fn pixels(&self) -> u64 {
-        self.spans.iter().map(|s| s.count as u64).sum()
-    }
-}
 
 /// Where finished chunks go; called from the render threads.
 pub type Sink<'a> = &'a (dyn Fn(Chunk) + Sync);

@@ -2,8 +2,8 @@
 //! straight into one shared PPM file with a single collective `MPI_File_write_at_all`, its file
 //! view listing where its pixels go. rsmpi has no safe MPI-IO, hence the raw calls.
 
-use super::Chunk;
-use crate::output::stream::srgb8;
+use crate::framebuffer::Chunk;
+use crate::ppm::srgb8;
 use mpi::ffi;
 use std::ffi::CString;
 use std::os::raw::{c_int, c_void};
@@ -70,7 +70,7 @@ pub fn write_ppm(
     height: u32,
     chunks: &[Chunk],
 ) -> Result<(), String> {
-    let base = crate::output::stream::ppm_header(width, height).len() as u64;
+    let base = crate::ppm::ppm_header(width, height).len() as u64;
     let total = ffi_len(base + width as u64 * height as u64 * 3)?;
     let (runs, data) = runs(base, header, width, chunks);
     let name = CString::new(path.to_string_lossy().as_bytes()).map_err(|e| e.to_string())?;
@@ -141,7 +141,7 @@ fn ffi_len(n: u64) -> Result<c_int, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::schedule::Span;
+    use crate::framebuffer::Span;
 
     #[test]
     fn runs_are_sorted_and_merged() {

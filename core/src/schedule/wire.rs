@@ -1,7 +1,8 @@
 //! Chunks and statistics as bytes, for messages between ranks (all ranks run the same binary on
 //! machines of one byte order, so native-endian words are enough).
 
-use super::{Chunk, RankStats, Span, WorkerStats};
+use super::{RankStats, WorkerStats};
+use crate::framebuffer::{Chunk, Span};
 use crate::geometry::Counters;
 use std::time::Duration;
 

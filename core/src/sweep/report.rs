@@ -4,7 +4,7 @@
 
 use super::{Param, Row, Sweep};
 use crate::error::Error;
-use crate::output::write_atomic;
+use crate::files::write_atomic;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,212 @@
+//! The vector arithmetic that needs `unsafe`: the box tests of a wide node (SSE or AVX
+//! intrinsics, a portable loop on other targets), running the traversal loops compiled for AVX
+//! when the CPU has it, and the unchecked float-to-index conversion of the build's binning.
+
+use super::wide::Wide;
+use super::{Bvh, LANES};
+use crate::math::{gamma, Vec3A};
+
+/// What a ray precomputes for the box tests: for each axis the row of the plane it meets
+/// first (min or max, by the sign of its direction) and the row of the other.
+pub(super) struct BoxRay {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    /// `inv` times [`WIDEN`], for the far planes.
+    inv_far: [f32; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+/// Far-plane distances and `t_max` are widened by 2·gamma(3) so rounding never culls a box the
+/// ray really touches (Ize 2013). The far planes get it through their reciprocals: as many
+/// roundings as widening each result, and a multiply less on the path from one node to the next.
+const WIDEN: f32 = 1.0 + 2.0 * gamma(3);
+
+impl BoxRay {
+    #[inline(always)]
+    pub(super) fn new(origin: Vec3A, dir: Vec3A) -> BoxRay {
+        let inv: [f32; 3] = dir.recip().into();
+        let neg = inv.map(|x| usize::from(x < 0.0) * 3);
+        BoxRay {
+            origin: origin.into(),
+            inv,
+            inv_far: inv.map(|x| x * WIDEN),
+            near: [neg[0], 1 + neg[1], 2 + neg[2]],
+            far: [3 - neg[0], 4 - neg[1], 5 - neg[2]],
+        }
+    }
+
+    /// Which of the node's boxes the ray meets in [0, t_max] (bit l for lane l), and the entry
+    /// distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
+    /// which is inside that slab for every t) are NaN and are skipped: max(t, acc) and
+    /// min(t, acc) keep `acc` when t is NaN (x86's maxps/minps return the second operand).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        use std::arch::x86_64::*;
+        let mut t = [0.0; LANES];
+        let mut mask = 0;
+        for h in 0..LANES / 4 {
+            // SAFETY: SSE is part of the x86_64 baseline; each load reads four floats of a row.
+            unsafe {
+                let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr().add(4 * h));
+                let mut near = _mm_setzero_ps();
+                let mut far = _mm_set1_ps(t_max * WIDEN);
+                for k in 0..3 {
+                    let o = _mm_set1_ps(self.origin[k]);
+                    let inv = _mm_set1_ps(self.inv[k]);
+                    let inv_far = _mm_set1_ps(self.inv_far[k]);
+                    let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv_far);
+                    near = _mm_max_ps(t0, near);
+                    far = _mm_min_ps(t1, far);
+                }
+                let hit = _mm_cmple_ps(near, far);
+                _mm_storeu_ps(t.as_mut_ptr().add(4 * h), near);
+                mask |= (_mm_movemask_ps(hit) as u32) << (4 * h);
+            }
+        }
+        (mask, t)
+    }
+
+    /// The same with AVX: all eight lanes in one pass (bitwise the same results).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn enter_avx(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        use std::arch::x86_64::*;
+        let row = |r: usize| {
+            // SAFETY: reads one row of eight floats.
+            unsafe { _mm256_loadu_ps(node.b[r].as_ptr()) }
+        };
+        let mut near = _mm256_setzero_ps();
+        let mut far = _mm256_set1_ps(t_max * WIDEN);
+        for k in 0..3 {
+            let o = _mm256_set1_ps(self.origin[k]);
+            let inv = _mm256_set1_ps(self.inv[k]);
+            let inv_far = _mm256_set1_ps(self.inv_far[k]);
+            let t0 = _mm256_mul_ps(_mm256_sub_ps(row(self.near[k]), o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(row(self.far[k]), o), inv_far);
+            near = _mm256_max_ps(t0, near);
+            far = _mm256_min_ps(t1, far);
+        }
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(near, far);
+        let mut t = [0.0; LANES];
+        // SAFETY: writes eight floats.
+        unsafe { _mm256_storeu_ps(t.as_mut_ptr(), near) };
+        (_mm256_movemask_ps(hit) as u32, t)
+    }
+
+    /// The box test of the traversal compiled for `avx` (see `Bvh::intersect`).
+    #[inline(always)]
+    pub(super) fn enter_with<const AVX: bool>(
+        &self,
+        node: &Wide,
+        t_max: f32,
+    ) -> (u32, [f32; LANES]) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: only the AVX instantiations call this, after checking the CPU.
+            return unsafe { self.enter_avx(node, t_max) };
+        }
+        self.enter(node, t_max)
+    }
+
+    /// The same, lane by lane, for other targets.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        let mut near = [0.0f32; LANES];
+        let mut far = [t_max * WIDEN; LANES];
+        for k in 0..3 {
+            let (lo, hi) = (&node.b[self.near[k]], &node.b[self.far[k]]);
+            for l in 0..LANES {
+                let t0 = (lo[l] - self.origin[k]) * self.inv[k];
+                let t1 = (hi[l] - self.origin[k]) * self.inv_far[k];
+                near[l] = if t0 > near[l] { t0 } else { near[l] };
+                far[l] = if t1 < far[l] { t1 } else { far[l] };
+            }
+        }
+        let mask = (0..LANES).fold(0, |m, l| m | u32::from(near[l] <= far[l]) << l);
+        (mask, near)
+    }
+}
+
+/// Whether this CPU has AVX (8-wide box tests); the check is a cached load.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn avx() -> bool {
+    std::arch::is_x86_feature_detected!("avx")
+}
+
+/// The lanes of `v` clamped to `[0, max]` and truncated to indices. Clamped first (max maps NaN
+/// to 0), so the cheap truncating conversion is exact; Rust's saturating `as` cost a fifth of
+/// the BVH build.
+#[inline(always)]
+pub(super) fn clamped_index(v: Vec3A, max: f32) -> [usize; 3] {
+    let x: [f32; 3] = v.max(Vec3A::ZERO).min(Vec3A::splat(max)).into();
+    // SAFETY: each x is finite and in [0, max], and max is a small bin count.
+    x.map(|x| unsafe { x.to_int_unchecked::<u32>() } as usize)
+}
+
+/// The traversal loops (`Bvh::closest` and `Bvh::first`) compiled for AVX where the CPU has it,
+/// else for the baseline.
+impl Bvh {
+    #[inline(always)]
+    pub(super) fn intersect_dispatch<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        if avx() {
+            // SAFETY: the CPU has AVX.
+            return unsafe { self.intersect_avx(origin, dir, t_max, test) };
+        }
+        self.intersect_base(origin, dir, t_max, test)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline(never)]
+    fn intersect_avx<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        self.closest::<true, F>(origin, dir, t_max, test)
+    }
+
+    #[inline(always)]
+    pub(super) fn any_dispatch<F: FnMut(usize) -> bool>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if avx() {
+            // SAFETY: the CPU has AVX.
+            return unsafe { self.any_avx(origin, dir, t_max, test) };
+        }
+        self.any_base(origin, dir, t_max, test)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline(never)]
+    fn any_avx<F: FnMut(usize) -> bool>(
+        &self,
+        origin: Vec3A,
+        dir: Vec3A,
+        t_max: f32,
+        test: F,
+    ) -> bool {
+        self.first::<true, F>(origin, dir, t_max, test)
+    }
+}

@@ -1,0 +1,56 @@
+//! The pixel kernel: the values of a list of spans of pixels, each the average of its samples
+//! (uniform, or adaptive supersampling) of the radiance along its camera rays.
+
+use super::{IorStack, Whitted};
+use crate::adaptive;
+use crate::framebuffer::Span;
+use crate::geometry::Counters;
+use crate::math::Vec3A;
+use crate::sampler::pixel_sample;
+use crate::scene::Scene;
+
+/// Renders the pixels of `spans`, returning their RGBA values span after span.
+pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
+    let s = &scene.settings;
+    let integrator = Whitted::new(scene);
+    let count: usize = spans.iter().map(|s| s.count as usize).sum();
+    let mut out = Vec::with_capacity(count * 4);
+    let n = s.samples.max(1);
+    let inv_n = 1.0 / n as f32;
+    let media = IorStack::default();
+    let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
+    for span in spans {
+        let y = span.y;
+        for x in span.xs() {
+            let mut shade = |jx: f32, jy: f32| {
+                let (px, py) = (x as f32 + jx, y as f32 + jy);
+                // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
+                match scene.camera.primary(px, py, s.width, s.height, s.time) {
+                    Some(ray) => {
+                        c.primary += 1;
+                        integrator.radiance(&ray, 0, 1.0, &media, c)
+                    }
+                    None => Vec3A::ZERO,
+                }
+            };
+            let mut v = match &plan {
+                Some(p) => p.pixel(x, y, s.frame, &mut shade),
+                None => {
+                    let mut sum = Vec3A::ZERO;
+                    for i in 0..n {
+                        let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
+                        sum += shade(jx, jy);
+                    }
+                    sum * inv_n
+                }
+            };
+            if !v.is_finite() {
+                // A NaN never aborts a render: count it and clamp the pixel.
+                c.nan_pixels += 1;
+                v = Vec3A::ZERO;
+            }
+            out.extend_from_slice(&[v.x, v.y, v.z, 1.0]);
+        }
+    }
+    out
+}

@@ -1,0 +1,198 @@
+//! Primitive plugins: `create` and the host side of `GeometrySink`, which stores what a plugin
+//! adds (spheres, planes, cones, discs, meshes, custom geometry) in the scene's native sets.
+
+use super::calls::{call_context, call_plugin, checked_len, fail, slice};
+use super::registry::{Entry, Registry};
+use crate::geometry::cone::Cones;
+use crate::geometry::custom::{CustomObject, Customs};
+use crate::geometry::disc::Discs;
+use crate::geometry::plane::Planes;
+use crate::geometry::sphere::Spheres;
+use crate::geometry::triangle::{MeshInput, Triangles};
+use crate::math::DVec3;
+use luxon_formats::Origin;
+use luxon_plugin::abi;
+use std::ffi::c_void;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::Path;
+
+/// Where a primitive plugin's geometry goes. Coordinates arrive in f64 world space and are
+/// stored re-centred on `world_offset` in f32.
+pub struct GeometryBuilder<'a> {
+    pub spheres: &'a mut Spheres,
+    pub triangles: &'a mut Triangles,
+    pub planes: &'a mut Planes,
+    pub cones: &'a mut Cones,
+    pub discs: &'a mut Discs,
+    pub customs: &'a mut Customs,
+    pub material: u32,
+    pub world_offset: DVec3,
+    pub plugin: String,
+    /// Degenerate triangles dropped.
+    pub dropped: u64,
+}
+
+/// Host callbacks must never unwind into plugin frames.
+fn guard(err: *const abi::ErrorSink, f: impl FnOnce() -> Result<(), String>) -> abi::Status {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(())) => abi::STATUS_OK,
+        Ok(Err(m)) => fail(err, &m),
+        Err(_) => fail(err, "internal error in the host while storing geometry"),
+    }
+}
+
+fn builder<'a>(ctx: *mut c_void) -> &'a mut GeometryBuilder<'a> {
+    // SAFETY: ctx is the builder passed in `GeometrySink::ctx` for the duration of create().
+    unsafe { &mut *(ctx as *mut GeometryBuilder) }
+}
+
+/// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`.
+fn add_batch<const N: usize>(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+    what: &str,
+    push: impl Fn(&mut GeometryBuilder, usize, [f64; N]) -> Result<(), String>,
+) -> abi::Status {
+    guard(err, || {
+        let b = builder(ctx);
+        // SAFETY: the plugin passes `count` records of N values (ABI contract).
+        let v = unsafe { slice(data, checked_len(count, N as u64, what)?) };
+        for (i, r) in v.chunks_exact(N).enumerate() {
+            push(b, i, r.try_into().expect("chunk of N"))?;
+        }
+        Ok(())
+    })
+}
+
+extern "C" fn add_spheres(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    add_batch(ctx, data, count, err, "sphere", |b, i, r: [f64; 4]| {
+        b.spheres.push_world(i, r, b.world_offset, b.material)
+    })
+}
+
+extern "C" fn add_planes(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    add_batch(ctx, data, count, err, "plane", |b, i, r: [f64; 6]| {
+        b.planes.push_world(i, r, b.world_offset, b.material)
+    })
+}
+
+extern "C" fn add_cones(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
+        b.cones.push_world(i, r, b.world_offset, b.material)
+    })
+}
+
+extern "C" fn add_discs(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
+        b.discs.push_world(i, r, b.world_offset, b.material)
+    })
+}
+
+extern "C" fn add_mesh(
+    ctx: *mut c_void,
+    mesh: *const abi::MeshData,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    guard(err, || {
+        let b = builder(ctx);
+        let m = unsafe { mesh.as_ref() }.ok_or("no mesh data")?;
+        let nv = checked_len(m.vertex_count, 1, "vertex")?;
+        let optional = |p: bool, per: usize| if p { 0 } else { nv * per };
+        // SAFETY: the plugin guarantees the arrays' lengths (ABI contract of MeshData).
+        let input = unsafe {
+            MeshInput {
+                positions: slice(m.positions, checked_len(m.vertex_count, 3, "vertex")?),
+                indices: slice(m.indices, checked_len(m.triangle_count, 3, "triangle")?),
+                normals: slice(m.normals, optional(m.normals.is_null(), 3)),
+                colors: slice(m.colors, optional(m.colors.is_null(), 3)),
+                uvs: slice(m.uvs, optional(m.uvs.is_null(), 2)),
+            }
+        };
+        b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
+        Ok(())
+    })
+}
+
+extern "C" fn add_custom(
+    ctx: *mut c_void,
+    g: *const abi::CustomGeometry,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    guard(err, || {
+        let b = builder(ctx);
+        let g = unsafe { g.as_ref() }.ok_or("no custom geometry")?;
+        if g.vtable.is_null() {
+            return Err("custom geometry without a function table".into());
+        }
+        // Own it first so it is destroyed even if we reject it.
+        let object = CustomObject {
+            object: g.object,
+            vtable: g.vtable,
+            plugin: b.plugin.clone(),
+            count: g.count,
+        };
+        if g.count > u32::MAX as u64 {
+            return Err(format!(
+                "custom geometry with {} primitives is too large",
+                g.count
+            ));
+        }
+        let o = b.customs.objects.len() as u32;
+        for i in 0..object.count {
+            b.customs.refs.push((o, i));
+            b.customs.material.push(b.material);
+        }
+        b.customs.objects.push(object);
+        Ok(())
+    })
+}
+
+/// Runs a primitive plugin's `create` into `builder`.
+pub fn create_primitive(
+    registry: &Registry,
+    entry: &Entry,
+    params: &str,
+    params_at: &Origin,
+    scene_dir: &Path,
+    instance: &str,
+    builder: &mut GeometryBuilder,
+) -> Result<(), (Origin, String)> {
+    let sink = abi::GeometrySink {
+        ctx: builder as *mut GeometryBuilder as *mut c_void,
+        add_spheres,
+        add_planes,
+        add_cones,
+        add_discs,
+        add_mesh,
+        add_custom,
+    };
+    let dir = scene_dir.to_string_lossy();
+    let ctx = call_context(&dir, instance);
+    // SAFETY: the entry is a primitive, so its vtable is a PrimitiveVTable.
+    let vt = unsafe { &*(entry.vtable as *const abi::PrimitiveVTable) };
+    call_plugin(registry, entry, params_at, |err| {
+        (vt.create)(abi::Str::new(params), &ctx, &sink, err)
+    })
+}

@@ -1,0 +1,297 @@
+//! Volume-reader plugins: `read` and the host side of `VolumeSink`. The storage and every check
+//! of what a reader sends live in [`VolumeBuilder`]; this is the calling side.
+
+use super::calls::{call_context, call_plugin, fail, plugin_label, slice};
+use super::registry::{Entry, PluginKind, Registry};
+use crate::volume::{Volume, VolumeBuilder};
+use luxon_formats::Origin;
+use luxon_plugin::abi;
+use std::ffi::c_void;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::Path;
+
+/// Reads one volume with a volume-reader plugin. `instance` is the scene's name for the volume
+/// (it becomes [`Volume::name`] and is passed to the plugin for its messages). Errors carry the
+/// scene position: inside `params` when the plugin reports one, otherwise `params_at`.
+pub fn read_volume(
+    registry: &Registry,
+    entry: &Entry,
+    params: &str,
+    params_at: &Origin,
+    scene_dir: &Path,
+    instance: &str,
+) -> Result<Volume, (Origin, String)> {
+    let mut builder = VolumeBuilder::new(instance, &entry.name);
+    read_volume_into(
+        registry,
+        entry,
+        params,
+        params_at,
+        scene_dir,
+        instance,
+        &mut builder,
+    )?;
+    builder.finish().map_err(|m| {
+        (
+            params_at.clone(),
+            format!("{} {m}", plugin_label(registry, entry)),
+        )
+    })
+}
+
+/// Runs one volume sink callback: never unwinds, and any failure (a panic included) stops the
+/// volume so the read fails even if the plugin ignores the error.
+fn volume_call(
+    ctx: *mut c_void,
+    err: *const abi::ErrorSink,
+    f: impl FnOnce(&mut VolumeBuilder) -> Result<(), String>,
+) -> abi::Status {
+    if ctx.is_null() {
+        return fail(err, "the volume sink has no context");
+    }
+    // SAFETY: ctx is the builder passed in `VolumeSink::ctx` for the duration of read().
+    let b = unsafe { &mut *(ctx as *mut VolumeBuilder) };
+    let message = match catch_unwind(AssertUnwindSafe(|| f(&mut *b))) {
+        Ok(Ok(())) => return abi::STATUS_OK,
+        Ok(Err(m)) => m,
+        Err(_) => {
+            let m = "internal error in the host while storing volume data";
+            let _ = catch_unwind(AssertUnwindSafe(|| b.fail(m)));
+            m.to_string()
+        }
+    };
+    fail(err, &message)
+}
+
+extern "C" fn volume_begin(
+    ctx: *mut c_void,
+    desc: *const abi::VolumeDesc,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    volume_call(ctx, err, |b| {
+        let Some(d) = (unsafe { desc.as_ref() }) else {
+            let m = "`begin` was given no grid description";
+            b.fail(m);
+            return Err(m.into());
+        };
+        let Ok(name) = (unsafe { d.grid_name.as_str() }) else {
+            let m = "the grid name is not valid UTF-8";
+            b.fail(m);
+            return Err(m.into());
+        };
+        b.begin(
+            d.world_from_index,
+            d.background,
+            d.index_min,
+            d.index_max,
+            name,
+        )
+    })
+}
+
+extern "C" fn volume_add_dense(
+    ctx: *mut c_void,
+    origin: *const [i64; 3],
+    dims: *const [u64; 3],
+    values: *const f32,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    volume_call(ctx, err, |b| {
+        let (Some(&origin), Some(&dims)) = (unsafe { origin.as_ref() }, unsafe { dims.as_ref() })
+        else {
+            let m = "`add_dense` was given a null origin or size";
+            b.fail(m);
+            return Err(m.into());
+        };
+        // The builder checks the size against the grid; here it only has to be addressable.
+        let n = dims
+            .iter()
+            .try_fold(1u64, |a, &d| a.checked_mul(d))
+            .and_then(|n| usize::try_from(n).ok())
+            .filter(|&n| n <= usize::MAX / std::mem::size_of::<f32>());
+        let Some(n) = n else {
+            let m = format!(
+                "dense block at {origin:?} of {}x{}x{} voxels has too many voxels (the count \
+                 overflows)",
+                dims[0], dims[1], dims[2]
+            );
+            b.fail(&m);
+            return Err(m);
+        };
+        if values.is_null() && n > 0 {
+            let m = format!("dense block at {origin:?} was given no values (a null pointer)");
+            b.fail(&m);
+            return Err(m);
+        }
+        // Borrowed for the call (ABI contract); `n` values, x fastest.
+        let values = unsafe { slice(values, n) };
+        b.add_dense(origin, dims, values)
+    })
+}
+
+extern "C" fn volume_add_tile(
+    ctx: *mut c_void,
+    origin: *const [i64; 3],
+    dims: *const [u64; 3],
+    value: f32,
+    err: *const abi::ErrorSink,
+) -> abi::Status {
+    volume_call(ctx, err, |b| {
+        let (Some(&origin), Some(&dims)) = (unsafe { origin.as_ref() }, unsafe { dims.as_ref() })
+        else {
+            let m = "`add_tile` was given a null origin or size";
+            b.fail(m);
+            return Err(m.into());
+        };
+        b.add_tile(origin, dims, value)
+    })
+}
+
+/// Runs a volume-reader plugin's `read` into `builder` (which must be fresh). `entry` must be a
+/// volume reader.
+#[allow(clippy::too_many_arguments)]
+pub fn read_volume_into(
+    registry: &Registry,
+    entry: &Entry,
+    params: &str,
+    params_at: &Origin,
+    scene_dir: &Path,
+    instance: &str,
+    builder: &mut VolumeBuilder,
+) -> Result<(), (Origin, String)> {
+    if entry.kind != PluginKind::VolumeReader {
+        return Err((
+            params_at.clone(),
+            format!(
+                "{} is a {}, but a volume reader is expected here",
+                plugin_label(registry, entry),
+                entry.kind
+            ),
+        ));
+    }
+    let sink = abi::VolumeSink {
+        ctx: builder as *mut VolumeBuilder as *mut c_void,
+        begin: volume_begin,
+        add_dense: volume_add_dense,
+        add_tile: volume_add_tile,
+    };
+    let dir = scene_dir.to_string_lossy();
+    let ctx = call_context(&dir, instance);
+    // SAFETY: the entry is a volume reader (checked above), so its vtable is a
+    // VolumeReaderVTable.
+    let vt = unsafe { &*(entry.vtable as *const abi::VolumeReaderVTable) };
+    call_plugin(registry, entry, params_at, |err| {
+        (vt.read)(abi::Str::new(params), &ctx, &sink, err)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const IDENTITY: [f64; 12] = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
+
+    /// A reader that misbehaves in the way its params say, through the real sink callbacks.
+    extern "C" fn sloppy_read(
+        params: abi::Str,
+        _ctx: *const abi::CallContext,
+        sink: *const abi::VolumeSink,
+        err: *const abi::ErrorSink,
+    ) -> abi::Status {
+        let s = unsafe { &*sink };
+        let desc = abi::VolumeDesc {
+            world_from_index: IDENTITY,
+            background: 0.5,
+            index_min: [0; 3],
+            index_max: [3; 3],
+            grid_name: abi::Str::new("sloppy"),
+        };
+        let origin = [2i64, 2, 2];
+        let dims = [2u64, 2, 3];
+        let values = [1.0f32; 12];
+        match unsafe { params.as_str() }.unwrap() {
+            // Data before `begin`, passing the host's error on.
+            "early" => (s.add_tile)(s.ctx, &origin, &[1; 3], 1.0, err),
+            // A block outside the box, its error ignored.
+            "ignore" => {
+                (s.begin)(s.ctx, &desc, err);
+                (s.add_dense)(s.ctx, &origin, &dims, values.as_ptr(), err);
+                abi::STATUS_OK
+            }
+            "nobegin" => abi::STATUS_OK,
+            "null" => {
+                (s.begin)(s.ctx, &desc, err);
+                (s.add_dense)(s.ctx, &origin, &[2; 3], std::ptr::null(), err)
+            }
+            "huge" => {
+                (s.begin)(s.ctx, &desc, err);
+                (s.add_dense)(s.ctx, &origin, &[u64::MAX; 3], values.as_ptr(), err)
+            }
+            _ => {
+                (s.begin)(s.ctx, &desc, err);
+                (s.add_dense)(s.ctx, &origin, &[2; 3], values.as_ptr(), err)
+            }
+        }
+    }
+
+    static SLOPPY: abi::VolumeReaderVTable = abi::VolumeReaderVTable { read: sloppy_read };
+
+    fn sloppy_registry() -> Registry {
+        let mut r = Registry::default();
+        r.libraries.push(crate::plugin::Library {
+            path: "/plugins/libluxon_sloppy.so".into(),
+            name: "sloppy".into(),
+            sdk_version: luxon_plugin::SDK_VERSION.into(),
+            abi_version: abi::ABI_VERSION,
+        });
+        r.entries.push(Entry {
+            kind: PluginKind::VolumeReader,
+            name: "sloppy".into(),
+            description: String::new(),
+            params_doc: String::new(),
+            extensions: Vec::new(),
+            library: 0,
+            vtable: &SLOPPY as *const abi::VolumeReaderVTable as *const std::ffi::c_void,
+            shadowed: false,
+        });
+        r
+    }
+
+    #[test]
+    fn sink_errors_reach_the_scene_position_and_stick() {
+        let reg = sloppy_registry();
+        let entry = &reg.entries[0];
+        let at = Origin {
+            file: std::sync::Arc::new("scene.ron".into()),
+            line: 4,
+            col: 9,
+        };
+        let read = |params: &str| read_volume(&reg, entry, params, &at, Path::new("."), "v");
+
+        let v = read("ok").unwrap();
+        assert_eq!((v.value([3, 3, 3]), v.value([1, 1, 1])), (1.0, 0.5));
+        assert_eq!((v.grid_name.as_str(), v.voxel_count()), ("sloppy", 8));
+
+        let (o, m) = read("early").unwrap_err();
+        assert_eq!(o, at);
+        assert_eq!(
+            m,
+            "plugin `sloppy` (libluxon_sloppy.so) failed: tile at [2, 2, 2] of 1x1x1 voxels: \
+             `add_tile` was called before `begin`; a reader must describe the grid first"
+        );
+        let (o, m) = read("ignore").unwrap_err();
+        assert_eq!(o, at);
+        assert!(
+            m.starts_with("plugin `sloppy` (libluxon_sloppy.so) ignored an error")
+                && m.contains("dense block at [2, 2, 2] of 2x2x3 voxels reaches from")
+                && m.contains("outside the grid's index box [0, 0, 0] to [3, 3, 3]"),
+            "{m}"
+        );
+        let (_, m) = read("nobegin").unwrap_err();
+        assert!(m.contains("never called `begin`"), "{m}");
+        let (_, m) = read("null").unwrap_err();
+        assert!(m.contains("no values (a null pointer)"), "{m}");
+        let (_, m) = read("huge").unwrap_err();
+        assert!(m.contains("too many voxels"), "{m}");
+    }
+}

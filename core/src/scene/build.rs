@@ -1,0 +1,709 @@
+//! Building a [`Scene`] from its description, in the stages [`Scene::build_from`] runs in order:
+//! textures, volumes, materials, clip groups, render volumes, objects (plugins, then imported
+//! geometry, then a cache's prebuilt geometry), BVHs, lights, and the effects the scene calls
+//! for. A new kind of scene content gets a stage of its own here.
+
+use super::{Ao, Features, Fog, Light, Material, Scene, Settings};
+use crate::camera::Camera;
+use crate::error::Error;
+use crate::geometry::cone::Cones;
+use crate::geometry::custom::Customs;
+use crate::geometry::disc::Discs;
+use crate::geometry::plane::Planes;
+use crate::geometry::sphere::Spheres;
+use crate::geometry::triangle::{MeshInput, Triangles};
+use crate::geometry::{pack, Clips, MAX_CLIP_GROUPS, MAX_MATERIALS};
+use crate::math::{DVec3, Vec3A};
+use crate::plugin::primitive::{create_primitive, GeometryBuilder};
+use crate::plugin::texture::{create_texture, TextureInstance};
+use crate::plugin::{read_volume, PluginKind, Registry};
+use crate::volume::Volume;
+use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
+use luxon_formats::{Highlight, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned};
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A scene's native geometry with its BVHs built, as a geometry cache gives it back
+/// ([`crate::cache`]).
+pub struct Prebuilt {
+    pub world_offset: DVec3,
+    /// Per material of the scene (index 0: the default): whether any primitive uses it.
+    pub used: Vec<bool>,
+    pub degenerate: u64,
+    pub spheres: Spheres,
+    pub triangles: Triangles,
+    pub cones: Cones,
+}
+
+/// Imported geometry groups, handed over one at a time.
+type Inline<'g> = Box<dyn Iterator<Item = Cow<'g, InlineGeometry>> + 'g>;
+
+impl Scene {
+    /// Resolves plugins, instantiates every object and builds the BVHs.
+    pub fn build(desc: &SceneDesc, registry: &Registry) -> Result<Scene, Error> {
+        let groups = desc.inline.iter().map(Cow::Borrowed);
+        Scene::build_from(desc, Box::new(groups), None, registry)
+    }
+
+    /// Builds with the native geometry and BVHs of a geometry cache (`desc` holds the rest of
+    /// the scene and no inline geometry).
+    pub fn build_prebuilt(
+        desc: &SceneDesc,
+        geometry: Prebuilt,
+        registry: &Registry,
+    ) -> Result<Scene, Error> {
+        Scene::build_from(desc, Box::new(std::iter::empty()), Some(geometry), registry)
+    }
+
+    /// Like `build`, but takes the imported geometry (`desc.inline`) out of `desc` and frees
+    /// each group once it is stored, so a large import is not held twice while the BVHs are
+    /// built and the image rendered.
+    pub fn build_taking_geometry(
+        desc: &mut SceneDesc,
+        registry: &Registry,
+    ) -> Result<Scene, Error> {
+        let groups = std::mem::take(&mut desc.inline).into_iter().map(Cow::Owned);
+        Scene::build_from(desc, Box::new(groups), None, registry)
+    }
+
+    /// The build, stage after stage (errors are reported in this order too).
+    fn build_from(
+        desc: &SceneDesc,
+        inline: Inline,
+        prebuilt: Option<Prebuilt>,
+        registry: &Registry,
+    ) -> Result<Scene, Error> {
+        let b = Build::new(desc, registry);
+        let t0 = Instant::now();
+        let (textures, texture_names) = b.textures()?;
+        let volumes = b.volumes()?;
+        let (materials, material_names) = b.materials(&texture_names)?;
+        let clips = b.clips()?;
+        let render_volumes = b.render_volumes(&volumes)?;
+        let mut stored = Stored::new(b.world_offset, materials.len());
+        b.objects(&material_names, &mut stored)?;
+        b.imported(inline, &material_names, &mut stored)?;
+        let native_built = prebuilt.is_some();
+        if let Some(p) = prebuilt {
+            stored.take_prebuilt(p, b.world_offset)?;
+        }
+        let plugin_time = t0.elapsed();
+
+        let t1 = Instant::now();
+        stored.build_bvhs(!native_built)?;
+        let bvh_time = t1.elapsed();
+
+        let lights = b.lights();
+        let (fog, ao) = b.effects();
+        let features = features(
+            &desc.render,
+            &materials,
+            &stored,
+            &lights,
+            &fog,
+            &ao,
+            &render_volumes,
+        );
+        let r = &desc.render;
+        let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
+        Ok(Scene {
+            source: desc.source.clone(),
+            camera: camera.clone(),
+            primary_width: camera.footprint().0,
+            pixel_spread: camera.footprint().1,
+            background: v3(desc.background),
+            lights,
+            fog,
+            ao,
+            materials,
+            material_names,
+            textures,
+            texture_names,
+            spheres: stored.spheres,
+            triangles: stored.triangles,
+            planes: stored.planes,
+            cones: stored.cones,
+            discs: stored.discs,
+            customs: stored.customs,
+            clips,
+            volumes,
+            render_volumes,
+            world_offset: b.world_offset,
+            settings: settings(r),
+            outputs: r.outputs.clone(),
+            features,
+            used_materials: stored.used,
+            object_counts: stored.object_counts,
+            degenerate_triangles: stored.dropped,
+            bvh_time,
+            plugin_time,
+        })
+    }
+}
+
+/// What every stage reads: the description, the plugins, where relative paths start, and the
+/// world position of render space's origin (the camera).
+struct Build<'a> {
+    desc: &'a SceneDesc,
+    registry: &'a Registry,
+    scene_dir: PathBuf,
+    world_offset: DVec3,
+}
+
+/// The scene's geometry while it is being stored, and what storing it tells.
+struct Stored {
+    spheres: Spheres,
+    triangles: Triangles,
+    planes: Planes,
+    cones: Cones,
+    discs: Discs,
+    customs: Customs,
+    /// Per material: whether any object uses it.
+    used: Vec<bool>,
+    /// Objects per plugin name, in first-use order.
+    object_counts: Vec<(String, usize)>,
+    /// Degenerate triangles dropped.
+    dropped: u64,
+}
+
+impl<'a> Build<'a> {
+    fn new(desc: &'a SceneDesc, registry: &'a Registry) -> Build<'a> {
+        Build {
+            desc,
+            registry,
+            scene_dir: desc
+                .source
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default(),
+            world_offset: DVec3::from(desc.camera.value.position),
+        }
+    }
+
+    /// Stage: an instance of every texture, through its plugin; and their names.
+    fn textures(&self) -> Result<(Vec<TextureInstance>, Vec<String>), Error> {
+        let mut texture_names = Vec::new();
+        let mut textures = Vec::new();
+        for (name, call) in &self.desc.textures {
+            let entry = self
+                .registry
+                .get(&call.value.plugin.value, PluginKind::Texture)
+                .map_err(|e| Error::at(&call.value.plugin.at, e.to_string()))?;
+            let tex = create_texture(
+                self.registry,
+                entry,
+                &call.value.params,
+                &call.value.params_at,
+                &self.scene_dir,
+                name,
+            )
+            .map_err(|(at, m)| Error::at(&at, m))?;
+            texture_names.push(name.clone());
+            textures.push(tex);
+        }
+        Ok((textures, texture_names))
+    }
+
+    /// Stage: every volume, read by its reader plugin.
+    fn volumes(&self) -> Result<Vec<Volume>, Error> {
+        let mut volumes = Vec::with_capacity(self.desc.volumes.len());
+        for (i, v) in self.desc.volumes.iter().enumerate() {
+            let call = &v.value.call;
+            let entry = self
+                .registry
+                .get(&call.plugin.value, PluginKind::VolumeReader)
+                .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
+            let name = match &v.value.name {
+                Some(n) => n.value.clone(),
+                None => format!("volume {i}"),
+            };
+            let volume = read_volume(
+                self.registry,
+                entry,
+                &call.params,
+                &call.params_at,
+                &self.scene_dir,
+                &name,
+            )
+            .map_err(|(at, m)| Error::at(&at, m))?;
+            volumes.push(volume);
+        }
+        Ok(volumes)
+    }
+
+    /// Stage: the materials (index 0: the default, which the scene may redefine) with their
+    /// textures resolved; and their names.
+    fn materials(&self, texture_names: &[String]) -> Result<(Vec<Material>, Vec<String>), Error> {
+        let mut material_names = vec!["default".to_string()];
+        let mut materials = vec![material(&Default::default(), [None; 3])];
+        for (name, m) in &self.desc.materials {
+            let find = |t: &Option<Spanned<String>>| -> Result<Option<u32>, Error> {
+                match t {
+                    Some(t) => texture_names
+                        .iter()
+                        .position(|n| n == &t.value)
+                        .map(|i| Some(i as u32))
+                        .ok_or_else(|| Error::at(&t.at, format!("no texture named `{}`", t.value))),
+                    None => Ok(None),
+                }
+            };
+            let tex = [
+                find(&m.value.texture)?,
+                find(&m.value.reflect_texture)?,
+                find(&m.value.transmit_texture)?,
+            ];
+            let mat = material(&m.value, tex);
+            if let Some(i) = material_names.iter().position(|n| n == name) {
+                materials[i] = mat;
+            } else {
+                material_names.push(name.clone());
+                materials.push(mat);
+            }
+        }
+        if materials.len() as u32 > MAX_MATERIALS {
+            return Err(Error::Render(format!(
+                "the scene defines {} materials; at most {MAX_MATERIALS} are supported",
+                materials.len()
+            )));
+        }
+        Ok((materials, material_names))
+    }
+
+    /// Stage: the clip groups, in render space.
+    fn clips(&self) -> Result<Clips, Error> {
+        let groups = &self.desc.clip_groups;
+        if groups.len() as u32 >= MAX_CLIP_GROUPS {
+            return Err(Error::Render(format!(
+                "the scene defines {} clip groups; at most {} are supported",
+                groups.len(),
+                MAX_CLIP_GROUPS - 1
+            )));
+        }
+        Ok(Clips {
+            groups: groups
+                .iter()
+                .map(|(_, g)| {
+                    g.value
+                        .iter()
+                        .map(|p| {
+                            let q =
+                                Vec3A::from((DVec3::from(p.point) - self.world_offset).as_vec3());
+                            (q, Vec3A::from(DVec3::from(p.normal).normalize().as_vec3()))
+                        })
+                        .collect()
+                })
+                .collect(),
+        })
+    }
+
+    /// Stage: the volumes with `render` settings, prepared for ray casting.
+    fn render_volumes(&self, volumes: &[Volume]) -> Result<Vec<RenderVolume>, Error> {
+        let desc = self.desc;
+        let mut out = Vec::new();
+        for (i, (v, volume)) in desc.volumes.iter().zip(volumes).enumerate() {
+            let Some(r) = &v.value.render else {
+                continue;
+            };
+            if out.len() == MAX_RENDERED_VOLUMES {
+                return Err(Error::at(
+                    &r.at,
+                    format!("more than {MAX_RENDERED_VOLUMES} volumes are drawn; at most {MAX_RENDERED_VOLUMES} may have `render` settings"),
+                ));
+            }
+            let clip = self.clip_group(&r.value.clip)?;
+            let rv = RenderVolume::new(
+                &r.value,
+                volume,
+                i,
+                desc.render.volume_step,
+                self.world_offset,
+                clip,
+            )
+            .map_err(|m| Error::at(&r.at, m))?;
+            out.push(rv);
+        }
+        Ok(out)
+    }
+
+    /// Stage: every object, created by its primitive plugin into the native sets.
+    fn objects(&self, material_names: &[String], stored: &mut Stored) -> Result<(), Error> {
+        for (i, obj) in self.desc.objects.iter().enumerate() {
+            let call = &obj.value.call;
+            let entry = self
+                .registry
+                .get(&call.plugin.value, PluginKind::Primitive)
+                .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
+            let material = material_index(material_names, &obj.value.material)?;
+            stored.used[material] = true;
+            let clip = self.clip_group(&obj.value.clip)?;
+            let mut b = GeometryBuilder {
+                spheres: &mut stored.spheres,
+                triangles: &mut stored.triangles,
+                planes: &mut stored.planes,
+                cones: &mut stored.cones,
+                discs: &mut stored.discs,
+                customs: &mut stored.customs,
+                material: pack(material as u32, clip),
+                world_offset: self.world_offset,
+                plugin: entry.name.clone(),
+                dropped: 0,
+            };
+            create_primitive(
+                self.registry,
+                entry,
+                &call.params,
+                &call.params_at,
+                &self.scene_dir,
+                &format!("object {i}"),
+                &mut b,
+            )
+            .map_err(|(at, m)| Error::at(&at, m))?;
+            stored.dropped += b.dropped;
+            match stored
+                .object_counts
+                .iter_mut()
+                .find(|(n, _)| n == &entry.name)
+            {
+                Some((_, c)) => *c += 1,
+                None => stored.object_counts.push((entry.name.clone(), 1)),
+            }
+        }
+        Ok(())
+    }
+
+    /// Stage: imported geometry (NFF, OBJ), stored group by group.
+    fn imported(
+        &self,
+        inline: Inline,
+        material_names: &[String],
+        stored: &mut Stored,
+    ) -> Result<(), Error> {
+        let world_offset = self.world_offset;
+        for (k, g) in inline.enumerate() {
+            let at = || g.at.clone().unwrap_or_else(|| self.desc.camera.at.clone());
+            let material = material_index(material_names, &g.material)?;
+            stored.used[material] = true;
+            let m = material as u32;
+            let fail = |e: String| Error::at(&at(), format!("imported geometry group {k}: {e}"));
+            for (i, s) in g.spheres.iter().enumerate() {
+                stored
+                    .spheres
+                    .push_world(i, *s, world_offset, m)
+                    .map_err(fail)?;
+            }
+            for (i, c) in g.cones.iter().enumerate() {
+                stored
+                    .cones
+                    .push_world(i, *c, world_offset, m)
+                    .map_err(fail)?;
+            }
+            for (i, d) in g.discs.iter().enumerate() {
+                stored
+                    .discs
+                    .push_world(i, *d, world_offset, m)
+                    .map_err(fail)?;
+            }
+            for (i, p) in g.planes.iter().enumerate() {
+                stored
+                    .planes
+                    .push_world(i, *p, world_offset, m)
+                    .map_err(fail)?;
+            }
+            if !g.mesh.indices.is_empty() {
+                let input = MeshInput {
+                    positions: g.mesh.positions.as_flattened(),
+                    indices: g.mesh.indices.as_flattened(),
+                    normals: g.mesh.normals.as_flattened(),
+                    colors: &[],
+                    uvs: &g
+                        .mesh
+                        .uvs
+                        .iter()
+                        .flat_map(|u| u.map(|x| x as f32))
+                        .collect::<Vec<_>>(),
+                };
+                stored.dropped += stored
+                    .triangles
+                    .push_mesh(&input, world_offset, m)
+                    .map_err(fail)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Stage: the lights, in render space.
+    fn lights(&self) -> Vec<Light> {
+        let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - self.world_offset).as_vec3());
+        let unit = |d: &[f64; 3]| Vec3A::from(DVec3::from(*d).normalize().as_vec3());
+        let att = |a: &luxon_formats::Attenuation| {
+            [a.constant as f32, a.linear as f32, a.quadratic as f32]
+        };
+        self.desc
+            .lights
+            .iter()
+            .map(|l| match &l.value {
+                LightDesc::Point {
+                    position,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Point {
+                    position: at(position),
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
+                LightDesc::Directional {
+                    direction,
+                    color,
+                    intensity,
+                    shadows,
+                } => Light::Directional {
+                    to_light: -unit(direction),
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                },
+                LightDesc::Spot {
+                    position,
+                    direction,
+                    cone_deg,
+                    falloff_deg,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Spot {
+                    position: at(position),
+                    axis: unit(direction),
+                    cos_inner: ((cone_deg - falloff_deg) * 0.5).to_radians().cos() as f32,
+                    cos_outer: (cone_deg * 0.5).to_radians().cos() as f32,
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
+                LightDesc::Sphere {
+                    center,
+                    radius,
+                    samples,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Sphere {
+                    center: at(center),
+                    radius: *radius as f32,
+                    samples: *samples,
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
+                LightDesc::Rect {
+                    corner,
+                    edge1,
+                    edge2,
+                    samples,
+                    color,
+                    intensity,
+                    shadows,
+                    attenuation,
+                } => Light::Rect {
+                    corner: at(corner),
+                    edge1: v3(*edge1),
+                    edge2: v3(*edge2),
+                    normal: v3(*edge1).cross(v3(*edge2)).normalize(),
+                    samples: *samples,
+                    color: v3(*color) * *intensity as f32,
+                    shadows: *shadows,
+                    attenuation: att(attenuation),
+                },
+            })
+            .collect()
+    }
+
+    /// Stage: fog and ambient occlusion.
+    fn effects(&self) -> (Option<Fog>, Option<Ao>) {
+        let fog = self.desc.fog.as_ref().map(|f| Fog {
+            mode: f.mode,
+            color: v3(f.color),
+            planar: f.planar,
+        });
+        let ao = self.desc.ambient_occlusion.as_ref().map(|a| Ao {
+            samples: a.samples,
+            max_distance: a.max_distance as f32,
+            sky: v3(a.color) * a.intensity as f32,
+            direct: a.direct as f32,
+        });
+        (fog, ao)
+    }
+
+    /// The clip group a name refers to (0: none; group `k` is the `k`-th in the scene).
+    fn clip_group(&self, name: &Option<Spanned<String>>) -> Result<u32, Error> {
+        Ok(match name {
+            Some(c) => {
+                1 + self
+                    .desc
+                    .clip_groups
+                    .iter()
+                    .position(|(n, _)| n == &c.value)
+                    .ok_or_else(|| Error::at(&c.at, format!("no clip group named `{}`", c.value)))?
+                    as u32
+            }
+            None => 0,
+        })
+    }
+}
+
+/// The material a name refers to (0: the default).
+fn material_index(names: &[String], name: &Option<Spanned<String>>) -> Result<usize, Error> {
+    Ok(match name {
+        Some(m) => names
+            .iter()
+            .position(|n| n == &m.value)
+            .ok_or_else(|| Error::at(&m.at, format!("no material named `{}`", m.value)))?,
+        None => 0,
+    })
+}
+
+impl Stored {
+    fn new(world_offset: DVec3, materials: usize) -> Stored {
+        Stored {
+            spheres: Spheres::default(),
+            triangles: Triangles::default(),
+            planes: Planes::default(),
+            cones: Cones::default(),
+            discs: Discs::default(),
+            customs: Customs::new(world_offset),
+            used: vec![false; materials],
+            object_counts: Vec::new(),
+            dropped: 0,
+        }
+    }
+
+    /// Stage (with a geometry cache): its native sets and BVHs replace the (empty) ones here.
+    fn take_prebuilt(&mut self, p: Prebuilt, world_offset: DVec3) -> Result<(), Error> {
+        if p.used.len() != self.used.len() || p.world_offset != world_offset {
+            return Err(Error::Render(
+                "the geometry cache does not match the scene".into(),
+            ));
+        }
+        self.spheres = p.spheres;
+        self.triangles = p.triangles;
+        self.cones = p.cones;
+        for (u, p) in self.used.iter_mut().zip(p.used) {
+            *u |= p;
+        }
+        self.dropped += p.degenerate;
+        Ok(())
+    }
+
+    /// Stage: the BVHs of every set, in parallel; the native ones only when `native` (a
+    /// cache's come built).
+    fn build_bvhs(&mut self, native: bool) -> Result<(), Error> {
+        let Stored {
+            spheres,
+            triangles,
+            cones,
+            discs,
+            customs,
+            ..
+        } = self;
+        let (_, custom_result) = rayon::join(
+            || {
+                if native {
+                    rayon::join(
+                        || rayon::join(|| spheres.build(), || triangles.set.build()),
+                        || rayon::join(|| cones.build(), || discs.build()),
+                    );
+                }
+            },
+            || customs.build(),
+        );
+        custom_result.map_err(Error::Plugin)
+    }
+
+    fn has_geometry(&self) -> bool {
+        !(self.spheres.is_empty()
+            && self.triangles.is_empty()
+            && self.planes.planes.is_empty()
+            && self.customs.is_empty())
+    }
+}
+
+/// Last: the effects the scene calls for, so the integrator skips the others.
+fn features(
+    r: &RenderDesc,
+    materials: &[Material],
+    stored: &Stored,
+    lights: &[Light],
+    fog: &Option<Fog>,
+    ao: &Option<Ao>,
+    render_volumes: &[RenderVolume],
+) -> Features {
+    let used_mats: Vec<&Material> = materials
+        .iter()
+        .zip(&stored.used)
+        .filter(|(_, u)| **u)
+        .map(|(m, _)| m)
+        .collect();
+    let has_geometry = stored.has_geometry();
+    Features {
+        shadows: has_geometry && lights.iter().any(Light::casts_shadows),
+        ambient_occlusion: has_geometry && ao.is_some(),
+        fog: fog.is_some(),
+        reflection: used_mats.iter().any(|m| m.reflect > 0.0),
+        transmission: used_mats.iter().any(|m| m.transmit > 0.0),
+        textures: used_mats.iter().any(|m| {
+            m.texture
+                .or(m.reflect_texture)
+                .or(m.transmit_texture)
+                .is_some()
+        }),
+        antialiasing: r.samples > 1 || r.adaptive.is_some(),
+        volumes: !render_volumes.is_empty(),
+    }
+}
+
+/// The render settings (after command-line overrides, which change the description).
+fn settings(r: &RenderDesc) -> Settings {
+    Settings {
+        width: r.width,
+        height: r.height,
+        samples: r.samples,
+        max_depth: r.max_depth,
+        min_weight: r.min_weight as f32,
+        frame: r.frame,
+        time: r.time as f32,
+        threads: r.parallel.threads,
+        tile_size: r.parallel.tile_size,
+        transparency: r.transparency,
+        mode: r.parallel.mode,
+        decomposition: r.parallel.decomposition,
+        io: r.parallel.io,
+        volume_skip: r.volume_skip,
+        adaptive: r.adaptive,
+    }
+}
+
+fn v3(a: [f64; 3]) -> Vec3A {
+    Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
+}
+
+/// `textures`: the material's colour, reflect and transmit textures.
+fn material(m: &luxon_formats::MaterialDesc, textures: [Option<u32>; 3]) -> Material {
+    Material {
+        color: v3(m.color),
+        texture: textures[0],
+        reflect_texture: textures[1],
+        transmit_texture: textures[2],
+        ambient: m.ambient as f32,
+        diffuse: m.diffuse as f32,
+        specular: m.specular as f32,
+        shininess: m.shininess as f32,
+        blinn: m.highlight == Highlight::Blinn,
+        reflect: m.reflect as f32,
+        transmit: m.transmit as f32,
+        ior: m.ior as f32,
+    }
+}
