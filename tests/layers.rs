@@ -1,5 +1,5 @@
-//! One-way layering: a module of `core` may import only modules of lower layers (the table in
-//! the crate documentation, core/src/lib.rs). Modules of one layer must not import each other,
+//! One-way layering: a module of `core` (or of `formats`) may import only modules of lower layers
+//! (the tables in the crate documentation, core/src/lib.rs and formats/src/lib.rs). Modules of one layer must not import each other,
 //! so the layers are a strict order and nothing runs in a circle.
 //!
 //! The check reads the source: every `crate::…` path (`use` lines, grouped and multi-line uses,
@@ -31,16 +31,38 @@ const CORE: &[(&str, &[&str])] = &[
     ("cli", &["cli"]),
 ];
 
-#[test]
-fn core_imports_only_from_lower_layers() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("core/src");
-    let problems = check(&src, CORE);
+/// The layers of formats/src, bottom to top. Keep in step with the table in formats/src/lib.rs.
+const FORMATS: &[(&str, &[&str])] = &[
+    ("origin", &["origin"]),
+    ("leaves", &["error", "geometry", "spans", "raw"]),
+    ("description", &["desc"]),
+    ("scanner", &["scanner"]),
+    ("checks", &["validate", "ron_error"]),
+    ("conversion", &["convert", "camera", "effects", "volume_render"]),
+    ("importers", &["nff", "obj"]),
+    ("formats", &["ron_scene", "spd"]),
+    ("front door", &["load"]),
+];
+
+fn assert_layered(crate_dir: &str, layers: &[(&str, &[&str])]) {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(crate_dir);
+    let problems = check(&src, layers);
     assert!(
         problems.is_empty(),
-        "layering of core/src broken ({} problems):\n{}",
+        "layering of {crate_dir} broken ({} problems):\n{}",
         problems.len(),
         problems.join("\n")
     );
+}
+
+#[test]
+fn core_imports_only_from_lower_layers() {
+    assert_layered("core/src", CORE);
+}
+
+#[test]
+fn formats_imports_only_from_lower_layers() {
+    assert_layered("formats/src", FORMATS);
 }
 
 /// Checks the modules under `src_dir` against `layers` (name and modules of each layer, bottom
