@@ -1,4 +1,4 @@
-//! Inline native geometry: what importers of fixed formats (NFF, OBJ, Tachyon) hand the core
+//! Inline native geometry: what the importers of fixed formats (NFF, OBJ) hand the core
 //! directly. A million triangles must not round-trip through RON text to reach a plugin, so an
 //! importer fills these arrays and the core stores them as it stores a primitive plugin's output
 //! (same validation, same native types). World coordinates, f64.
