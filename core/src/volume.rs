@@ -12,6 +12,10 @@
 //! given twice, and an index box of at most [`MAX_VOXELS`] voxels (checked before anything is
 //! allocated). The first error stops the volume: later calls fail, and the read fails even if
 //! the plugin ignores the error.
+//!
+//! The readers are plugins (`plugins/volume-raw`, `plugins/volume-vdb`); how volumes are drawn:
+//! the module `volume_render`; what a scene writes (transfer functions, steps, shading): in
+//! the Volumes section of `formats/README.md`.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};

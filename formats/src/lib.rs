@@ -1,9 +1,10 @@
-//! # luxon-formats: scene files into `SceneDesc`
+#![doc = include_str!("../README.md")]
 //!
-//! Reads Luxon's RON scene format and the NFF and OBJ importers into a [`SceneDesc`]: plain
-//! data with the source position of everything, so that every error names `file:line:col` and
-//! what was expected. [`spd`] generates Eric Haines' SPD test scenes as NFF or RON. Depends on
-//! no renderer code and knows no plugins.
+//! ## The API
+//!
+//! [`load`] reads any supported file, [`load_ron_str`] RON text; both give a [`SceneDesc`]
+//! (module [`desc`]) or a [`SceneError`]. The importers are [`nff`] and [`obj`]; [`spd`]
+//! generates the SPD scenes; [`geometry`] holds the inline arrays importers hand the core.
 //!
 //! Modules import only modules of lower layers (bottom first; `tests/layers.rs` keeps this):
 //!

@@ -122,7 +122,7 @@ impl<'r> AsyncOutput<'r> {
 
     /// Takes chunks until every sender is gone, then finishes every file; returns the paths
     /// written. Incomplete rows (a failed render) leave no file behind. Unpark the thread
-    /// running this after dropping the last sender, or the end waits up to `POLL` (20 ms).
+    /// running this after dropping the last sender, or the end waits up to `POLL`.
     pub fn run(
         mut self,
         chunks: Receiver<Chunk>,

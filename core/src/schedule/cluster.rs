@@ -9,7 +9,7 @@
 //!
 //! All MPI calls are made by each rank's main thread, which polls (and sleeps briefly: OpenMPI's
 //! blocking calls spin and would steal a core from the render threads), except on failure: an
-//! error or panic anywhere ends the whole job through [`fail`] (`MPI_Abort`), after rank 0 has
+//! error or panic anywhere ends the whole job through `abort::fail` (`MPI_Abort`), after rank 0 has
 //! printed the cause.
 
 use super::abort::{abort_job, fail, Injected, TAG_ERROR};

@@ -1,6 +1,4 @@
-//! Parallel scheduling: which worker renders which pixels, in one process ([`render_local`]) or
-//! across MPI ranks (`cluster`, with the `mpi` feature). Whatever the decomposition, each pixel's
-//! samples come from its own deterministic sequence, so the image never depends on it.
+#![doc = include_str!("README.md")]
 
 pub mod decompose;
 pub mod wire;

@@ -29,7 +29,7 @@
 //! ## Build and use
 //! ```text
 //! cargo build --release -p luxon-torus          # -> target/release/libluxon_torus.so
-//! LUXON_PLUGIN_PATH=target/release luxon scene.ron
+//! LUXON_PLUGIN_PATH=target/release luxon render scene.ron
 //! ```
 //! Instead of the environment variable a scene can name the directory (or the `.so` itself),
 //! relative to the scene file: `plugin_path: ["../target/release"]`.

@@ -32,6 +32,10 @@
 //!
 //! Panics inside any entry point are caught here and reported to the host as errors naming the
 //! plugin; they never unwind across `extern "C"`.
+//!
+//! The rest of this page is the repository's `plugins/README.md`: the shipped plugins and how
+//! to write one. Its Rust example is compiled as a doctest here.
+#![doc = include_str!("../../README.md")]
 
 pub mod abi;
 

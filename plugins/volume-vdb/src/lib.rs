@@ -55,6 +55,22 @@
 //! ],
 //! ```
 //!
+//! `scenes/volumes/cloud.vdb` is a small cloud-like fog volume (48³, half floats) that
+//! `scenes/vdb-cloud.ron` renders, gradient shaded and casting its shadow on a floor.
+//!
+//! ## Tested against OpenVDB
+//!
+//! The test fixtures (`tests/fixtures/`) are written by OpenVDB itself: `/usr/bin/python3
+//! plugins/volume-vdb/tests/fixtures/make_fixtures.py --cloud scenes/volumes/cloud.vdb` (Debian's
+//! `python3-openvdb`; `libopenvdb-dev` and `libboost-dev` for the double, uncompressed and
+//! mask-less ones). The tests read every fixture voxel by voxel against the values OpenVDB
+//! wrote, and every truncation, random corruption, wrong type and name.
+//!
+//! When `python3-openvdb` is installed (CI installs it), `tests/pyopenvdb_oracle.rs` also asks
+//! OpenVDB itself, live, for every fixture's values and active flags on a lattice around its
+//! active box and compares them with this reader: 18,309 voxels of 11 grids agree. Without
+//! pyopenvdb it says it is skipped.
+//!
 //! ## Fuzzing
 //!
 //! The parser has a cargo-fuzz target (`plugins/volume-vdb/fuzz`, seeded with the test
