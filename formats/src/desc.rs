@@ -527,7 +527,7 @@ impl Default for RenderDesc {
     }
 }
 
-/// How the work is spread. Threads only in this version; the scheduler issue adds MPI and hybrid.
+/// How the work is spread: threads in one process, MPI ranks, or both (hybrid), and how pixels are dealt.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParallelDesc {
     pub mode: ParallelMode,
