@@ -501,6 +501,7 @@ fn stream(
 }
 
 #[cfg(test)]
+#[allow(unsafe_code)] // drives the reader through its C entry point, as the host does
 mod tests {
     use super::*;
     use luxon_plugin::abi;
