@@ -170,33 +170,41 @@ pub fn describe_ron_error(code: &ron::Error) -> String {
     }
 }
 
-/// The candidate closest to `word` by edit distance, if it is close enough to be a likely typo.
+/// The candidate closest to `word` by edit distance, if it is close enough to be a likely typo:
+/// at most `max(2, len / 3)` edits (len: `word`'s length in characters), and not a complete
+/// rewrite of the word. The first of equally close candidates wins.
+///
+/// Luxon's one "did you mean" rule: plugin parameters and names here, scene files through
+/// `luxon-formats` (which re-exports it).
 pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let mut best: Option<(usize, &str)> = None;
-    for c in candidates {
-        let d = edit_distance(word, c);
-        if best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, c));
+    let len = word.chars().count();
+    let limit = (len / 3).max(2);
+    let mut best: Option<(usize, &'a str)> = None;
+    for candidate in candidates {
+        let d = edit_distance(word, candidate);
+        // Replacing every character is not a typo ("x" is not a misspelt "up").
+        let whole = len.max(candidate.chars().count());
+        if d <= limit && d < whole && !matches!(best, Some((b, _)) if b <= d) {
+            best = Some((d, candidate));
         }
     }
-    best.filter(|(d, c)| *d <= 2.max(c.len() / 3))
-        .map(|(_, c)| c)
+    best.map(|(_, c)| c)
 }
 
 /// Levenshtein distance over chars.
 pub fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    let mut cur = vec![0; b.len() + 1];
+    let mut row: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {
-        cur[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let sub = prev[j] + usize::from(ca != *cb);
-            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let substitute = diagonal + usize::from(ca != cb);
+            diagonal = row[j + 1];
+            row[j + 1] = substitute.min(row[j] + 1).min(diagonal + 1);
         }
-        std::mem::swap(&mut prev, &mut cur);
     }
-    prev[b.len()]
+    row[b.len()]
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -1059,9 +1067,28 @@ mod tests {
     }
 
     #[test]
-    fn suggestions() {
+    fn distance_counts_edits() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("fov", "fov"), 0);
+        assert_eq!(edit_distance("fvo", "fov"), 2);
+    }
+
+    #[test]
+    fn suggests_close_names_only() {
         assert_eq!(suggest("sphre", ["sphere", "plane"]), Some("sphere"));
         assert_eq!(suggest("xyzzy", ["sphere", "plane"]), None);
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(suggest("Pont", ["Point", "Directional"]), Some("Point"));
+        assert_eq!(suggest("radus", ["center", "radius"]), Some("radius"));
+        assert_eq!(suggest("glas", ["red", "glass", "floor"]), Some("glass"));
+        assert_eq!(suggest("zzzzzz", ["red", "glass"]), None);
+        assert_eq!(suggest("x", ["up"]), None);
+        // Long words tolerate more edits: 12 / 3 = 4.
+        assert_eq!(
+            suggest("declmpositio", ["decomposition"]),
+            Some("decomposition")
+        );
+        // The first of equally close candidates.
+        assert_eq!(suggest("cat", ["bat", "cut"]), Some("bat"));
     }
 }
