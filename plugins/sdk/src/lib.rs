@@ -1012,8 +1012,8 @@ macro_rules! export {
             ///
             /// # Safety
             /// `host` is null or the host's table, valid for the rest of the process.
-            // SAFETY: the one symbol of this name in the library (the host looks it up by it);
-            // `export!` may be used once per library.
+            // Unmangled, which is unsafe only if the name clashes: the host looks the library's
+            // one symbol of this name up (`export!` is used once per library).
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn luxon_plugin_declare(
                 host: *const abi::HostTable,

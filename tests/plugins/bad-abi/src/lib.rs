@@ -16,7 +16,8 @@ static HEADER: Header = Header(PluginHeader {
     declaration: std::ptr::null(),
 });
 
-// SAFETY: the one symbol of this name in the library (no SDK `export!` here).
+// Unmangled, which is unsafe only if the name clashes: the library's one symbol of this name
+// (no SDK `export!` here).
 #[unsafe(no_mangle)]
 pub extern "C" fn luxon_plugin_declare(_host: *const HostTable) -> *const PluginHeader {
     &HEADER.0
