@@ -74,7 +74,7 @@ filter: nearest|bilinear|mip = mip  mip: trilinear, level chosen from the ray's 
 }
 
 impl ImageTexture {
-    /// `create` with an explicit cache (the plugin uses [`cache::global`]).
+    /// `create` with an explicit cache (the plugin uses `cache::global`).
     pub fn create_in(p: ImageParams, ctx: &Context, cache: Arc<Cache>) -> Result<Self, Error> {
         if p.mapping == Kind::Uv {
             for (name, given) in [("center", p.center.is_some()), ("axis", p.axis.is_some())] {
