@@ -38,7 +38,10 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("description", &["desc"]),
     ("scanner", &["scanner"]),
     ("checks", &["validate", "ron_error"]),
-    ("conversion", &["convert", "camera", "effects", "volume_render"]),
+    (
+        "conversion",
+        &["convert", "camera", "effects", "volume_render"],
+    ),
     ("importers", &["nff", "obj"]),
     ("formats", &["ron_scene", "spd"]),
     ("front door", &["load"]),
