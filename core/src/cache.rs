@@ -357,8 +357,12 @@ pub fn open(source: &Path) -> Lookup {
                 continue;
             }
         }
-        // SAFETY: the map is read-only and only read through checked slices; a file changed
-        // underneath at worst yields wrong bytes, which the checksums reject.
+        // SAFETY: a file map is sound while nothing changes the file in place. Luxon never
+        // does: a cache file is written whole under a temporary name and renamed over the old
+        // one (`write`), which leaves the mapped file as it is. Another program writing into
+        // a cache file is outside what a map can guard against; the bytes are only read through
+        // bounds-checked slices and checked against their checksums, so such a change at worst
+        // yields a rejected cache.
         let map = match unsafe { memmap2::Mmap::map(&file) } {
             Ok(m) => m,
             Err(_) => continue,
@@ -371,8 +375,10 @@ pub fn open(source: &Path) -> Lookup {
             let start = (at - base).next_multiple_of(PAGE);
             let end = (at - base + len) / PAGE * PAGE;
             if end > start {
-                // SAFETY: a read-only private file mapping; dropped pages are read from the
-                // file again if touched (and the checksum has already been taken).
+                // SAFETY: a read-only map of a file that does not change (see above): pages
+                // dropped here are read back from the file if touched again, so every slice into
+                // them still sees the same bytes; the range lies inside the map (whole pages
+                // within the `len` bytes at `at`, which the reader took from it).
                 let _ = unsafe {
                     map.unchecked_advise_range(
                         memmap2::UncheckedAdvice::DontNeed,

@@ -1,5 +1,8 @@
 //! `luxon`: the command-line shell over the library.
 
+// Unsafe code only where allowed by name (the allocator setting).
+#![deny(unsafe_code)]
+
 mod cli;
 
 use clap::{Parser, Subcommand};
@@ -61,8 +64,11 @@ enum Command {
 /// loader's freed buffers stay in the heap for the rest of the run (balls6: 96 MB peak instead
 /// of 69 MB). A fixed threshold keeps large blocks mmapped and returned when freed.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[allow(unsafe_code)]
 fn keep_large_blocks_returnable() {
-    // SAFETY: mallopt only changes allocator parameters; called before any other thread runs.
+    // SAFETY: mallopt takes two integers and only changes a parameter of glibc's allocator
+    // (under the allocator's own lock); the threshold is within its valid range. It runs first in
+    // `main`, before any other thread exists.
     unsafe {
         libc::mallopt(libc::M_MMAP_THRESHOLD, 128 * 1024);
     }

@@ -33,37 +33,9 @@ impl SceneError {
     }
 }
 
-/// The candidate closest to `word` by edit distance, if it is close enough to be a likely typo:
-/// at most `max(2, len / 3)` edits (len in characters), and not a complete rewrite of the word.
-pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let len = word.chars().count();
-    let limit = (len / 3).max(2);
-    let mut best: Option<(usize, &'a str)> = None;
-    for candidate in candidates {
-        let d = edit_distance(word, candidate);
-        // Replacing every character is not a typo ("x" is not a misspelt "up").
-        let whole = len.max(candidate.chars().count());
-        if d <= limit && d < whole && !matches!(best, Some((b, _)) if b <= d) {
-            best = Some((d, candidate));
-        }
-    }
-    best.map(|(_, c)| c)
-}
-
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut diagonal = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let substitute = diagonal + usize::from(ca != cb);
-            diagonal = row[j + 1];
-            row[j + 1] = substitute.min(row[j] + 1).min(diagonal + 1);
-        }
-    }
-    row[b.len()]
-}
+// The "did you mean" rule, shared with plugin parameters (it lives in the plugin SDK, which
+// plugins depend on alone).
+pub use luxon_plugin::suggest;
 
 /// "`a`, `b`, `c`" for messages.
 pub(crate) fn quoted_list<'a>(names: impl IntoIterator<Item = &'a str>) -> String {
@@ -97,24 +69,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn distance_counts_edits() {
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
-        assert_eq!(edit_distance("", "abc"), 3);
-        assert_eq!(edit_distance("fov", "fov"), 0);
-        assert_eq!(edit_distance("fvo", "fov"), 2);
-    }
-
-    #[test]
     fn suggests_close_names_only() {
         assert_eq!(suggest("Pont", ["Point", "Directional"]), Some("Point"));
-        assert_eq!(suggest("radus", ["center", "radius"]), Some("radius"));
         assert_eq!(suggest("glas", ["red", "glass", "floor"]), Some("glass"));
         assert_eq!(suggest("zzzzzz", ["red", "glass"]), None);
         assert_eq!(suggest("x", ["up"]), None);
-        // Long words tolerate more edits: 12 / 3 = 4.
+    }
+
+    #[test]
+    fn unknown_names_suggest_and_list() {
         assert_eq!(
-            suggest("declmpositio", ["decomposition"]),
-            Some("decomposition")
+            unknown_name("material", "glas", " in object 3", ["red", "glass"]),
+            "unknown material `glas` in object 3; did you mean `glass`? expected one of `red`, `glass`"
+        );
+        assert_eq!(
+            unknown_name("texture", "wood", "", []),
+            "unknown texture `wood`; none are defined"
         );
     }
 }

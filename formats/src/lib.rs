@@ -20,6 +20,8 @@
 //! | formats     | `ron_scene`, `spd`                               |
 //! | front door  | `load`                                           |
 
+#![forbid(unsafe_code)]
+
 mod camera;
 mod convert;
 pub mod desc;

@@ -120,7 +120,8 @@ type Bins<const K: usize> = ([[Aabb; K]; 3], [[usize; K]; 3]);
 /// binning and the partition that follows it both call this, so they agree on every primitive.
 #[inline(always)]
 fn bin_of(c: Vec3A, lo: Vec3A, scale: Vec3A, bins: usize) -> [usize; 3] {
-    clamped_index((c - lo) * scale, (bins - 1) as f32)
+    // At most `BINS` bins, so `bins - 1` fits a u8.
+    clamped_index((c - lo) * scale, (bins - 1) as u8)
 }
 
 /// Adds the primitives to `bins` by centroid ([`bin_of`]).

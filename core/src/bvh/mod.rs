@@ -10,7 +10,11 @@
 //! and node fetches). All unsafe code of the BVH is in `simd` and `stack`.
 
 mod build;
+// Intrinsics and the AVX dispatch.
+#[allow(unsafe_code)]
 mod simd;
+// Unchecked stack and node accesses.
+#[allow(unsafe_code)]
 mod stack;
 mod traversal;
 mod wide;

@@ -47,7 +47,8 @@ impl BoxRay {
         let mut t = [0.0; LANES];
         let mut mask = 0;
         for h in 0..LANES / 4 {
-            // SAFETY: SSE is part of the x86_64 baseline; each load reads four floats of a row.
+            // SAFETY: SSE is part of the x86_64 baseline. Each row of `node.b` and `t` hold
+            // `LANES` = 8 floats and h < 2, so the four floats at `4 * h` are in bounds.
             unsafe {
                 let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr().add(4 * h));
                 let mut near = _mm_setzero_ps();
@@ -76,7 +77,8 @@ impl BoxRay {
     fn enter_avx(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
         use std::arch::x86_64::*;
         let row = |r: usize| {
-            // SAFETY: reads one row of eight floats.
+            // SAFETY: a row of `node.b` holds `LANES` = 8 floats (`r` itself is bounds-checked),
+            // and this function only runs with AVX enabled.
             unsafe { _mm256_loadu_ps(node.b[r].as_ptr()) }
         };
         let mut near = _mm256_setzero_ps();
@@ -92,7 +94,7 @@ impl BoxRay {
         }
         let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(near, far);
         let mut t = [0.0; LANES];
-        // SAFETY: writes eight floats.
+        // SAFETY: `t` holds `LANES` = 8 floats.
         unsafe { _mm256_storeu_ps(t.as_mut_ptr(), near) };
         (_mm256_movemask_ps(hit) as u32, t)
     }
@@ -106,7 +108,10 @@ impl BoxRay {
     ) -> (u32, [f32; LANES]) {
         #[cfg(target_arch = "x86_64")]
         if AVX {
-            // SAFETY: only the AVX instantiations call this, after checking the CPU.
+            debug_assert!(avx());
+            // SAFETY: the CPU has AVX: `AVX` is true only in the loops `intersect_avx` and
+            // `any_avx` instantiate, which run only after `avx()` said so (the `_dispatch`
+            // functions below); nothing else in `bvh` passes `true`.
             return unsafe { self.enter_avx(node, t_max) };
         }
         self.enter(node, t_max)
@@ -139,14 +144,34 @@ fn avx() -> bool {
     std::arch::is_x86_feature_detected!("avx")
 }
 
-/// The lanes of `v` clamped to `[0, max]` and truncated to indices. Clamped first (max maps NaN
-/// to 0), so the cheap truncating conversion is exact; Rust's saturating `as` cost a fifth of
-/// the BVH build.
+/// The lanes of `v` clamped to `[0, max]` (NaN to 0) and truncated to indices. Clamped with
+/// SSE first, so the cheap truncating conversion is exact; Rust's saturating `as` cost a fifth
+/// of the BVH build.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub(super) fn clamped_index(v: Vec3A, max: f32) -> [usize; 3] {
-    let x: [f32; 3] = v.max(Vec3A::ZERO).min(Vec3A::splat(max)).into();
-    // SAFETY: each x is finite and in [0, max], and max is a small bin count.
+pub(super) fn clamped_index(v: Vec3A, max: u8) -> [usize; 3] {
+    use std::arch::x86_64::*;
+    // `maxps` returns its second operand when either is NaN (Intel's definition; glam's `max`
+    // does not promise it on every target), so NaN lanes become 0 here.
+    // SAFETY: SSE is part of the x86_64 baseline.
+    let clamped = unsafe {
+        _mm_min_ps(
+            _mm_max_ps(v.into(), _mm_setzero_ps()),
+            _mm_set1_ps(f32::from(max)),
+        )
+    };
+    let x: [f32; 3] = Vec3A::from(clamped).into();
+    // SAFETY: each x is in [0, max] with max <= 255 (no NaN, see above), so its truncation is
+    // representable in a u32.
     x.map(|x| unsafe { x.to_int_unchecked::<u32>() } as usize)
+}
+
+/// The same with Rust's saturating conversion, which maps NaN to 0, on other targets.
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+pub(super) fn clamped_index(v: Vec3A, max: u8) -> [usize; 3] {
+    let x: [f32; 3] = v.into();
+    x.map(|x| x.max(0.0).min(f32::from(max)) as usize)
 }
 
 /// The traversal loops (`Bvh::closest` and `Bvh::first`) compiled for AVX where the CPU has it,
@@ -162,7 +187,7 @@ impl Bvh {
     ) -> f32 {
         #[cfg(target_arch = "x86_64")]
         if avx() {
-            // SAFETY: the CPU has AVX.
+            // SAFETY: the CPU has AVX (just checked), the feature `intersect_avx` is built for.
             return unsafe { self.intersect_avx(origin, dir, t_max, test) };
         }
         self.intersect_base(origin, dir, t_max, test)
@@ -191,7 +216,7 @@ impl Bvh {
     ) -> bool {
         #[cfg(target_arch = "x86_64")]
         if avx() {
-            // SAFETY: the CPU has AVX.
+            // SAFETY: the CPU has AVX (just checked), the feature `any_avx` is built for.
             return unsafe { self.any_avx(origin, dir, t_max, test) };
         }
         self.any_base(origin, dir, t_max, test)

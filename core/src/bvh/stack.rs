@@ -15,7 +15,9 @@ const STACK: usize = (LANES - 1) * MAX_DEPTH + 1;
 /// array beside `len` in one struct.
 pub(super) struct Stack<'a, T> {
     entries: &'a mut [MaybeUninit<T>; STACK],
-    pub(super) len: usize,
+    /// Entries below `len` are initialised (private, so only `push` and `insert_sorted` raise
+    /// it, each after writing the entry).
+    len: usize,
 }
 
 /// The storage of a [`Stack`].
@@ -31,10 +33,19 @@ impl<'a, T: Copy> Stack<'a, T> {
     }
 
     #[inline(always)]
+    pub(super) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Pushes an entry. The traversals keep `len < STACK` here: they push only a node's hit
+    /// children, and after taking one of them hold at most `LANES - 1` entries per level above
+    /// the current node; every inner node is less than `MAX_DEPTH` deep (`collapse` keeps the
+    /// binary tree's depth, and `from_words` refuses deeper cached trees along any path), so at
+    /// most `(LANES - 1) * (MAX_DEPTH - 1) + LANES = STACK` entries are ever held.
+    #[inline(always)]
     pub(super) fn push(&mut self, entry: T) {
         debug_assert!(self.len < STACK);
-        // SAFETY: a traversal holds at most `LANES - 1` entries per level of the tree plus one,
-        // and no tree is deeper than `MAX_DEPTH` (built so, and checked for cached trees).
+        // SAFETY: `len < STACK` (see above), so the slot is in bounds.
         unsafe { *self.entries.get_unchecked_mut(self.len) = MaybeUninit::new(entry) };
         self.len += 1;
     }
@@ -45,19 +56,21 @@ impl<'a, T: Copy> Stack<'a, T> {
             return None;
         }
         self.len -= 1;
-        // SAFETY: entries below `len` were written by `push`.
+        // SAFETY: `len` was at most `STACK`, so the slot is in bounds, and it is below the old
+        // `len`, so it is initialised.
         Some(unsafe { self.entries.get_unchecked(self.len).assume_init() })
     }
 }
 
 impl Stack<'_, (u64, f32)> {
-    /// Pushes keeping the entries above `base` in decreasing order of `t`.
+    /// Pushes keeping the entries above `base` (at most `len`) in decreasing order of `t`.
     #[inline(always)]
     pub(super) fn insert_sorted(&mut self, base: usize, link: u64, t: f32) {
         let mut j = self.len;
-        debug_assert!(j < STACK);
-        // SAFETY: entries in base..len were written by `push` or here, and len stays in range
-        // as in `push`.
+        debug_assert!(j < STACK && base <= j);
+        // SAFETY: `len < STACK` as in `push`, so every slot up to `len` is in bounds; the loop
+        // reads only slots `j - 1 >= base` below `len`, which are initialised, and moves them
+        // up one, so slots up to the old `len` stay initialised.
         unsafe {
             while j > base && self.entries.get_unchecked(j - 1).assume_init().1 < t {
                 *self.entries.get_unchecked_mut(j) = *self.entries.get_unchecked(j - 1);
@@ -70,12 +83,14 @@ impl Stack<'_, (u64, f32)> {
 }
 
 impl Bvh {
-    /// Node `i` of a link. Links come from `collapse` or passed `from_words`, so they are in
-    /// range; the traversal loops skip the check.
+    /// Node `i` of a link, or the root (0). The traversal loops skip the bounds check.
     #[inline(always)]
     pub(super) fn node(&self, i: usize) -> &Wide {
         debug_assert!(i < self.nodes.len());
-        // SAFETY: see above; the root (0) exists whenever a traversal starts.
+        // SAFETY: `i` is in bounds: the traversals ask for the root only when `nodes` is not
+        // empty, and otherwise for an inner node's link, which `collapse` makes and
+        // `from_words` checks to be an index below `nodes.len()` (`nodes` is private to `bvh`
+        // and only ever set by those two).
         unsafe { self.nodes.get_unchecked(i) }
     }
 }

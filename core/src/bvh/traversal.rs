@@ -76,7 +76,7 @@ impl Bvh {
                 }
             } else {
                 // Push the children hit, nearest last so it is taken first.
-                let base = stack.len;
+                let base = stack.len();
                 while mask != 0 {
                     let l = first_lane(mask);
                     mask &= mask - 1;

@@ -117,8 +117,11 @@ impl Bvh {
                 if !ok || depth[i] as usize >= MAX_DEPTH {
                     return None;
                 }
+                // A node may have several parents (cached words are not trusted to be a
+                // tree): it is as deep as its deepest path. Parents come first, so a node's
+                // depth is final when its own links are checked.
                 if link != EMPTY && count == 0 {
-                    depth[offset] = depth[i] + 1;
+                    depth[offset] = depth[offset].max(depth[i] + 1);
                 }
             }
             nodes.push(node);
@@ -240,5 +243,41 @@ mod tests {
         backwards[last * WORDS + LINK_WORDS] = 1;
         assert!(Bvh::from_words(&backwards, 3000).is_none());
         assert!(Bvh::from_words(&w[..w.len() - 1], 3000).is_none());
+    }
+
+    /// Words of `n` wide nodes with the given inner links (node, child) and one primitive in a
+    /// leaf of the last node.
+    fn dag_words(n: usize, links: &[(usize, usize)]) -> Vec<u32> {
+        let mut nodes = vec![Wide::NONE; n];
+        let unit = Aabb::new(Vec3A::ZERO, Vec3A::ONE);
+        for &(from, to) in links {
+            let lane = nodes[from].link.iter().position(|&l| l == EMPTY).unwrap();
+            nodes[from].set(lane, &unit, to as u64);
+        }
+        nodes[n - 1].set(0, &unit, 1 << super::super::OFFSET_BITS);
+        let mut w = Vec::new();
+        Bvh { nodes }.to_words(&mut |x| w.push(x));
+        w
+    }
+
+    /// A node reached both by a short and by a long path counts as deep as the long one: a
+    /// cache file whose short parent comes last must not hide a path deeper than the traversal
+    /// stack holds.
+    #[test]
+    fn words_deeper_than_the_stack_along_any_path_are_refused() {
+        // 0 → 1 → … → m (depth m), and 0 → m + 1 (depth 1); both m and m + 1 lead to m + 2,
+        // from which a chain of `tail` nodes goes on.
+        let (m, tail) = (MAX_DEPTH - 20, 40);
+        let n = m + 2 + tail;
+        let mut links: Vec<(usize, usize)> = (0..m).map(|i| (i, i + 1)).collect();
+        links.extend([(0, m + 1), (m, m + 2), (m + 1, m + 2)]);
+        links.extend((m + 2..n - 1).map(|i| (i, i + 1)));
+        assert!(Bvh::from_words(&dag_words(n, &links), 1).is_none());
+        // The same shape with a short tail fits.
+        let n = m + 2 + 10;
+        let mut links: Vec<(usize, usize)> = (0..m).map(|i| (i, i + 1)).collect();
+        links.extend([(0, m + 1), (m, m + 2), (m + 1, m + 2)]);
+        links.extend((m + 2..n - 1).map(|i| (i, i + 1)));
+        assert!(Bvh::from_words(&dag_words(n, &links), 1).is_some());
     }
 }

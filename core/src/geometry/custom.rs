@@ -13,20 +13,46 @@ use std::sync::Mutex;
 
 /// One object handed over by a plugin; destroyed through the plugin when the scene drops.
 pub struct CustomObject {
-    pub object: *mut c_void,
-    pub vtable: *const abi::CustomVTable,
+    /// Live until `drop` passes it to `vtable.destroy`.
+    object: *mut c_void,
+    vtable: &'static abi::CustomVTable,
     pub plugin: String,
     pub count: u64,
 }
 
-// SAFETY: the SDK requires `CustomShape: Send + Sync`; the host only calls the table.
+impl CustomObject {
+    /// Takes ownership of a plugin's object.
+    ///
+    /// # Safety
+    /// `object` is a live object of the plugin that `vtable` serves, handed over to the host
+    /// (no one else destroys it); `vtable` is that plugin's table for it.
+    pub unsafe fn new(
+        object: *mut c_void,
+        vtable: &'static abi::CustomVTable,
+        plugin: String,
+        count: u64,
+    ) -> CustomObject {
+        CustomObject {
+            object,
+            vtable,
+            plugin,
+            count,
+        }
+    }
+}
+
+// SAFETY: the ABI requires a plugin's custom objects to take `bounds`, `intersect` and
+// `occluded` from several threads at once and `destroy` from any thread (the SDK makes that
+// `CustomShape: Send + Sync`); the host owns the object and touches it only through its table.
 unsafe impl Send for CustomObject {}
+// SAFETY: see `Send`: `&CustomObject` only ever calls the table's thread-safe functions.
 unsafe impl Sync for CustomObject {}
 
 impl Drop for CustomObject {
     fn drop(&mut self) {
-        // SAFETY: the library stays loaded for the process lifetime; destroy is called once.
-        unsafe { ((*self.vtable).destroy)(self.object) };
+        // SAFETY: `object` is live (`new`'s contract) and this is the last use of it: the host
+        // owns it, and `drop` runs once, after every borrow that could call into it.
+        unsafe { (self.vtable.destroy)(self.object) };
     }
 }
 
@@ -90,8 +116,8 @@ impl Customs {
         for &(o, i) in &self.refs {
             let obj = &self.objects[o as usize];
             let (mut min, mut max) = ([0.0f64; 3], [0.0f64; 3]);
-            // SAFETY: valid table from a loaded plugin; out-pointers are ours.
-            let status = unsafe { ((*obj.vtable).bounds)(obj.object, i, &mut min, &mut max) };
+            // SAFETY: `obj` is live (see `CustomObject`) and the out-pointers are our locals.
+            let status = unsafe { (obj.vtable.bounds)(obj.object, i, &mut min, &mut max) };
             if status != abi::STATUS_OK {
                 return Err(format!(
                     "plugin `{}` panicked computing bounds of primitive {i}",
@@ -155,8 +181,9 @@ impl Customs {
             let obj = &self.objects[o as usize];
             let wr = self.world_ray(ray, tm);
             let mut h = abi::HitF64::default();
-            // SAFETY: valid table of a loaded plugin.
-            match unsafe { ((*obj.vtable).intersect)(obj.object, idx, &wr, &mut h) } {
+            // SAFETY: `obj` is live (see `CustomObject`), the ray and hit are our locals, and
+            // the ABI allows concurrent calls.
+            match unsafe { (obj.vtable.intersect)(obj.object, idx, &wr, &mut h) } {
                 1 => {
                     let t = h.t as f32;
                     let n = Vec3A::from(DVec3::from(h.normal).normalize_or_zero().as_vec3());
@@ -200,13 +227,12 @@ impl Customs {
             c.tests += 1;
             let (o, idx) = self.refs[i];
             let obj = &self.objects[o as usize];
-            // SAFETY: valid table of a loaded plugin.
             if clipped(i) {
                 let mut h = abi::HitF64::default();
                 let mut r = wr;
                 r.tmax = t_max as f64;
-                // SAFETY: valid table of a loaded plugin.
-                return match unsafe { ((*obj.vtable).intersect)(obj.object, idx, &r, &mut h) } {
+                // SAFETY: as in `intersect`.
+                return match unsafe { (obj.vtable.intersect)(obj.object, idx, &r, &mut h) } {
                     1 => {
                         !clips.cut(clip_of(self.material[i]), ray.at(h.t as f32))
                             && on_hit(material_of(self.material[i]), 1)
@@ -218,7 +244,8 @@ impl Customs {
                     _ => false,
                 };
             }
-            match unsafe { ((*obj.vtable).occluded)(obj.object, idx, &wr) } {
+            // SAFETY: as in `intersect`.
+            match unsafe { (obj.vtable.occluded)(obj.object, idx, &wr) } {
                 1 => on_hit(material_of(self.material[i]), 1),
                 abi::HIT_PANIC => {
                     self.panicked(o);

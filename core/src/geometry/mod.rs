@@ -2,11 +2,15 @@
 //! each kind in its own BVH, so every traversal loop is monomorphic.
 
 pub mod cone;
+// Calls into plugin objects.
+#[allow(unsafe_code)]
 pub mod custom;
 pub mod disc;
 pub mod plane;
 pub mod set;
 pub mod sphere;
+// An unchecked axis index and a prefetch.
+#[allow(unsafe_code)]
 pub mod triangle;
 
 #[cfg(test)]

@@ -81,7 +81,8 @@ impl TriRay {
     #[inline(always)]
     fn coord(&self, v: &Vec3, i: usize) -> f32 {
         let v: &[f32; 3] = v.as_ref();
-        // SAFETY: `new` only stores indices 0, 1 and 2.
+        // SAFETY: `k` is private and only `new` sets it, to axes from `NEXT` and `kz`, all in
+        // 0..3, the length of `v` (`self.k[i]` itself is bounds-checked).
         unsafe { *v.get_unchecked(self.k[i]) }
     }
 }
@@ -390,7 +391,8 @@ fn terminator_lift(p: Vec3A, v: [Vec3A; 3], b: [f32; 3], va: &[VertexAttr; 3], s
 #[inline(always)]
 fn prefetch<T>(x: &T) {
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch reads nothing and cannot fault.
+    // SAFETY: SSE is part of the x86_64 baseline, and a prefetch is a hint: it reads nothing
+    // the program sees and cannot fault, whatever the address.
     unsafe {
         std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
             (x as *const T).cast(),

@@ -1,7 +1,7 @@
 //! Calling into plugins: one call with an error sink, its errors mapped back to the scene file,
 //! and the helpers every kind's sink callbacks share.
 
-use super::registry::{Entry, Registry};
+use super::registry::{Entry, PluginKind, Registry};
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
@@ -13,14 +13,16 @@ struct Reported {
     col: u32,
 }
 
-extern "C" fn set_error(ctx: *mut c_void, message: abi::Str, line: u32, col: u32) {
-    // SAFETY: ctx is the `Reported` owned by `call_plugin` for the duration of the call.
-    let r = unsafe { &mut *(ctx as *mut Reported) };
-    r.message = Some(
-        unsafe { message.as_str() }
-            .unwrap_or("(invalid UTF-8)")
-            .to_string(),
-    );
+/// The host's `ErrorSink::set`.
+///
+/// # Safety
+/// `ctx` is the `Reported` of the running [`call_plugin`]; `message` is readable for the call.
+unsafe extern "C" fn set_error(ctx: *mut c_void, message: abi::Str, line: u32, col: u32) {
+    // SAFETY: the plugin calls this only through the sink of a running `call_plugin`, on its
+    // thread (ABI contract), so `ctx` is that call's `Reported` and nothing else touches it
+    // until the plugin returns; the message is copied before returning.
+    let (r, message) = unsafe { (&mut *(ctx as *mut Reported), message.as_str()) };
+    r.message = Some(message.unwrap_or("(invalid UTF-8)").to_string());
     r.line = line;
     r.col = col;
 }
@@ -93,20 +95,44 @@ pub fn call_context<'a>(scene_dir: &'a str, instance: &'a str) -> abi::CallConte
 }
 
 /// Reports `msg` through the plugin's error sink (if it gave one); the status to return.
-pub(super) fn fail(err: *const abi::ErrorSink, msg: &str) -> abi::Status {
-    if let Some(e) = unsafe { err.as_ref() } {
-        (e.set)(e.ctx, abi::Str::new(msg), 0, 0);
+pub(super) fn fail(err: Option<&abi::ErrorSink>, msg: &str) -> abi::Status {
+    if let Some(e) = err {
+        // SAFETY: `e` is the error sink the plugin passed to the running sink call, valid for
+        // it, and `ctx` its own (ABI contract); `msg` is borrowed across the call.
+        unsafe { (e.set)(e.ctx, abi::Str::new(msg), 0, 0) };
     }
     abi::STATUS_ERROR
 }
 
 /// A borrowed array from a plugin: `len` elements at `ptr` (none when null or empty).
+///
+/// # Safety
+/// Unless `ptr` is null or `len` is 0, `ptr` points to `len` initialised values of one
+/// allocation that stay valid and unmodified for `'a`.
 pub(super) unsafe fn slice<'a, T>(ptr: *const T, len: usize) -> &'a [T] {
     if len == 0 || ptr.is_null() {
         &[]
     } else {
-        std::slice::from_raw_parts(ptr, len)
+        // SAFETY: the caller's promise, for non-null `ptr` and non-zero `len`.
+        unsafe { std::slice::from_raw_parts(ptr, len) }
     }
+}
+
+/// The error `call` gives for an entry of another kind than the call needs.
+pub(super) fn wrong_kind(
+    registry: &Registry,
+    entry: &Entry,
+    expected: PluginKind,
+    params_at: &Origin,
+) -> (Origin, String) {
+    (
+        params_at.clone(),
+        format!(
+            "{} is a {}, but a {expected} is expected here",
+            plugin_label(registry, entry),
+            entry.kind
+        ),
+    )
 }
 
 /// `count` records of `per` values each, as a length that fits memory.

@@ -1,8 +1,8 @@
 //! Primitive plugins: `create` and the host side of `GeometrySink`, which stores what a plugin
 //! adds (spheres, planes, cones, discs, meshes, custom geometry) in the scene's native sets.
 
-use super::calls::{call_context, call_plugin, checked_len, fail, slice};
-use super::registry::{Entry, Registry};
+use super::calls::{call_context, call_plugin, checked_len, fail, slice, wrong_kind};
+use super::registry::{Entry, PluginKind, Registry, Table};
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::{CustomObject, Customs};
 use crate::geometry::disc::Discs;
@@ -32,22 +32,35 @@ pub struct GeometryBuilder<'a> {
     pub dropped: u64,
 }
 
-/// Host callbacks must never unwind into plugin frames.
-fn guard(err: *const abi::ErrorSink, f: impl FnOnce() -> Result<(), String>) -> abi::Status {
-    match catch_unwind(AssertUnwindSafe(f)) {
+// The host side of `GeometrySink`. The plugin calls these during `create_primitive`, on its
+// thread and one at a time (ABI contract), with the `ctx` we put in the sink: our
+// `GeometryBuilder`, which nothing else touches until `create` returns. Errors go to the
+// plugin's `err`, null or valid for the call.
+
+/// Runs one sink call: never unwinds into plugin frames, and reports failures to `err`.
+///
+/// # Safety
+/// `ctx` is the `GeometryBuilder` of the running `create_primitive`, not otherwise borrowed
+/// during the call; `err` is null or valid for the call.
+unsafe fn guard(
+    ctx: *mut c_void,
+    err: *const abi::ErrorSink,
+    f: impl FnOnce(&mut GeometryBuilder) -> Result<(), String>,
+) -> abi::Status {
+    // SAFETY: the caller's promise.
+    let (b, err) = unsafe { (&mut *(ctx as *mut GeometryBuilder), err.as_ref()) };
+    match catch_unwind(AssertUnwindSafe(|| f(b))) {
         Ok(Ok(())) => abi::STATUS_OK,
         Ok(Err(m)) => fail(err, &m),
         Err(_) => fail(err, "internal error in the host while storing geometry"),
     }
 }
 
-fn builder<'a>(ctx: *mut c_void) -> &'a mut GeometryBuilder<'a> {
-    // SAFETY: ctx is the builder passed in `GeometrySink::ctx` for the duration of create().
-    unsafe { &mut *(ctx as *mut GeometryBuilder) }
-}
-
 /// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`.
-fn add_batch<const N: usize>(
+///
+/// # Safety
+/// As for [`guard`]; `data` is null or points to `count * N` values.
+unsafe fn add_batch<const N: usize>(
     ctx: *mut c_void,
     data: *const f64,
     count: u64,
@@ -55,72 +68,96 @@ fn add_batch<const N: usize>(
     what: &str,
     push: impl Fn(&mut GeometryBuilder, usize, [f64; N]) -> Result<(), String>,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
-        // SAFETY: the plugin passes `count` records of N values (ABI contract).
+    let store = |b: &mut GeometryBuilder| {
+        // SAFETY: the caller's promise about `data` (the length is checked to fit memory).
         let v = unsafe { slice(data, checked_len(count, N as u64, what)?) };
         for (i, r) in v.chunks_exact(N).enumerate() {
             push(b, i, r.try_into().expect("chunk of N"))?;
         }
         Ok(())
-    })
+    };
+    // SAFETY: the caller's promise.
+    unsafe { guard(ctx, err, store) }
 }
 
-extern "C" fn add_spheres(
+/// # Safety
+/// See the comment above [`guard`].
+unsafe extern "C" fn add_spheres(
     ctx: *mut c_void,
     data: *const f64,
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    add_batch(ctx, data, count, err, "sphere", |b, i, r: [f64; 4]| {
-        b.spheres.push_world(i, r, b.world_offset, b.material)
-    })
+    // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
+    unsafe {
+        add_batch(ctx, data, count, err, "sphere", |b, i, r: [f64; 4]| {
+            b.spheres.push_world(i, r, b.world_offset, b.material)
+        })
+    }
 }
 
-extern "C" fn add_planes(
+/// # Safety
+/// See the comment above [`guard`].
+unsafe extern "C" fn add_planes(
     ctx: *mut c_void,
     data: *const f64,
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    add_batch(ctx, data, count, err, "plane", |b, i, r: [f64; 6]| {
-        b.planes.push_world(i, r, b.world_offset, b.material)
-    })
+    // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
+    unsafe {
+        add_batch(ctx, data, count, err, "plane", |b, i, r: [f64; 6]| {
+            b.planes.push_world(i, r, b.world_offset, b.material)
+        })
+    }
 }
 
-extern "C" fn add_cones(
+/// # Safety
+/// See the comment above [`guard`].
+unsafe extern "C" fn add_cones(
     ctx: *mut c_void,
     data: *const f64,
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
-        b.cones.push_world(i, r, b.world_offset, b.material)
-    })
+    // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
+    unsafe {
+        add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
+            b.cones.push_world(i, r, b.world_offset, b.material)
+        })
+    }
 }
 
-extern "C" fn add_discs(
+/// # Safety
+/// See the comment above [`guard`].
+unsafe extern "C" fn add_discs(
     ctx: *mut c_void,
     data: *const f64,
     count: u64,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
-        b.discs.push_world(i, r, b.world_offset, b.material)
-    })
+    // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
+    unsafe {
+        add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
+            b.discs.push_world(i, r, b.world_offset, b.material)
+        })
+    }
 }
 
-extern "C" fn add_mesh(
+/// # Safety
+/// See the comment above [`guard`]; `mesh` is null or valid, its arrays as `MeshData` says.
+unsafe extern "C" fn add_mesh(
     ctx: *mut c_void,
     mesh: *const abi::MeshData,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
+    let store = |b: &mut GeometryBuilder| {
+        // SAFETY: the caller's promise about `mesh`.
         let m = unsafe { mesh.as_ref() }.ok_or("no mesh data")?;
         let nv = checked_len(m.vertex_count, 1, "vertex")?;
         let optional = |p: bool, per: usize| if p { 0 } else { nv * per };
-        // SAFETY: the plugin guarantees the arrays' lengths (ABI contract of MeshData).
+        // SAFETY: the plugin guarantees the arrays' lengths (ABI contract of MeshData),
+        // checked here to fit memory; optional arrays are null or one entry per vertex.
         let input = unsafe {
             MeshInput {
                 positions: slice(m.positions, checked_len(m.vertex_count, 3, "vertex")?),
@@ -132,27 +169,29 @@ extern "C" fn add_mesh(
         };
         b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
         Ok(())
-    })
+    };
+    // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
+    unsafe { guard(ctx, err, store) }
 }
 
-extern "C" fn add_custom(
+/// # Safety
+/// See the comment above [`guard`]; `g` is null or valid, and passes its object to the host.
+unsafe extern "C" fn add_custom(
     ctx: *mut c_void,
     g: *const abi::CustomGeometry,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    guard(err, || {
-        let b = builder(ctx);
+    let store = |b: &mut GeometryBuilder| {
+        // SAFETY: the caller's promise about `g`.
         let g = unsafe { g.as_ref() }.ok_or("no custom geometry")?;
-        if g.vtable.is_null() {
+        // SAFETY: a non-null table of custom geometry is a static of the library (ABI), which
+        // is never unloaded.
+        let Some(vtable) = (unsafe { g.vtable.as_ref() }) else {
             return Err("custom geometry without a function table".into());
-        }
-        // Own it first so it is destroyed even if we reject it.
-        let object = CustomObject {
-            object: g.object,
-            vtable: g.vtable,
-            plugin: b.plugin.clone(),
-            count: g.count,
         };
+        // Own it first so it is destroyed even if we reject it.
+        // SAFETY: the plugin hands over `object`, which `vtable` serves (ABI contract).
+        let object = unsafe { CustomObject::new(g.object, vtable, b.plugin.clone(), g.count) };
         if g.count > u32::MAX as u64 {
             return Err(format!(
                 "custom geometry with {} primitives is too large",
@@ -166,7 +205,9 @@ extern "C" fn add_custom(
         }
         b.customs.objects.push(object);
         Ok(())
-    })
+    };
+    // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
+    unsafe { guard(ctx, err, store) }
 }
 
 /// Runs a primitive plugin's `create` into `builder`.
@@ -188,11 +229,20 @@ pub fn create_primitive(
         add_mesh,
         add_custom,
     };
+    let Table::Primitive(vt) = entry.table else {
+        return Err(wrong_kind(
+            registry,
+            entry,
+            PluginKind::Primitive,
+            params_at,
+        ));
+    };
     let dir = scene_dir.to_string_lossy();
     let ctx = call_context(&dir, instance);
-    // SAFETY: the entry is a primitive, so its vtable is a PrimitiveVTable.
-    let vt = unsafe { &*(entry.vtable as *const abi::PrimitiveVTable) };
     call_plugin(registry, entry, params_at, |err| {
-        (vt.create)(abi::Str::new(params), &ctx, &sink, err)
+        // SAFETY: the calling contract: `params`, `ctx`, `sink` and `err` live across the
+        // call; `sink.ctx` is `builder`, which this function borrows mutably and does not touch
+        // until the plugin returns, and the callbacks only reach it through `ctx`.
+        unsafe { (vt.create)(abi::Str::new(params), &ctx, &sink, err) }
     })
 }

@@ -29,6 +29,50 @@ impl PluginKind {
     }
 }
 
+/// An entry's function table, typed by its kind: the calls take the table they need from
+/// here, so no caller casts a pointer by what an entry claims to be.
+#[derive(Clone, Copy)]
+pub(crate) enum Table {
+    Primitive(&'static abi::PrimitiveVTable),
+    Texture(&'static abi::TextureVTable),
+    VolumeReader(&'static abi::VolumeReaderVTable),
+    Writer(&'static abi::WriterVTable),
+}
+
+impl Table {
+    /// The table of an entry of kind `kind`.
+    ///
+    /// # Safety
+    /// `vtable` points to the table of that kind (the ABI's `Entry::vtable`), which stays valid
+    /// and unchanged for the rest of the process (a static of a library never unloaded).
+    unsafe fn new(kind: PluginKind, vtable: *const c_void) -> Table {
+        // SAFETY: the caller's promise, for the type `kind` names.
+        unsafe {
+            match kind {
+                PluginKind::Primitive => Table::Primitive(&*vtable.cast()),
+                PluginKind::Texture => Table::Texture(&*vtable.cast()),
+                PluginKind::VolumeReader => Table::VolumeReader(&*vtable.cast()),
+                PluginKind::Writer => Table::Writer(&*vtable.cast()),
+            }
+        }
+    }
+
+    fn kind(&self) -> PluginKind {
+        match self {
+            Table::Primitive(_) => PluginKind::Primitive,
+            Table::Texture(_) => PluginKind::Texture,
+            Table::VolumeReader(_) => PluginKind::VolumeReader,
+            Table::Writer(_) => PluginKind::Writer,
+        }
+    }
+}
+
+impl fmt::Debug for Table {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Table({})", self.kind())
+    }
+}
+
 impl fmt::Display for PluginKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -61,14 +105,10 @@ pub struct Entry {
     pub extensions: Vec<String>,
     /// Index into `Registry::libraries`.
     pub library: usize,
-    pub(crate) vtable: *const c_void,
+    pub(crate) table: Table,
     /// Set when an earlier library in the search order already provides this name.
     pub shadowed: bool,
 }
-
-// SAFETY: vtables are immutable statics in libraries that are never unloaded.
-unsafe impl Send for Entry {}
-unsafe impl Sync for Entry {}
 
 /// A file that looked like a plugin but could not be used.
 #[derive(Clone, Debug)]
@@ -140,10 +180,14 @@ pub struct Registry {
     by_name: HashMap<String, usize>,
 }
 
-extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
-    // SAFETY: the plugin passes strings valid for the call.
-    let plugin = unsafe { plugin.as_str() }.unwrap_or("?");
-    let message = unsafe { message.as_str() }.unwrap_or("(invalid UTF-8)");
+/// `HostTable::log`: prints a plugin's message (debug ones only with `LUXON_DEBUG` set).
+///
+/// # Safety
+/// Both strings are readable for the call (the ABI's calling contract).
+unsafe extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
+    // SAFETY: the caller's promise; the strings are only used within this call.
+    let (plugin, message) = unsafe { (plugin.as_str(), message.as_str()) };
+    let (plugin, message) = (plugin.unwrap_or("?"), message.unwrap_or("(invalid UTF-8)"));
     let level = match level {
         0 => "error",
         1 => "warning",
@@ -238,12 +282,16 @@ impl Registry {
         if self.libraries.iter().any(|l| l.path == canonical) {
             return;
         }
-        // SAFETY: loading runs the library's initialisers; plugin files are trusted code by
-        // design (the user put them on the search path).
+        // SAFETY: loading runs the library's initialisers, and from here on its code runs in
+        // this process. Nothing here can check that code: plugin files are trusted by design
+        // (the user put them on the search path), as is everything below that relies on a
+        // library keeping the ABI's promises.
         let lib = match unsafe { libloading::Library::new(&canonical) } {
             Ok(l) => l,
             Err(e) => return self.problem(path, format!("cannot be loaded: {e}")),
         };
+        // SAFETY: `DeclareFn` is the type the ABI gives this symbol; the function pointer is
+        // used while `lib` is loaded, which is forever (see the module comment).
         let declare: libloading::Symbol<abi::DeclareFn> =
             match unsafe { lib.get(abi::DECLARE_SYMBOL) } {
                 Ok(s) => s,
@@ -254,47 +302,58 @@ impl Registry {
                     )
                 }
             };
-        // SAFETY: the symbol has the declared signature by the ABI contract; every pointer read
-        // below is checked for null and the header's leading fields are fixed across versions.
+        // SAFETY: the handshake's one argument is the host table, valid for the process (a
+        // static here).
         let header = unsafe { declare(&HOST) };
-        let Some(header) = (unsafe { header.as_ref() }) else {
+        if header.is_null() {
             return self.problem(path, "not a Luxon plugin (its declaration is null)".into());
-        };
-        if header.magic != abi::MAGIC {
+        }
+        // SAFETY: a non-null header is the library's static, valid for the process. Its leading
+        // `magic`, `abi_version` and `sdk_version` keep their layout in every ABI version, so
+        // they are read on their own, before the version says what follows them; the version
+        // string is only read (and copied) once the magic says this is a Luxon header.
+        let (magic, abi_version) = unsafe { ((*header).magic, (*header).abi_version) };
+        if magic != abi::MAGIC {
             return self.problem(
                 path,
                 "not a Luxon plugin (bad magic in its declaration)".into(),
             );
         }
-        let sdk = unsafe { header.sdk_version.as_str() }
+        // SAFETY: as above; the string is a static of the library.
+        let sdk = unsafe { (*header).sdk_version.as_str() }
             .unwrap_or("?")
             .to_string();
-        if header.abi_version != abi::ABI_VERSION {
+        if abi_version != abi::ABI_VERSION {
             return self.problem(
                 path,
                 format!(
                     "built for plugin ABI {} (luxon-plugin {sdk}), but this Luxon uses ABI {} \
                      (luxon-plugin {}); rebuild it against luxon-plugin {}",
-                    header.abi_version,
+                    abi_version,
                     abi::ABI_VERSION,
                     luxon_plugin::SDK_VERSION,
                     luxon_plugin::SDK_VERSION
                 ),
             );
         }
-        let Some(decl) = (unsafe { header.declaration.as_ref() }) else {
+        // From here on the library speaks this ABI version: its header, declaration, entries
+        // and strings are statics of the library laid out as `abi` says, valid for the process.
+        // SAFETY: see above.
+        let Some(decl) = (unsafe { (*header).declaration.as_ref() }) else {
             return self.problem(path, "plugin declares nothing (null declaration)".into());
         };
-        let name = unsafe { decl.library.as_str() }.unwrap_or("?").to_string();
+        // SAFETY: see above.
+        let text = |s: &abi::Str| unsafe { s.as_str() }.unwrap_or("").to_string();
+        let name = text(&decl.library);
         let raw: &[abi::Entry] = if decl.entry_count == 0 || decl.entries.is_null() {
             &[]
         } else {
+            // SAFETY: see above; `entries` points to `entry_count` entries.
             unsafe { std::slice::from_raw_parts(decl.entries, decl.entry_count) }
         };
         let index = self.libraries.len();
         let mut entries = Vec::new();
         for e in raw {
-            let text = |s: &abi::Str| unsafe { s.as_str() }.unwrap_or("").to_string();
             let Some(kind) = PluginKind::from_abi(e.kind) else {
                 return self.problem(path, format!("declares an unknown plugin kind {}", e.kind));
             };
@@ -315,7 +374,9 @@ impl Registry {
                     .filter(|s| !s.is_empty())
                     .collect(),
                 library: index,
-                vtable: e.vtable,
+                // SAFETY: a non-null `vtable` points to the table of the entry's kind, a static
+                // of the library (see above).
+                table: unsafe { Table::new(kind, e.vtable) },
                 shadowed: false,
             });
         }
@@ -323,7 +384,7 @@ impl Registry {
             path: canonical,
             name,
             sdk_version: sdk,
-            abi_version: header.abi_version,
+            abi_version,
         });
         for mut e in entries {
             if self.by_name.contains_key(&e.name) {

@@ -1,7 +1,7 @@
 //! Texture plugins: creating an instance, and evaluating it while rendering.
 
-use super::calls::{call_context, call_plugin};
-use super::registry::{Entry, Registry};
+use super::calls::{call_context, call_plugin, wrong_kind};
+use super::registry::{Entry, PluginKind, Registry, Table};
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
@@ -9,13 +9,17 @@ use std::path::Path;
 
 /// A texture instance created by a plugin; destroyed through it on drop.
 pub struct TextureInstance {
+    /// Live until `drop` passes it to `vtable.destroy`.
     object: *mut c_void,
-    vtable: *const abi::TextureInstanceVTable,
+    vtable: &'static abi::TextureInstanceVTable,
     pub plugin: String,
 }
 
-// SAFETY: the SDK requires textures to be Send + Sync.
+// SAFETY: the ABI requires a plugin's texture objects to take `eval` from several threads at
+// once and `destroy` from any thread (the SDK makes that `Texture: Send + Sync`); the host owns
+// the object and touches it only through its table.
 unsafe impl Send for TextureInstance {}
+// SAFETY: see `Send`: `&TextureInstance` only ever calls `eval`.
 unsafe impl Sync for TextureInstance {}
 
 impl TextureInstance {
@@ -23,16 +27,18 @@ impl TextureInstance {
     #[inline]
     pub fn eval(&self, q: &abi::TexQuery) -> Option<[f32; 4]> {
         let mut out = [0.0f32; 4];
-        // SAFETY: valid table of a loaded plugin.
-        let s = unsafe { ((*self.vtable).eval)(self.object, q, &mut out) };
+        // SAFETY: `object` is live until `drop`, the query and result live across the call, and
+        // the ABI allows concurrent `eval`s.
+        let s = unsafe { (self.vtable.eval)(self.object, q, &mut out) };
         (s == abi::STATUS_OK).then_some(out)
     }
 }
 
 impl Drop for TextureInstance {
     fn drop(&mut self) {
-        // SAFETY: created by this plugin, destroyed once.
-        unsafe { ((*self.vtable).destroy)(self.object) };
+        // SAFETY: `object` is live and this is its last use: the host owns it, and `drop` runs
+        // once, when nothing can call `eval` any more.
+        unsafe { (self.vtable.destroy)(self.object) };
     }
 }
 
@@ -44,26 +50,31 @@ pub fn create_texture(
     scene_dir: &Path,
     instance: &str,
 ) -> Result<TextureInstance, (Origin, String)> {
+    let Table::Texture(vt) = entry.table else {
+        return Err(wrong_kind(registry, entry, PluginKind::Texture, params_at));
+    };
     let dir = scene_dir.to_string_lossy();
     let ctx = call_context(&dir, instance);
     let mut out = abi::TextureObject {
         object: std::ptr::null_mut(),
         vtable: std::ptr::null(),
     };
-    // SAFETY: the entry is a texture, so its vtable is a TextureVTable.
-    let vt = unsafe { &*(entry.vtable as *const abi::TextureVTable) };
     call_plugin(registry, entry, params_at, |err| {
-        (vt.create)(abi::Str::new(params), &ctx, &mut out, err)
+        // SAFETY: the calling contract: `params`, `ctx`, `out` and `err` live across the call,
+        // and `out` is only written by the plugin.
+        unsafe { (vt.create)(abi::Str::new(params), &ctx, &mut out, err) }
     })?;
-    if out.vtable.is_null() {
+    // SAFETY: a non-null table of a texture object is a static of the library (ABI), which is
+    // never unloaded.
+    let Some(vtable) = (unsafe { out.vtable.as_ref() }) else {
         return Err((
             params_at.clone(),
             format!("plugin `{}` returned no texture", entry.name),
         ));
-    }
+    };
     Ok(TextureInstance {
         object: out.object,
-        vtable: out.vtable,
+        vtable,
         plugin: entry.name.clone(),
     })
 }

@@ -1,8 +1,8 @@
 //! Volume-reader plugins: `read` and the host side of `VolumeSink`. The storage and every check
 //! of what a reader sends live in [`VolumeBuilder`]; this is the calling side.
 
-use super::calls::{call_context, call_plugin, fail, plugin_label, slice};
-use super::registry::{Entry, PluginKind, Registry};
+use super::calls::{call_context, call_plugin, fail, plugin_label, slice, wrong_kind};
+use super::registry::{Entry, PluginKind, Registry, Table};
 use crate::volume::{Volume, VolumeBuilder};
 use luxon_formats::Origin;
 use luxon_plugin::abi;
@@ -39,18 +39,27 @@ pub fn read_volume(
     })
 }
 
+// The host side of `VolumeSink`. The plugin calls these during `read_volume_into`, on its
+// thread and one at a time (ABI contract), with the `ctx` we put in the sink: our
+// `VolumeBuilder`, which nothing else touches until `read` returns. Errors go to the plugin's
+// `err`, null or valid for the call; the other pointers are null or valid for the call.
+
 /// Runs one volume sink callback: never unwinds, and any failure (a panic included) stops the
 /// volume so the read fails even if the plugin ignores the error.
-fn volume_call(
+///
+/// # Safety
+/// `ctx` is null or the `VolumeBuilder` of the running `read_volume_into`, not otherwise
+/// borrowed during the call; `err` is null or valid for the call.
+unsafe fn volume_call(
     ctx: *mut c_void,
     err: *const abi::ErrorSink,
     f: impl FnOnce(&mut VolumeBuilder) -> Result<(), String>,
 ) -> abi::Status {
-    if ctx.is_null() {
+    // SAFETY: the caller's promise.
+    let (b, err) = unsafe { ((ctx as *mut VolumeBuilder).as_mut(), err.as_ref()) };
+    let Some(b) = b else {
         return fail(err, "the volume sink has no context");
-    }
-    // SAFETY: ctx is the builder passed in `VolumeSink::ctx` for the duration of read().
-    let b = unsafe { &mut *(ctx as *mut VolumeBuilder) };
+    };
     let message = match catch_unwind(AssertUnwindSafe(|| f(&mut *b))) {
         Ok(Ok(())) => return abi::STATUS_OK,
         Ok(Err(m)) => m,
@@ -63,18 +72,22 @@ fn volume_call(
     fail(err, &message)
 }
 
-extern "C" fn volume_begin(
+/// # Safety
+/// See the comment above [`volume_call`].
+unsafe extern "C" fn volume_begin(
     ctx: *mut c_void,
     desc: *const abi::VolumeDesc,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    volume_call(ctx, err, |b| {
-        let Some(d) = (unsafe { desc.as_ref() }) else {
+    // SAFETY: the caller's promise: `desc` and its name are null or valid for the call.
+    let desc = unsafe { desc.as_ref().map(|d| (d, d.grid_name.as_str())) };
+    let begin = |b: &mut VolumeBuilder| {
+        let Some((d, name)) = desc else {
             let m = "`begin` was given no grid description";
             b.fail(m);
             return Err(m.into());
         };
-        let Ok(name) = (unsafe { d.grid_name.as_str() }) else {
+        let Ok(name) = name else {
             let m = "the grid name is not valid UTF-8";
             b.fail(m);
             return Err(m.into());
@@ -86,19 +99,25 @@ extern "C" fn volume_begin(
             d.index_max,
             name,
         )
-    })
+    };
+    // SAFETY: the caller keeps the ABI contract (see the comment above `volume_call`).
+    unsafe { volume_call(ctx, err, begin) }
 }
 
-extern "C" fn volume_add_dense(
+/// # Safety
+/// See the comment above [`volume_call`]; `values` is null or `dims[0] * dims[1] * dims[2]`
+/// values.
+unsafe extern "C" fn volume_add_dense(
     ctx: *mut c_void,
     origin: *const [i64; 3],
     dims: *const [u64; 3],
     values: *const f32,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    volume_call(ctx, err, |b| {
-        let (Some(&origin), Some(&dims)) = (unsafe { origin.as_ref() }, unsafe { dims.as_ref() })
-        else {
+    // SAFETY: the caller's promise: both are null or valid for the call.
+    let (origin, dims) = unsafe { (origin.as_ref().copied(), dims.as_ref().copied()) };
+    let add = |b: &mut VolumeBuilder| {
+        let (Some(origin), Some(dims)) = (origin, dims) else {
             let m = "`add_dense` was given a null origin or size";
             b.fail(m);
             return Err(m.into());
@@ -123,28 +142,35 @@ extern "C" fn volume_add_dense(
             b.fail(&m);
             return Err(m);
         }
-        // Borrowed for the call (ABI contract); `n` values, x fastest.
+        // SAFETY: the caller's promise: `n` values, x fastest, borrowed for the call.
         let values = unsafe { slice(values, n) };
         b.add_dense(origin, dims, values)
-    })
+    };
+    // SAFETY: the caller keeps the ABI contract (see the comment above `volume_call`).
+    unsafe { volume_call(ctx, err, add) }
 }
 
-extern "C" fn volume_add_tile(
+/// # Safety
+/// See the comment above [`volume_call`].
+unsafe extern "C" fn volume_add_tile(
     ctx: *mut c_void,
     origin: *const [i64; 3],
     dims: *const [u64; 3],
     value: f32,
     err: *const abi::ErrorSink,
 ) -> abi::Status {
-    volume_call(ctx, err, |b| {
-        let (Some(&origin), Some(&dims)) = (unsafe { origin.as_ref() }, unsafe { dims.as_ref() })
-        else {
+    // SAFETY: the caller's promise: both are null or valid for the call.
+    let (origin, dims) = unsafe { (origin.as_ref().copied(), dims.as_ref().copied()) };
+    let add = |b: &mut VolumeBuilder| {
+        let (Some(origin), Some(dims)) = (origin, dims) else {
             let m = "`add_tile` was given a null origin or size";
             b.fail(m);
             return Err(m.into());
         };
         b.add_tile(origin, dims, value)
-    })
+    };
+    // SAFETY: the caller keeps the ABI contract (see the comment above `volume_call`).
+    unsafe { volume_call(ctx, err, add) }
 }
 
 /// Runs a volume-reader plugin's `read` into `builder` (which must be fresh). `entry` must be a
@@ -159,16 +185,14 @@ pub fn read_volume_into(
     instance: &str,
     builder: &mut VolumeBuilder,
 ) -> Result<(), (Origin, String)> {
-    if entry.kind != PluginKind::VolumeReader {
-        return Err((
-            params_at.clone(),
-            format!(
-                "{} is a {}, but a volume reader is expected here",
-                plugin_label(registry, entry),
-                entry.kind
-            ),
+    let Table::VolumeReader(vt) = entry.table else {
+        return Err(wrong_kind(
+            registry,
+            entry,
+            PluginKind::VolumeReader,
+            params_at,
         ));
-    }
+    };
     let sink = abi::VolumeSink {
         ctx: builder as *mut VolumeBuilder as *mut c_void,
         begin: volume_begin,
@@ -177,11 +201,11 @@ pub fn read_volume_into(
     };
     let dir = scene_dir.to_string_lossy();
     let ctx = call_context(&dir, instance);
-    // SAFETY: the entry is a volume reader (checked above), so its vtable is a
-    // VolumeReaderVTable.
-    let vt = unsafe { &*(entry.vtable as *const abi::VolumeReaderVTable) };
     call_plugin(registry, entry, params_at, |err| {
-        (vt.read)(abi::Str::new(params), &ctx, &sink, err)
+        // SAFETY: the calling contract: `params`, `ctx`, `sink` and `err` live across the
+        // call; `sink.ctx` is `builder`, which this function borrows mutably and does not touch
+        // until the plugin returns, and the callbacks only reach it through `ctx`.
+        unsafe { (vt.read)(abi::Str::new(params), &ctx, &sink, err) }
     })
 }
 
@@ -192,13 +216,17 @@ mod tests {
     const IDENTITY: [f64; 12] = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
 
     /// A reader that misbehaves in the way its params say, through the real sink callbacks.
-    extern "C" fn sloppy_read(
+    ///
+    /// # Safety
+    /// The ABI's calling contract, as `read_volume_into` keeps it.
+    unsafe extern "C" fn sloppy_read(
         params: abi::Str,
         _ctx: *const abi::CallContext,
         sink: *const abi::VolumeSink,
         err: *const abi::ErrorSink,
     ) -> abi::Status {
-        let s = unsafe { &*sink };
+        // SAFETY: the host's sink and params are valid for the call.
+        let (s, params) = unsafe { (&*sink, params.as_str().unwrap()) };
         let desc = abi::VolumeDesc {
             world_from_index: IDENTITY,
             background: 0.5,
@@ -209,27 +237,32 @@ mod tests {
         let origin = [2i64, 2, 2];
         let dims = [2u64, 2, 3];
         let values = [1.0f32; 12];
-        match unsafe { params.as_str() }.unwrap() {
-            // Data before `begin`, passing the host's error on.
-            "early" => (s.add_tile)(s.ctx, &origin, &[1; 3], 1.0, err),
-            // A block outside the box, its error ignored.
-            "ignore" => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &dims, values.as_ptr(), err);
-                abi::STATUS_OK
-            }
-            "nobegin" => abi::STATUS_OK,
-            "null" => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &[2; 3], std::ptr::null(), err)
-            }
-            "huge" => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &[u64::MAX; 3], values.as_ptr(), err)
-            }
-            _ => {
-                (s.begin)(s.ctx, &desc, err);
-                (s.add_dense)(s.ctx, &origin, &[2; 3], values.as_ptr(), err)
+        // SAFETY: each call is to the host's sink with its own `ctx` and error sink, with
+        // pointers to our locals or null (which the host checks for); "huge" claims more values
+        // than it passes, which the host must refuse before reading any.
+        unsafe {
+            match params {
+                // Data before `begin`, passing the host's error on.
+                "early" => (s.add_tile)(s.ctx, &origin, &[1; 3], 1.0, err),
+                // A block outside the box, its error ignored.
+                "ignore" => {
+                    (s.begin)(s.ctx, &desc, err);
+                    (s.add_dense)(s.ctx, &origin, &dims, values.as_ptr(), err);
+                    abi::STATUS_OK
+                }
+                "nobegin" => abi::STATUS_OK,
+                "null" => {
+                    (s.begin)(s.ctx, &desc, err);
+                    (s.add_dense)(s.ctx, &origin, &[2; 3], std::ptr::null(), err)
+                }
+                "huge" => {
+                    (s.begin)(s.ctx, &desc, err);
+                    (s.add_dense)(s.ctx, &origin, &[u64::MAX; 3], values.as_ptr(), err)
+                }
+                _ => {
+                    (s.begin)(s.ctx, &desc, err);
+                    (s.add_dense)(s.ctx, &origin, &[2; 3], values.as_ptr(), err)
+                }
             }
         }
     }
@@ -251,7 +284,7 @@ mod tests {
             params_doc: String::new(),
             extensions: Vec::new(),
             library: 0,
-            vtable: &SLOPPY as *const abi::VolumeReaderVTable as *const std::ffi::c_void,
+            table: Table::VolumeReader(&SLOPPY),
             shadowed: false,
         });
         r

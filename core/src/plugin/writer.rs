@@ -1,19 +1,23 @@
 //! Writer plugins: encoding an image into bytes (the host side of `ByteSink`).
 
-use super::calls::{call_context, call_plugin, slice};
-use super::registry::{Entry, Registry};
+use super::calls::{call_context, call_plugin, slice, wrong_kind};
+use super::registry::{Entry, PluginKind, Registry, Table};
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-extern "C" fn collect_bytes(ctx: *mut c_void, data: *const u8, len: usize) -> abi::Status {
-    // SAFETY: ctx is the Vec owned by `encode_image` for the duration of the call.
-    let v = unsafe { &mut *(ctx as *mut Vec<u8>) };
-    match catch_unwind(AssertUnwindSafe(|| {
-        v.extend_from_slice(unsafe { slice(data, len) })
-    })) {
+/// The host's `ByteSink::write`: appends the bytes to the `Vec` of the running `encode_image`.
+///
+/// # Safety
+/// `ctx` is that `Vec`, not otherwise borrowed during the call; `data` is null or `len` bytes.
+unsafe extern "C" fn collect_bytes(ctx: *mut c_void, data: *const u8, len: usize) -> abi::Status {
+    // SAFETY: the plugin calls this only through the sink of a running `encode_image`, on its
+    // thread and one call at a time (ABI contract): `ctx` is that call's `Vec`, which nothing
+    // else touches until the plugin returns, and `data` is `len` readable bytes.
+    let (v, data) = unsafe { (&mut *(ctx as *mut Vec<u8>), slice(data, len)) };
+    match catch_unwind(AssertUnwindSafe(|| v.extend_from_slice(data))) {
         Ok(()) => abi::STATUS_OK,
         Err(_) => abi::STATUS_ERROR,
     }
@@ -31,6 +35,23 @@ pub fn encode_image(
     height: u32,
     rgba: &[f32],
 ) -> Result<Vec<u8>, (Origin, String)> {
+    let Table::Writer(vt) = entry.table else {
+        return Err(wrong_kind(registry, entry, PluginKind::Writer, params_at));
+    };
+    // The plugin reads `width * height * 4` values.
+    if Some(rgba.len())
+        != (width as usize)
+            .checked_mul(height as usize)
+            .and_then(|n| n.checked_mul(4))
+    {
+        return Err((
+            params_at.clone(),
+            format!(
+                "{width}x{height} image given {} values instead of 4 per pixel",
+                rgba.len()
+            ),
+        ));
+    }
     let mut bytes: Vec<u8> = Vec::new();
     let sink = abi::ByteSink {
         ctx: &mut bytes as *mut Vec<u8> as *mut c_void,
@@ -43,10 +64,11 @@ pub fn encode_image(
     };
     let dir = scene_dir.to_string_lossy();
     let ctx = call_context(&dir, "");
-    // SAFETY: the entry is a writer, so its vtable is a WriterVTable.
-    let vt = unsafe { &*(entry.vtable as *const abi::WriterVTable) };
     call_plugin(registry, entry, params_at, |err| {
-        (vt.write)(abi::Str::new(params), &ctx, &image, &sink, err)
+        // SAFETY: the calling contract: `params`, `ctx`, `image` (with its `width * height * 4`
+        // values, checked above), `sink` and `err` live across the call; `sink.ctx` is `bytes`,
+        // which we do not touch until the plugin returns.
+        unsafe { (vt.write)(abi::Str::new(params), &ctx, &image, &sink, err) }
     })?;
     Ok(bytes)
 }

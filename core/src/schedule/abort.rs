@@ -10,10 +10,12 @@ use std::time::{Duration, Instant};
 /// Tag of the message carrying a failing rank's cause to rank 0.
 pub(super) const TAG_ERROR: i32 = 6;
 
-/// This process's rank once MPI is up (-1 before): read by [`fail`] from any thread.
+/// This process's rank while MPI is up (-1 before `MPI_Init_thread` and from `MPI_Finalize` on):
+/// read by [`fail`] and [`abort_job`] from any thread.
 static RANK: AtomicI32 = AtomicI32::new(-1);
 
-/// Records this process's rank and makes a panic on any thread end the whole job.
+/// Records this process's rank (MPI was just initialised with `MPI_THREAD_MULTIPLE`) and makes a
+/// panic on any thread end the whole job.
 pub(super) fn on_rank(rank: usize) {
     RANK.store(rank as i32, Ordering::SeqCst);
     let previous = std::panic::take_hook();
@@ -41,8 +43,10 @@ pub fn fail(message: &str) -> ! {
         // Rank 0 normally prints the cause and aborts within milliseconds; if it is not
         // listening (busy in a collective), this rank prints it and aborts itself.
         let bytes = message.as_bytes();
-        // SAFETY: MPI is initialised with MPI_THREAD_MULTIPLE; `bytes` outlives the request
-        // because this function never returns.
+        // SAFETY: MPI is up with `MPI_THREAD_MULTIPLE` (`RANK` is set only then), so any thread
+        // may call it. The send may read `bytes` for as long as the process runs: this function
+        // never returns and `abort_job` exits without unwinding, so `message` outlives it.
+        // `req` and `flag` are locals; the `RSMPI_*` statics are rsmpi's constant handles.
         unsafe {
             let mut req = ffi::RSMPI_REQUEST_NULL;
             ffi::MPI_Isend(
@@ -72,11 +76,19 @@ pub fn fail(message: &str) -> ! {
 
 pub(super) fn abort_job() -> ! {
     crate::files::discard_temp_files();
-    // SAFETY: plain FFI call on the world communicator.
-    unsafe {
-        ffi::MPI_Abort(ffi::RSMPI_COMM_WORLD, 1);
+    if RANK.load(Ordering::SeqCst) >= 0 {
+        // SAFETY: MPI is up with `MPI_THREAD_MULTIPLE` (`RANK` is set only then), and the call
+        // takes the world communicator's handle (rsmpi's constant) and an error code.
+        unsafe {
+            ffi::MPI_Abort(ffi::RSMPI_COMM_WORLD, 1);
+        }
     }
     std::process::exit(1)
+}
+
+/// MPI is about to be finalised: from now on a failure ends this process only.
+pub(super) fn on_finalize() {
+    RANK.store(-1, Ordering::SeqCst);
 }
 
 /// A failure injected by tests on one rank: `LUXON_TEST_FAIL_RANK=k` with

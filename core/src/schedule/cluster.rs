@@ -40,6 +40,13 @@ pub struct Cluster {
     _universe: mpi::environment::Universe,
 }
 
+impl Drop for Cluster {
+    /// Runs before the fields drop (`_universe` finalises MPI): no MPI call after that.
+    fn drop(&mut self) {
+        super::abort::on_finalize();
+    }
+}
+
 /// What [`Cluster::render`] leaves: every rank's statistics (rank 0; others: their own) and the
 /// chunks this rank rendered, when asked to keep them.
 pub struct Rendered {
@@ -50,8 +57,15 @@ pub struct Rendered {
 impl Cluster {
     /// Initialises MPI (once per process) and makes a panic anywhere end the whole job.
     pub fn init() -> Result<Cluster, Error> {
-        let (universe, _) = mpi::initialize_with_threading(mpi::Threading::Multiple)
+        let (universe, threading) = mpi::initialize_with_threading(mpi::Threading::Multiple)
             .ok_or_else(|| Error::Render("MPI was already initialised in this process".into()))?;
+        // A failure on any thread reaches rank 0 and ends the job through MPI (`abort`).
+        if threading != mpi::Threading::Multiple {
+            return Err(Error::Render(format!(
+                "the MPI library offers {threading:?} threading, but Luxon needs Multiple \
+                 (MPI_THREAD_MULTIPLE)"
+            )));
+        }
         let world = universe.world();
         let (rank, size) = (world.rank() as usize, world.size() as usize);
         super::abort::on_rank(rank);
@@ -170,9 +184,7 @@ impl Cluster {
         } else {
             Vec::new()
         };
-        if let Err(e) =
-            super::mpi_io::write_ppm(self.world.as_raw(), tmp, &header, width, height, mine)
-        {
+        if let Err(e) = super::mpi_io::write_ppm(&self.world, tmp, &header, width, height, mine) {
             fail(&format!("{}: MPI-IO: {e}", tmp.display()));
         }
     }
@@ -317,7 +329,7 @@ impl Run<'_> {
         let dynamic = matches!(share, Share::Queue { .. });
         let root = self.cluster.world.process_at_rank(0);
         let mut kept = Vec::new();
-        let mut outbox = Outbox::new(self.cluster.world.as_raw());
+        let mut outbox = Outbox::new(&self.cluster.world);
         let mut no_more_tiles = !dynamic;
         // Tiles requested and not finished: every thread's plus at least one ahead.
         let threads = self.threads[self.cluster.rank];

@@ -3,6 +3,8 @@
 
 use super::abort::fail;
 use mpi::ffi;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::AsRaw;
 use std::collections::VecDeque;
 use std::os::raw::{c_int, c_void};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -14,13 +16,14 @@ pub(super) const POLL: Duration = Duration::from_micros(500);
 
 /// Chunks on their way to rank 0. Non-blocking sends: a blocking send of a large message waits
 /// for rank 0 to poll, and OpenMPI waits by spinning, which takes a core from the renderers.
-pub(super) struct Outbox {
-    comm: ffi::MPI_Comm,
+pub(super) struct Outbox<'c> {
+    comm: &'c SimpleCommunicator,
+    /// Sends not known to be complete, each with the buffer MPI may still be reading.
     pending: Vec<(ffi::MPI_Request, Vec<u8>)>,
 }
 
-impl Outbox {
-    pub(super) fn new(comm: ffi::MPI_Comm) -> Outbox {
+impl<'c> Outbox<'c> {
+    pub(super) fn new(comm: &'c SimpleCommunicator) -> Outbox<'c> {
         Outbox {
             comm,
             pending: Vec::new(),
@@ -28,31 +31,40 @@ impl Outbox {
     }
 
     pub(super) fn send(&mut self, bytes: Vec<u8>, tag: i32) {
-        // SAFETY: the buffer stays alive and unmoved (heap) in `pending` until MPI_Test says
-        // the send completed.
-        unsafe {
+        let Ok(len) = c_int::try_from(bytes.len()) else {
+            fail("a chunk is too large for one MPI message");
+        };
+        // SAFETY: MPI is up (a `SimpleCommunicator` exists only while it is) and `comm` is a
+        // live communicator; the `RSMPI_*` statics are rsmpi's constant handles. The send reads
+        // `len` bytes of `bytes` until it completes: the buffer is heap memory that moves into
+        // `pending` with its request (moving a `Vec` does not move its buffer) and is freed
+        // only once `MPI_Test` reports the send complete (`progress`), or after waiting for
+        // that (`Drop`); `req` is a local.
+        let (code, req) = unsafe {
             let mut req = ffi::RSMPI_REQUEST_NULL;
             let code = ffi::MPI_Isend(
                 bytes.as_ptr() as *const c_void,
-                bytes.len() as c_int,
+                len,
                 ffi::RSMPI_UINT8_T,
                 0,
                 tag,
-                self.comm,
+                self.comm.as_raw(),
                 &mut req,
             );
-            if code != 0 {
-                fail("MPI_Isend failed");
-            }
-            self.pending.push((req, bytes));
+            (code, req)
+        };
+        if code != 0 {
+            fail("MPI_Isend failed");
         }
+        self.pending.push((req, bytes));
     }
 
     /// Drops the buffers of completed sends.
     pub(super) fn progress(&mut self) {
         self.pending.retain_mut(|(req, _)| {
             let mut done: c_int = 0;
-            // SAFETY: `req` is a live request from MPI_Isend.
+            // SAFETY: `req` is a request of `MPI_Isend` not yet reported complete (those are
+            // removed here), `done` a local, and `RSMPI_STATUS_IGNORE` rsmpi's constant.
             unsafe { ffi::MPI_Test(req, &mut done, ffi::RSMPI_STATUS_IGNORE) };
             done == 0
         });
@@ -63,6 +75,13 @@ impl Outbox {
             self.progress();
             std::thread::sleep(POLL);
         }
+    }
+}
+
+impl Drop for Outbox<'_> {
+    /// Buffers of unfinished sends must outlive them (nothing to wait for after `flush`).
+    fn drop(&mut self) {
+        self.flush();
     }
 }
 

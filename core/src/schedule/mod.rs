@@ -3,13 +3,19 @@
 pub mod decompose;
 pub mod wire;
 
+// MPI calls (the raw rsmpi FFI).
 #[cfg(feature = "mpi")]
+#[allow(unsafe_code)]
 mod abort;
 #[cfg(feature = "mpi")]
 pub mod cluster;
+// MPI calls (the raw rsmpi FFI).
 #[cfg(feature = "mpi")]
+#[allow(unsafe_code)]
 mod mailbox;
+// MPI calls (the raw rsmpi FFI).
 #[cfg(feature = "mpi")]
+#[allow(unsafe_code)]
 mod mpi_io;
 
 use crate::error::Error;

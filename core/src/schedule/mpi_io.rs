@@ -5,6 +5,8 @@
 use crate::framebuffer::Chunk;
 use crate::ppm::srgb8;
 use mpi::ffi;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::AsRaw;
 use std::ffi::CString;
 use std::os::raw::{c_int, c_void};
 use std::path::Path;
@@ -52,9 +54,10 @@ fn check(what: &str, code: c_int) -> Result<(), String> {
     if code == 0 {
         return Ok(());
     }
-    let mut buf = vec![0u8; 512];
+    let mut buf = vec![0u8; ffi::MPI_MAX_ERROR_STRING as usize];
     let mut len: c_int = 0;
-    // SAFETY: the buffer holds MPI_MAX_ERROR_STRING (256 in OpenMPI) bytes and more.
+    // SAFETY: MPI writes at most `MPI_MAX_ERROR_STRING` bytes (the library's own constant) to
+    // the string, and `len` is a local.
     unsafe { ffi::MPI_Error_string(code, buf.as_mut_ptr() as *mut _, &mut len) };
     buf.truncate(len.max(0) as usize);
     Err(format!("{what} failed: {}", String::from_utf8_lossy(&buf)))
@@ -63,7 +66,7 @@ fn check(what: &str, code: c_int) -> Result<(), String> {
 /// Collective over `comm`: writes this rank's pixels (and `header`, non-empty on one rank only)
 /// of a `width`×`height` 8-bit PPM to `path`.
 pub fn write_ppm(
-    comm: ffi::MPI_Comm,
+    comm: &SimpleCommunicator,
     path: &Path,
     header: &[u8],
     width: u32,
@@ -77,8 +80,12 @@ pub fn write_ppm(
     let lens: Vec<c_int> = runs.iter().map(|r| r.1 as c_int).collect();
     let offsets: Vec<ffi::MPI_Aint> = runs.iter().map(|r| r.0 as ffi::MPI_Aint).collect();
     let count = ffi_len(data.len() as u64)?;
-    // SAFETY: every pointer is valid for the call it is passed to; the derived datatype is
-    // freed before returning and the file is closed on every path after a successful open.
+    let comm = comm.as_raw();
+    // SAFETY: MPI is up and `comm` live (a `SimpleCommunicator` exists only while they are).
+    // Every pointer is valid for the call it is passed to: `name` is NUL-terminated, `lens` and
+    // `offsets` hold `lens.len()` entries each, `data` holds `count` bytes, and `file` and
+    // `view` are locals; the `RSMPI_*` statics are rsmpi's constant handles. The derived datatype is freed before returning and the file is closed
+    // on every path after a successful open.
     unsafe {
         let byte = ffi::RSMPI_UINT8_T;
         let mut file: ffi::MPI_File = ffi::RSMPI_FILE_NULL;

@@ -61,6 +61,8 @@
 //! exactly when the ends differ in sign and is found by safeguarded Newton iteration. This never
 //! skips a pair of close roots (a grazing hit), which sampling-based searches can.
 
+#![forbid(unsafe_code)]
+
 use luxon_plugin::{
     finite, invalid, Aabb, Context, CustomShape, Describe, Error, Geometry, Hit, Primitive, Ray,
 };

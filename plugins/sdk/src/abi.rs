@@ -5,11 +5,39 @@
 //! freed by the side that allocated it. Enumerations travel as `u32` so that a bad value from the
 //! other side is an error, not undefined behaviour.
 //!
-//! Handshake: the library exports [`DECLARE_SYMBOL`], an `extern "C" fn(*const HostTable) ->
-//! *const PluginHeader`. The host reads `magic` and `abi_version` first and stops there when they
-//! do not match; everything after them may change between ABI versions.
+//! Handshake: the library exports [`DECLARE_SYMBOL`], an `unsafe extern "C" fn(*const HostTable)
+//! -> *const PluginHeader`. The host reads the header's `magic`, `abi_version` and
+//! `sdk_version` (for its messages) and stops there when the magic or the version does not
+//! match: these three keep their layout in every ABI version; everything after them may change.
 //!
-//! Any change to a type or a function signature in this file must bump [`ABI_VERSION`].
+//! # The calling contract
+//!
+//! Every function pointer is an `unsafe extern "C" fn`: it takes raw pointers whose validity
+//! only its caller can promise, and the promise is the same for all of them.
+//! - A pointer argument is non-null, aligned and points to a live value of its type (for a
+//!   data pointer with a count: that many values) for the duration of the call, unless the
+//!   field's documentation allows null. Nothing else writes to what it points to during the
+//!   call; the callee writes only through its out-pointers (`*mut` arguments).
+//! - A `ctx` argument is the `ctx` stored next to the function in the same table.
+//! - An `object` argument is one the same library created (in a [`CustomGeometry`] or
+//!   [`TextureObject`]) and has not destroyed; `destroy` is called once, with no other call on
+//!   the object running or following.
+//! - A [`Str`] points to `len` readable bytes (or is null with `len` 0); that they are UTF-8 is
+//!   checked by the receiver, not promised.
+//! - Borrowed pointers are not kept after the call returns (ownership passes only where a field
+//!   says so).
+//! - A callee never unwinds across the boundary: panics are caught on the side they happen.
+//! - Threads: the host's sinks ([`ErrorSink`], [`GeometrySink`], [`VolumeSink`], [`ByteSink`])
+//!   are called only on the thread running the call they were passed to, one call at a time;
+//!   [`HostTable::log`] from any thread. A plugin's objects ([`CustomVTable`],
+//!   [`TextureInstanceVTable`]) take `intersect`/`occluded`/`bounds` and `eval` calls from
+//!   several threads at once (they must be thread-safe), and `destroy` from any thread.
+//!
+//! Any change to a type or a function signature in this file must bump [`ABI_VERSION`]: the
+//! version protects compiled plugins, so the rule is about what the machine code sees. Marking a
+//! function pointer `unsafe` (or removing the mark) is not such a change: `unsafe extern "C" fn`
+//! and `extern "C" fn` have the same calling convention and representation, so a plugin built
+//! before such a change loads and runs unchanged after it.
 
 use std::ffi::c_void;
 
@@ -44,13 +72,18 @@ impl Str {
         }
     }
 
+    /// The text, or an error when it is not UTF-8. A null or empty `Str` is `""`.
+    ///
     /// # Safety
-    /// `ptr`/`len` must describe valid memory for the lifetime `'a`.
+    /// Unless `ptr` is null or `len` is 0, `ptr` must point to `len` initialised bytes of one
+    /// allocation that stay valid and unmodified for the lifetime `'a`.
     pub unsafe fn as_str<'a>(&self) -> Result<&'a str, std::str::Utf8Error> {
         if self.ptr.is_null() || self.len == 0 {
             return Ok("");
         }
-        std::str::from_utf8(std::slice::from_raw_parts(self.ptr, self.len))
+        // SAFETY: non-null and non-empty here, so the caller promised `len` readable bytes at
+        // `ptr`, unmodified for `'a`.
+        std::str::from_utf8(unsafe { std::slice::from_raw_parts(self.ptr, self.len) })
     }
 }
 
@@ -73,8 +106,8 @@ pub const KIND_WRITER: u32 = 4;
 #[repr(C)]
 pub struct HostTable {
     pub abi_version: u32,
-    /// level: 0 error, 1 warning, 2 info, 3 debug.
-    pub log: extern "C" fn(level: u32, plugin: Str, message: Str),
+    /// level: 0 error, 1 warning, 2 info, 3 debug. Callable from any thread.
+    pub log: unsafe extern "C" fn(level: u32, plugin: Str, message: Str),
 }
 
 /// Returned by the handshake; lives for the process lifetime (a static in the plugin).
@@ -84,7 +117,7 @@ pub struct PluginHeader {
     pub abi_version: u32,
     /// Version of the `luxon-plugin` crate the plugin was built with, e.g. "0.1.0".
     pub sdk_version: Str,
-    /// Only read when `magic` and `abi_version` match.
+    /// Only read when `magic` and `abi_version` match (the fields above this one never move).
     pub declaration: *const Declaration,
 }
 
@@ -108,7 +141,7 @@ pub struct Entry {
     /// Writers: comma-separated file extensions without dots ("ppm,pnm"); empty otherwise.
     pub extensions: Str,
     /// Points to the table for `kind`: [`PrimitiveVTable`], [`TextureVTable`],
-    /// [`VolumeReaderVTable`] or [`WriterVTable`].
+    /// [`VolumeReaderVTable`] or [`WriterVTable`], a static of the library.
     pub vtable: *const c_void,
 }
 
@@ -117,7 +150,7 @@ pub struct Entry {
 #[repr(C)]
 pub struct ErrorSink {
     pub ctx: *mut c_void,
-    pub set: extern "C" fn(ctx: *mut c_void, message: Str, line: u32, col: u32),
+    pub set: unsafe extern "C" fn(ctx: *mut c_void, message: Str, line: u32, col: u32),
 }
 
 /// What every create/read/write call receives besides its params.
@@ -141,7 +174,9 @@ pub struct CallContext {
 
 #[repr(C)]
 pub struct PrimitiveVTable {
-    pub create: extern "C" fn(
+    /// `ctx` may be null (a context outside any scene); `err` may be null (errors are then
+    /// only reported by the status).
+    pub create: unsafe extern "C" fn(
         params: Str,
         ctx: *const CallContext,
         sink: *const GeometrySink,
@@ -193,21 +228,22 @@ pub struct HitF64 {
 /// plugin panicked (the host then stops the render with an error naming the plugin).
 #[repr(C)]
 pub struct CustomVTable {
-    pub bounds: extern "C" fn(
+    pub bounds: unsafe extern "C" fn(
         object: *const c_void,
         index: u64,
         min: *mut [f64; 3],
         max: *mut [f64; 3],
     ) -> Status,
-    pub intersect: extern "C" fn(
+    pub intersect: unsafe extern "C" fn(
         object: *const c_void,
         index: u64,
         ray: *const RayF64,
         hit: *mut HitF64,
     ) -> u32,
-    pub occluded: extern "C" fn(object: *const c_void, index: u64, ray: *const RayF64) -> u32,
+    pub occluded:
+        unsafe extern "C" fn(object: *const c_void, index: u64, ray: *const RayF64) -> u32,
     /// Called once by the host when it no longer needs the object.
-    pub destroy: extern "C" fn(object: *mut c_void),
+    pub destroy: unsafe extern "C" fn(object: *mut c_void),
 }
 
 /// Return value of `intersect`/`occluded` when the plugin panicked.
@@ -217,6 +253,7 @@ pub const HIT_PANIC: u32 = 3;
 pub struct CustomGeometry {
     pub object: *mut c_void,
     pub count: u64,
+    /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const CustomVTable,
 }
 
@@ -226,14 +263,14 @@ pub struct CustomGeometry {
 pub struct GeometrySink {
     pub ctx: *mut c_void,
     /// `count` spheres as x, y, z, radius.
-    pub add_spheres: extern "C" fn(
+    pub add_spheres: unsafe extern "C" fn(
         ctx: *mut c_void,
         data: *const f64,
         count: u64,
         err: *const ErrorSink,
     ) -> Status,
     /// `count` infinite planes as point x, y, z then normal x, y, z.
-    pub add_planes: extern "C" fn(
+    pub add_planes: unsafe extern "C" fn(
         ctx: *mut c_void,
         data: *const f64,
         count: u64,
@@ -241,23 +278,26 @@ pub struct GeometrySink {
     ) -> Status,
     /// `count` open cones as base x, y, z, base radius, apex x, y, z, apex radius (equal radii:
     /// a cylinder; one radius may be 0: a pointed cone). No caps: add discs for them.
-    pub add_cones: extern "C" fn(
+    pub add_cones: unsafe extern "C" fn(
         ctx: *mut c_void,
         data: *const f64,
         count: u64,
         err: *const ErrorSink,
     ) -> Status,
     /// `count` discs (rings) as centre x, y, z, normal x, y, z, inner radius, outer radius.
-    pub add_discs: extern "C" fn(
+    pub add_discs: unsafe extern "C" fn(
         ctx: *mut c_void,
         data: *const f64,
         count: u64,
         err: *const ErrorSink,
     ) -> Status,
-    pub add_mesh:
-        extern "C" fn(ctx: *mut c_void, mesh: *const MeshData, err: *const ErrorSink) -> Status,
+    pub add_mesh: unsafe extern "C" fn(
+        ctx: *mut c_void,
+        mesh: *const MeshData,
+        err: *const ErrorSink,
+    ) -> Status,
     /// Ownership of `geometry.object` passes to the host, which calls `destroy` when done.
-    pub add_custom: extern "C" fn(
+    pub add_custom: unsafe extern "C" fn(
         ctx: *mut c_void,
         geometry: *const CustomGeometry,
         err: *const ErrorSink,
@@ -270,7 +310,9 @@ pub struct GeometrySink {
 
 #[repr(C)]
 pub struct TextureVTable {
-    pub create: extern "C" fn(
+    /// On success fills `out` with an object the host later destroys through its table.
+    /// `ctx` and `err` may be null (as for [`PrimitiveVTable::create`]).
+    pub create: unsafe extern "C" fn(
         params: Str,
         ctx: *const CallContext,
         out: *mut TextureObject,
@@ -281,6 +323,7 @@ pub struct TextureVTable {
 #[repr(C)]
 pub struct TextureObject {
     pub object: *mut c_void,
+    /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const TextureInstanceVTable,
 }
 
@@ -304,9 +347,12 @@ pub struct TexQuery {
 #[repr(C)]
 pub struct TextureInstanceVTable {
     /// Writes linear RGBA into `out`; returns [`STATUS_PANIC`] when the plugin panicked.
-    pub eval:
-        extern "C" fn(object: *const c_void, query: *const TexQuery, out: *mut [f32; 4]) -> Status,
-    pub destroy: extern "C" fn(object: *mut c_void),
+    pub eval: unsafe extern "C" fn(
+        object: *const c_void,
+        query: *const TexQuery,
+        out: *mut [f32; 4],
+    ) -> Status,
+    pub destroy: unsafe extern "C" fn(object: *mut c_void),
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -316,7 +362,8 @@ pub struct TextureInstanceVTable {
 
 #[repr(C)]
 pub struct VolumeReaderVTable {
-    pub read: extern "C" fn(
+    /// `ctx` and `err` may be null (as for [`PrimitiveVTable::create`]).
+    pub read: unsafe extern "C" fn(
         params: Str,
         ctx: *const CallContext,
         sink: *const VolumeSink,
@@ -340,10 +387,13 @@ pub struct VolumeDesc {
 pub struct VolumeSink {
     pub ctx: *mut c_void,
     /// Called once, before any block or tile.
-    pub begin:
-        extern "C" fn(ctx: *mut c_void, desc: *const VolumeDesc, err: *const ErrorSink) -> Status,
+    pub begin: unsafe extern "C" fn(
+        ctx: *mut c_void,
+        desc: *const VolumeDesc,
+        err: *const ErrorSink,
+    ) -> Status,
     /// A dense block of `dims[0]*dims[1]*dims[2]` values, x fastest, starting at index `origin`.
-    pub add_dense: extern "C" fn(
+    pub add_dense: unsafe extern "C" fn(
         ctx: *mut c_void,
         origin: *const [i64; 3],
         dims: *const [u64; 3],
@@ -351,7 +401,7 @@ pub struct VolumeSink {
         err: *const ErrorSink,
     ) -> Status,
     /// A constant box of `dims` voxels starting at `origin`.
-    pub add_tile: extern "C" fn(
+    pub add_tile: unsafe extern "C" fn(
         ctx: *mut c_void,
         origin: *const [i64; 3],
         dims: *const [u64; 3],
@@ -366,7 +416,8 @@ pub struct VolumeSink {
 
 #[repr(C)]
 pub struct WriterVTable {
-    pub write: extern "C" fn(
+    /// `ctx` and `err` may be null (as for [`PrimitiveVTable::create`]).
+    pub write: unsafe extern "C" fn(
         params: Str,
         ctx: *const CallContext,
         image: *const ImageView,
@@ -380,11 +431,12 @@ pub struct WriterVTable {
 pub struct ImageView {
     pub width: u32,
     pub height: u32,
+    /// `width * height * 4` values (may be null when that is 0).
     pub rgba: *const f32,
 }
 
 #[repr(C)]
 pub struct ByteSink {
     pub ctx: *mut c_void,
-    pub write: extern "C" fn(ctx: *mut c_void, data: *const u8, len: usize) -> Status,
+    pub write: unsafe extern "C" fn(ctx: *mut c_void, data: *const u8, len: usize) -> Status,
 }

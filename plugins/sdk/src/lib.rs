@@ -174,33 +174,41 @@ pub fn describe_ron_error(code: &ron::Error) -> String {
     }
 }
 
-/// The candidate closest to `word` by edit distance, if it is close enough to be a likely typo.
+/// The candidate closest to `word` by edit distance, if it is close enough to be a likely typo:
+/// at most `max(2, len / 3)` edits (len: `word`'s length in characters), and not a complete
+/// rewrite of the word. The first of equally close candidates wins.
+///
+/// Luxon's one "did you mean" rule: plugin parameters and names here, scene files through
+/// `luxon-formats` (which re-exports it).
 pub fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let mut best: Option<(usize, &str)> = None;
-    for c in candidates {
-        let d = edit_distance(word, c);
-        if best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, c));
+    let len = word.chars().count();
+    let limit = (len / 3).max(2);
+    let mut best: Option<(usize, &'a str)> = None;
+    for candidate in candidates {
+        let d = edit_distance(word, candidate);
+        // Replacing every character is not a typo ("x" is not a misspelt "up").
+        let whole = len.max(candidate.chars().count());
+        if d <= limit && d < whole && !matches!(best, Some((b, _)) if b <= d) {
+            best = Some((d, candidate));
         }
     }
-    best.filter(|(d, c)| *d <= 2.max(c.len() / 3))
-        .map(|(_, c)| c)
+    best.map(|(_, c)| c)
 }
 
 /// Levenshtein distance over chars.
 pub fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    let mut cur = vec![0; b.len() + 1];
+    let mut row: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {
-        cur[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let sub = prev[j] + usize::from(ca != *cb);
-            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let substitute = diagonal + usize::from(ca != cb);
+            diagonal = row[j + 1];
+            row[j + 1] = substitute.min(row[j] + 1).min(diagonal + 1);
         }
-        std::mem::swap(&mut prev, &mut cur);
     }
-    prev[b.len()]
+    row[b.len()]
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -255,15 +263,22 @@ pub trait CustomShape: Send + Sync + 'static {
 
 struct SinkError(Option<Error>);
 
-extern "C" fn sink_error_set(ctx: *mut c_void, message: abi::Str, line: u32, col: u32) {
-    // SAFETY: ctx is the SinkError we created below for the duration of the call.
+/// The SDK's error sink: keeps the message the host reports for one call.
+///
+/// # Safety
+/// `ctx` is the `SinkError` of the running [`call_sink`]; `message` as in the ABI contract.
+unsafe extern "C" fn sink_error_set(ctx: *mut c_void, message: abi::Str, line: u32, col: u32) {
+    // SAFETY: the host calls this only through the `ErrorSink` of a running `call_sink`, whose
+    // `ctx` points to that call's `SinkError`; nothing else touches it until the call returns.
     let slot = unsafe { &mut *(ctx as *mut SinkError) };
+    // SAFETY: the host's `Str` is readable for this call (ABI contract); it is copied here.
     let message = unsafe { message.as_str() }
         .unwrap_or("(invalid UTF-8)")
         .to_string();
     slot.0 = Some(Error { message, line, col });
 }
 
+/// Runs one call into a host sink with an error sink of our own; the host's message on failure.
 fn call_sink(f: impl FnOnce(&abi::ErrorSink) -> abi::Status) -> Result<(), Error> {
     let mut slot = SinkError(None);
     let err = abi::ErrorSink {
@@ -278,54 +293,53 @@ fn call_sink(f: impl FnOnce(&abi::ErrorSink) -> abi::Status) -> Result<(), Error
     }
 }
 
+/// The signature of the sinks taking `count` records of f64 (spheres, planes, cones, discs).
+type AddRecords = unsafe extern "C" fn(
+    ctx: *mut c_void,
+    data: *const f64,
+    count: u64,
+    err: *const abi::ErrorSink,
+) -> abi::Status;
+
 impl Geometry<'_> {
+    /// Hands `records` to one of the sink's `add_*` functions.
+    fn add<const N: usize>(&mut self, add: AddRecords, records: &[[f64; N]]) -> Result<(), Error> {
+        let sink = self.sink;
+        call_sink(|err| {
+            // SAFETY: `add` is a function of `sink`, the host's table for the running `create`
+            // (a `Geometry` exists only inside that call) and `sink.ctx` its own context;
+            // `records` is `len` records of N contiguous f64, borrowed across the call; `err`
+            // lives in `call_sink`.
+            unsafe {
+                add(
+                    sink.ctx,
+                    records.as_ptr() as *const f64,
+                    records.len() as u64,
+                    err,
+                )
+            }
+        })
+    }
+
     /// Spheres as `[x, y, z, radius]`.
     pub fn spheres(&mut self, spheres: &[[f64; 4]]) -> Result<(), Error> {
-        call_sink(|err| {
-            (self.sink.add_spheres)(
-                self.sink.ctx,
-                spheres.as_ptr() as *const f64,
-                spheres.len() as u64,
-                err,
-            )
-        })
+        self.add(self.sink.add_spheres, spheres)
     }
 
     /// Infinite planes as `[px, py, pz, nx, ny, nz]`.
     pub fn planes(&mut self, planes: &[[f64; 6]]) -> Result<(), Error> {
-        call_sink(|err| {
-            (self.sink.add_planes)(
-                self.sink.ctx,
-                planes.as_ptr() as *const f64,
-                planes.len() as u64,
-                err,
-            )
-        })
+        self.add(self.sink.add_planes, planes)
     }
 
     /// Open cones as `[bx, by, bz, base_radius, ax, ay, az, apex_radius]`; equal radii make a
     /// cylinder. Caps are not included: add discs.
     pub fn cones(&mut self, cones: &[[f64; 8]]) -> Result<(), Error> {
-        call_sink(|err| {
-            (self.sink.add_cones)(
-                self.sink.ctx,
-                cones.as_ptr() as *const f64,
-                cones.len() as u64,
-                err,
-            )
-        })
+        self.add(self.sink.add_cones, cones)
     }
 
     /// Discs or rings as `[cx, cy, cz, nx, ny, nz, inner_radius, outer_radius]`.
     pub fn discs(&mut self, discs: &[[f64; 8]]) -> Result<(), Error> {
-        call_sink(|err| {
-            (self.sink.add_discs)(
-                self.sink.ctx,
-                discs.as_ptr() as *const f64,
-                discs.len() as u64,
-                err,
-            )
-        })
+        self.add(self.sink.add_discs, discs)
     }
 
     pub fn mesh(&mut self, mesh: &Mesh) -> Result<(), Error> {
@@ -357,7 +371,11 @@ impl Geometry<'_> {
             colors: opt(&mesh.colors) as *const f32,
             uvs: opt(&mesh.uvs) as *const f32,
         };
-        call_sink(|err| (self.sink.add_mesh)(self.sink.ctx, &data, err))
+        let sink = self.sink;
+        // SAFETY: `sink` is the host's table for the running `create` and `ctx` its own; every
+        // array of `data` borrows `mesh` for the call with the length `MeshData` states (the
+        // optional ones were checked to have one entry per vertex, or are null).
+        call_sink(|err| unsafe { (sink.add_mesh)(sink.ctx, &data, err) })
     }
 
     /// Hands `shape` to the host, which owns it from now on.
@@ -369,8 +387,11 @@ impl Geometry<'_> {
             count,
             vtable: custom_vtable::<S>(),
         };
+        let sink = self.sink;
         // The host takes ownership even when it reports an error (it destroys the object).
-        call_sink(|err| (self.sink.add_custom)(self.sink.ctx, &geometry, err))
+        // SAFETY: `sink` is the host's table for the running `create` and `ctx` its own;
+        // `geometry` lives across the call, its object is a live `S` whose table is `S`'s.
+        call_sink(|err| unsafe { (sink.add_custom)(sink.ctx, &geometry, err) })
     }
 }
 
@@ -387,15 +408,23 @@ fn custom_vtable<S: CustomShape>() -> &'static abi::CustomVTable {
     &Holder::<S>::VTABLE
 }
 
-extern "C" fn custom_bounds<S: CustomShape>(
+// The functions of a custom shape's table. Their `object` is the `Box<S>` that
+// `Geometry::custom` leaked and handed to the host, which destroys it once, after every other
+// call (ABI contract); `S: Sync`, so concurrent calls from the host's render threads are fine.
+
+/// # Safety
+/// `object` is a live `S` from [`Geometry::custom`]; `min` and `max` are writable.
+unsafe extern "C" fn custom_bounds<S: CustomShape>(
     object: *const c_void,
     index: u64,
     min: *mut [f64; 3],
     max: *mut [f64; 3],
 ) -> abi::Status {
+    // SAFETY: see the comment above these functions.
     let shape = unsafe { &*(object as *const S) };
     match catch_unwind(AssertUnwindSafe(|| shape.bounds(index))) {
         Ok(b) => {
+            // SAFETY: the host passes two writable `[f64; 3]` for the call (ABI contract).
             unsafe {
                 *min = b.min;
                 *max = b.max;
@@ -406,16 +435,19 @@ extern "C" fn custom_bounds<S: CustomShape>(
     }
 }
 
-extern "C" fn custom_intersect<S: CustomShape>(
+/// # Safety
+/// `object` is a live `S` from [`Geometry::custom`]; `ray` is readable, `hit` writable.
+unsafe extern "C" fn custom_intersect<S: CustomShape>(
     object: *const c_void,
     index: u64,
     ray: *const abi::RayF64,
     hit: *mut abi::HitF64,
 ) -> u32 {
-    let shape = unsafe { &*(object as *const S) };
-    let ray = unsafe { &*ray };
+    // SAFETY: see the comment above these functions; the host's ray is valid for the call.
+    let (shape, ray) = unsafe { (&*(object as *const S), &*ray) };
     match catch_unwind(AssertUnwindSafe(|| shape.intersect(index, ray))) {
         Ok(Some(h)) => {
+            // SAFETY: the host passes a writable `HitF64` for the call (ABI contract).
             unsafe { *hit = h };
             1
         }
@@ -424,23 +456,28 @@ extern "C" fn custom_intersect<S: CustomShape>(
     }
 }
 
-extern "C" fn custom_occluded<S: CustomShape>(
+/// # Safety
+/// `object` is a live `S` from [`Geometry::custom`]; `ray` is readable.
+unsafe extern "C" fn custom_occluded<S: CustomShape>(
     object: *const c_void,
     index: u64,
     ray: *const abi::RayF64,
 ) -> u32 {
-    let shape = unsafe { &*(object as *const S) };
-    let ray = unsafe { &*ray };
+    // SAFETY: see the comment above these functions; the host's ray is valid for the call.
+    let (shape, ray) = unsafe { (&*(object as *const S), &*ray) };
     match catch_unwind(AssertUnwindSafe(|| shape.occluded(index, ray))) {
         Ok(b) => u32::from(b),
         Err(_) => abi::HIT_PANIC,
     }
 }
 
-extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        drop(unsafe { Box::from_raw(object as *mut S) })
-    }));
+/// # Safety
+/// `object` is a live `S` from [`Geometry::custom`], not used again after this call.
+unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
+    // SAFETY: `object` came from `Box::into_raw` of a `Box<S>` and the host destroys it once,
+    // after every other call on it (see the comment above these functions).
+    let shape = unsafe { Box::from_raw(object as *mut S) };
+    let _ = catch_unwind(AssertUnwindSafe(|| drop(shape)));
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -467,15 +504,22 @@ fn texture_instance_vtable<T: Texture>() -> &'static abi::TextureInstanceVTable 
     &Holder::<T>::VTABLE
 }
 
-extern "C" fn texture_eval<T: Texture>(
+// The functions of a texture instance's table. Their `object` is the `Box<T>` that
+// `shim::texture_create` leaked into the host's `TextureObject`; the host destroys it once,
+// after every other call (ABI contract); `T: Sync`, so concurrent `eval`s are fine.
+
+/// # Safety
+/// `object` is a live `T` from `shim::texture_create`; `query` is readable, `out` writable.
+unsafe extern "C" fn texture_eval<T: Texture>(
     object: *const c_void,
     query: *const abi::TexQuery,
     out: *mut [f32; 4],
 ) -> abi::Status {
-    let tex = unsafe { &*(object as *const T) };
-    let q = unsafe { &*query };
+    // SAFETY: see the comment above these functions; the host's query is valid for the call.
+    let (tex, q) = unsafe { (&*(object as *const T), &*query) };
     match catch_unwind(AssertUnwindSafe(|| tex.eval(q))) {
         Ok(c) => {
+            // SAFETY: the host passes a writable `[f32; 4]` for the call (ABI contract).
             unsafe { *out = c };
             abi::STATUS_OK
         }
@@ -483,10 +527,13 @@ extern "C" fn texture_eval<T: Texture>(
     }
 }
 
-extern "C" fn texture_destroy<T: Texture>(object: *mut c_void) {
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        drop(unsafe { Box::from_raw(object as *mut T) })
-    }));
+/// # Safety
+/// `object` is a live `T` from `shim::texture_create`, not used again after this call.
+unsafe extern "C" fn texture_destroy<T: Texture>(object: *mut c_void) {
+    // SAFETY: `object` came from `Box::into_raw` of a `Box<T>` and the host destroys it once,
+    // after every other call on it (see the comment above these functions).
+    let tex = unsafe { Box::from_raw(object as *mut T) };
+    let _ = catch_unwind(AssertUnwindSafe(|| drop(tex)));
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -524,7 +571,10 @@ impl VolumeOut<'_> {
             index_max: info.index_max,
             grid_name: abi::Str::new(&info.name),
         };
-        call_sink(|err| (self.sink.begin)(self.sink.ctx, &desc, err))
+        let sink = self.sink;
+        // SAFETY: `sink` is the host's table for the running `read` (a `VolumeOut` exists only
+        // inside it) and `ctx` its own; `desc` and its name live across the call.
+        call_sink(|err| unsafe { (sink.begin)(sink.ctx, &desc, err) })
     }
 
     /// A dense block, x fastest; `values.len()` must be `dims[0] * dims[1] * dims[2]`.
@@ -536,11 +586,16 @@ impl VolumeOut<'_> {
                 values.len()
             )));
         }
-        call_sink(|err| (self.sink.add_dense)(self.sink.ctx, &origin, &dims, values.as_ptr(), err))
+        let sink = self.sink;
+        // SAFETY: `sink` is the host's table for the running `read` and `ctx` its own; `values`
+        // holds the `dims[0] * dims[1] * dims[2]` values the call reads (checked above).
+        call_sink(|err| unsafe { (sink.add_dense)(sink.ctx, &origin, &dims, values.as_ptr(), err) })
     }
 
     pub fn tile(&mut self, origin: [i64; 3], dims: [u64; 3], value: f32) -> Result<(), Error> {
-        call_sink(|err| (self.sink.add_tile)(self.sink.ctx, &origin, &dims, value, err))
+        let sink = self.sink;
+        // SAFETY: `sink` is the host's table for the running `read` and `ctx` its own.
+        call_sink(|err| unsafe { (sink.add_tile)(sink.ctx, &origin, &dims, value, err) })
     }
 }
 
@@ -572,7 +627,9 @@ struct ByteOut<'a>(&'a abi::ByteSink);
 
 impl std::io::Write for ByteOut<'_> {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        match (self.0.write)(self.0.ctx, buf.as_ptr(), buf.len()) {
+        // SAFETY: the sink is the host's table for the running `write` (a `ByteOut` exists only
+        // inside it) and `ctx` its own; `buf` is `len` bytes borrowed across the call.
+        match unsafe { (self.0.write)(self.0.ctx, buf.as_ptr(), buf.len()) } {
             abi::STATUS_OK => Ok(buf.len()),
             _ => Err(std::io::Error::other("the host could not take the bytes")),
         }
@@ -597,13 +654,15 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 // ------------------------------------------------------------------------------------------------
 
 #[doc(hidden)]
-#[allow(clippy::not_unsafe_ptr_arg_deref)] // the host guarantees the pointers (ABI contract)
 pub mod shim {
     use super::*;
+    use std::marker::PhantomData;
 
-    fn report(err: *const abi::ErrorSink, e: &Error) {
-        if let Some(sink) = unsafe { err.as_ref() } {
-            (sink.set)(sink.ctx, abi::Str::new(&e.message), e.line, e.col);
+    fn report(err: Option<&abi::ErrorSink>, e: &Error) {
+        if let Some(sink) = err {
+            // SAFETY: `sink` is the host's error sink for the running call and `ctx` its own
+            // (ABI contract); the message is borrowed across the call.
+            unsafe { (sink.set)(sink.ctx, abi::Str::new(&e.message), e.line, e.col) };
         }
     }
 
@@ -617,20 +676,24 @@ pub mod shim {
         }
     }
 
-    fn context(ctx: *const abi::CallContext) -> Context {
-        match unsafe { ctx.as_ref() } {
-            Some(c) => Context {
-                scene_dir: PathBuf::from(unsafe { c.scene_dir.as_str() }.unwrap_or(".")),
-                instance: unsafe { c.instance.as_str() }.unwrap_or("").to_string(),
-                texture_cache_bytes: c.texture_cache_bytes,
-                threads: c.threads,
+    fn context(ctx: Option<&abi::CallContext>) -> Context {
+        match ctx {
+            // SAFETY: the host's strings are readable for the running call (ABI contract);
+            // they are copied here.
+            Some(c) => unsafe {
+                Context {
+                    scene_dir: PathBuf::from(c.scene_dir.as_str().unwrap_or(".")),
+                    instance: c.instance.as_str().unwrap_or("").to_string(),
+                    texture_cache_bytes: c.texture_cache_bytes,
+                    threads: c.threads,
+                }
             },
             None => Context::default(),
         }
     }
 
     /// Runs `f` with panics caught and errors sent to `err`.
-    fn guarded(err: *const abi::ErrorSink, f: impl FnOnce() -> Result<(), Error>) -> abi::Status {
+    fn guarded(err: Option<&abi::ErrorSink>, f: impl FnOnce() -> Result<(), Error>) -> abi::Status {
         match catch_unwind(AssertUnwindSafe(f)) {
             Ok(Ok(())) => abi::STATUS_OK,
             Ok(Err(e)) => {
@@ -644,71 +707,118 @@ pub mod shim {
         }
     }
 
-    fn params<P: serde::de::DeserializeOwned>(text: abi::Str) -> Result<P, Error> {
-        let text = unsafe { text.as_str() }.map_err(|_| Error::new("params are not UTF-8"))?;
-        parse_params(text)
+    fn params<P: serde::de::DeserializeOwned>(
+        text: Result<&str, std::str::Utf8Error>,
+    ) -> Result<P, Error> {
+        parse_params(text.map_err(|_| Error::new("params are not UTF-8"))?)
     }
 
-    pub extern "C" fn primitive_create<P: Primitive>(
+    /// [`abi::PrimitiveVTable::create`] for `P`.
+    ///
+    /// # Safety
+    /// The ABI's calling contract (see [`abi`]): `text` readable; `ctx` and `err` null or
+    /// valid; `sink` valid, all for the duration of the call.
+    pub unsafe extern "C" fn primitive_create<P: Primitive>(
         text: abi::Str,
         ctx: *const abi::CallContext,
         sink: *const abi::GeometrySink,
         err: *const abi::ErrorSink,
     ) -> abi::Status {
+        // SAFETY: the caller promises each pointer is null or valid for this call, and the
+        // references do not outlive it (the closure runs before we return).
+        let (text, ctx, sink, err) =
+            unsafe { (text.as_str(), ctx.as_ref(), sink.as_ref(), err.as_ref()) };
         guarded(err, || {
             let p = params::<P::Params>(text)?;
-            let sink = unsafe { sink.as_ref() }.ok_or_else(|| Error::new("no geometry sink"))?;
+            let sink = sink.ok_or_else(|| Error::new("no geometry sink"))?;
             P::create(p, &context(ctx), &mut Geometry { sink })
         })
     }
 
-    pub extern "C" fn texture_create<T: Texture>(
+    /// [`abi::TextureVTable::create`] for `T`.
+    ///
+    /// # Safety
+    /// The ABI's calling contract (see [`abi`]): `text` readable; `ctx` and `err` null or
+    /// valid; `out` writable, all for the duration of the call.
+    pub unsafe extern "C" fn texture_create<T: Texture>(
         text: abi::Str,
         ctx: *const abi::CallContext,
         out: *mut abi::TextureObject,
         err: *const abi::ErrorSink,
     ) -> abi::Status {
+        // SAFETY: as in `primitive_create`; `out` is the host's slot, written only here.
+        let (text, ctx, out, err) =
+            unsafe { (text.as_str(), ctx.as_ref(), out.as_mut(), err.as_ref()) };
         guarded(err, || {
+            let out = out.ok_or_else(|| Error::new("no place for the texture"))?;
             let p = params::<T::Params>(text)?;
             let tex = T::create(p, &context(ctx))?;
-            let object = Box::into_raw(Box::new(tex)) as *mut c_void;
-            unsafe {
-                *out = abi::TextureObject {
-                    object,
-                    vtable: texture_instance_vtable::<T>(),
-                }
+            *out = abi::TextureObject {
+                object: Box::into_raw(Box::new(tex)) as *mut c_void,
+                vtable: texture_instance_vtable::<T>(),
             };
             Ok(())
         })
     }
 
-    pub extern "C" fn volume_read<V: VolumeReader>(
+    /// [`abi::VolumeReaderVTable::read`] for `V`.
+    ///
+    /// # Safety
+    /// The ABI's calling contract (see [`abi`]): `text` readable; `ctx` and `err` null or
+    /// valid; `sink` valid, all for the duration of the call.
+    pub unsafe extern "C" fn volume_read<V: VolumeReader>(
         text: abi::Str,
         ctx: *const abi::CallContext,
         sink: *const abi::VolumeSink,
         err: *const abi::ErrorSink,
     ) -> abi::Status {
+        // SAFETY: as in `primitive_create`.
+        let (text, ctx, sink, err) =
+            unsafe { (text.as_str(), ctx.as_ref(), sink.as_ref(), err.as_ref()) };
         guarded(err, || {
             let p = params::<V::Params>(text)?;
-            let sink = unsafe { sink.as_ref() }.ok_or_else(|| Error::new("no volume sink"))?;
+            let sink = sink.ok_or_else(|| Error::new("no volume sink"))?;
             V::read(p, &context(ctx), &mut VolumeOut { sink })
         })
     }
 
-    pub extern "C" fn writer_write<W: Writer>(
+    /// [`abi::WriterVTable::write`] for `W`.
+    ///
+    /// # Safety
+    /// The ABI's calling contract (see [`abi`]): `text` readable; `ctx` and `err` null or
+    /// valid; `image` (with its `width * height * 4` values) and `out` valid, all for the
+    /// duration of the call.
+    pub unsafe extern "C" fn writer_write<W: Writer>(
         text: abi::Str,
         ctx: *const abi::CallContext,
         image: *const abi::ImageView,
         out: *const abi::ByteSink,
         err: *const abi::ErrorSink,
     ) -> abi::Status {
+        // SAFETY: as in `primitive_create`.
+        let (text, ctx, view, out, err) = unsafe {
+            (
+                text.as_str(),
+                ctx.as_ref(),
+                image.as_ref(),
+                out.as_ref(),
+                err.as_ref(),
+            )
+        };
         guarded(err, || {
             let p = params::<W::Params>(text)?;
-            let view = unsafe { image.as_ref() }.ok_or_else(|| Error::new("no image"))?;
-            let n = view.width as usize * view.height as usize * 4;
+            let view = view.ok_or_else(|| Error::new("no image"))?;
+            let n = (view.width as usize)
+                .checked_mul(view.height as usize)
+                .and_then(|n| n.checked_mul(4))
+                .ok_or_else(|| Error::new("image too large"))?;
             let rgba = if n == 0 {
                 &[][..]
+            } else if view.rgba.is_null() {
+                return Err(Error::new("no pixels"));
             } else {
+                // SAFETY: the host's image holds `width * height * 4` values, unchanged while
+                // the call runs (ABI contract), and the slice does not outlive the call.
                 unsafe { std::slice::from_raw_parts(view.rgba, n) }
             };
             let image = Image {
@@ -716,13 +826,13 @@ pub mod shim {
                 height: view.height,
                 rgba,
             };
-            let sink = unsafe { out.as_ref() }.ok_or_else(|| Error::new("no byte sink"))?;
+            let sink = out.ok_or_else(|| Error::new("no byte sink"))?;
             let mut w = ByteOut(sink);
             W::write(p, &context(ctx), &image, &mut w)
         })
     }
 
-    pub const fn entry<D: Describe>(
+    const fn entry<D: Describe>(
         kind: u32,
         extensions: &'static str,
         vtable: *const c_void,
@@ -737,15 +847,83 @@ pub mod shim {
         }
     }
 
-    /// Holds the host table for `log`.
-    pub static HOST: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    // The entries of each kind, each with the table the host expects for that kind: a safe
+    // function cannot pair a kind with another kind's table.
+
+    /// The declaration entry of primitive `P`.
+    pub const fn primitive_entry<P: Primitive>() -> abi::Entry {
+        struct Table<P>(PhantomData<P>);
+        impl<P: Primitive> Table<P> {
+            const VTABLE: abi::PrimitiveVTable = abi::PrimitiveVTable {
+                create: primitive_create::<P>,
+            };
+        }
+        let vtable: &'static abi::PrimitiveVTable = &Table::<P>::VTABLE;
+        entry::<P>(abi::KIND_PRIMITIVE, "", vtable as *const _ as *const c_void)
+    }
+
+    /// The declaration entry of texture `T`.
+    pub const fn texture_entry<T: Texture>() -> abi::Entry {
+        struct Table<T>(PhantomData<T>);
+        impl<T: Texture> Table<T> {
+            const VTABLE: abi::TextureVTable = abi::TextureVTable {
+                create: texture_create::<T>,
+            };
+        }
+        let vtable: &'static abi::TextureVTable = &Table::<T>::VTABLE;
+        entry::<T>(abi::KIND_TEXTURE, "", vtable as *const _ as *const c_void)
+    }
+
+    /// The declaration entry of volume reader `V`.
+    pub const fn volume_reader_entry<V: VolumeReader>() -> abi::Entry {
+        struct Table<V>(PhantomData<V>);
+        impl<V: VolumeReader> Table<V> {
+            const VTABLE: abi::VolumeReaderVTable = abi::VolumeReaderVTable {
+                read: volume_read::<V>,
+            };
+        }
+        let vtable: &'static abi::VolumeReaderVTable = &Table::<V>::VTABLE;
+        entry::<V>(
+            abi::KIND_VOLUME_READER,
+            "",
+            vtable as *const _ as *const c_void,
+        )
+    }
+
+    /// The declaration entry of writer `W`.
+    pub const fn writer_entry<W: Writer>() -> abi::Entry {
+        struct Table<W>(PhantomData<W>);
+        impl<W: Writer> Table<W> {
+            const VTABLE: abi::WriterVTable = abi::WriterVTable {
+                write: writer_write::<W>,
+            };
+        }
+        let vtable: &'static abi::WriterVTable = &Table::<W>::VTABLE;
+        entry::<W>(
+            abi::KIND_WRITER,
+            W::EXTENSIONS,
+            vtable as *const _ as *const c_void,
+        )
+    }
+
+    /// The host's table, for `log`.
+    pub(crate) static HOST: std::sync::OnceLock<&'static abi::HostTable> =
+        std::sync::OnceLock::new();
 
     /// Called by the handshake. A cdylib has its own copy of std and so its own panic hook: the
     /// default one would print every caught panic (one per ray for a broken intersect). Ours
     /// sends the first panic's location through the host log and stays quiet after that; the
     /// message itself reaches the host as the call's error.
-    pub fn init(host: *const abi::HostTable, library: &'static str) {
-        if host.is_null() || HOST.set(host as usize).is_err() {
+    ///
+    /// # Safety
+    /// `host` is null or points to a `HostTable` that stays valid and unchanged for the rest
+    /// of the process (what the host promises in the handshake).
+    pub unsafe fn init(host: *const abi::HostTable, library: &'static str) {
+        // SAFETY: the caller's promise.
+        let Some(host) = (unsafe { host.as_ref() }) else {
+            return;
+        };
+        if HOST.set(host).is_err() {
             return;
         }
         static REPORTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -760,17 +938,38 @@ pub mod shim {
         }));
     }
 
-    /// Wrapper making the static tables `Sync` (they hold raw pointers to other statics).
-    pub struct SyncWrap<T>(pub T);
-    unsafe impl<T> Sync for SyncWrap<T> {}
+    /// The static tables `export!` hands the host: the handshake's header, the declaration
+    /// and the entry array. Only these can be wrapped (see [`SyncWrap`]).
+    pub trait StaticTable: sealed::Sealed {}
+    mod sealed {
+        pub trait Sealed {}
+    }
+    impl sealed::Sealed for abi::PluginHeader {}
+    impl StaticTable for abi::PluginHeader {}
+    impl sealed::Sealed for abi::Declaration {}
+    impl StaticTable for abi::Declaration {}
+    impl sealed::Sealed for &'static [abi::Entry] {}
+    impl StaticTable for &'static [abi::Entry] {}
+
+    /// Makes the static tables of `export!` `Sync`, so they can be statics. Their raw pointers
+    /// make them `!Sync` by default; for these types that is too cautious (see the `Sync` impl).
+    pub struct SyncWrap<T: StaticTable>(pub T);
+
+    // SAFETY: a `StaticTable` is plain data with no interior mutability: integers, function
+    // pointers, and raw pointers (to string literals, the entry array, the vtables and the
+    // declaration: all immutable statics). Sharing one between threads only lets them read
+    // those values; reading through the raw pointers is unsafe code with its own contract
+    // (the ABI's), which no more depends on the thread than a read of a static does.
+    unsafe impl<T: StaticTable> Sync for SyncWrap<T> {}
 }
 
 /// Logs through the host (a plugin's own `log`/`println!` would bypass the host's output).
 /// Level: 0 error, 1 warning, 2 info, 3 debug.
 pub fn host_log(library: &str, level: u32, message: &str) {
-    if let Some(&ptr) = shim::HOST.get() {
-        let host = unsafe { &*(ptr as *const abi::HostTable) };
-        (host.log)(level, abi::Str::new(library), abi::Str::new(message));
+    if let Some(host) = shim::HOST.get() {
+        // SAFETY: the host's table stays valid for the process (`shim::init`'s contract), `log`
+        // may be called from any thread, and both strings are borrowed across the call.
+        unsafe { (host.log)(level, abi::Str::new(library), abi::Str::new(message)) };
     }
 }
 
@@ -779,6 +978,10 @@ pub fn host_log(library: &str, level: u32, message: &str) {
 /// ```text
 /// export!(library: "luxon-shapes", primitives: [Sphere, Plane], textures: [], writers: []);
 /// ```
+///
+/// The expansion holds the handshake (the library's one `#[no_mangle]` function) and its
+/// static tables; its unsafe code is the SDK's, so a plugin crate can still
+/// `#![forbid(unsafe_code)]` (the lint does not look into other crates' macros).
 #[macro_export]
 macro_rules! export {
     (library: $lib:literal
@@ -792,30 +995,10 @@ macro_rules! export {
             use $crate::abi;
             use $crate::shim::SyncWrap;
             static ENTRIES: SyncWrap<&[abi::Entry]> = SyncWrap(&[
-                $($($crate::shim::entry::<$prim>(
-                    abi::KIND_PRIMITIVE,
-                    "",
-                    &abi::PrimitiveVTable { create: $crate::shim::primitive_create::<$prim> }
-                        as *const abi::PrimitiveVTable as *const ::std::ffi::c_void,
-                ),)*)?
-                $($($crate::shim::entry::<$tex>(
-                    abi::KIND_TEXTURE,
-                    "",
-                    &abi::TextureVTable { create: $crate::shim::texture_create::<$tex> }
-                        as *const abi::TextureVTable as *const ::std::ffi::c_void,
-                ),)*)?
-                $($($crate::shim::entry::<$vol>(
-                    abi::KIND_VOLUME_READER,
-                    "",
-                    &abi::VolumeReaderVTable { read: $crate::shim::volume_read::<$vol> }
-                        as *const abi::VolumeReaderVTable as *const ::std::ffi::c_void,
-                ),)*)?
-                $($($crate::shim::entry::<$wr>(
-                    abi::KIND_WRITER,
-                    <$wr as $crate::Writer>::EXTENSIONS,
-                    &abi::WriterVTable { write: $crate::shim::writer_write::<$wr> }
-                        as *const abi::WriterVTable as *const ::std::ffi::c_void,
-                ),)*)?
+                $($($crate::shim::primitive_entry::<$prim>(),)*)?
+                $($($crate::shim::texture_entry::<$tex>(),)*)?
+                $($($crate::shim::volume_reader_entry::<$vol>(),)*)?
+                $($($crate::shim::writer_entry::<$wr>(),)*)?
             ]);
             static DECLARATION: SyncWrap<abi::Declaration> = SyncWrap(abi::Declaration {
                 library: abi::Str::new($lib),
@@ -829,11 +1012,18 @@ macro_rules! export {
                 declaration: &DECLARATION.0,
             });
 
-            #[no_mangle]
-            pub extern "C" fn luxon_plugin_declare(
+            /// The handshake ([`abi::DeclareFn`]).
+            ///
+            /// # Safety
+            /// `host` is null or the host's table, valid for the rest of the process.
+            // Unmangled, which is unsafe only if the name clashes: the host looks the library's
+            // one symbol of this name up (`export!` is used once per library).
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn luxon_plugin_declare(
                 host: *const abi::HostTable,
             ) -> *const abi::PluginHeader {
-                $crate::shim::init(host, $lib);
+                // SAFETY: the caller's promise, which is `init`'s contract.
+                unsafe { $crate::shim::init(host, $lib) };
                 &HEADER.0
             }
         };
@@ -881,9 +1071,28 @@ mod tests {
     }
 
     #[test]
-    fn suggestions() {
+    fn distance_counts_edits() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("fov", "fov"), 0);
+        assert_eq!(edit_distance("fvo", "fov"), 2);
+    }
+
+    #[test]
+    fn suggests_close_names_only() {
         assert_eq!(suggest("sphre", ["sphere", "plane"]), Some("sphere"));
         assert_eq!(suggest("xyzzy", ["sphere", "plane"]), None);
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(suggest("Pont", ["Point", "Directional"]), Some("Point"));
+        assert_eq!(suggest("radus", ["center", "radius"]), Some("radius"));
+        assert_eq!(suggest("glas", ["red", "glass", "floor"]), Some("glass"));
+        assert_eq!(suggest("zzzzzz", ["red", "glass"]), None);
+        assert_eq!(suggest("x", ["up"]), None);
+        // Long words tolerate more edits: 12 / 3 = 4.
+        assert_eq!(
+            suggest("declmpositio", ["decomposition"]),
+            Some("decomposition")
+        );
+        // The first of equally close candidates.
+        assert_eq!(suggest("cat", ["bat", "cut"]), Some("bat"));
     }
 }

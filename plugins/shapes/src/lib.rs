@@ -177,6 +177,8 @@
 //! ]
 //! ```
 
+#![forbid(unsafe_code)]
+
 mod cones;
 mod custom;
 mod params;

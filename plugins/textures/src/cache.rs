@@ -162,7 +162,9 @@ impl CachedImage {
         for slot in self.slots.iter() {
             let p = slot.data.swap(ptr::null_mut(), SeqCst);
             if !p.is_null() {
-                // SAFETY: from `Arc::into_raw`; swapped out, so released exactly once.
+                // SAFETY: from `Arc::into_raw`; swapped out, so released exactly once; and no
+                // lookup can be reading it: `free_all` runs only when none can run on this image
+                // (on drop, or when `release` drops its last instance).
                 drop(unsafe { Arc::from_raw(p) });
                 freed += slot.bytes;
             }

@@ -189,6 +189,11 @@
 //! },
 //! ```
 
+// Unsafe code only in the texture cache (`cache.rs`: its lock-free resident levels).
+#![deny(unsafe_code)]
+
+// Levels shared through atomic pointers.
+#[allow(unsafe_code)]
 mod cache;
 mod decode;
 mod image;

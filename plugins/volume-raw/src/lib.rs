@@ -62,6 +62,10 @@
 //! ],
 //! ```
 
+// No unsafe code; only the tests that call the reader's C entry point as the host does need it.
+#![cfg_attr(not(test), forbid(unsafe_code))]
+#![cfg_attr(test, deny(unsafe_code))]
+
 mod procedural;
 mod raw;
 

@@ -501,6 +501,7 @@ fn stream(
 }
 
 #[cfg(test)]
+#[allow(unsafe_code)] // drives the reader through its C entry point, as the host does
 mod tests {
     use super::*;
     use luxon_plugin::abi;
@@ -522,18 +523,26 @@ mod tests {
         blocks: Vec<([i64; 3], [u64; 3])>,
     }
 
-    extern "C" fn begin(
+    // The sink below stands in for the host's. The reader calls it during `read`, on the test's
+    // thread and one call at a time (ABI contract), with the `ctx` put in the sink: the `Got`
+    // that `read` owns and does not touch until the reader returns; every other pointer is
+    // valid for the call.
+
+    /// # Safety
+    /// See the comment above.
+    unsafe extern "C" fn begin(
         ctx: *mut c_void,
         desc: *const abi::VolumeDesc,
         _err: *const abi::ErrorSink,
     ) -> abi::Status {
-        let g = unsafe { &mut *(ctx as *mut Got) };
-        let d = unsafe { &*desc };
+        // SAFETY: see the comment above.
+        let (g, d) = unsafe { (&mut *(ctx as *mut Got), &*desc) };
         g.begins += 1;
         g.world_from_index = d.world_from_index;
         g.background = d.background;
         assert_eq!(d.index_min, [0; 3]);
         g.index_max = d.index_max;
+        // SAFETY: see the comment above.
         g.name = unsafe { d.grid_name.as_str() }.unwrap().to_string();
         let n: i64 = d.index_max.iter().map(|m| m + 1).product();
         g.values = vec![f32::NAN; n as usize];
@@ -541,17 +550,20 @@ mod tests {
         abi::STATUS_OK
     }
 
-    extern "C" fn add_dense(
+    /// # Safety
+    /// See the comment above `begin`; `values` holds `dims[0] * dims[1] * dims[2]` values.
+    unsafe extern "C" fn add_dense(
         ctx: *mut c_void,
         origin: *const [i64; 3],
         dims: *const [u64; 3],
         values: *const f32,
         _err: *const abi::ErrorSink,
     ) -> abi::Status {
-        let g = unsafe { &mut *(ctx as *mut Got) };
-        let (o, d) = unsafe { (*origin, *dims) };
+        // SAFETY: see the comment above `begin`.
+        let (g, o, d) = unsafe { (&mut *(ctx as *mut Got), *origin, *dims) };
         g.blocks.push((o, d));
         let n = (d[0] * d[1] * d[2]) as usize;
+        // SAFETY: the reader's promise: `n` values, borrowed for the call.
         let v = unsafe { std::slice::from_raw_parts(values, n) };
         let [sx, sy, _] = g.index_max.map(|m| (m + 1) as usize);
         let mut i = 0;
@@ -569,7 +581,9 @@ mod tests {
         abi::STATUS_OK
     }
 
-    extern "C" fn add_tile(
+    /// # Safety
+    /// Nothing to promise: it only panics (the raw reader must not call it).
+    unsafe extern "C" fn add_tile(
         _ctx: *mut c_void,
         _origin: *const [i64; 3],
         _dims: *const [u64; 3],
@@ -579,9 +593,12 @@ mod tests {
         panic!("the raw reader sends no tiles");
     }
 
-    extern "C" fn set_error(ctx: *mut c_void, message: abi::Str, _line: u32, _col: u32) {
-        let e = unsafe { &mut *(ctx as *mut Option<String>) };
-        *e = Some(unsafe { message.as_str() }.unwrap().to_string());
+    /// # Safety
+    /// `ctx` is the message slot of the running `read`; `message` is readable for the call.
+    unsafe extern "C" fn set_error(ctx: *mut c_void, message: abi::Str, _line: u32, _col: u32) {
+        // SAFETY: the caller's promise; `read` does not touch the slot until the call returns.
+        let (e, message) = unsafe { (&mut *(ctx as *mut Option<String>), message.as_str()) };
+        *e = Some(message.unwrap().to_string());
     }
 
     /// Runs the reader through its C entry point, as the host does. A null call context means
@@ -599,12 +616,17 @@ mod tests {
             ctx: &mut message as *mut Option<String> as *mut c_void,
             set: set_error,
         };
-        let status = luxon_plugin::shim::volume_read::<Raw>(
-            abi::Str::new(params),
-            std::ptr::null(),
-            &sink,
-            &err,
-        );
+        // SAFETY: the calling contract: `params`, `sink` and `err` live across the call (a
+        // null context is allowed), and `got` and `message` are only reached through them
+        // until it returns.
+        let status = unsafe {
+            luxon_plugin::shim::volume_read::<Raw>(
+                abi::Str::new(params),
+                std::ptr::null(),
+                &sink,
+                &err,
+            )
+        };
         match status {
             abi::STATUS_OK => {
                 assert_eq!(got.begins, 1);

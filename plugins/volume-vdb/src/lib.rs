@@ -86,6 +86,8 @@
 //! inputs; `-max_len=32768` keeps whole small fixtures. 1.19 million runs over three workers
 //! found no crash; an input that ever crashes belongs in `tests/fixtures.rs` as a regression test.)
 
+#![forbid(unsafe_code)]
+
 mod blosc;
 mod bytes;
 mod file;

@@ -71,6 +71,8 @@
 //! )
 //! ```
 
+#![forbid(unsafe_code)]
+
 mod encode;
 mod jpeg;
 mod openexr;

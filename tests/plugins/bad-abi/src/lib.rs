@@ -3,8 +3,10 @@
 
 use luxon_plugin::abi::{DeclareFn, HostTable, PluginHeader, Str, MAGIC};
 
+/// The header as a static (spelled out by hand: this library does not use `export!`).
 struct Header(PluginHeader);
-// SAFETY: immutable static data; the only pointers are to static strings or null.
+// SAFETY: immutable static data without interior mutability; its only pointers are to a static
+// string and null, so threads sharing it can only read the same values.
 unsafe impl Sync for Header {}
 
 static HEADER: Header = Header(PluginHeader {
@@ -14,7 +16,9 @@ static HEADER: Header = Header(PluginHeader {
     declaration: std::ptr::null(),
 });
 
-#[no_mangle]
+// Unmangled, which is unsafe only if the name clashes: the library's one symbol of this name
+// (no SDK `export!` here).
+#[unsafe(no_mangle)]
 pub extern "C" fn luxon_plugin_declare(_host: *const HostTable) -> *const PluginHeader {
     &HEADER.0
 }

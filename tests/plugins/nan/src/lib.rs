@@ -11,6 +11,8 @@
 //! textures: { "half": (plugin: "nan_texture", params: (color: (1, 0, 0))) },
 //! ```
 
+#![forbid(unsafe_code)]
+
 use luxon_plugin::abi::TexQuery;
 use luxon_plugin::{finite, Context, Describe, Error, Texture};
 

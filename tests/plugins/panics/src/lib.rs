@@ -6,6 +6,8 @@
 //!   and `occluded` panic (`bounds` works, so the host gets as far as tracing rays).
 //! - `panic_texture` (texture): created fine, panics in `eval`.
 
+#![forbid(unsafe_code)]
+
 use luxon_plugin::abi::TexQuery;
 use luxon_plugin::{
     Aabb, Context, CustomShape, Describe, Error, Geometry, Hit, Primitive, Ray, Texture,
