@@ -34,6 +34,7 @@
 //! plugin; they never unwind across `extern "C"`.
 
 pub mod abi;
+pub mod files;
 
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
