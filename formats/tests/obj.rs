@@ -132,7 +132,13 @@ fn a_missing_mtl_is_a_warning() {
     let text = format!("mtllib gone.mtl\nusemtl red\n{QUAD}");
     let obj = load_obj(&write(&dir, "a.obj", &text), None).unwrap();
     assert_eq!(obj.warnings.len(), 1, "{:?}", obj.warnings);
-    assert!(obj.warnings[0].contains("gone.mtl"), "{}", obj.warnings[0]);
+    let w = obj.warnings[0].to_string();
+    // At the `mtllib` line, naming the library and saying what happened.
+    assert!(
+        w.starts_with(&format!("{}:1:1: ", dir.join("a.obj").display())),
+        "{w}"
+    );
+    assert!(w.contains("gone.mtl`: it does not exist"), "{w}");
     assert!(obj.materials.is_empty());
     assert!(only(&obj.geometry).material.is_none());
 }

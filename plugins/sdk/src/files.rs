@@ -70,22 +70,26 @@ impl FileError {
     /// A whole message: "`{path}` is a FIFO (named pipe); expected {what} (a regular file)".
     /// `what` names what the file should have been, with its article ("a scene file").
     pub fn sentence(&self, path: &Path, what: &str) -> String {
-        let p = path.display();
         match self {
-            FileError::Missing => format!("`{p}` does not exist; expected {what}"),
-            FileError::NotRegular(kind) => {
-                format!("`{p}` is {kind}; expected {what} (a regular file)")
+            FileError::Io(e) => format!("cannot read `{}`: {e}; expected {what}", path.display()),
+            _ => format!("`{}` {}", path.display(), self.explain(what)),
+        }
+    }
+
+    /// The message without the file's name, to follow it: "is a FIFO (named pipe); expected
+    /// {what} (a regular file)".
+    pub fn explain(&self, what: &str) -> String {
+        match self {
+            FileError::Missing => format!("does not exist; expected {what}"),
+            FileError::NotRegular(kind) => format!("is {kind}; expected {what} (a regular file)"),
+            FileError::TooLarge { size, max } => {
+                format!("is {}; {what} may be at most {}", bytes(*size), bytes(*max))
             }
-            FileError::TooLarge { size, max } => format!(
-                "`{p}` is {}; {what} may be at most {}",
-                bytes(*size),
-                bytes(*max)
-            ),
-            FileError::Utf16 => format!("`{p}` is UTF-16 text; expected UTF-8 ({what})"),
+            FileError::Utf16 => format!("is UTF-16 text; expected UTF-8 ({what})"),
             FileError::NotText { .. } | FileError::LineTooLong { .. } => {
-                format!("`{p}` {self}; expected {what} (plain text)")
+                format!("{self}; expected {what} (plain text)")
             }
-            FileError::Io(e) => format!("cannot read `{p}`: {e}; expected {what}"),
+            FileError::Io(e) => format!("cannot be read: {e}; expected {what}"),
         }
     }
 
@@ -129,7 +133,7 @@ pub fn bytes(n: u64) -> String {
     ];
     for (size, unit) in UNITS {
         if n >= size {
-            return if n % size == 0 {
+            return if n.is_multiple_of(size) {
                 format!("{} {unit}", n / size)
             } else {
                 format!("{:.1} {unit}", n as f64 / size as f64)
@@ -224,9 +228,12 @@ pub fn text(mut bytes: Vec<u8>) -> Result<String, FileError> {
         Bom::Utf16 => return Err(FileError::Utf16),
         Bom::None => {}
     }
-    let bad = match std::str::from_utf8(&bytes) {
-        Ok(s) => s.bytes().position(|b| b == 0),
-        Err(e) => Some(e.valid_up_to()),
+    // The first NUL byte or invalid UTF-8, whichever comes first.
+    let nul = bytes.iter().position(|&b| b == 0);
+    let invalid = std::str::from_utf8(&bytes).err().map(|e| e.valid_up_to());
+    let bad = match (nul, invalid) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
     };
     if let Some(at) = bad {
         let (line, col) = line_col(&bytes[..at]);
@@ -297,11 +304,23 @@ struct Counter {
     /// Bytes and characters of the current line so far.
     line_bytes: u64,
     line_chars: u64,
+    /// The last byte counted.
+    last: u8,
 }
 
 impl Counter {
+    /// The line the next byte is on.
     fn line(&self) -> u64 {
         self.newlines + 1
+    }
+
+    /// The line of the last byte counted (1 before any).
+    fn last_line(&self) -> u64 {
+        if self.last == b'\n' {
+            self.newlines.max(1)
+        } else {
+            self.newlines + 1
+        }
     }
 
     /// Accounts for `bytes`; the first problem in them, if any.
@@ -326,6 +345,9 @@ impl Counter {
         self.fits(segment.len())?;
         self.line_bytes += segment.len() as u64;
         self.line_chars += chars(segment);
+        if let Some(&b) = bytes.last() {
+            self.last = b;
+        }
         Ok(())
     }
 
@@ -354,14 +376,16 @@ impl<R: Read> TextReader<R> {
                 newlines: 0,
                 line_bytes: 0,
                 line_chars: 0,
+                last: b'\n',
             },
             failed: None,
         }
     }
 
-    /// The 1-based line of the last byte handed out (the next line after a newline).
+    /// The 1-based line of the last byte handed out (or consumed): after a whole line has
+    /// been read, that line.
     pub fn line(&self) -> u64 {
-        self.count.line()
+        self.count.last_line()
     }
 
     /// Reads the first bytes and looks for a byte-order mark.
@@ -615,7 +639,7 @@ mod tests {
             .unwrap();
         assert_eq!(out.len(), 21);
 
-        let e = TextReader::new(&"ok\né\0".as_bytes()[..], 100)
+        let e = TextReader::new("ok\né\0".as_bytes(), 100)
             .read_to_end(&mut Vec::new())
             .unwrap_err();
         let e = FileError::from_io(e);
@@ -633,6 +657,12 @@ mod tests {
         let mut r = TextReader::new(&b"a\nb\nc"[..], 100);
         r.read_to_end(&mut Vec::new()).unwrap();
         assert_eq!(r.line(), 3);
+        let mut r = TextReader::new(&b"a\nb\n"[..], 100);
+        assert_eq!(r.line(), 1);
+        r.read_line(&mut String::new()).unwrap();
+        assert_eq!(r.line(), 1);
+        r.read_line(&mut String::new()).unwrap();
+        assert_eq!(r.line(), 2);
     }
 
     #[test]
