@@ -22,7 +22,7 @@
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -157,7 +157,7 @@ impl ObjFile<'_> {
     /// The file through tobj, after our own pass over it (`prescan`).
     fn parse(&self) -> Result<Parsed, SceneError> {
         let scan = self.prescan()?;
-        let mut reader = self.open()?;
+        let mut reader = WithoutLines::new(self.open()?);
         let warnings = RefCell::new(scan.warnings);
         let dir = self.path.parent().unwrap_or(Path::new("")).to_path_buf();
         // The update fills the fields tobj's optional features (merging, reordering) add.
@@ -198,7 +198,7 @@ impl ObjFile<'_> {
                 "a face index is out of range; expected indices of defined vertices".to_string(),
             )
         })?;
-        let (models, materials) = loaded.map_err(|e| self.tobj_error(e, reader.line()))?;
+        let (models, materials) = loaded.map_err(|e| self.tobj_error(e, reader.line))?;
         Ok(Parsed {
             models,
             materials: materials.unwrap_or_default(),
@@ -208,6 +208,7 @@ impl ObjFile<'_> {
 
     /// tobj's error, found while reading line `line`, as ours.
     fn tobj_error(&self, e: tobj::LoadError, line: u64) -> SceneError {
+        // `line` counts from 1; 0 (nothing read yet) means no line is known.
         let line = to_u32(line);
         match e {
             tobj::LoadError::ReadError => {
@@ -279,6 +280,69 @@ impl ObjFile<'_> {
             }
         }
         Ok(out)
+    }
+}
+
+/// The OBJ text as tobj reads it, a line at a time, with `l` statements blanked: tobj takes a
+/// polyline of 3 or more points for a face, and Luxon draws no lines (they are counted for a
+/// warning by the prescan). Counts the lines handed out.
+struct WithoutLines<R> {
+    inner: R,
+    buf: Vec<u8>,
+    pos: usize,
+    /// The line in `buf` (1-based; 0 before the first).
+    line: u64,
+}
+
+impl<R: BufRead> WithoutLines<R> {
+    fn new(inner: R) -> WithoutLines<R> {
+        WithoutLines {
+            inner,
+            buf: Vec::new(),
+            pos: 0,
+            line: 0,
+        }
+    }
+}
+
+impl<R: BufRead> Read for WithoutLines<R> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let n = {
+            let buf = self.fill_buf()?;
+            let n = buf.len().min(out.len());
+            out[..n].copy_from_slice(&buf[..n]);
+            n
+        };
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for WithoutLines<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if self.pos == self.buf.len() {
+            self.buf.clear();
+            self.pos = 0;
+            if self.inner.read_until(b'\n', &mut self.buf)? > 0 {
+                self.line += 1;
+                let first = self
+                    .buf
+                    .split(u8::is_ascii_whitespace)
+                    .find(|w| !w.is_empty());
+                if first == Some(b"l") {
+                    let newline = self.buf.ends_with(b"\n");
+                    self.buf.clear();
+                    if newline {
+                        self.buf.push(b'\n');
+                    }
+                }
+            }
+        }
+        Ok(&self.buf[self.pos..])
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.pos = (self.pos + amt).min(self.buf.len());
     }
 }
 

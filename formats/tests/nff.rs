@@ -183,6 +183,39 @@ fn spheres_and_negative_radii() {
     let g = &i.desc.inline[0];
     let at = g.at.as_ref().unwrap();
     assert_eq!((at.line, at.col), (8, 1));
+    // NFF's inside-only sphere: accepted (NFF defines it), drawn two-sided with a warning at
+    // the radius, written as in the file.
+    assert_eq!(i.desc.warnings.len(), 1, "{:?}", i.desc.warnings);
+    let w = &i.desc.warnings[0];
+    assert_eq!((w.at.line, w.at.col), (9, 9));
+    assert_eq!(
+        w.message,
+        "sphere radius -2 is negative (NFF's inside-only sphere); Luxon's spheres are \
+         two-sided, so it is drawn with radius 2"
+    );
+}
+
+/// A warning per kind and file: the first one, with a count of the others.
+#[test]
+fn repeated_warnings_are_counted() {
+    let mut text = VIEW.to_string();
+    for k in 0..1000 {
+        text.push_str(&format!("s {k} 0 0 -0.50\n"));
+    }
+    text.push_str("c 0 0 0 -1 0 0 1 -1\n");
+    for block in [64, 1 << 20] {
+        let i = nff::import_reader_blocks(text.as_bytes(), path(), block).unwrap();
+        let w: Vec<String> = i.desc.warnings.iter().map(|w| w.to_string()).collect();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert_eq!(
+            w[0],
+            "dir/scene.nff:8:9: sphere radius -0.50 is negative (NFF's inside-only sphere); \
+             Luxon's spheres are two-sided, so it is drawn with radius 0.50 (999 more like it in \
+             this file)"
+        );
+        assert!(w[1].starts_with("dir/scene.nff:1008:9: cone radius -1 is negative"));
+        assert!(w[1].ends_with("(1 more like it in this file)"), "{}", w[1]);
+    }
 }
 
 #[test]
