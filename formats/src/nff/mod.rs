@@ -46,6 +46,14 @@
 //! mean"), a wrong number of values on a line, bad numbers, NaN and infinities, polygons with
 //! fewer than 3 vertices, a file that ends inside an entity, a missing or incomplete view.
 //!
+//! ## Warnings
+//!
+//! What NFF defines but Luxon renders differently is accepted with a warning (in the scene's
+//! `warnings`; the first of each kind in a file, with a count of the others): negative sphere
+//! and cone radii (drawn two-sided), and a polygon whose triangulation ran out of its time
+//! budget (a self-intersecting or very irregular polygon of many thousand corners: the rest of
+//! it becomes a fan from one corner, see `polygon`).
+//!
 //! ## Speed
 //!
 //! A reader thread reads (and decompresses) blocks of whole entities; each block is cut into

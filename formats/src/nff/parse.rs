@@ -72,6 +72,7 @@ pub(crate) struct Bucket {
 pub(crate) enum NoteKind {
     NegativeSphereRadius,
     NegativeConeRadius,
+    PolygonFan,
 }
 
 /// Something accepted with a caveat: a warning.
@@ -537,7 +538,19 @@ impl<'a> Parser<'a> {
             }
         }
         self.tris.clear();
-        self.tri.triangulate(&self.verts, &mut self.tris);
+        let outcome = self.tri.triangulate(&self.verts, &mut self.tris);
+        if outcome.fan > 0 {
+            self.out.notes.push(Note {
+                at: kw_loc,
+                kind: NoteKind::PolygonFan,
+                message: format!(
+                    "{what} of {count} vertices could not be cut into ears within its time \
+                     budget (it intersects itself or is very irregular); its last {} triangles \
+                     are a fan from one corner, which may cover area outside the polygon",
+                    outcome.fan
+                ),
+            });
+        }
         if patch {
             self.out.stats.patches += 1;
         } else {
