@@ -58,18 +58,22 @@ impl std::fmt::Display for Warning {
 /// and anything longer than 40 characters is cut, ending in `…`.
 pub fn shown(s: &str) -> Cow<'_, str> {
     const MAX: usize = 40;
-    let control = |c: char| c.is_control();
-    if !s.chars().any(control) && s.chars().nth(MAX).is_none() {
+    if s.chars().nth(MAX).is_none() {
+        return printable(s);
+    }
+    let cut: String = s.chars().take(MAX).collect();
+    Cow::Owned(format!("{}…", printable(&cut)))
+}
+
+/// `s` with its control characters (C0, DEL, C1) written as escapes (`\u{1b}`).
+pub(crate) fn printable(s: &str) -> Cow<'_, str> {
+    if !s.chars().any(char::is_control) {
         return Cow::Borrowed(s);
     }
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i == MAX {
-            out.push('…');
-            break;
-        }
-        if control(c) {
-            out.push_str(&c.escape_unicode().to_string());
+    let mut out = String::with_capacity(s.len() + 8);
+    for c in s.chars() {
+        if c.is_control() {
+            out.extend(c.escape_unicode());
         } else {
             out.push(c);
         }

@@ -595,7 +595,10 @@ impl<'a> Parser<'a> {
             if f[i] < 0.0 {
                 return self.err(
                     self.l.col(i + 1),
-                    format!("`f` {name} is {}; expected a value >= 0", f[i]),
+                    format!(
+                        "`f` {name} is {}; expected a value >= 0",
+                        show(self.l.tok(i + 1))
+                    ),
                 );
             }
         }
@@ -604,7 +607,7 @@ impl<'a> Parser<'a> {
                 self.l.col(8),
                 format!(
                     "`f` index of refraction is {}; expected a value >= 0 (0: none)",
-                    f[7]
+                    show(self.l.tok(8))
                 ),
             );
         }
@@ -635,7 +638,10 @@ impl<'a> Parser<'a> {
                 if let Some(k) = (3..6).find(|&k| v[k] < 0.0) {
                     return self.err(
                         self.l.col(k + 1),
-                        format!("light colour {} is negative; expected a value >= 0", v[k]),
+                        format!(
+                            "light colour {} is negative; expected a value >= 0",
+                            show(self.l.tok(k + 1))
+                        ),
                     );
                 }
                 ([v[0], v[1], v[2]], Some([v[3], v[4], v[5]]))
@@ -733,7 +739,10 @@ impl<'a> Parser<'a> {
         if !(a > 0.0 && a < 180.0) {
             return self.err(
                 self.l.col(1),
-                format!("`angle` is {a}; expected a field of view in (0, 180) degrees"),
+                format!(
+                    "`angle` is {}; expected a field of view in (0, 180) degrees",
+                    show(self.l.tok(1))
+                ),
             );
         }
         Ok(a)
