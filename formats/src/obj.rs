@@ -140,8 +140,16 @@ impl ObjFile<'_> {
     fn unreadable(&self, e: FileError) -> SceneError {
         match (self.at, e.position()) {
             (None, _) => file_error(e, self.path, "a Wavefront .obj file"),
-            (Some(_), Some((line, _))) => self.fail(to_u32(line), e.explain("OBJ text")),
-            (Some(_), None) => self.fail(0, e.explain("a Wavefront .obj file")),
+            (Some(_), Some((line, _))) => {
+                self.fail(to_u32(line), e.explain("a Wavefront .obj file"))
+            }
+            (Some(at), None) => SceneError::at(
+                at.clone(),
+                format!(
+                    "mesh file {}",
+                    e.sentence(self.path, "a Wavefront .obj file")
+                ),
+            ),
         }
     }
 

@@ -218,9 +218,6 @@ pub fn skeleton(path: &Path) -> Result<String, SceneError> {
 /// without an end, binary data), else about the file.
 fn read_error(e: std::io::Error, path: &Path) -> SceneError {
     match FileError::from_io(e) {
-        e @ (FileError::NotText { .. } | FileError::LineTooLong { .. } | FileError::Utf16) => {
-            file_error(e, path, "NFF text")
-        }
         FileError::Io(source) => SceneError::Io {
             path: path.to_path_buf(),
             source,

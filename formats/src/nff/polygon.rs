@@ -7,8 +7,8 @@
 //! so the triangles stay compact), looking for vertices inside a candidate ear only in the
 //! cells of a grid of the reflex vertices that the ear overlaps: the same answer as looking at
 //! all of them, in far less time. A self-intersecting or very irregular polygon can still need
-//! O(m²) steps: the work is counted, and past a budget of `32 m log2 m` steps (about 0.2 s for
-//! 100,000 corners) the rest of the polygon becomes a fan from one corner, which the caller
+//! O(m²) steps: the work is counted, and past a budget of `32 m log2 m` steps (about a second
+//! for 100,000 corners) the rest of the polygon becomes a fan from one corner, which the caller
 //! reports as a warning (a fan may cover area outside the polygon).
 
 /// Reused buffers of the triangulator.
@@ -543,7 +543,7 @@ fn inside_or_on(pa: [f64; 2], pb: [f64; 2], pc: [f64; 2], q: [f64; 2]) -> bool {
 }
 
 /// The work the ear search of a polygon of `m` corners may do: `32 m ceil(log2 m)` steps
-/// (54 million for 100,000 corners, a fraction of a second).
+/// (54 million for 100,000 corners, about a second).
 fn work_budget(m: usize) -> u64 {
     let m = m as u64;
     32 * m * u64::from(m.next_power_of_two().trailing_zeros().max(1))

@@ -323,10 +323,46 @@ impl Counter {
         }
     }
 
-    /// Accounts for `bytes`; the first problem in them, if any.
+    /// Accounts for `bytes`; the first problem in them, if any. Text is checked in parts of
+    /// at most `PART` bytes: in a part, only its first and last line can be longer than the
+    /// part, so a part without a NUL byte needs a search for its first and last newline
+    /// (short, in text), a count of its newlines and a search for NUL (both vectorised),
+    /// rather than a look at every line.
     fn check(&mut self, bytes: &[u8]) -> Result<(), FileError> {
+        const PART: usize = 64 << 10;
+        if self.max_line < PART as u64 {
+            return self.check_lines(bytes);
+        }
+        for part in bytes.chunks(PART) {
+            if part.contains(&0) {
+                return self.check_lines(part);
+            }
+            match part.iter().position(|&b| b == b'\n') {
+                None => {
+                    self.fits(part.len())?;
+                    self.line_bytes += part.len() as u64;
+                    self.line_chars += chars(part);
+                }
+                Some(first) => {
+                    self.fits(first)?;
+                    let last = part.iter().rposition(|&b| b == b'\n').unwrap_or(first);
+                    self.newlines += part.iter().filter(|&&b| b == b'\n').count() as u64;
+                    let tail = &part[last + 1..];
+                    self.line_bytes = tail.len() as u64;
+                    self.line_chars = chars(tail);
+                }
+            }
+            if let Some(&b) = part.last() {
+                self.last = b;
+            }
+        }
+        Ok(())
+    }
+
+    /// `check`, line by line: finds the NUL byte's column, and serves caps below a part.
+    fn check_lines(&mut self, bytes: &[u8]) -> Result<(), FileError> {
         if let Some(at) = bytes.iter().position(|&b| b == 0) {
-            self.check(&bytes[..at])?;
+            self.check_lines(&bytes[..at])?;
             return Err(FileError::NotText {
                 line: self.line(),
                 col: self.line_chars + 1,
@@ -663,6 +699,47 @@ mod tests {
         assert_eq!(r.line(), 1);
         r.read_line(&mut String::new()).unwrap();
         assert_eq!(r.line(), 2);
+    }
+
+    /// Caps of a part (64 KiB) or more take the fast path: the same lines and errors.
+    #[test]
+    fn text_reader_counts_lines_in_large_reads() {
+        let mut text = "abc\n".repeat(100_000);
+        let mut r = TextReader::new(text.as_bytes(), 1 << 20);
+        r.read_to_end(&mut Vec::new()).unwrap();
+        assert_eq!(r.line(), 100_000);
+        text.push_str(&"x".repeat((1 << 20) + 1));
+        text.push('\n');
+        let e = TextReader::new(text.as_bytes(), 1 << 20)
+            .read_to_end(&mut Vec::new())
+            .unwrap_err();
+        let e = FileError::from_io(e);
+        assert!(
+            matches!(
+                e,
+                FileError::LineTooLong {
+                    line: 100_001,
+                    max: 1_048_576
+                }
+            ),
+            "{e:?}"
+        );
+        let text = format!("{}ab\0", "é\n".repeat(70_000));
+        let e = TextReader::new(text.as_bytes(), 1 << 20)
+            .read_to_end(&mut Vec::new())
+            .unwrap_err();
+        let e = FileError::from_io(e);
+        assert!(
+            matches!(
+                e,
+                FileError::NotText {
+                    line: 70_001,
+                    col: 3,
+                    byte: 0
+                }
+            ),
+            "{e:?}"
+        );
     }
 
     #[test]
