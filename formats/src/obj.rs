@@ -419,6 +419,8 @@ fn named_materials(
         .collect();
     let mut out: Vec<(String, Spanned<MaterialDesc>)> = Vec::new();
     let mut place: HashMap<&str, usize> = HashMap::new();
+    // The first name defined again, and how many more definitions repeat a name.
+    let mut repeated: Option<(&str, usize)> = None;
     for (m, name) in materials.iter().zip(&names) {
         let material = Spanned {
             value: material_of_mtl(m),
@@ -426,14 +428,7 @@ fn named_materials(
         };
         match place.get(name.as_str()) {
             Some(&i) => {
-                warnings.push(file.warn(
-                    0,
-                    format!(
-                        "material `{}` is defined more than once in its material libraries; \
-                         the last definition is used",
-                        shown(&m.name)
-                    ),
-                ));
+                repeated.get_or_insert((&m.name, 0)).1 += 1;
                 out[i].1 = material;
             }
             None => {
@@ -441,6 +436,20 @@ fn named_materials(
                 out.push((name.clone(), material));
             }
         }
+    }
+    if let Some((name, count)) = repeated {
+        let more = match count {
+            1 => String::new(),
+            n => format!(" ({} more repeated definitions)", n - 1),
+        };
+        warnings.push(file.warn(
+            0,
+            format!(
+                "material `{}` is defined more than once in its material libraries; the last \
+                 definition is used{more}",
+                shown(name)
+            ),
+        ));
     }
     (names, out)
 }

@@ -16,6 +16,8 @@ use crate::validate::references;
 /// Included files are read from disk, within the default [`LoadOptions`].
 pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
     let options = LoadOptions::default();
+    // As read from a file: without a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     load_root(text.to_string(), path, &mut DiskSource, &options)
 }
 

@@ -272,7 +272,8 @@ fn a_material_defined_twice_takes_the_last_definition() {
     write(
         &dir,
         "m.mtl",
-        "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\nnewmtl red\nKd 0.5 0 0\n",
+        "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\nnewmtl red\nKd 0.7 0 0\nnewmtl red\nKd 0.5 0 0\n\
+         newmtl blue\n",
     );
     let p = write(&dir, "m.obj", &format!("mtllib m.mtl\nusemtl red\n{QUAD}"));
     let obj = load_obj(&p, None).unwrap();
@@ -280,9 +281,12 @@ fn a_material_defined_twice_takes_the_last_definition() {
     assert_eq!(names, ["obj:m:red", "obj:m:blue"]);
     assert_eq!(obj.materials[0].1.value.color, [0.5, 0.0, 0.0]);
     assert_eq!(obj.warnings.len(), 1, "{:?}", obj.warnings);
-    assert!(obj.warnings[0]
-        .message
-        .contains("material `red` is defined more than once"));
+    // One warning for all repeats.
+    assert_eq!(
+        obj.warnings[0].message,
+        "material `red` is defined more than once in its material libraries; the last \
+         definition is used (2 more repeated definitions)"
+    );
 }
 
 /// In a RON scene's `meshes:`, the OBJ's warnings join the scene's, at the `file` string.
