@@ -89,10 +89,12 @@ pub(crate) fn resolve(
     let mut stack = vec![frame(text, root, key)?];
     while let Some(top) = stack.last_mut() {
         let Some((file, at)) = top.includes.get(top.next).cloned() else {
-            let done_frame = stack.pop().expect("the loop saw a top frame");
-            on_stack.remove(&done_frame.key);
-            done.insert(done_frame.key);
-            merged.absorb(done_frame.own);
+            // All its includes are merged: the file's own content comes after them.
+            if let Some(finished) = stack.pop() {
+                on_stack.remove(&finished.key);
+                done.insert(finished.key);
+                merged.absorb(finished.own);
+            }
             continue;
         };
         top.next += 1;

@@ -15,9 +15,13 @@
 //!   `Ns` the shininess, `d` (or `Tr`) the transmission `1 - d` (`Tr`), `Ni` the index of
 //!   refraction. Colours are taken as linear. Textures are not read.
 //! - A missing or broken `.mtl` file is a warning, not an error: its faces get Luxon's default
-//!   material (so does `usemtl` of a name no `.mtl` file defines).
-//! - Errors (missing file, bad numbers, bad faces, indices out of bounds) name the file and,
-//!   where it can be found, the line.
+//!   material (so does `usemtl` of a name no `.mtl` file defines). A material defined twice
+//!   takes its last definition, with a warning.
+//! - Lines (`l`) and points (`p`) are left out with a warning that counts them: Luxon draws
+//!   faces only.
+//! - Errors (missing file, not a regular file, not text, bad numbers, faces with fewer than 3
+//!   corners or indices out of bounds) name the file and, where it can be found, the line.
+//!   Warnings go to the import's (and the scene's) `warnings`.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
