@@ -13,11 +13,12 @@
 //! | origin      | `origin`                                         |
 //! | leaves      | `error`, `geometry`, `spans`, `raw`              |
 //! | description | `desc`                                           |
+//! | input       | `input`                                          |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
 //! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
 //! | importers   | `nff`, `obj`                                     |
-//! | formats     | `ron_scene`, `spd`                               |
+//! | formats     | `includes`, `ron_scene`, `spd`                   |
 //! | front door  | `load`                                           |
 
 #![forbid(unsafe_code)]
@@ -28,6 +29,8 @@ pub mod desc;
 mod effects;
 mod error;
 pub mod geometry;
+mod includes;
+pub mod input;
 mod load;
 pub mod nff;
 pub mod obj;
@@ -42,7 +45,9 @@ mod validate;
 mod volume_render;
 
 pub use desc::*;
-pub use error::{suggest, SceneError};
+pub use error::{shown, suggest, SceneError, Warning};
 pub use geometry::{InlineGeometry, InlineMesh};
-pub use load::load;
-pub use ron_scene::load_ron_str;
+pub use includes::MAX_DEPTH as MAX_INCLUDE_DEPTH;
+pub use input::{DiskSource, LoadOptions, MemorySource, Source};
+pub use load::{load, load_with};
+pub use ron_scene::{load_ron_str, load_ron_with};

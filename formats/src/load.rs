@@ -4,12 +4,18 @@ use std::path::Path;
 
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
+use crate::input::{DiskSource, LoadOptions};
 use crate::{nff, obj, ron_scene};
 
 /// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
 /// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
-/// any case).
+/// any case), within the default [`LoadOptions`].
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] within the limits of `options`.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneError> {
     if nff::is_nff_path(path) {
         return nff::load(path);
     }
@@ -31,9 +37,5 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             source: std::io::Error::new(std::io::ErrorKind::Unsupported, message),
         });
     }
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    ron_scene::load_ron_str(&text, path)
+    ron_scene::load_ron_with(&mut DiskSource, path, options)
 }

@@ -38,6 +38,7 @@
 #![doc = include_str!("../../README.md")]
 
 pub mod abi;
+pub mod files;
 
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -169,6 +170,11 @@ pub fn describe_ron_error(code: &ron::Error) -> String {
         }
         ron::Error::MissingStructField { field, .. } => {
             format!("missing parameter `{field}`")
+        }
+        // ron's own words point at its options, which a scene's author cannot set.
+        ron::Error::ExceededRecursionLimit => {
+            "values are nested more than 128 levels deep; expected at most 128 levels of brackets"
+                .to_string()
         }
         other => other.to_string(),
     }
@@ -1050,6 +1056,16 @@ mod tests {
                 center: [0.0, 1.0, 2.0],
                 radius: 1.0
             }
+        );
+    }
+
+    #[test]
+    fn deep_nesting_is_explained_without_rons_options() {
+        let text = format!("(v: {}1{})", "[".repeat(200), "]".repeat(200));
+        let e = parse_params::<ron::Value>(&text).unwrap_err();
+        assert_eq!(
+            e.message,
+            "values are nested more than 128 levels deep; expected at most 128 levels of brackets"
         );
     }
 
