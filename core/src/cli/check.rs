@@ -8,6 +8,7 @@ use std::path::Path;
 pub fn run(path: &Path) -> Result<(), Error> {
     let desc = luxon_formats::load(path)?;
     let registry = Registry::discover(&desc.plugin_path);
+    super::warn_skipped(&registry);
     let scene = Scene::build(&desc, &registry)?;
     let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
     describe(&desc, &scene, &outputs);

@@ -9,6 +9,16 @@ pub mod shading;
 pub mod spd;
 pub mod sweep;
 
+use luxon::plugin::Registry;
+
+/// Warns about every file on the plugin search path that was skipped (a truncated library, a
+/// FIFO named like a plugin...): the run goes on without it, but the user should know.
+pub fn warn_skipped(registry: &Registry) {
+    for p in &registry.problems {
+        luxon::error::print_warning(&format!("skipped plugin file {p}"));
+    }
+}
+
 /// `--res WIDTHxHEIGHT`.
 pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

@@ -195,6 +195,9 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     };
     let empty = Vec::new();
     let registry = Registry::discover(desc.as_ref().map_or(&empty, |d| &d.plugin_path));
+    if job.rank() == 0 {
+        super::warn_skipped(&registry);
+    }
     let load_time = t0.elapsed();
     let ready = desc.and_then(|desc| prepare(path, o, desc, cached, &registry, &job, &mut cache));
     let (ready, status) = match ready {

@@ -75,6 +75,7 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
     // The sweep writes its own files, not the scene's outputs.
     desc.render.outputs.clear();
     let registry = Registry::discover(&desc.plugin_path);
+    super::warn_skipped(&registry);
     let options = Options {
         curves,
         reference: a.reference.clone(),
