@@ -45,7 +45,8 @@ pub fn print_warning(message: &str) {
     print_line("warning", message);
 }
 
-fn print_line(level: &str, message: &str) {
+/// Prints `luxon: {level}: {message}` to stderr, as [`print_error`] does.
+pub fn print_line(level: &str, message: &str) {
     use std::io::Write;
     let line = format!("luxon: {level}: {}\n", escape_controls(message));
     let _ = std::io::stderr().lock().write_all(line.as_bytes());

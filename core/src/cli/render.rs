@@ -264,10 +264,10 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         eprintln!("luxon: wrote geometry cache {}", p.display());
     }
     if stats.counters.nan_pixels > 0 {
-        eprintln!(
-            "luxon: warning: {} pixel(s) came out NaN or infinite and were set to black",
+        luxon::error::print_warning(&format!(
+            "{} pixel(s) came out NaN or infinite and were set to black",
             stats.counters.nan_pixels
-        );
+        ));
     }
     Ok(())
 }
@@ -299,10 +299,10 @@ impl CacheUse {
             Lookup::Hit(c) => Some(c),
             Lookup::Miss => None,
             Lookup::Corrupt(p, why) => {
-                eprintln!(
-                    "luxon: warning: geometry cache {} is unusable ({why}); rebuilding it",
+                luxon::error::print_warning(&format!(
+                    "geometry cache {} is unusable ({why}); rebuilding it",
                     p.display()
-                );
+                ));
                 None
             }
         }

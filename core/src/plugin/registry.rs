@@ -157,7 +157,7 @@ extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
         _ => "debug",
     };
     if level != "debug" || std::env::var_os("LUXON_DEBUG").is_some() {
-        eprintln!("luxon: {level}: {plugin}: {message}");
+        crate::error::print_line(level, &format!("{plugin}: {message}"));
     }
 }
 
