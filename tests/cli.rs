@@ -288,3 +288,31 @@ fn shading_switches_change_what_is_traced() {
     assert_eq!(count(&[], "occlusion"), 0);
     assert!(count(&["--ao", "4"], "occlusion") > 0);
 }
+
+/// Command-line errors are one `luxon: error:` line with status 1, like every other error;
+/// help and version print with status 0.
+#[test]
+fn command_line_errors_are_one_line_and_exit_1() {
+    for (args, want) in [
+        (
+            &["render", "--samples", "x", "s.ron"][..],
+            "luxon: error: invalid value 'x' for '--samples",
+        ),
+        (&["rendr"][..], "did you mean `render`?"),
+        (&["render"][..], "<SCENE>"),
+    ] {
+        let out = run(args);
+        let e = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: {e}");
+        assert!(
+            e.contains(want) && e.starts_with("luxon: error: "),
+            "{args:?}: {e}"
+        );
+    }
+    for args in [&["--help"][..], &["--version"], &["render", "--help"]] {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(!out.stdout.is_empty(), "{args:?}");
+    }
+}

@@ -6,8 +6,10 @@ pub mod plugins;
 pub mod progress;
 pub mod render;
 pub mod shading;
+pub mod signals;
 pub mod spd;
 pub mod sweep;
+pub mod usage;
 
 use luxon::plugin::Registry;
 

@@ -191,7 +191,7 @@ fn check(file: &mut (impl Read + Seek), len: u64, host: &Host) -> Result<(), Str
         ));
     }
     let table = u64::from(phnum) * u64::from(phentsize);
-    let table_end = phoff.checked_add(table).unwrap_or(u64::MAX);
+    let table_end = phoff.saturating_add(table);
     if table_end > len {
         return Err(truncated("its program header table", phoff, table_end, len));
     }
@@ -211,16 +211,14 @@ fn check(file: &mut (impl Read + Seek), len: u64, host: &Host) -> Result<(), Str
         }
         let offset = f.word(wide, at + 8, at + 4);
         let filesz = f.word(wide, at + 32, at + 16);
-        let end = offset.checked_add(filesz).unwrap_or(u64::MAX);
+        let end = offset.saturating_add(filesz);
         if end > len {
             return Err(truncated(&format!("its segment {k}"), offset, end, len));
         }
     }
     // The loader does not need the section headers, but a file cut short of them is broken.
     if shoff != 0 {
-        let end = shoff
-            .checked_add(u64::from(shnum) * u64::from(shentsize))
-            .unwrap_or(u64::MAX);
+        let end = shoff.saturating_add(u64::from(shnum) * u64::from(shentsize));
         if end > len {
             return Err(truncated("its section header table", shoff, end, len));
         }
