@@ -111,6 +111,19 @@ impl TempFile {
         &self.target
     }
 
+    /// Drops this process's lock while the file stays in use: before MPI-IO writes it from
+    /// every rank (on NFS, `flock` is a POSIX lock that MPI-IO's own byte-range locks of other
+    /// nodes would wait for). [`OutputSet::commit`](crate::output::OutputSet::commit) still
+    /// checks the file is in place.
+    pub fn unlock(&self) {
+        #[cfg(unix)]
+        {
+            use std::os::unix::io::AsRawFd;
+            // SAFETY: a valid open descriptor.
+            unsafe { libc::flock(self.file.as_raw_fd(), libc::LOCK_UN) };
+        }
+    }
+
     /// Flushes the file to disk.
     pub fn sync(&mut self) -> Result<(), Error> {
         self.file.sync_all().map_err(|source| Error::Io {
@@ -153,7 +166,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
 }
 
 /// Takes this process's lock on a new temporary file; `false` when the file at `path` is no
-/// longer the one opened (a sweep removed it in between).
+/// longer the one opened (a sweep removed it in between). A file system without `flock` (Lustre
+/// mounted without it, some FUSE ones) leaves the file unlocked: it is written all the same, and
+/// a later sweep, unable to lock it either, leaves it alone.
 #[cfg(unix)]
 fn lock(file: &File, path: &Path) -> std::io::Result<bool> {
     use std::os::unix::fs::MetadataExt;
@@ -161,10 +176,9 @@ fn lock(file: &File, path: &Path) -> std::io::Result<bool> {
     // SAFETY: a valid open descriptor.
     if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
         let e = std::io::Error::last_os_error();
-        return match e.raw_os_error() {
-            Some(libc::EWOULDBLOCK) => Ok(false),
-            _ => Err(e),
-        };
+        if e.raw_os_error() == Some(libc::EWOULDBLOCK) {
+            return Ok(false);
+        }
     }
     let open = file.metadata()?;
     Ok(match std::fs::symlink_metadata(path) {

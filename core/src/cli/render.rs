@@ -257,6 +257,9 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     // Rank 0's output files: kept here, or back from the stream writer.
     let files = files.or(r.files);
     for (i, _) in &concurrent {
+        if let Some(f) = &files {
+            f.unlock(*i);
+        }
         let tmp = files.as_ref().map(|f| f.temp_path(*i));
         job.write_concurrent(tmp, s.width, s.height, &r.kept)?;
     }

@@ -97,6 +97,12 @@ impl OutputSet {
         self.files[i].path()
     }
 
+    /// Releases the lock of output `i`'s temporary file, before MPI-IO writes it from every rank
+    /// (see [`TempFile::unlock`]).
+    pub fn unlock(&self, i: usize) {
+        self.files[i].unlock();
+    }
+
     /// The target of output `i`.
     pub fn target(&self, i: usize) -> &Path {
         self.files[i].target()
