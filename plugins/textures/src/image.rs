@@ -144,7 +144,11 @@ impl Texture for ImageTexture {
                     .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
             }
         };
-        got.unwrap_or(MAGENTA)
+        got.unwrap_or_else(|| {
+            // The cache logged why, once; the host stops the render.
+            luxon_plugin::texture_failed();
+            MAGENTA
+        })
     }
 }
 

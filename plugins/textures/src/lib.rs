@@ -165,7 +165,7 @@
 //! Least recently used levels are evicted when the budget is exceeded and decoded again when
 //! needed, so scenes with more texture data than the budget still render; a warning says once
 //! when that happens (the cache is thrashing), with the budget and the data size. An image
-//! that cannot be decoded renders magenta, with one error in the log. See `cache.rs`.
+//! that cannot be decoded logs one error and makes the render fail. See `cache.rs`.
 //!
 //! ## Scene
 //!

@@ -27,12 +27,12 @@
 //!
 //! gzip-compressed files (such as `mri-head-256x256x109-u8.raw.gz`) are read transparently,
 //! recognised by their magic bytes whatever their name; `header` and the size check apply to
-//! the decompressed bytes. A compressed file is decompressed into memory first (once its
-//! decompressed size is known to be right), so it briefly costs its raw size in memory.
+//! the decompressed bytes (a stream that ends early or goes on is an error stating both sizes).
 //!
-//! An uncompressed file is streamed: slabs of at most 8 z-slices (and, for very wide slices,
-//! parts of them) are read, converted and handed to the host one at a time, so only about
-//! 1 Mi voxels are ever held besides the host's copy.
+//! Both kinds are streamed in file order: slabs of 8 z-slices (at most 64 MiB of the file; for
+//! wider slices, rows of one slice or parts of a row) are read, converted and handed to the host
+//! in blocks of about 1 Mi voxels, so the reader holds at most one slab whatever the file
+//! claims. The host stores only what is not background, so an empty volume costs almost nothing.
 //!
 //! ## Procedural volumes
 //!
