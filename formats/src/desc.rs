@@ -44,6 +44,9 @@ pub struct SceneDesc {
     pub render: RenderDesc,
     /// Extra plugin directories (or files), already resolved against the scene file's directory.
     pub plugin_path: Vec<PathBuf>,
+    /// Problems that did not stop the load (an importer's substitutes for missing files,
+    /// features it cannot render yet), each where it was found; the command line prints them.
+    pub warnings: Vec<Spanned<String>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

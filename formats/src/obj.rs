@@ -560,5 +560,6 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             ..RenderDesc::default()
         },
         plugin_path: Vec::new(),
+        warnings: Vec::new(),
     })
 }

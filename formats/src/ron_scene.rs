@@ -46,6 +46,7 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         volumes: part.volumes,
         render,
         plugin_path: part.plugin_path,
+        warnings: Vec::new(),
     };
     references(&scene)?;
     add_meshes(&mut scene, meshes)?;

@@ -7,6 +7,7 @@ use std::path::Path;
 
 pub fn run(path: &Path) -> Result<(), Error> {
     let desc = luxon_formats::load(path)?;
+    super::print_warnings(&desc);
     let registry = Registry::discover(&desc.plugin_path);
     let scene = Scene::build(&desc, &registry)?;
     let outputs = luxon::output::resolve(&scene.outputs, &registry)?;

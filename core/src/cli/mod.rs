@@ -9,6 +9,13 @@ pub mod shading;
 pub mod spd;
 pub mod sweep;
 
+/// Prints the problems an importer worked around (`SceneDesc::warnings`) to standard error.
+pub fn print_warnings(desc: &luxon_formats::SceneDesc) {
+    for w in &desc.warnings {
+        eprintln!("luxon: warning: {}: {}", w.at, w.value);
+    }
+}
+
 /// `--res WIDTHxHEIGHT`.
 pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

@@ -189,6 +189,9 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let mut cache = CacheUse::new(path, o);
     let cached = cache.open(path);
     let desc = load(path, o, cached.as_ref().map(|c| c.skeleton.as_str()));
+    if let (Ok(d), 0) = (&desc, job.rank()) {
+        super::print_warnings(d);
+    }
     let job = match &desc {
         Ok(d) => job.for_mode(d.render.parallel.mode)?,
         Err(_) => job,

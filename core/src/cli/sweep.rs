@@ -56,6 +56,7 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
         }
     }
     let mut desc = luxon_formats::load(path)?;
+    super::print_warnings(&desc);
     if let Some((w, h)) = a.res {
         desc.render.width = w;
         desc.render.height = h;

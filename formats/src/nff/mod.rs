@@ -366,6 +366,7 @@ impl Assembler {
             self.inline.push(InlineGeometry {
                 material,
                 at: Some(self.origin(b.first)),
+                clip: None,
                 spheres: b.spheres,
                 cones: b.cones,
                 discs: Vec::new(),
@@ -472,6 +473,7 @@ impl Assembler {
                 ..RenderDesc::default()
             },
             plugin_path: Vec::new(),
+            warnings: Vec::new(),
         };
         Ok(Imported {
             desc,
