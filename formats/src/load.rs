@@ -4,17 +4,20 @@ use std::path::Path;
 
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
-use crate::{nff, obj, ron_scene};
+use crate::{nff, obj, ron_scene, tachyon};
 
 /// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
 /// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
-/// any case).
+/// `.dat` through the [`tachyon`] importer; any case).
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
     if nff::is_nff_path(path) {
         return nff::load(path);
     }
     if obj::is_obj_path(path) {
         return obj::load(path);
+    }
+    if tachyon::is_tachyon_path(path) {
+        return tachyon::load(path);
     }
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !extension.eq_ignore_ascii_case("ron") {
@@ -23,7 +26,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             e => format!("unsupported scene file extension `.{e}`"),
         };
         let message = format!(
-            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`",
+            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`, `.dat` (Tachyon)",
             ron_scene::supported_extensions()
         );
         return Err(SceneError::Io {
