@@ -6,7 +6,7 @@ use std::collections::HashSet;
 
 use super::materials::Materials;
 use super::notes::Notes;
-use super::shapes::{tpoly_vertex, Shapes};
+use super::shapes::{tpoly_vertex, volume_slices, Shapes};
 use super::syntax::*;
 use super::terrain::scape;
 use super::{mirror, Warnings};
@@ -198,7 +198,9 @@ impl Mapper {
                     "are not rendered yet: the triangles are white",
                     at,
                 );
-                let m = self.materials.surface_material(surface, at)?;
+                let m = self
+                    .materials
+                    .surface_material(surface, at, &mut self.notes)?;
                 self.shapes.triangle(&m, *v, Some(*n), at);
             }
             Kind::VertexArray(va) => self.vertex_array(va, at)?,
@@ -271,25 +273,36 @@ impl Mapper {
                     TexRef::Body(b) => b.surface.opacity,
                     TexRef::Name(_) => 1.0,
                 };
-                if path.is_some() {
-                    self.notes.add(
-                        "SCALARVOL",
-                        "is drawn by Luxon's emission-absorption ray casting with Tachyon's \
-                         colour ramp (Tachyon sums the samples' opacity and marches the box \
-                         twice)",
-                        at,
-                    );
+                let slices = match path {
+                    Some(p) => volume_slices(p, *dim).map(|n| (p, n)),
+                    None => Err(String::new()),
+                };
+                match slices {
+                    Ok((p, n)) => {
+                        self.notes.add(
+                            "SCALARVOL",
+                            "is drawn by Luxon's emission-absorption ray casting with Tachyon's \
+                             colour ramp (Tachyon sums the samples' opacity and marches the box \
+                             twice)",
+                            at,
+                        );
+                        self.shapes.volume(*min, *max, *dim, p, n, density, at)?;
+                    }
+                    Err(why) => {
+                        // Tachyon draws the box in the texture's colour, unlit.
+                        if !why.is_empty() {
+                            self.warnings.push(Spanned {
+                                value: format!(
+                                    "{why}; Tachyon draws the volume's box in its texture's \
+                                     colour instead, and so does Luxon"
+                                ),
+                                at: at.clone(),
+                            });
+                        }
+                        let flat = self.materials.unlit(&m, at);
+                        self.shapes.boxed(&flat, *min, *max, at, &mut self.warnings);
+                    }
                 }
-                self.shapes.volume(
-                    &m,
-                    *min,
-                    *max,
-                    *dim,
-                    path.as_deref(),
-                    density,
-                    at,
-                    &mut self.warnings,
-                )?;
             }
             Kind::TpolyFile {
                 scale,

@@ -124,10 +124,36 @@ impl Materials {
 
     /// A VCSTRI's material: its surface with a white colour (the vertex colours are not
     /// rendered yet).
-    pub fn surface_material(&mut self, surface: &Surface, at: &Origin) -> Result<String> {
+    pub fn surface_material(
+        &mut self,
+        surface: &Surface,
+        at: &Origin,
+        notes: &mut Notes,
+    ) -> Result<String> {
         check_surface(surface, at)?;
+        note_surface(surface, at, notes);
         let m = material_of(surface, [1.0; 3]);
         Ok(self.shared_material(m, None, at))
+    }
+
+    /// `material`'s colour, unlit (ambient 1, nothing else): what Tachyon draws for a volume
+    /// whose file is missing.
+    pub fn unlit(&mut self, material: &str, at: &Origin) -> String {
+        let color = self
+            .materials
+            .iter()
+            .find(|(n, _)| n == material)
+            .map_or([1.0; 3], |(_, m)| m.value.color);
+        let m = MaterialDesc {
+            color,
+            ambient: 1.0,
+            diffuse: 0.0,
+            specular: 0.0,
+            reflect: 0.0,
+            transmit: 0.0,
+            ..MaterialDesc::default()
+        };
+        self.shared_material(m, None, at)
     }
 
     fn by_name(
@@ -243,7 +269,8 @@ impl Materials {
     ) -> (V3, Option<(String, String)>) {
         let at = &body.texfunc.at;
         let c = body.color;
-        const GREY: V3 = [0.5; 3];
+        // Tachyon says "Faking it using solid gray" but renders the surface white (measured).
+        const FAKE: V3 = [1.0; 3];
         match &body.texfunc.value {
             TexFunc::Plain(_) => (c, None),
             TexFunc::Solid { kind, frame } => match kind {
@@ -268,7 +295,7 @@ impl Materials {
                 axes,
                 ..
             } => match path {
-                None => (GREY, None),
+                None => (FAKE, None),
                 Some(path) => match image(*kind, path, frame, axes.as_ref()) {
                     Ok(params) => (c, Some(("image".into(), params))),
                     Err(why) => {
@@ -286,12 +313,12 @@ impl Materials {
                     warnings.push(Spanned {
                         value: format!(
                             "no IMAGEDEF named `{}` precedes this; Tachyon renders the texture \
-                             as solid grey, and so does Luxon",
+                             white (its message says solid gray), and so does Luxon",
                             image.value
                         ),
                         at: image.at.clone(),
                     });
-                    return (GREY, None);
+                    return (FAKE, None);
                 }
                 notes.add(
                     "TEXFUNC 10 (volume image)",

@@ -33,7 +33,8 @@
 //! Where Tachyon's leniency is part of what real files show, Luxon does the same and adds a
 //! warning (`SceneDesc::warnings`, printed by the command line): an undefined texture name
 //! (Tachyon's default texture: AMBIENT 0.1, DIFFUSE 0.9, white), a missing image map or
-//! undefined IMAGEDEF (solid grey), a missing volume file (the volume's box in its texture's
+//! undefined IMAGEDEF (white: Tachyon's message says "solid gray", its picture is white), a
+//! missing volume file (the volume's box in its texture's
 //! colour), a second TEXDEF of a name (the first stays). Features Luxon does not render as
 //! Tachyon does yet are one warning each, at their first use (see "Not yet" below).
 //!

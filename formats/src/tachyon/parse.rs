@@ -4,7 +4,7 @@
 //! optional parts in Tachyon's order); where Tachyon reads past a mistake and renders something
 //! else, this parser stops with an error at `file:line:col` saying what was expected and what
 //! was found. Where Tachyon's leniency is what real files rely on, the parser warns and goes
-//! on: missing image maps (grey) and volume files (a box in the texture's colour).
+//! on: missing image maps (white) and volume files (a box in the texture's colour).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -982,7 +982,8 @@ impl<'a> Parser<'a, '_> {
                     self.warn(
                         file.at.clone(),
                         format!(
-                            "image map {why}; Tachyon renders it as solid grey, and so does Luxon"
+                            "image map {why}; Tachyon renders the surface white (its message \
+                             says solid gray), and so does Luxon"
                         ),
                     );
                     None

@@ -313,54 +313,25 @@ impl Shapes {
 
     /// SCALARVOL: the raw file's bytes (x fastest) through the `raw` reader, voxel (0, 0, 0) at
     /// MIN and the last at MAX, drawn by emission and absorption with Tachyon's colour ramp;
-    /// `density` is the texture's OPACITY. Without the file: the box in the texture's colour.
+    /// `density` is the texture's OPACITY; `slices` the z slices read ([`volume_slices`]).
     #[allow(clippy::too_many_arguments)]
     pub fn volume(
         &mut self,
-        material: &str,
         min: V3,
         max: V3,
         dim: [u32; 3],
-        path: Option<&Path>,
+        path: &Path,
+        slices: u32,
         density: f64,
         at: &Origin,
-        warnings: &mut Warnings,
     ) -> Result<()> {
         let extent = sub(max, min);
-        if extent.iter().any(|&e| e == 0.0) {
+        if extent.contains(&0.0) {
             return Err(SceneError::at(
                 at.clone(),
                 "SCALARVOL: MIN and MAX are equal on an axis; expected a box with volume",
             ));
         }
-        let Some(path) = path else {
-            self.boxed(material, min, max, at, warnings);
-            return Ok(());
-        };
-        // Tachyon reads the first nx·ny·nz bytes; a file with whole extra slices is read
-        // whole and cropped to the box (`voltest.dat` reads 100 of 109 slices).
-        let slice = u64::from(dim[0]) * u64::from(dim[1]);
-        let needed = slice * u64::from(dim[2]);
-        let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-        let slices = if len == needed {
-            dim[2]
-        } else if len > needed && len % slice == 0 && len / slice <= u64::from(u32::MAX) {
-            (len / slice) as u32
-        } else {
-            warnings.push(Spanned {
-                value: format!(
-                    "volume file {} has {len} bytes; DIM {} {} {} needs {needed} (or whole extra \
-                     slices); the volume's box is drawn in its texture's colour instead",
-                    path.display(),
-                    dim[0],
-                    dim[1],
-                    dim[2]
-                ),
-                at: at.clone(),
-            });
-            self.boxed(material, min, max, at, warnings);
-            return Ok(());
-        };
         let spacing = [0, 1, 2].map(|k| {
             let n = f64::from(dim[k].max(2) - 1);
             extent[k] / n
@@ -431,6 +402,30 @@ impl Shapes {
             at: at.clone(),
         });
         Ok(())
+    }
+}
+
+/// How many z slices of a volume file to read: Tachyon reads the first nx·ny·nz bytes, so a
+/// file with whole extra slices is read whole and cropped to the box (`voltest.dat` reads 100
+/// of 109 slices); any other size is an error message.
+pub(super) fn volume_slices(path: &Path, dim: [u32; 3]) -> std::result::Result<u32, String> {
+    let slice = u64::from(dim[0]) * u64::from(dim[1]);
+    let needed = slice * u64::from(dim[2]);
+    let len = std::fs::metadata(path)
+        .map_err(|e| format!("volume file {}: {e}", path.display()))?
+        .len();
+    if len == needed {
+        Ok(dim[2])
+    } else if len > needed && len % slice == 0 && len / slice <= u64::from(u32::MAX) {
+        Ok((len / slice) as u32)
+    } else {
+        Err(format!(
+            "volume file {} has {len} bytes; DIM {} {} {} needs {needed} (or whole extra slices)",
+            path.display(),
+            dim[0],
+            dim[1],
+            dim[2]
+        ))
     }
 }
 
