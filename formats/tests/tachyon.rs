@@ -390,6 +390,53 @@ fn a_texture_body_becomes_a_material() {
 }
 
 #[test]
+fn optional_surface_parts_are_kept_in_the_tree() {
+    let dir = TempDir::new("surface");
+    let p = dir.write(
+        "s.dat",
+        &format!(
+            "{HEAD}TEXDEF glass AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0.2 OPACITY 0.4\n\
+             TRANSMODE R3D OUTLINE 0.5 OUTLINE_WIDTH 0.3 PHONG shiny 0.6 PHONG_SIZE 12\n\
+             COLOR 1 1 1 TEXFUNC 0\nSHADER_MODE medium TRANS_VMD END_SHADER_MODE\n\
+             SPHERE CENTER 0 0 5 RAD 1 glass\n"
+        ),
+    );
+    let tree = parse_file(&p).unwrap();
+    let body = match &tree.statements[0].kind {
+        syntax::Kind::TexDef { name, body } => {
+            assert_eq!(
+                (name.value.as_str(), name.at.line, name.at.col),
+                ("glass", 3, 8)
+            );
+            body
+        }
+        other => panic!("{other:?}"),
+    };
+    let s = &body.surface;
+    let t = s.transmode.as_ref().unwrap();
+    assert_eq!((t.value.as_str(), t.at.line, t.at.col), ("R3D", 4, 11));
+    let o = s.outline.as_ref().unwrap();
+    assert_eq!((o.value, o.at.line, o.at.col), ([0.5, 0.3], 4, 15));
+    let ph = s.phong.as_ref().unwrap();
+    assert_eq!(ph.value.kind, syntax::PhongKind::Other("shiny".into()));
+    assert_eq!((ph.value.phong, ph.value.size), (0.6, 12.0));
+    assert_eq!((body.texfunc.at.line, body.texfunc.at.col), (5, 13));
+    match &tree.statements[1].kind {
+        syntax::Kind::ShaderMode(m) => {
+            assert_eq!(m.level.value, syntax::ShadeLevel::Medium);
+            assert_eq!(m.options[0].value, syntax::ShaderOption::TransVmd);
+            assert_eq!((m.options[0].at.line, m.options[0].at.col), (6, 20));
+        }
+        other => panic!("{other:?}"),
+    }
+    let d = load(&p).unwrap();
+    // Any PHONG word but METAL is plastic: Luxon's highlight, no note.
+    assert_eq!(material(&d, "glass").specular, 0.6);
+    assert!(!warned(&d, "PHONG METAL"));
+    assert!(warned(&d, "TRANSMODE R3D") && warned(&d, "OUTLINE"));
+}
+
+#[test]
 fn texdef_first_definition_wins_aliases_and_undefined_names() {
     let d = scene(
         "texdef",

@@ -174,10 +174,7 @@ impl Mapper {
                 self.materials
                     .define(name, body, &mut self.notes, &mut self.warnings)?
             }
-            Kind::TexAlias { name, target } => {
-                self.materials
-                    .alias(name, target, &mut self.notes, &mut self.warnings)?
-            }
+            Kind::TexAlias { name, target } => self.materials.alias(name, target, &mut self.notes),
             Kind::ImageDef(def) => self.materials.imagedef(&def.name.value),
             Kind::Include { .. } => {}
             Kind::Sphere { center, rad, tex } => {

@@ -38,6 +38,10 @@ pub(super) struct Materials {
     named: HashMap<String, (String, Origin)>,
     /// A mapped material's content → its name: identical inline bodies share one.
     shared: HashMap<String, String>,
+    /// An inline body as written ([`body_key`]) → its material.
+    bodies: HashMap<Vec<u8>, String>,
+    /// The default texture's material, once made.
+    default: Option<String>,
     next: usize,
     /// IMAGEDEF names defined so far.
     imagedefs: HashSet<String>,
@@ -52,6 +56,8 @@ impl Materials {
             reserved,
             named: HashMap::new(),
             shared: HashMap::new(),
+            bodies: HashMap::new(),
+            default: None,
             next: 0,
             imagedefs: HashSet::new(),
             materials: Vec::new(),
@@ -83,21 +89,14 @@ impl Materials {
     }
 
     /// `TEXALIAS name target`.
-    pub fn alias(
-        &mut self,
-        name: &Spanned<String>,
-        target: &Spanned<String>,
-        notes: &mut Notes,
-        warnings: &mut Warnings,
-    ) -> Result<()> {
+    pub fn alias(&mut self, name: &Spanned<String>, target: &Spanned<String>, notes: &mut Notes) {
         if let Some((_, first)) = self.named.get(&name.value) {
             redefined(notes, name, first);
-            return Ok(());
+            return;
         }
-        let material = self.by_name(target, notes, warnings)?;
+        let material = self.by_name(target, notes);
         self.named
             .insert(name.value.clone(), (material, name.at.clone()));
-        Ok(())
     }
 
     /// The material a texture reference stands for.
@@ -108,18 +107,31 @@ impl Materials {
         warnings: &mut Warnings,
     ) -> Result<String> {
         match tex {
-            TexRef::Name(name) => self.by_name(name, notes, warnings),
+            TexRef::Name(name) => Ok(self.by_name(name, notes)),
             TexRef::Body(body) => {
+                // Files repeat the same body on every primitive: map each distinct one once.
+                let key = body_key(body);
+                if let Some(name) = self.bodies.get(&key) {
+                    note_surface(&body.surface, notes);
+                    return Ok(name.clone());
+                }
                 let (m, t) = self.map_body(body, notes, warnings)?;
-                Ok(self.shared_material(m, t, &body.at))
+                let name = self.shared_material(m, t, &body.at);
+                self.bodies.insert(key, name.clone());
+                Ok(name)
             }
         }
     }
 
     /// The default texture (for meshes of a VERTEXARRAY before its first TEXTURE).
     pub fn default_material(&mut self, at: &Origin) -> String {
+        if let Some(name) = &self.default {
+            return name.clone();
+        }
         let m = material_of(&default_surface(), [1.0; 3]);
-        self.shared_material(m, None, at)
+        let name = self.shared_material(m, None, at);
+        self.default = Some(name.clone());
+        name
     }
 
     /// A VCSTRI's material: its surface with a white colour (the vertex colours are not
@@ -130,10 +142,17 @@ impl Materials {
         at: &Origin,
         notes: &mut Notes,
     ) -> Result<String> {
+        note_surface(surface, notes);
+        let mut key = surface_key(surface);
+        key.extend_from_slice(b"\0vcstri");
+        if let Some(name) = self.bodies.get(&key) {
+            return Ok(name.clone());
+        }
         check_surface(surface, at)?;
-        note_surface(surface, at, notes);
         let m = material_of(surface, [1.0; 3]);
-        Ok(self.shared_material(m, None, at))
+        let name = self.shared_material(m, None, at);
+        self.bodies.insert(key, name.clone());
+        Ok(name)
     }
 
     /// `material`'s colour, unlit (ambient 1, nothing else): what Tachyon draws for a volume
@@ -156,14 +175,9 @@ impl Materials {
         self.shared_material(m, None, at)
     }
 
-    fn by_name(
-        &mut self,
-        name: &Spanned<String>,
-        notes: &mut Notes,
-        warnings: &mut Warnings,
-    ) -> Result<String> {
+    fn by_name(&mut self, name: &Spanned<String>, notes: &mut Notes) -> String {
         if let Some((material, _)) = self.named.get(&name.value) {
-            return Ok(material.clone());
+            return material.clone();
         }
         notes.add(
             "undefined texture names",
@@ -174,8 +188,7 @@ impl Materials {
             ),
             &name.at,
         );
-        let _ = warnings;
-        Ok(self.default_material(&name.at))
+        self.default_material(&name.at)
     }
 
     /// A material for mapped content, shared with identical content mapped before.
@@ -255,7 +268,7 @@ impl Materials {
                 ),
             ));
         }
-        note_surface(&body.surface, &body.at, notes);
+        note_surface(&body.surface, notes);
         let (color, texture) = self.texfunc(body, notes, warnings);
         Ok((material_of(&body.surface, color), texture))
     }
@@ -331,6 +344,107 @@ impl Materials {
     }
 }
 
+/// A texture body's content as bytes (numbers by their bits, words as written), positions
+/// left out: equal keys map to the same material.
+fn body_key(b: &TexBody) -> Vec<u8> {
+    let mut k = surface_key(&b.surface);
+    let num = |k: &mut Vec<u8>, x: f64| k.extend_from_slice(&x.to_bits().to_le_bytes());
+    let word = |k: &mut Vec<u8>, w: &str| {
+        k.extend_from_slice(&(w.len() as u64).to_le_bytes());
+        k.extend_from_slice(w.as_bytes());
+    };
+    for x in b.color {
+        num(&mut k, x);
+    }
+    let frame = |k: &mut Vec<u8>, f: &Frame| {
+        for v in [f.center, f.rotate, f.scale] {
+            for x in v {
+                k.extend_from_slice(&x.to_bits().to_le_bytes());
+            }
+        }
+    };
+    match &b.texfunc.value {
+        TexFunc::Plain(n) => k.extend_from_slice(&n.to_le_bytes()),
+        TexFunc::Solid { kind, frame: f } => {
+            k.push(*kind as u8);
+            frame(&mut k, f);
+        }
+        TexFunc::Image {
+            kind,
+            file,
+            path,
+            frame: f,
+            axes,
+        } => {
+            k.push(*kind as u8);
+            // The file found: the same word may name different files in different INCLUDEs.
+            word(&mut k, &file.value);
+            word(
+                &mut k,
+                &path
+                    .as_ref()
+                    .map(|p| p.to_string_lossy())
+                    .unwrap_or_default(),
+            );
+            frame(&mut k, f);
+            for v in axes.iter().flatten() {
+                for &x in v {
+                    num(&mut k, x);
+                }
+            }
+        }
+        TexFunc::Volume {
+            image,
+            frame: f,
+            axes,
+        } => {
+            k.push(10);
+            word(&mut k, &image.value);
+            frame(&mut k, f);
+            for v in axes {
+                for &x in v {
+                    num(&mut k, x);
+                }
+            }
+        }
+    }
+    k
+}
+
+/// A surface's content as bytes (see [`body_key`]).
+fn surface_key(s: &Surface) -> Vec<u8> {
+    let mut k = Vec::with_capacity(128);
+    let num = |k: &mut Vec<u8>, x: f64| k.extend_from_slice(&x.to_bits().to_le_bytes());
+    let word = |k: &mut Vec<u8>, w: &str| {
+        k.extend_from_slice(&(w.len() as u64).to_le_bytes());
+        k.extend_from_slice(w.as_bytes());
+    };
+    for x in [s.ambient, s.diffuse, s.specular, s.opacity] {
+        num(&mut k, x);
+    }
+    word(
+        &mut k,
+        s.transmode.as_ref().map_or("", |t| t.value.as_str()),
+    );
+    for x in s.outline.as_ref().map_or([-1.0; 2], |o| o.value) {
+        num(&mut k, x);
+    }
+    match &s.phong {
+        Some(p) => {
+            let kind = match &p.value.kind {
+                PhongKind::Plastic => "\0plastic",
+                PhongKind::Metal => "\0metal",
+                PhongKind::Other(w) => w.as_str(),
+            };
+            word(&mut k, kind);
+            num(&mut k, p.value.phong);
+            num(&mut k, p.value.size);
+        }
+        None => word(&mut k, "\0none"),
+    }
+    k
+}
+
 /// A TEXDEF or TEXALIAS of a name already defined.
 fn redefined(notes: &mut Notes, name: &Spanned<String>, first: &Origin) {
     notes.add(
@@ -365,7 +479,7 @@ fn check_surface(s: &Surface, at: &Origin) -> Result<()> {
 }
 
 /// Notes for the parts of a surface Luxon does not render yet.
-fn note_surface(s: &Surface, at: &Origin, notes: &mut Notes) {
+fn note_surface(s: &Surface, notes: &mut Notes) {
     if let Some(p) = &s.phong {
         if p.value.kind == PhongKind::Metal && p.value.phong > 0.0 {
             notes.add(
@@ -393,7 +507,6 @@ fn note_surface(s: &Surface, at: &Origin, notes: &mut Notes) {
             );
         }
     }
-    let _ = at;
 }
 
 /// Tachyon's shading coefficients as a Luxon material: ambient and diffuse as they are,

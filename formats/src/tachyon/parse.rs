@@ -6,6 +6,7 @@
 //! was found. Where Tachyon's leniency is what real files rely on, the parser warns and goes
 //! on: missing image maps (white) and volume files (a box in the texture's colour).
 
+use std::fmt::{self, Display};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -154,6 +155,46 @@ fn canonical(path: &Path) -> PathBuf {
     path.canonicalize().unwrap_or_else(|_| path.to_path_buf())
 }
 
+/// `` `kw` `` in messages.
+#[derive(Clone, Copy)]
+struct Quoted<'x>(&'x str);
+
+impl Display for Quoted<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "`{}`", self.0)
+    }
+}
+
+/// `prefix` then `D`.
+#[derive(Clone, Copy)]
+struct Prefixed<D>(&'static str, D);
+
+impl<D: Display> Display for Prefixed<D> {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "{}{}", self.0, self.1)
+    }
+}
+
+/// A component of a field: "CENTER (x)".
+#[derive(Clone, Copy)]
+struct Part<D>(D, &'static str);
+
+impl<D: Display> Display for Part<D> {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "{} ({})", self.0, self.1)
+    }
+}
+
+/// An element of a list: "vertex 3 of COORDS".
+#[derive(Clone, Copy)]
+struct Item<'x>(&'static str, u32, &'x str);
+
+impl Display for Item<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "{} {} of {}", self.0, self.1, self.2)
+    }
+}
+
 /// What all files of one scene add to.
 struct Context {
     statements: Vec<Statement>,
@@ -197,7 +238,7 @@ impl<'a> Parser<'a, '_> {
     }
 
     /// The next word; at the end of the file an error saying `expected` was.
-    fn word(&mut self, expected: &str) -> Result<Word<'a>> {
+    fn word(&mut self, expected: impl Display) -> Result<Word<'a>> {
         match self.lex.next_word() {
             Some(w) => Ok(w),
             None => {
@@ -212,7 +253,7 @@ impl<'a> Parser<'a, '_> {
 
     /// The keyword `kw` (any case).
     fn keyword(&mut self, kw: &str) -> Result<Origin> {
-        let w = self.word(&format!("`{kw}`"))?;
+        let w = self.word(Quoted(kw))?;
         if is(w.text, kw) {
             Ok(self.origin(&w))
         } else {
@@ -234,7 +275,7 @@ impl<'a> Parser<'a, '_> {
         }
     }
 
-    fn number_error<T>(&self, w: &Word, what: &str, e: NumberError) -> Result<T> {
+    fn number_error<T>(&self, w: &Word, what: impl Display, e: NumberError) -> Result<T> {
         let found = lex::show(w.text);
         let message = match e {
             NumberError::NotANumber => format!("expected a number for {what}, found `{found}`"),
@@ -250,24 +291,25 @@ impl<'a> Parser<'a, '_> {
         self.error(self.origin(w), message)
     }
 
-    fn float(&mut self, what: &str) -> Result<f64> {
-        let w = self.word(&format!("a number for {what}"))?;
+    /// A number; `what` names it in messages (formatted only for one).
+    fn float(&mut self, what: impl Display + Copy) -> Result<f64> {
+        let w = self.word(Prefixed("a number for ", what))?;
         lex::float(w.text).or_else(|e| self.number_error(&w, what, e))
     }
 
-    fn vec3(&mut self, what: &str) -> Result<V3> {
+    fn vec3(&mut self, what: impl Display + Copy) -> Result<V3> {
         Ok([
-            self.float(&format!("{what} (x)"))?,
-            self.float(&format!("{what} (y)"))?,
-            self.float(&format!("{what} (z)"))?,
+            self.float(Part(what, "x"))?,
+            self.float(Part(what, "y"))?,
+            self.float(Part(what, "z"))?,
         ])
     }
 
-    fn color(&mut self, what: &str) -> Result<V3> {
+    fn color(&mut self, what: impl Display + Copy) -> Result<V3> {
         Ok([
-            self.float(&format!("{what} (red)"))?,
-            self.float(&format!("{what} (green)"))?,
-            self.float(&format!("{what} (blue)"))?,
+            self.float(Part(what, "red"))?,
+            self.float(Part(what, "green"))?,
+            self.float(Part(what, "blue"))?,
         ])
     }
 
@@ -289,9 +331,9 @@ impl<'a> Parser<'a, '_> {
         self.float(kw)
     }
 
-    /// A whole number in `[min, max]`, and where it is.
-    fn int_at(&mut self, what: &str, min: i64, max: i64) -> Result<(u32, Origin)> {
-        let w = self.word(&format!("a whole number for {what}"))?;
+    /// A whole number in `[min, max]` (C's `int` at most).
+    fn whole(&mut self, what: impl Display + Copy, min: i64, max: i64) -> Result<i64> {
+        let w = self.word(Prefixed("a whole number for ", what))?;
         let n = lex::int(w.text).or_else(|e| self.number_error(&w, what, e))?;
         if n < min || n > max {
             return self.error(
@@ -299,11 +341,12 @@ impl<'a> Parser<'a, '_> {
                 format!("{what} is {n}; expected a whole number from {min} to {max}"),
             );
         }
-        Ok((n as u32, self.origin(&w)))
+        Ok(n)
     }
 
-    fn int(&mut self, what: &str, min: i64, max: i64) -> Result<u32> {
-        Ok(self.int_at(what, min, max)?.0)
+    /// A whole number in `[min, max]`, `min >= 0`.
+    fn int(&mut self, what: impl Display + Copy, min: i64, max: i64) -> Result<u32> {
+        Ok(self.whole(what, min.max(0), max)? as u32)
     }
 
     /// `KW n`.
@@ -503,7 +546,7 @@ impl<'a> Parser<'a, '_> {
                 let n = self.ki("POINTS", 0, i32::MAX as i64)?;
                 let mut points = Vec::with_capacity(n.min(4096) as usize);
                 for i in 0..n {
-                    points.push(self.vec3(&format!("point {i} of POINTS"))?);
+                    points.push(self.vec3(Item("point", i, "POINTS"))?);
                 }
                 Kind::Polycylinder {
                     points,
@@ -937,8 +980,7 @@ impl<'a> Parser<'a, '_> {
 
     fn texfunc(&mut self) -> Result<Spanned<TexFunc>> {
         let at = self.keyword("TEXFUNC")?;
-        let (n, _) = self.int_at("TEXFUNC", i32::MIN as i64, i32::MAX as i64)?;
-        let n = n as i32 as i64;
+        let n = self.whole("TEXFUNC", i32::MIN as i64, i32::MAX as i64)?;
         let solid = |k| match k {
             1 => Some(SolidKind::Checker),
             2 => Some(SolidKind::Grit),
@@ -1101,9 +1143,9 @@ impl<'a> Parser<'a, '_> {
             let mut out = Vec::with_capacity(n.min(1 << 16) as usize);
             for i in 0..n {
                 out.push(if kw == "COLORS" {
-                    p.color(&format!("colour {i} of COLORS"))?
+                    p.color(Item("colour", i, "COLORS"))?
                 } else {
-                    p.vec3(&format!("vertex {i} of {kw}"))?
+                    p.vec3(Item("vertex", i, kw))?
                 });
             }
             Ok(out)
@@ -1120,7 +1162,7 @@ impl<'a> Parser<'a, '_> {
                 "COLORS" => {
                     let mut colors = Vec::with_capacity(n.min(1 << 16) as usize);
                     for i in 0..n {
-                        colors.push(self.color(&format!("colour {i} of COLORS"))?);
+                        colors.push(self.color(Item("colour", i, "COLORS"))?);
                     }
                     VertexBlock::Colors(colors)
                 }
