@@ -624,8 +624,7 @@ fn imagedef_and_volume_textures() {
 fn primitives_become_mirrored_inline_geometry_and_objects() {
     let d = scene(
         "prims",
-        &format!(
-            "TEXDEF t AMBIENT 0.1 DIFFUSE 0.9 SPECULAR 0 OPACITY 1 COLOR 1 1 1 TEXFUNC 0\n\
+        "TEXDEF t AMBIENT 0.1 DIFFUSE 0.9 SPECULAR 0 OPACITY 1 COLOR 1 1 1 TEXFUNC 0\n\
              SPHERE CENTER 1 2 3 RAD -2 t\n\
              FCYLINDER BASE 0 0 1 APEX 0 1 1 RAD 0.5 t\n\
              RING CENTER 0 0 4 NORMAL 0 0 1 INNER 0.5 OUTER 1 t\n\
@@ -635,8 +634,7 @@ fn primitives_become_mirrored_inline_geometry_and_objects() {
              CYLINDER CENTER 0 0 5 AXIS 0 1 1 RAD 0.3 t\n\
              TRI V0 0 0 5 V1 1 0 5 V2 0 1 5 t\n\
              TRI V0 0 0 5 V1 1 0 5 V2 2 0 5 t\n\
-             STRI V0 0 0 5 V1 1 0 5 V2 0 1 5 N0 0 0 -1 N1 0 0 -1 N2 0 1 -1 t"
-        ),
+             STRI V0 0 0 5 V1 1 0 5 V2 0 1 5 N0 0 0 -1 N1 0 0 -1 N2 0 1 -1 t",
     );
     let flat = d.inline.iter().find(|g| g.mesh.normals.is_empty()).unwrap();
     // The sphere and the polycylinder's three joints; a negative radius is its size.

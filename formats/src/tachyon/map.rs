@@ -162,7 +162,7 @@ impl Mapper {
             }),
             Kind::Spotlight(l) => self.spotlight(l, at)?,
             Kind::SkyLight { samples, color } => {
-                self.ao = (*samples > 0).then(|| AoDesc {
+                self.ao = (*samples > 0).then_some(AoDesc {
                     samples: *samples,
                     max_distance: f64::INFINITY,
                     color: *color,
@@ -340,7 +340,7 @@ impl Mapper {
                     rescale_direct,
                     samples,
                 } => {
-                    self.ao = (*samples > 0).then(|| AoDesc {
+                    self.ao = (*samples > 0).then_some(AoDesc {
                         samples: *samples,
                         max_distance: f64::INFINITY,
                         color: *color,
@@ -394,7 +394,7 @@ impl Mapper {
                     continue;
                 }
                 VertexBlock::Texture(body) => {
-                    material = Some(self.material(&TexRef::Body(Box::new(body.clone())))?);
+                    material = Some(self.material(&TexRef::Body(body.clone()))?);
                     continue;
                 }
                 VertexBlock::TriMesh(t) => t.clone(),
@@ -613,13 +613,13 @@ impl Mapper {
                 },
             ),
         };
-        if !(c.zoom > 0.0) {
+        if c.zoom <= 0.0 {
             return Err(SceneError::at(
                 at,
                 format!("ZOOM is {}; expected a number greater than 0", c.zoom),
             ));
         }
-        if !(c.aspect > 0.0) {
+        if c.aspect <= 0.0 {
             return Err(SceneError::at(
                 at,
                 format!(
@@ -701,7 +701,7 @@ impl Mapper {
                 // distance); its lens is a rectangle aperture × the window: a disc of the same
                 // area stands in for it. Without antialiasing it traces the pinhole ray only.
                 let focal_distance = if focal_dist { focal } else { 1.0 };
-                if !(focal_distance > 0.0) {
+                if focal_distance <= 0.0 {
                     return Err(SceneError::at(
                         p_at,
                         format!("FOCALDIST is {focal}; expected a distance greater than 0"),

@@ -35,7 +35,7 @@
 //! (Tachyon's default texture: AMBIENT 0.1, DIFFUSE 0.9, white), a missing image map or
 //! undefined IMAGEDEF (white: Tachyon's message says "solid gray", its picture is white), a
 //! missing volume file (the volume's box in its texture's
-//! colour), a second TEXDEF of a name (the first stays). Features Luxon does not render as
+//! colour, unlit), a second TEXDEF of a name (the first stays). Features Luxon does not render as
 //! Tachyon does yet are one warning each, at their first use (see "Not yet" below).
 //!
 //! ## Coordinates
@@ -111,7 +111,7 @@
 //! | 1 checker | the `checker` texture, exactly Tachyon's: cells ⅓ wide with boundaries ⅙ from CENTER, odd cells (1, 0.2, 0), even (0, 0.2, 1); COLOR, ROTATE, SCALE ignored as in Tachyon |
 //! | 2 grit | the `noise` texture from 0.8·COLOR to COLOR, fine-grained (Tachyon draws a new random factor at every lookup) |
 //! | 5 gradient noise | the colour (Tachyon's noise value is clamped to 1 almost everywhere) |
-//! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row) |
+//! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: bilinear` (Tachyon's MIP blur grows with the distance travelled, not with the pixel's footprint: plain bilinear lookups look closer to it than Luxon's footprint MIP) |
 //!
 //! ## Geometry
 //!
@@ -145,7 +145,8 @@
 //! (wood), 6 (cylindrical checker) and 10 (IMAGEDEF volume textures), and image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
 //! Tachyon's two-pass volume compositing; the output without sRGB encoding. Also different in
-//! small ways: spot falloff shape, highlights attenuated, the 1/510 light threshold, image
+//! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
+//! windows blur more sideways in Tachyon), spot falloff shape, highlights attenuated, the 1/510 light threshold, image
 //! texel centres (Tachyon puts u = 0 and 1 on the first and last texel centres), MIP level
 //! choice, the unscaled background added when the ray depth runs out, and the noise of
 //! antialiasing, depth of field and occlusion.

@@ -1166,7 +1166,7 @@ impl<'a> Parser<'a, '_> {
                     }
                     VertexBlock::Colors(colors)
                 }
-                "TEXTURE" => VertexBlock::Texture(self.body()?),
+                "TEXTURE" => VertexBlock::Texture(Box::new(self.body()?)),
                 "TRIMESH" => {
                     let m = self.int("TRIMESH (triangle count)", 0, i32::MAX as i64)?;
                     let mut tris = Vec::with_capacity(m.min(1 << 16) as usize);

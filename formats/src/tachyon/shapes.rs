@@ -433,7 +433,10 @@ pub(super) fn volume_slices(path: &Path, dim: [u32; 3]) -> std::result::Result<u
 /// ROT (degrees; not a rotation when ROT.y ≠ 0: its bottom-left entry is +sin y), then moved
 /// by CENTER.
 pub(super) fn tpoly_vertex(v: V3, scale: V3, rot: V3, center: V3) -> V3 {
-    let r = rot.map(|a| a * 3.1415926 / 180.0);
+    // Tachyon's own value of π here (its degree conversion), not `std`'s.
+    #[allow(clippy::approx_constant)]
+    const PI: f64 = 3.1415926;
+    let r = rot.map(|a| a * PI / 180.0);
     let (sx, cx) = r[0].sin_cos();
     let (sy, cy) = r[1].sin_cos();
     let (sz, cz) = r[2].sin_cos();

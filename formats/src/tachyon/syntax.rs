@@ -396,7 +396,7 @@ pub enum VertexBlock {
     /// One colour per vertex, for the meshes that follow.
     Colors(Vec<V3>),
     /// The texture of the meshes that follow.
-    Texture(TexBody),
+    Texture(Box<TexBody>),
     TriMesh(Vec<[u32; 3]>),
     /// `k` indices: `k - 2` triangles.
     TriStrip(Vec<u32>),
