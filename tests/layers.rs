@@ -42,7 +42,7 @@ const FORMATS: &[(&str, &[&str])] = &[
         "conversion",
         &["convert", "camera", "effects", "volume_render"],
     ),
-    ("importers", &["nff", "obj"]),
+    ("importers", &["nff", "obj", "tachyon"]),
     ("formats", &["ron_scene", "spd"]),
     ("front door", &["load"]),
 ];
