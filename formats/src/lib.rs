@@ -18,7 +18,8 @@
 //! | checks      | `validate`, `ron_error`                          |
 //! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
-//! | formats     | `includes`, `ron_scene`, `spd`                   |
+//! | includes    | `includes`                                       |
+//! | formats     | `ron_scene`, `spd`                               |
 //! | front door  | `load`                                           |
 
 #![forbid(unsafe_code)]
