@@ -85,7 +85,7 @@
 //! | `DIRECTIONAL_LIGHT DIRECTION d COLOR c` | `Directional` travelling along d |
 //! | `SPOTLIGHT ... FALLOFF_START s FALLOFF_END e` | `Spot` with `angle: 2e`, `falloff: 2(e − s)`: full inside s, none beyond e; Tachyon fades linearly in the angle, Luxon smoothly in its cosine |
 //! | `SKY_LIGHT NUMSAMPLES n COLOR c` | `ambient_occlusion`: n samples, unlimited distance, colour c, direct 1 |
-//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r` |
+//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r`; r scales direct light even where occlusion is off (MEDIUM shading, measured), there as every light's `intensity` |
 //! | `SHADER_MODE FULL` / `MEDIUM` | everything / no shadows and no occlusion |
 //! | `SHADER_MODE LOW` / `LOWEST` | every surface shows its texture colour unlit (no fog) / white on black |
 //! | `TRANS_VMD`, `TRANS_RASTER3D`, `TRANS_ORIG` | `transparency` `PostMultiplied`, `AngleModulated`, `Filter` (see "Not yet") |
@@ -94,6 +94,19 @@
 //! | `FOG EXP` / `EXP2 DENSITY d` | `Exp` / `Exp2 { density }` (from the eye: START is not used) |
 //! | `FOG_VMD` | `planar: true` (depth along the view direction) |
 //! | `BACKGROUND c` | `background` |
+//!
+//! ## Command-line options
+//!
+//! [`load_with`] takes [`Options`], Tachyon's command-line overrides (`luxon tachyon` fills
+//! them). They replace the scene's settings after the whole file is read, as Tachyon applies
+//! them, and then map like the statements they stand for (`-mediumshade` as `SHADER_MODE
+//! MEDIUM`, `-trans_vmd` as `TRANS_VMD`, `-aasamples n` as `ANTIALIASING n`, `-res` as
+//! `RESOLUTION`), with the same warnings, placed at the command line. Tachyon keeps one direct
+//! light scale: RESCALE_DIRECT sets it, `-rescale_lights f` replaces it when f < 1 (Tachyon
+//! ignores larger factors), `-auto_skylight f` sets it to 1 − f and turns on occlusion of
+//! colour f (`-add_skylight f`: occlusion only), with `-skylight_samples` rays (128 by
+//! default). `-shade_phong` gives every material Phong highlights, `-shade_nullphong` none;
+//! `-shade_blinn_fast` is rendered as Blinn (one warning).
 //!
 //! ## Textures and materials
 //!
@@ -156,6 +169,7 @@ mod lex;
 mod map;
 mod materials;
 mod notes;
+mod options;
 mod parse;
 mod ron;
 mod shapes;
@@ -166,7 +180,10 @@ use std::path::Path;
 
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
-use crate::origin::Spanned;
+use crate::origin::{Origin, Spanned};
+
+pub use options::{Highlights, Options, Skylight};
+pub use syntax::ShadeLevel;
 
 /// Problems that did not stop the import, each where it was found.
 type Warnings = Vec<Spanned<String>>;
@@ -190,5 +207,15 @@ pub fn parse_file(path: &Path) -> Result<syntax::Scene, SceneError> {
 
 /// Loads a Tachyon scene file as a Luxon scene (no outputs: the command line gives them).
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
-    map::to_desc(parse::parse_file(path)?)
+    let at = Origin {
+        file: std::sync::Arc::new(path.to_path_buf()),
+        line: 1,
+        col: 1,
+    };
+    load_with(path, &Options::new(at))
+}
+
+/// [`load`] with Tachyon's command-line overrides (`luxon tachyon`).
+pub fn load_with(path: &Path, options: &Options) -> Result<SceneDesc, SceneError> {
+    map::to_desc(parse::parse_file(path)?, options)
 }
