@@ -10,6 +10,7 @@
 //! | `jpeg` | `jpg, jpeg` | sRGB, 8 bits, RGB (alpha is dropped) |
 //! | `ppm`  | `ppm, pnm`  | sRGB, binary P6, 8 or 16 bits (big-endian), RGB |
 //! | `tga`  | `tga`       | sRGB, 8 bits, RGB or RGBA |
+//! | `bmp`  | `bmp`       | sRGB, 8 bits, RGB (uncompressed Windows BMP) |
 //! | `exr`  | `exr`       | linear float RGBA, 32-bit or half |
 //!
 //! The integer formats clamp each colour channel to [0, 1], apply the sRGB transfer function and
@@ -17,7 +18,7 @@
 //! colour is stored as given, i.e. as straight alpha. EXR stores the values unchanged (including
 //! values above 1, negative values, NaN and infinities).
 //!
-//! One file per writer (`png.rs`, `jpeg.rs`, `ppm.rs`, `tga.rs`, `openexr.rs`); `encode.rs` holds
+//! One file per writer (`png.rs`, `jpeg.rs`, `ppm.rs`, `tga.rs`, `bmp.rs`, `openexr.rs`); `encode.rs` holds
 //! the checks and the sRGB encoding the integer formats share.
 //!
 //! ## Parameters
@@ -73,6 +74,7 @@
 
 #![forbid(unsafe_code)]
 
+mod bmp;
 mod encode;
 mod jpeg;
 mod openexr;
@@ -82,13 +84,14 @@ mod ppm;
 mod testing;
 mod tga;
 
+pub use bmp::Bmp;
 pub use jpeg::Jpeg;
 pub use openexr::Exr;
 pub use png::Png;
 pub use ppm::Ppm;
 pub use tga::Tga;
 
-luxon_plugin::export!(library: "luxon-writers", writers: [Png, Jpeg, Ppm, Tga, Exr]);
+luxon_plugin::export!(library: "luxon-writers", writers: [Png, Jpeg, Ppm, Tga, Bmp, Exr]);
 
 #[cfg(test)]
 mod tests {
@@ -113,6 +116,7 @@ mod tests {
         check::<Jpeg>("()");
         check::<Ppm>("()");
         check::<Tga>("()");
+        check::<Bmp>("()");
         check::<Exr>("()");
     }
 
@@ -140,6 +144,7 @@ mod tests {
             (Jpeg::NAME, Jpeg::PARAMS),
             (Ppm::NAME, Ppm::PARAMS),
             (Tga::NAME, Tga::PARAMS),
+            (Bmp::NAME, Bmp::PARAMS),
             (Exr::NAME, Exr::PARAMS),
         ] {
             for line in params.lines() {
