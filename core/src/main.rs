@@ -47,6 +47,14 @@ enum Command {
         #[arg(long = "plugin-path")]
         plugin_path: Vec<PathBuf>,
     },
+    /// Render Tachyon scene files (`.dat`) with Tachyon's own command line, for drop-in use by
+    /// VMD: `luxon tachyon [Tachyon's options] scene.dat` (see `luxon tachyon -help`).
+    #[command(disable_help_flag = true)]
+    Tachyon {
+        /// Tachyon's options and scene files, in any order.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 0..)]
+        args: Vec<std::ffi::OsString>,
+    },
     /// Generate an SPD scene (Eric Haines' Standard Procedural Databases); without a name, list
     /// them.
     Spd {
@@ -115,6 +123,7 @@ fn main() -> ExitCode {
             cli::plugins::run(&plugin_path);
             Ok(())
         }
+        Command::Tachyon { args } => cli::tachyon::run(&args),
         Command::Spd { name, size, output } => {
             cli::spd::run(name.as_deref(), size, output.as_deref())
         }

@@ -293,7 +293,10 @@ fn command_line_options_override_the_scene() {
     assert_eq!((d.render.width, d.render.height), (64, 32));
     assert_eq!((d.render.samples, d.render.max_depth), (3, 7));
     assert_eq!(d.render.transparency.mode, TransparencyMode::PostMultiplied);
-    assert!(matches!(d.lights[0].value, LightDesc::Point { shadows: false, .. }));
+    assert!(matches!(
+        d.lights[0].value,
+        LightDesc::Point { shadows: false, .. }
+    ));
     let d = scene_with("cli-all", body, |o| {
         o.resolution = Some([20, 10]);
         o.antialiasing = Some(0);
@@ -308,18 +311,26 @@ fn command_line_options_override_the_scene() {
     assert_eq!((d.render.samples, d.render.max_depth), (1, 2));
     assert_eq!(d.render.transparency.mode, TransparencyMode::AngleModulated);
     assert_eq!(d.render.transparency.max_surfaces, Some(1));
-    assert!(matches!(d.lights[0].value, LightDesc::Point { shadows: true, .. }));
+    assert!(matches!(
+        d.lights[0].value,
+        LightDesc::Point { shadows: true, .. }
+    ));
     let m = &d.materials[0].1.value;
     assert_eq!((m.highlight, m.specular), (Highlight::Phong, 0.5));
     // The command line's own warnings name where they come from.
-    let max = d.warnings.iter().find(|w| w.message.contains("TRANS_MAX_SURFACES"));
+    let max = d
+        .warnings
+        .iter()
+        .find(|w| w.message.contains("TRANS_MAX_SURFACES"));
     assert_eq!(max.unwrap().at.file.to_str(), Some("<command line>"));
     // The window follows the new resolution: 2:1 stays 2:1.
     let f = d.camera.value.frustum.unwrap();
     assert!(close((f.right - f.left) / (f.top - f.bottom), 2.0));
     let d = scene_with("cli-null", body, |o| o.highlights = Some(Highlights::None));
     assert_eq!(d.materials[0].1.value.specular, 0.0);
-    let d = scene_with("cli-fast", body, |o| o.highlights = Some(Highlights::BlinnFast));
+    let d = scene_with("cli-fast", body, |o| {
+        o.highlights = Some(Highlights::BlinnFast)
+    });
     assert_eq!(d.materials[0].1.value.highlight, Highlight::Blinn);
     assert!(warned(&d, "-shade_blinn_fast"));
 }
@@ -335,7 +346,9 @@ fn light_scale_and_skylight_follow_tachyon() {
     assert_eq!(intensity(&d.lights[0].value), 1.0);
     let d = scene_with("scale-down", light, |o| o.light_scale = Some(0.25));
     assert_eq!(intensity(&d.lights[0].value), 0.25);
-    let d = scene_with("scale-ao", &format!("{ao}\n{light}"), |o| o.light_scale = Some(0.8));
+    let d = scene_with("scale-ao", &format!("{ao}\n{light}"), |o| {
+        o.light_scale = Some(0.8)
+    });
     let a = d.ambient_occlusion.unwrap();
     assert_eq!((a.direct, intensity(&d.lights[0].value)), (0.8, 1.0));
     // MEDIUM traces no occlusion but keeps the scene's RESCALE_DIRECT (measured: 66 -> 33).
@@ -350,10 +363,14 @@ fn light_scale_and_skylight_follow_tachyon() {
         samples: 32,
         rescale,
     };
-    let d = scene_with("auto", &format!("{ao}\n{light}"), |o| o.skylight = Some(sky(true)));
+    let d = scene_with("auto", &format!("{ao}\n{light}"), |o| {
+        o.skylight = Some(sky(true))
+    });
     let a = d.ambient_occlusion.unwrap();
     assert_eq!((a.samples, a.color, a.direct), (32, [0.25; 3], 0.75));
-    let d = scene_with("add", &format!("{ao}\n{light}"), |o| o.skylight = Some(sky(false)));
+    let d = scene_with("add", &format!("{ao}\n{light}"), |o| {
+        o.skylight = Some(sky(false))
+    });
     let a = d.ambient_occlusion.unwrap();
     assert_eq!((a.samples, a.color, a.direct), (32, [0.25; 3], 0.5));
     let d = scene_with("add-plain", light, |o| o.skylight = Some(sky(false)));

@@ -11,6 +11,7 @@ pub mod shading;
 pub mod signals;
 pub mod spd;
 pub mod sweep;
+pub mod tachyon;
 pub mod usage;
 
 use luxon::plugin::Registry;

@@ -13,8 +13,8 @@ use super::terrain::scape;
 use super::{mirror, Warnings};
 use crate::desc::{
     AoDesc, Attenuation, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum, Highlight,
-    LightDesc, Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc,
-    MaterialDesc, TransparencyMode,
+    LightDesc, MaterialDesc, Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc,
+    TransparencyMode,
 };
 use crate::error::SceneError;
 use crate::origin::{Origin, Spanned};
@@ -847,6 +847,43 @@ impl Mapper {
         let max_depth = c.raydepth.saturating_sub(1).min(MAX_DEPTH);
         Ok((Spanned { value: camera, at }, c.antialiasing + 1, max_depth))
     }
+}
+
+/// `camera` at Tachyon's CENTER, looking along VIEWDIR with UPDIR up (see `camera_at`).
+pub(super) fn moved_camera(
+    camera: &CameraDesc,
+    viewdir: V3,
+    updir: V3,
+    center: V3,
+) -> std::result::Result<CameraDesc, String> {
+    let finite = |v: V3| v.iter().all(|x| x.is_finite());
+    if !(finite(viewdir) && finite(updir) && finite(center)) {
+        return Err("a number is not finite; expected finite numbers".into());
+    }
+    if viewdir == [0.0; 3] {
+        return Err("VIEWDIR is (0, 0, 0); expected a direction".into());
+    }
+    if updir == [0.0; 3] {
+        return Err("UPDIR is (0, 0, 0); expected a direction".into());
+    }
+    let [v, u] = [viewdir, updir];
+    let cross = [
+        v[1] * u[2] - v[2] * u[1],
+        v[2] * u[0] - v[0] * u[2],
+        v[0] * u[1] - v[1] * u[0],
+    ];
+    if cross == [0.0; 3] {
+        return Err(
+            "UPDIR is parallel to VIEWDIR; expected an up direction across the view".into(),
+        );
+    }
+    let (p, v) = (mirror(center), mirror(viewdir));
+    Ok(CameraDesc {
+        position: p,
+        look_at: [p[0] + v[0], p[1] + v[1], p[2] + v[2]],
+        up: mirror(updir),
+        ..camera.clone()
+    })
 }
 
 /// A strip's triangles: (s[t], s[t+1], s[t+2]) for even t, (s[t+1], s[t], s[t+2]) for odd t,

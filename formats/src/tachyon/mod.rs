@@ -215,6 +215,18 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
     load_with(path, &Options::new(at))
 }
 
+/// The camera of `scene` moved to a frame of a Tachyon camera file (`-camfile`): VIEWDIR,
+/// UPDIR and CENTER as Tachyon writes them, mapped as a CAMERA's are (mirrored); zoom,
+/// window, projection and lens stay. The error says which vector is unusable.
+pub fn camera_at(
+    camera: &crate::desc::CameraDesc,
+    viewdir: [f64; 3],
+    updir: [f64; 3],
+    center: [f64; 3],
+) -> Result<crate::desc::CameraDesc, String> {
+    map::moved_camera(camera, viewdir, updir, center)
+}
+
 /// [`load`] with Tachyon's command-line overrides (`luxon tachyon`).
 pub fn load_with(path: &Path, options: &Options) -> Result<SceneDesc, SceneError> {
     map::to_desc(parse::parse_file(path)?, options)
