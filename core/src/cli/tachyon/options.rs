@@ -71,10 +71,11 @@ impl Format {
     }
 
     /// The writer plugin and its parameters: chosen by format, never by the file's extension
-    /// (`-o x.png` without `-format PNG` is a Targa called x.png, as in Tachyon).
+    /// (`-o x.png` without `-format PNG` is a Targa called x.png, as in Tachyon). Targa files
+    /// are uncompressed, as Tachyon's are.
     pub fn writer(self) -> (&'static str, &'static str) {
         match self {
-            Format::Targa => ("tga", "()"),
+            Format::Targa => ("tga", "(rle: false)"),
             Format::Bmp => ("bmp", "()"),
             Format::Ppm => ("ppm", "()"),
             Format::Ppm48 => ("ppm", "(bits: 16)"),
