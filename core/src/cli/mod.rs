@@ -1,6 +1,7 @@
 //! The subcommands of `luxon`, one module each.
 
 pub mod check;
+pub mod convert;
 pub mod job;
 pub mod plugins;
 pub mod progress;
