@@ -1,9 +1,9 @@
-//! `bmp`: Windows BMP, sRGB-encoded, 24-bit RGB, uncompressed (what Tachyon's `-format BMP`
-//! writes).
+//! `bmp`: Windows BMP, sRGB-encoded (or display values, `encoding: display`), 24-bit RGB,
+//! uncompressed (what Tachyon's `-format BMP` writes).
 
 use std::io::Write;
 
-use crate::encode::{check_image, encode_error, srgb8};
+use crate::encode::{check_image, encode_error, encoding_param, samples8, Encoding};
 use image::codecs::bmp::BmpEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 use luxon_plugin::{Context, Describe, Error, Image, Writer};
@@ -13,12 +13,16 @@ pub struct Bmp;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct BmpParams {}
+pub struct BmpParams {
+    #[serde(default)]
+    encoding: Encoding,
+}
 
 impl Describe for Bmp {
     const NAME: &'static str = "bmp";
-    const DESCRIPTION: &'static str = "Windows BMP, sRGB-encoded, 24-bit RGB, uncompressed.";
-    const PARAMS: &'static str = "";
+    const DESCRIPTION: &'static str =
+        "Windows BMP, sRGB-encoded or display values, 24-bit RGB, uncompressed.";
+    const PARAMS: &'static str = encoding_param!();
 }
 
 impl Writer for Bmp {
@@ -26,7 +30,7 @@ impl Writer for Bmp {
     type Params = BmpParams;
 
     fn write(
-        _params: BmpParams,
+        params: BmpParams,
         _ctx: &Context,
         image: &Image,
         out: &mut dyn Write,
@@ -35,7 +39,7 @@ impl Writer for Bmp {
         let mut bytes = Vec::new();
         BmpEncoder::new(&mut bytes)
             .write_image(
-                &srgb8(image, false),
+                &samples8(image, false, params.encoding),
                 image.width,
                 image.height,
                 ExtendedColorType::Rgb8,

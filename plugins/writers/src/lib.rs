@@ -121,6 +121,39 @@ mod tests {
     }
 
     #[test]
+    fn every_integer_writer_writes_display_values() {
+        use crate::testing::{decode, encode, gradient, srgb8_of};
+        use image::ImageFormat;
+        let rgba = gradient();
+        let first = |bytes: Vec<u8>, format| decode(&bytes, format).to_rgb8().get_pixel(0, 0).0;
+        // (0, 0.5, 0.25) truncated, as Tachyon writes it; sRGB by default.
+        for params in ["(encoding: display)", "()"] {
+            let expected = match params {
+                "()" => [0, srgb8_of(0.5), srgb8_of(0.25)],
+                _ => [0, 127, 63],
+            };
+            let png = encode::<Png>(params, &rgba).unwrap();
+            assert_eq!(first(png, ImageFormat::Png), expected, "png {params}");
+            let ppm = encode::<Ppm>(params, &rgba).unwrap();
+            assert_eq!(first(ppm, ImageFormat::Pnm), expected, "ppm {params}");
+            let tga = encode::<Tga>(params, &rgba).unwrap();
+            assert_eq!(first(tga, ImageFormat::Tga), expected, "tga {params}");
+            let bmp = encode::<Bmp>(params, &rgba).unwrap();
+            assert_eq!(first(bmp, ImageFormat::Bmp), expected, "bmp {params}");
+            let jpeg = decode(&encode::<Jpeg>(params, &rgba).unwrap(), ImageFormat::Jpeg);
+            let g = jpeg.to_rgb8().get_pixel(0, 0).0[1];
+            assert!(g.abs_diff(expected[1]) < 12, "jpeg {params}: {g}");
+        }
+        let png16 = encode::<Png>("(bits: 16, encoding: display)", &rgba).unwrap();
+        let px = decode(&png16, ImageFormat::Png)
+            .to_rgb16()
+            .get_pixel(0, 0)
+            .0;
+        assert_eq!(px, [0, 32767, 16383]);
+        assert!(encode::<Png>("(encoding: linear)", &rgba).is_err());
+    }
+
+    #[test]
     fn short_buffer_is_an_error() {
         let image = Image {
             width: 4,

@@ -1,10 +1,10 @@
-//! `tga`: Truevision TGA, sRGB-encoded, 8 bits per channel, RGB or RGBA, run-length encoded
-//! unless `rle: false` (uncompressed, as Tachyon writes its Targa files, for tools that read
-//! only those).
+//! `tga`: Truevision TGA, sRGB-encoded (or display values, `encoding: display`), 8 bits per
+//! channel, RGB or RGBA, run-length encoded unless `rle: false` (uncompressed, as Tachyon writes
+//! its Targa files, for tools that read only those).
 
 use std::io::Write;
 
-use crate::encode::{check_image, encode_error, srgb8};
+use crate::encode::{check_image, encode_error, encoding_param, samples8, Encoding};
 use image::codecs::tga::TgaEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 use luxon_plugin::{Context, Describe, Error, Image, Writer};
@@ -19,6 +19,8 @@ pub struct TgaParams {
     alpha: bool,
     #[serde(default = "yes")]
     rle: bool,
+    #[serde(default)]
+    encoding: Encoding,
 }
 
 fn yes() -> bool {
@@ -28,10 +30,12 @@ fn yes() -> bool {
 impl Describe for Tga {
     const NAME: &'static str = "tga";
     const DESCRIPTION: &'static str =
-        "Truevision TGA, sRGB-encoded, 8 bits per channel, RGB or RGBA, run-length encoded or not.";
-    const PARAMS: &'static str =
-        "alpha: bool = false  write an alpha channel (RGBA instead of RGB)\n\
-         rle: bool = true  run-length encode the pixels (false: uncompressed)";
+        "Truevision TGA, sRGB-encoded or display values, 8 bits per channel, RGB or RGBA, run-length encoded or not.";
+    const PARAMS: &'static str = concat!(
+        "alpha: bool = false  write an alpha channel (RGBA instead of RGB)\n",
+        "rle: bool = true  run-length encode the pixels (false: uncompressed)\n",
+        encoding_param!()
+    );
 }
 
 impl Writer for Tga {
@@ -57,7 +61,7 @@ impl Writer for Tga {
         };
         encoder
             .write_image(
-                &srgb8(image, params.alpha),
+                &samples8(image, params.alpha, params.encoding),
                 image.width,
                 image.height,
                 color,
