@@ -73,8 +73,10 @@
 //! NFF importer does), because Tachyon's arithmetic (ambient + diffuse sums, products of
 //! light and surface colours, mirror and transmission mixes) is on these values: converting
 //! would change every mix, and only an output written without sRGB encoding can show
-//! Tachyon's tones. Until Luxon has that output option, midtones come out brighter than
-//! Tachyon's (Luxon encodes its output as sRGB); where both are 0 or 1 they agree.
+//! Tachyon's tones: `luxon tachyon` writes its images so (the writers' `encoding: display`:
+//! values as they are, clamped and truncated as Tachyon writes them). `luxon render` writes
+//! sRGB unless an output asks for `encoding: display`, so there midtones come out brighter
+//! than Tachyon's; where both are 0 or 1 they agree.
 //!
 //! ## Lights, shading settings, fog
 //!
@@ -157,7 +159,7 @@
 //! EXP/EXP2 fog's START; vertex colours (VCSTRI, VERTEXARRAY COLORS); TEXFUNC 3 (marble), 4
 //! (wood), 6 (cylindrical checker) and 10 (IMAGEDEF volume textures), and image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
-//! Tachyon's two-pass volume compositing; the output without sRGB encoding. Also different in
+//! Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
 //! windows blur more sideways in Tachyon), spot falloff shape, highlights attenuated, the 1/510 light threshold, image
 //! texel centres (Tachyon puts u = 0 and 1 on the first and last texel centres), MIP level

@@ -3,7 +3,8 @@
 //! ([`args`]), each is mapped by the table of [`options`], the scene is read by the Tachyon
 //! importer with the scene options, rendered once or along a camera file ([`camfile`]), and
 //! written under the names Tachyon gives ([`names`]), after Tachyon's image processing
-//! ([`post`]). Timings go to standard output in Tachyon's words ("Scene Parsing Time", "Ray
+//! ([`post`]), holding the values Tachyon writes: colours as they are, clamped and truncated,
+//! without the sRGB curve (a Tachyon scene's colours are display values), Targa uncompressed. Timings go to standard output in Tachyon's words ("Scene Parsing Time", "Ray
 //! Tracing Time", ...); warnings and errors to standard error as for every command.
 //!
 //! A scene file is read as a Tachyon scene whatever its name, as Tachyon does (`.nff` and

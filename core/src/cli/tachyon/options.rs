@@ -71,16 +71,18 @@ impl Format {
     }
 
     /// The writer plugin and its parameters: chosen by format, never by the file's extension
-    /// (`-o x.png` without `-format PNG` is a Targa called x.png, as in Tachyon). Targa files
-    /// are uncompressed, as Tachyon's are.
+    /// (`-o x.png` without `-format PNG` is a Targa called x.png, as in Tachyon). The values
+    /// are written as Tachyon writes them: display values, clamped and truncated, without the
+    /// sRGB curve (a Tachyon scene's colours are display values, imported as written); Targa
+    /// files uncompressed, as Tachyon's are.
     pub fn writer(self) -> (&'static str, &'static str) {
         match self {
-            Format::Targa => ("tga", "(rle: false)"),
-            Format::Bmp => ("bmp", "()"),
-            Format::Ppm => ("ppm", "()"),
-            Format::Ppm48 => ("ppm", "(bits: 16)"),
-            Format::Png => ("png", "()"),
-            Format::Jpeg => ("jpeg", "()"),
+            Format::Targa => ("tga", "(rle: false, encoding: display)"),
+            Format::Bmp => ("bmp", "(encoding: display)"),
+            Format::Ppm => ("ppm", "(encoding: display)"),
+            Format::Ppm48 => ("ppm", "(bits: 16, encoding: display)"),
+            Format::Png => ("png", "(encoding: display)"),
+            Format::Jpeg => ("jpeg", "(encoding: display)"),
         }
     }
 }
@@ -458,7 +460,7 @@ mod tests {
             assert_eq!(p.format, f);
             assert_eq!((f.extension(), f.writer().0), (ext, writer));
         }
-        assert_eq!(Format::Ppm48.writer().1, "(bits: 16)");
+        assert_eq!(Format::Ppm48.writer().1, "(bits: 16, encoding: display)");
         let e = plan("-format PSD48").unwrap_err().to_string();
         assert!(
             e.contains("-format PSD48: Luxon cannot write this format; expected one of TARGA, BMP, PPM, PPM48, PNG, JPEG"),
