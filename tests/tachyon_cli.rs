@@ -294,6 +294,25 @@ fn images_hold_tachyons_values() {
     assert_eq!(px[0], [76, 153, 51]);
     assert_eq!(px[12 * 32 + 11], [127, 63, 25]);
     assert_eq!(px[11 * 32 + 22], [229, 178, 12]);
+    // -normalize and -gamma on a background of (0.5, 0.25, 0.1): tachyon-nox writes
+    // (255, 95, 0) and (255, 163, 0).
+    std::fs::write(
+        dir.join("flat.dat"),
+        "BEGIN_SCENE RESOLUTION 4 4 BACKGROUND 0.5 0.25 0.1 END_SCENE",
+    )
+    .unwrap();
+    for (option, rgb) in [
+        (&["-normalize"][..], [255, 95, 0]),
+        (&["-gamma", "2.2"][..], [255, 163, 0]),
+    ] {
+        let mut args = vec!["flat.dat", "-format", "PPM", "-o", "flat.ppm"];
+        args.extend(option);
+        let o = tachyon(&dir, &args);
+        ok(&o);
+        assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+        let ppm = std::fs::read(dir.join("flat.ppm")).unwrap();
+        assert_eq!(ppm[ppm.len() - 3..], rgb, "{option:?}");
+    }
     let Ok(run) = std::process::Command::new("tachyon-nox")
         .current_dir(&dir)
         .args(["tones.dat", "-format", "PPM", "-o", "tachyon.ppm"])

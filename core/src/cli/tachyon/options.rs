@@ -2,7 +2,7 @@
 //! the scene go into the importer's [`Options`] (it maps them as the scene statements they
 //! stand for, and warns once where Luxon does not render a feature as Tachyon does yet);
 //! the others set the render, the output or the run. An option Luxon cannot honour yet is
-//! [`Support::Ignored`] or [`Support::Approximated`] here, and warned about once.
+//! [`Support::Ignored`] here, and warned about once.
 
 use super::args::{usage, Arg};
 use luxon::Error;
@@ -16,8 +16,6 @@ use std::path::PathBuf;
 pub enum Support {
     /// As Tachyon does (or as the importer maps the scene statement it stands for).
     Yes,
-    /// Something close; the reason is printed once.
-    Approximated(&'static str),
     /// Accepted and ignored; the reason is printed once.
     Ignored(&'static str),
 }
@@ -189,10 +187,7 @@ pub fn apply(arg: &Arg, plan: &mut Plan) -> Result<Support, Error> {
                 return Err(usage("-gamma 0: expected a gamma greater than 0".into()));
             }
             plan.post = Post::Gamma(g);
-            Approximated(
-                "the gamma is applied to the normalized image, and Luxon's writers then encode \
-                 it as sRGB (Tachyon writes the values as they are)",
-            )
+            Yes
         }
         // The image and the render.
         "-res" => {
@@ -341,7 +336,6 @@ fn highlights(s: &mut Options, h: Highlights) -> Support {
 pub fn warning(name: &str, support: Support) -> Option<String> {
     match support {
         Support::Yes => None,
-        Support::Approximated(why) => Some(format!("{name} is approximated: {why}")),
         Support::Ignored(why) => Some(format!("{name} is not supported ({why}); ignored")),
     }
 }
@@ -474,7 +468,7 @@ mod tests {
     }
 
     #[test]
-    fn ignored_and_approximated_options_say_so() {
+    fn ignored_options_say_so() {
         for (line, fragment) in [
             (
                 "-nobounding",
@@ -494,13 +488,13 @@ mod tests {
                 "-rescale_lights 2",
                 "-rescale_lights is not supported (Tachyon only scales lights down",
             ),
-            ("-gamma 2.2", "-gamma is approximated"),
         ] {
             let (_, w) = plan(line).unwrap();
             assert_eq!(w.len(), 1, "{line}");
             assert!(w[0].contains(fragment), "{line}: {}", w[0]);
         }
         assert_eq!(plan("-rescale_lights 2").unwrap().0.scene.light_scale, None);
+        assert!(plan("-gamma 2.2 -normalize").unwrap().1.is_empty());
     }
 
     #[test]
