@@ -530,26 +530,71 @@ mod tests {
         }
     }
 
+    /// `name` with a valid example value for each of its values.
+    fn example(name: &str, arity: usize) -> String {
+        let value = match name {
+            "-format" => "PNG",
+            "-normalfixup" => "off",
+            "-aasamples"
+            | "-raydepth"
+            | "-numthreads"
+            | "-trans_max_surfaces"
+            | "-skylight_samples"
+            | "-boundthresh"
+            | "-res" => "2",
+            _ => "0.5",
+        };
+        format!("{name}{}", format!(" {value}").repeat(arity))
+    }
+
     #[test]
     fn the_table_has_a_row_for_every_option() {
         for &(name, arity) in OPTIONS {
-            let value = match name {
-                "-format" => "PNG",
-                "-normalfixup" => "off",
-                _ => "0.5",
-            };
-            let value = match name {
-                "-aasamples"
-                | "-raydepth"
-                | "-numthreads"
-                | "-trans_max_surfaces"
-                | "-skylight_samples"
-                | "-boundthresh"
-                | "-res" => "2",
-                _ => value,
-            };
-            let line = format!("{name}{}", format!(" {value}").repeat(arity));
+            let line = example(name, arity);
             assert!(plan(&line).is_ok(), "{line}: {:?}", plan(&line).err());
+        }
+    }
+
+    /// formats/README.md's option table: every option has a row, and each row's *yes* or
+    /// *scene* (honoured) and *ignored* (warned, no effect) is what [`apply`] returns.
+    #[test]
+    fn the_readme_table_is_the_code() {
+        let readme = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/formats/README.md"));
+        let start = readme
+            .find("| option | Luxon | notes |")
+            .expect("the option table");
+        let mut listed = std::collections::HashSet::new();
+        for row in readme[start..].lines().skip(2) {
+            let Some(row) = row.strip_prefix("| ") else {
+                break;
+            };
+            let cells: Vec<&str> = row.split(" | ").collect();
+            for item in cells[0].split(", ") {
+                let item = item.trim_matches('`');
+                let name = item.split(' ').next().unwrap();
+                let &(_, arity) = OPTIONS
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .unwrap_or_else(|| panic!("`{name}` in the README is not an option"));
+                listed.insert(name);
+                // An option written with a value stands for that value.
+                let line = match item.contains(' ') {
+                    true => item.to_string(),
+                    false => example(name, arity),
+                };
+                let (_, warnings) = plan(&line).unwrap();
+                match cells[1] {
+                    "yes" | "scene" => assert!(warnings.is_empty(), "{line}: {warnings:?}"),
+                    "ignored" => assert_eq!(warnings.len(), 1, "{line}"),
+                    other => panic!("{line}: `{other}` is not yes, scene or ignored"),
+                }
+            }
+        }
+        for (name, _) in OPTIONS {
+            assert!(
+                listed.contains(name),
+                "{name} has no row in the README's table"
+            );
         }
     }
 }
