@@ -9,17 +9,20 @@
 //! | `png`  | `png`       | sRGB, 8 or 16 bits, RGB or RGBA |
 //! | `jpeg` | `jpg, jpeg` | sRGB, 8 bits, RGB (alpha is dropped) |
 //! | `ppm`  | `ppm, pnm`  | sRGB, binary P6, 8 or 16 bits (big-endian), RGB |
-//! | `tga`  | `tga`       | sRGB, 8 bits, RGB or RGBA |
+//! | `tga`  | `tga`       | sRGB, 8 bits, RGB or RGBA, run-length encoded or not |
 //! | `bmp`  | `bmp`       | sRGB, 8 bits, RGB (uncompressed Windows BMP) |
 //! | `exr`  | `exr`       | linear float RGBA, 32-bit or half |
 //!
 //! The integer formats clamp each colour channel to [0, 1], apply the sRGB transfer function and
-//! round to the nearest code; NaN becomes 0. Alpha is stored linearly (clamped, NaN → 0) and the
+//! round to the nearest code; NaN becomes 0. With `encoding: display` (every integer format)
+//! the values are display values already, as a Tachyon scene's colours are: clamped and
+//! truncated as Tachyon writes them, floor(255·c) (floor(65535·c) at 16 bits), with no transfer
+//! function; `luxon tachyon` writes so. Alpha is stored linearly (clamped, NaN → 0) and the
 //! colour is stored as given, i.e. as straight alpha. EXR stores the values unchanged (including
 //! values above 1, negative values, NaN and infinities).
 //!
 //! One file per writer (`png.rs`, `jpeg.rs`, `ppm.rs`, `tga.rs`, `bmp.rs`, `openexr.rs`); `encode.rs` holds
-//! the checks and the sRGB encoding the integer formats share.
+//! the checks and the encodings the integer formats share.
 //!
 //! ## Parameters
 //!
@@ -29,24 +32,31 @@
 //! |---------|--------|---------|---------|
 //! | `bits`  | int    | 8       | bits per channel: 8 or 16 |
 //! | `alpha` | bool   | false   | write an alpha channel (RGBA instead of RGB) |
+//! | `encoding` | `srgb` or `display` | `srgb` | the sRGB curve, or the values as they are (above) |
 //!
 //! `jpeg`
 //!
 //! | name      | type | default | meaning |
 //! |-----------|------|---------|---------|
 //! | `quality` | int  | 90      | encoder quality, 1 (smallest) to 100 (best) |
+//! | `encoding` | `srgb` or `display` | `srgb` | as for `png` |
 //!
 //! `ppm`
 //!
 //! | name   | type | default | meaning |
 //! |--------|------|---------|---------|
 //! | `bits` | int  | 8       | 8 (maxval 255) or 16 (maxval 65535, big-endian samples) |
+//! | `encoding` | `srgb` or `display` | `srgb` | as for `png` |
 //!
 //! `tga`
 //!
 //! | name    | type | default | meaning |
 //! |---------|------|---------|---------|
 //! | `alpha` | bool | false   | write an alpha channel (RGBA instead of RGB) |
+//! | `rle`   | bool | true    | run-length encoded; `false`: uncompressed, as Tachyon writes |
+//! | `encoding` | `srgb` or `display` | `srgb` | as for `png` |
+//!
+//! `bmp`: `encoding`, as for `png`.
 //!
 //! `exr`
 //!
