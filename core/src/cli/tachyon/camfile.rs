@@ -75,7 +75,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Frame>, Error> {
         ));
     }
     let whole = numbers.len() / 9;
-    if numbers.len() % 9 != 0 {
+    if !numbers.len().is_multiple_of(9) {
         let (_, at) = &numbers[whole * 9];
         return Err(Error::at(
             at,

@@ -21,8 +21,8 @@ pub fn apply(post: Post, fb: &mut Framebuffer) {
     let hi = colours()
         .filter(|x| !x.is_nan())
         .fold(f32::NEG_INFINITY, f32::max);
-    // A flat (or empty) image has no range to stretch.
-    if !(hi > lo) || !(hi - lo).is_finite() {
+    // A flat (or empty) image has no range to stretch (NaN was left out: no NaN here).
+    if hi <= lo || !(hi - lo).is_finite() {
         return;
     }
     let scale = 1.0 / (hi - lo);
