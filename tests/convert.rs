@@ -445,6 +445,25 @@ fn converted_scenes_render_the_same_images_on_the_command_line() {
 }
 
 #[test]
+fn warnings_stay_in_comments() {
+    let dir = temp_dir("convert-warnings");
+    let file = dir.join("w.ron");
+    let ron = "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)))";
+    let mut desc = load_ron_str(ron, &file).unwrap();
+    desc.warnings.push(luxon_formats::Warning {
+        at: desc.camera.at.clone(),
+        message: "two\nlines) objects: [".into(),
+    });
+    let text = to_ron(&desc, &dir).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[1].starts_with("// Not carried over"), "{text}");
+    assert!(lines[3].starts_with("//   ") && lines[3].ends_with("two lines) objects: ["));
+    // Still a comment: the scene reads back without objects.
+    let back = load_ron_str(&text, &file).unwrap();
+    assert!(back.objects.is_empty() && back.warnings.is_empty());
+}
+
+#[test]
 fn convert_errors_are_one_line() {
     let dir = temp_dir("convert-errors");
     let p = dir.join("s.dat");

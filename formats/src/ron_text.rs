@@ -786,28 +786,6 @@ mod tests {
     }
 
     #[test]
-    fn warnings_are_listed_in_comments() {
-        let base = std::env::temp_dir();
-        let file = base.join("w.ron");
-        let mut desc = crate::load_ron_str(
-            "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)))",
-            &file,
-        )
-        .unwrap();
-        desc.warnings.push(Warning {
-            at: desc.camera.at.clone(),
-            message: "two\nlines) objects: [".into(),
-        });
-        let text = to_ron(&desc, &base).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        assert!(lines[1].starts_with("// Not carried over"), "{text}");
-        assert!(lines[3].starts_with("//   ") && lines[3].ends_with("two lines) objects: ["));
-        // Still a comment: the scene reads back without objects.
-        let back = crate::load_ron_str(&text, &file).unwrap();
-        assert!(back.objects.is_empty() && back.warnings.is_empty());
-    }
-
-    #[test]
     fn paths_inside_the_base_are_relative() {
         let base = std::env::temp_dir().join("scenes");
         assert_eq!(relative(&base.join("out/a.png"), &base), "out/a.png");
