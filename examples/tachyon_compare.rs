@@ -105,7 +105,10 @@ fn compare(dir: &Path, out: &Path, name: &str) -> Result<(f64, f64, f64), String
         if !theirs_path.exists() {
             return Err(format!(
                 "tachyon-nox wrote no image: {}",
-                String::from_utf8_lossy(&run.stdout).lines().last().unwrap_or("")
+                String::from_utf8_lossy(&run.stdout)
+                    .lines()
+                    .last()
+                    .unwrap_or("")
             ));
         }
     }
@@ -144,11 +147,10 @@ fn render(scene: &Path) -> Result<image::RgbImage, String> {
     let desc = luxon_formats::load(scene).map_err(|e| e.to_string())?;
     let mut extra = desc.plugin_path.clone();
     // Plugins live beside the workspace's binaries, one level above `examples/`.
-    if let Some(dir) = std::env::current_exe().ok().and_then(|e| {
-        e.parent()
-            .and_then(Path::parent)
-            .map(Path::to_path_buf)
-    }) {
+    if let Some(dir) = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent().and_then(Path::parent).map(Path::to_path_buf))
+    {
         extra.push(dir);
     }
     let registry = Registry::discover(&extra);
