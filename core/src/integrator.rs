@@ -606,7 +606,8 @@ impl Whitted<'_> {
     /// Light from one source reaching a shading point: diffuse and highlight, times what the
     /// shadow rays let through. Area lights average `samples` points on the light. With `T`
     /// (Tachyon's lights) the light's term must exceed Tachyon's threshold, and plain
-    /// highlights take the light's colour before attenuation, spot fade and filtering.
+    /// highlights take the light's colour before attenuation, spot fade and filtering (or, for
+    /// a surface-coloured highlight, the surface's colour in its place).
     fn direct<const T: bool>(
         &self,
         sh: &Shade,
@@ -674,21 +675,27 @@ impl Whitted<'_> {
                     } else {
                         cos.powf(mat.shininess)
                     };
-                    // White, or the surface's colour (metal).
-                    let tint = if mat.highlight_surface {
-                        sh.base
-                    } else {
-                        Vec3A::ONE
-                    };
                     if plain {
-                        highlight = (mat.specular * h) * tint;
+                        highlight = Vec3A::splat(mat.specular * h);
                     } else {
+                        // White, or the surface's colour (metal), times the light's.
+                        let tint = if mat.highlight_surface {
+                            sh.base
+                        } else {
+                            Vec3A::ONE
+                        };
                         lit += (mat.specular * h) * tint;
                     }
                 }
             }
             if plain {
-                arriving * lit + raw * highlight
+                // Tachyon's metal highlight takes the surface's colour in place of the light's.
+                let tint = if mat.highlight_surface {
+                    sh.base * self.scene.settings.light_scale
+                } else {
+                    raw
+                };
+                arriving * lit + tint * highlight
             } else {
                 arriving * lit
             }

@@ -260,7 +260,8 @@ pub enum HighlightColor {
     /// White: the light's own colour (plastic; Tachyon's PHONG PLASTIC).
     #[default]
     Light,
-    /// The surface's colour (metal; Tachyon's PHONG METAL).
+    /// The surface's colour (metal; Tachyon's PHONG METAL, where with
+    /// `TachyonDesc::plain_highlights` it replaces the light's colour).
     Surface,
 }
 
@@ -534,7 +535,8 @@ pub struct TachyonDesc {
     pub light_threshold: bool,
     /// Highlights take the light's whole colour: no distance attenuation, spot fade or
     /// filtering by transparent surfaces in the way (they still need the light in front of
-    /// the surface and not blocked by an opaque one).
+    /// the surface and not blocked by an opaque one); a `Surface`-coloured highlight takes the
+    /// surface's colour in place of the light's (Tachyon's METAL).
     pub plain_highlights: bool,
     /// A reflected or transmitted ray past `max_depth` adds the background colour unscaled
     /// (not times the mirror or transmission coefficient).
