@@ -529,6 +529,111 @@ fn shading_probes() -> Vec<Probe> {
             at([76, 153, 229]),
         ),
         (
+            "a light's sphere is not fogged",
+            probe(
+                6,
+                black,
+                "FOG EXP START 0 END 10 DENSITY 0.5 COLOR 0 0 1\n\
+                 LIGHT CENTER 0 0 3 RAD 0.5 COLOR 0.3 0.6 0.9\n",
+            ),
+            at([76, 153, 229]),
+        ),
+        (
+            "a light's sphere behind a transparent pane",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}LIGHT CENTER 0 0 4 RAD 0.5 COLOR 0.3 0.6 0.9\n",
+                    glass(0.5, "")
+                ),
+            ),
+            at([38, 76, 242]),
+        ),
+        (
+            "PHONG METAL under a black light",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 -1 RAD 0 COLOR 0 0 0\n{}",
+                    wall(2.0, &phong("METAL", [1.0, 0.5, 0.25], 0.5))
+                ),
+            ),
+            at([127, 63, 31]),
+        ),
+        (
+            "TRANS_VMD scales the mirror reflection too",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}{}{over_red}",
+                    mode("TRANS_VMD"),
+                    wall(2.0, &tex([0.0, 0.0, 1.0], 0.2, 0.0, 0.5, 0.5, ""))
+                ),
+            ),
+            at([127, 63, 25]),
+        ),
+        (
+            "TRANS_ORIG keeps the mirror reflection",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}{over_red}",
+                    wall(2.0, &tex([0.0, 0.0, 1.0], 0.2, 0.0, 0.5, 0.5, ""))
+                ),
+            ),
+            at([127, 127, 51]),
+        ),
+        (
+            "surfaces past TRANS_MAX_SURFACES cost a level of ray depth",
+            probe(
+                2,
+                [0.0, 1.0, 0.0],
+                &format!("{}{layers}{over_red}", mode("TRANS_MAX_SURFACES 1")),
+            ),
+            at([0, 127, 127]),
+        ),
+        (
+            "fog past skipped surfaces: only the last segment",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{layers}{over_red}",
+                    mode("TRANS_MAX_SURFACES 0")
+                ),
+            ),
+            at([216, 0, 38]),
+        ),
+        (
+            "a mirror seeing nothing under radial fog",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{}",
+                    wall(2.0, &tex([0.0; 3], 0.0, 0.0, 1.0, 1.0, ""))
+                ),
+            ),
+            at([0, 0, 255]),
+        ),
+        (
+            "a mirror seeing nothing under FOG_VMD",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{}",
+                    mode("FOG_VMD"),
+                    wall(2.0, &tex([0.0; 3], 0.0, 0.0, 1.0, 1.0, ""))
+                ),
+            ),
+            at([0, 204, 51]),
+        ),
+        (
             "a light's sphere casts no shadow",
             probe(
                 6,

@@ -625,6 +625,8 @@ impl Whitted<'_> {
             0.0
         };
         let plain = T && tachyon.plain_highlights;
+        // Tachyon's metal highlight needs no light colour: a black light still makes one.
+        let colourless = plain && mat.highlight_surface && mat.specular > 0.0;
         // (point on the light or None for a direction, direction to it, radiance arriving;
         // with `T`: the light's colour and its weight from attenuation and spot fade)
         let one = |target: Option<Vec3A>,
@@ -634,7 +636,7 @@ impl Whitted<'_> {
                    c: &mut Counters|
          -> Vec3A {
             let ndotl = sh.n.dot(to_light);
-            if ndotl <= 0.0 || arriving == Vec3A::ZERO {
+            if ndotl <= 0.0 || (arriving == Vec3A::ZERO && !colourless) {
                 return Vec3A::ZERO;
             }
             if T && ndotl * w * self.term_scale <= floor {
@@ -650,12 +652,25 @@ impl Whitted<'_> {
                         f32::INFINITY,
                     ),
                 };
-                arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
-                if scene.features.volumes && arriving != Vec3A::ZERO {
-                    arriving *= march::transmittance(scene, &sray, t_max, c);
-                }
-                if arriving == Vec3A::ZERO {
-                    return Vec3A::ZERO;
+                if colourless {
+                    // Blocked is what counts, not what arrives.
+                    let mut through =
+                        scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                    if scene.features.volumes && through != Vec3A::ZERO {
+                        through *= march::transmittance(scene, &sray, t_max, c);
+                    }
+                    if through == Vec3A::ZERO {
+                        return Vec3A::ZERO;
+                    }
+                    arriving *= through;
+                } else {
+                    arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                    if scene.features.volumes && arriving != Vec3A::ZERO {
+                        arriving *= march::transmittance(scene, &sray, t_max, c);
+                    }
+                    if arriving == Vec3A::ZERO {
+                        return Vec3A::ZERO;
+                    }
                 }
             }
             let mut lit = mat.diffuse * sh.opacity * ndotl * sh.base;
