@@ -507,3 +507,39 @@ fn help_version_and_warnings() {
     let e = stderr(&o);
     assert_eq!(e.matches("-nobounding is not supported").count(), 1, "{e}");
 }
+
+/// A light with a radius is also a sphere that casts no shadow: `luxon render` of the `.dat`
+/// (which takes the imported geometry out of the scene while building) lights the scene exactly
+/// as the same light without its sphere, where the sphere is out of view.
+#[test]
+fn light_spheres_do_not_shadow_their_own_light() {
+    let dir = temp_dir("tcli-lightsphere");
+    let scene = |rad: &str| {
+        SCENE
+            .replace(
+                "LIGHT CENTER 4 5 -6 RAD 0",
+                &format!("LIGHT CENTER 4 5 -6 RAD {rad}"),
+            )
+            .replace("CENTER 0 0 -6 VIEWDIR", "CENTER 0 0 -5 VIEWDIR")
+    };
+    let mut images = Vec::new();
+    for rad in ["0", "0.2"] {
+        let (dat, png) = (
+            dir.join(format!("l{rad}.dat")),
+            dir.join(format!("l{rad}.png")),
+        );
+        std::fs::write(&dat, scene(rad)).unwrap();
+        let o = run(&["render", dat.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        images.push(image::open(&png).unwrap().to_rgb8());
+    }
+    let lit = images[0]
+        .pixels()
+        .map(|p| p.0[0].max(p.0[1]).max(p.0[2]))
+        .max();
+    assert!(lit > Some(150), "the lit scene is dark: {lit:?}");
+    assert!(
+        images[0] == images[1],
+        "the light's sphere shadows the scene"
+    );
+}

@@ -128,6 +128,7 @@ pub fn inline_as_objects(g: &InlineGeometry, fallback: &Origin) -> Vec<Spanned<O
             },
             material: g.material.clone(),
             clip: g.clip.clone(),
+            shadows: !g.shadowless,
         },
         at: at.clone(),
     };
@@ -276,14 +277,20 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
             FogMode::Linear { start, end } => {
                 format!("Linear(start: {}, end: {})", num(start), num(end))
             }
-            FogMode::Exp { density } => format!("Exp(density: {})", num(density)),
-            FogMode::Exp2 { density } => format!("Exp2(density: {})", num(density)),
+            FogMode::Exp { density, start } => {
+                format!("Exp(density: {}, start: {})", num(density), num(start))
+            }
+            FogMode::Exp2 { density, start } => {
+                format!("Exp2(density: {}, start: {})", num(density), num(start))
+            }
         };
         let _ = writeln!(
             w,
-            "    fog: (mode: {mode}, color: {}, planar: {}),",
+            "    fog: (mode: {mode}, color: {}, planar: {}, every_ray: {}, misses: {}),",
             v3(&f.color),
-            f.planar
+            f.planar,
+            f.every_ray,
+            f.misses
         );
     }
     if let Some(a) = ambient_occlusion {
@@ -363,6 +370,9 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
             }
             if let Some(c) = &o.clip {
                 let _ = write!(w, ", clip: {}", string(&c.value));
+            }
+            if !o.shadows {
+                w.extend_from_slice(b", shadows: false");
             }
             w.extend_from_slice(b"),\n");
         }
@@ -490,13 +500,18 @@ fn light(l: &LightDesc) -> String {
             intensity,
             shadows,
             attenuation: a,
+            fade,
         } => format!(
-            "Spot(position: {}, direction: {}, angle: {}, falloff: {}, color: {}, intensity: {}, \
-             shadows: {shadows}, attenuation: {})",
+            "Spot(position: {}, direction: {}, angle: {}, falloff: {}, fade: {}, color: {}, \
+             intensity: {}, shadows: {shadows}, attenuation: {})",
             v3(position),
             v3(direction),
             num(*cone_deg),
             num(*falloff_deg),
+            match fade {
+                SpotFade::Smooth => "Smooth",
+                SpotFade::Linear => "Linear",
+            },
             v3(color),
             num(*intensity),
             attenuation(a)
@@ -551,9 +566,14 @@ fn material(m: &MaterialDesc) -> String {
         specular,
         shininess,
         highlight,
+        highlight_color,
         reflect,
         transmit,
         ior,
+        transparency_angle,
+        outline,
+        outline_width,
+        fog,
     } = m;
     let mut s = format!("(color: {}", v3(color));
     for (name, t) in [
@@ -568,6 +588,11 @@ fn material(m: &MaterialDesc) -> String {
     let highlight = match highlight {
         Highlight::Phong => "Phong",
         Highlight::Blinn => "Blinn",
+        Highlight::BlinnFast => "BlinnFast",
+    };
+    let highlight_color = match highlight_color {
+        HighlightColor::Light => "Light",
+        HighlightColor::Surface => "Surface",
     };
     // Without highlights the exponent is unused and may be 0, which RON does not take: the
     // default stands in (and reads back as itself, so a second conversion writes the same).
@@ -577,7 +602,7 @@ fn material(m: &MaterialDesc) -> String {
     };
     s += &format!(
         ", ambient: {}, diffuse: {}, specular: {}, shininess: {}, highlight: {highlight}, \
-         reflect: {}, transmit: {}, ior: {})",
+         highlight_color: {highlight_color}, reflect: {}, transmit: {}, ior: {}",
         num(*ambient),
         num(*diffuse),
         num(*specular),
@@ -586,7 +611,27 @@ fn material(m: &MaterialDesc) -> String {
         num(*transmit),
         num(*ior)
     );
-    s
+    if let Some(a) = transparency_angle {
+        s += &format!(", transparency_angle: {}", angle(*a));
+    }
+    if *outline != 0.0 || *outline_width != 0.0 {
+        s += &format!(
+            ", outline: {}, outline_width: {}",
+            num(*outline),
+            num(*outline_width)
+        );
+    }
+    if !fog {
+        s += ", fog: false";
+    }
+    s + ")"
+}
+
+fn angle(a: TransparencyAngle) -> &'static str {
+    match a {
+        TransparencyAngle::Constant => "Constant",
+        TransparencyAngle::Raster3D => "Raster3D",
+    }
 }
 
 fn volume(v: &VolumeDescEntry) -> String {
@@ -680,6 +725,8 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path) {
         volume_step,
         volume_skip,
         adaptive,
+        light_scale,
+        tachyon,
     } = r;
     let _ = writeln!(w, "    render: (");
     let _ = writeln!(w, "        width: {width},\n        height: {height},");
@@ -729,14 +776,47 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path) {
         "        parallel: (mode: {mode},{threads} decomposition: {decomposition}, tile_size: \
          {tile_size}, io: {io}),"
     );
-    let TransparencyDesc { mode, max_surfaces } = transparency;
+    let TransparencyDesc {
+        mode,
+        angle: transparency_angle,
+        max_surfaces,
+        beyond_max,
+        shadows,
+        scale_reflection,
+    } = transparency;
     let mode = match mode {
         TransparencyMode::Filter => "Filter",
         TransparencyMode::AngleModulated => "AngleModulated",
         TransparencyMode::PostMultiplied => "PostMultiplied",
+        TransparencyMode::Additive => "Additive",
     };
     let max = max_surfaces.map_or(String::new(), |n| format!(", max_surfaces: {n}"));
-    let _ = writeln!(w, "        transparency: (mode: {mode}{max}),");
+    let beyond_max = match beyond_max {
+        BeyondMax::Opaque => "Opaque",
+        BeyondMax::Skip => "Skip",
+    };
+    let shadows = match shadows {
+        TransparentShadows::Tinted => "Tinted",
+        TransparentShadows::Untinted => "Untinted",
+        TransparentShadows::Off => "Off",
+    };
+    let _ = writeln!(
+        w,
+        "        transparency: (mode: {mode}, angle: {}{max}, beyond_max: {beyond_max}, shadows: \
+         {shadows}, scale_reflection: {scale_reflection}),",
+        angle(*transparency_angle)
+    );
+    let TachyonDesc {
+        light_threshold,
+        plain_highlights,
+        depth_limit_background,
+    } = tachyon;
+    let _ = writeln!(
+        w,
+        "        light_scale: {},\n        tachyon: (light_threshold: {light_threshold}, \
+         plain_highlights: {plain_highlights}, depth_limit_background: {depth_limit_background}),",
+        num(*light_scale)
+    );
     let _ = writeln!(
         w,
         "        volume_step: {},\n        volume_skip: {volume_skip},",

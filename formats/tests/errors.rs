@@ -264,6 +264,14 @@ fn ambient_occlusion_errors() {
     check(found, 3, 34, &["`samples` is 0"]);
 }
 
+#[test]
+fn fog_errors() {
+    let found = scene_error("    fog: (mode: Exp(density: 0.1, start: -1), every_ray: true),");
+    check(found, 3, 42, &["`start` is -1", "0"]);
+    let found = scene_error("    fog: (mode: Exp2(density: 0.1), misses: 1),");
+    check(found, 3, 45, &["expected `true` or `false`"]);
+}
+
 // ---- Materials ----
 
 #[test]
@@ -276,6 +284,8 @@ fn material_coefficients() {
         ("ior: 0", "`ior` is 0"),
         ("ambient: -1", "`ambient` is -1"),
         ("color: (0.5, 0.5, -2)", "-2"),
+        ("outline: 1.5", "`outline` is 1.5"),
+        ("outline_width: -0.5", "`outline_width` is -0.5"),
     ];
     for (field, words) in cases {
         let body = format!("    materials: {{ \"m\": ({field}) }},");
@@ -403,6 +413,32 @@ fn adaptive_settings() {
     assert!(m.contains("depth"), "{m}");
     let (_, _, m) = render_error("adaptive: (max_depth: 2)");
     assert!(m.contains("threshold"), "{m}");
+}
+
+#[test]
+fn tachyon_shading_settings() {
+    check(
+        render_error("light_scale: -1"),
+        3,
+        27,
+        &["`light_scale` is -1", "0"],
+    );
+    check(
+        render_error("transparency: (mode: AngleModulated, angle: Raster3D)"),
+        3,
+        58,
+        &["`angle`", "AngleModulated", "expected one of them"],
+    );
+    check(
+        render_error("transparency: (mode: Filter, scale_reflection: true)"),
+        3,
+        61,
+        &["`scale_reflection`", "PostMultiplied"],
+    );
+    let (_, _, m) = render_error("transparency: (beyond_max: Hidden)");
+    assert!(m.contains("Skip"), "{m}");
+    let (_, _, m) = render_error("tachyon: (threshold: true)");
+    assert!(m.contains("light_threshold"), "{m}");
 }
 
 #[test]

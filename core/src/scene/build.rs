@@ -3,7 +3,7 @@
 //! geometry, then a cache's prebuilt geometry), BVHs, lights, and the effects the scene calls
 //! for. A new kind of scene content gets a stage of its own here.
 
-use super::{Ao, Features, Fog, Light, Material, Scene, Settings};
+use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
 use crate::camera::Camera;
 use crate::error::Error;
 use crate::geometry::cone::Cones;
@@ -19,7 +19,10 @@ use crate::plugin::texture::{create_texture, TextureInstance};
 use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
-use luxon_formats::{Highlight, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned};
+use luxon_formats::{
+    HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned, SpotFade,
+    TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
+};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -43,7 +46,8 @@ impl Scene {
     /// Resolves plugins, instantiates every object and builds the BVHs.
     pub fn build(desc: &SceneDesc, registry: &Registry) -> Result<Scene, Error> {
         let groups = desc.inline.iter().map(Cow::Borrowed);
-        Scene::build_from(desc, Box::new(groups), None, registry)
+        let shadowless = shadowless_groups(desc);
+        Scene::build_from(desc, Box::new(groups), shadowless, None, registry)
     }
 
     /// Builds with the native geometry and BVHs of a geometry cache (`desc` holds the rest of
@@ -53,7 +57,14 @@ impl Scene {
         geometry: Prebuilt,
         registry: &Registry,
     ) -> Result<Scene, Error> {
-        Scene::build_from(desc, Box::new(std::iter::empty()), Some(geometry), registry)
+        let none = Vec::new();
+        Scene::build_from(
+            desc,
+            Box::new(std::iter::empty()),
+            none,
+            Some(geometry),
+            registry,
+        )
     }
 
     /// Like `build`, but takes the imported geometry (`desc.inline`) out of `desc` and frees
@@ -63,14 +74,18 @@ impl Scene {
         desc: &mut SceneDesc,
         registry: &Registry,
     ) -> Result<Scene, Error> {
+        // Which groups cast no shadow is needed before they are taken: their materials get a
+        // shadowless copy in the palette.
+        let shadowless = shadowless_groups(desc);
         let groups = std::mem::take(&mut desc.inline).into_iter().map(Cow::Owned);
-        Scene::build_from(desc, Box::new(groups), None, registry)
+        Scene::build_from(desc, Box::new(groups), shadowless, None, registry)
     }
 
     /// The build, stage after stage (errors are reported in this order too).
     fn build_from(
         desc: &SceneDesc,
         inline: Inline,
+        shadowless: Vec<Option<Spanned<String>>>,
         prebuilt: Option<Prebuilt>,
         registry: &Registry,
     ) -> Result<Scene, Error> {
@@ -78,12 +93,17 @@ impl Scene {
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
-        let (materials, material_names) = b.materials(&texture_names)?;
+        let palette = b.materials(&texture_names, &shadowless)?;
         let clips = b.clips()?;
         let render_volumes = b.render_volumes(&volumes)?;
-        let mut stored = Stored::new(b.world_offset, materials.len());
-        b.objects(&material_names, &mut stored)?;
-        b.imported(inline, &material_names, &mut stored)?;
+        let mut stored = Stored::new(b.world_offset, palette.materials.len());
+        b.objects(&palette, &mut stored)?;
+        b.imported(inline, &palette, &mut stored)?;
+        let Palette {
+            materials,
+            names: material_names,
+            ..
+        } = palette;
         let native_built = prebuilt.is_some();
         if let Some(p) = prebuilt {
             stored.take_prebuilt(p, b.world_offset)?;
@@ -149,6 +169,32 @@ struct Build<'a> {
     registry: &'a Registry,
     scene_dir: PathBuf,
     world_offset: DVec3,
+}
+
+/// The materials of the imported geometry groups that cast no shadow.
+fn shadowless_groups(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
+    let groups = desc.inline.iter().filter(|g| g.shadowless);
+    groups.map(|g| g.material.clone()).collect()
+}
+
+/// The materials (index 0: the default; then the scene's, by name; then copies of those that
+/// objects casting no shadow use), their names, and each one's copy that casts no shadow.
+struct Palette {
+    materials: Vec<Material>,
+    names: Vec<String>,
+    shadowless: Vec<Option<usize>>,
+}
+
+impl Palette {
+    /// The material an object or geometry group names, its copy when it casts no shadow.
+    fn index(&self, name: &Option<Spanned<String>>, shadows: bool) -> Result<usize, Error> {
+        let m = material_index(&self.names, name)?;
+        Ok(if shadows {
+            m
+        } else {
+            self.shadowless[m].unwrap_or(m)
+        })
+    }
 }
 
 /// The scene's geometry while it is being stored, and what storing it tells.
@@ -233,10 +279,16 @@ impl<'a> Build<'a> {
     }
 
     /// Stage: the materials (index 0: the default, which the scene may redefine) with their
-    /// textures resolved; and their names.
-    fn materials(&self, texture_names: &[String]) -> Result<(Vec<Material>, Vec<String>), Error> {
+    /// textures resolved, then a copy casting no shadow of each material that objects casting
+    /// none use.
+    fn materials(
+        &self,
+        texture_names: &[String],
+        shadowless_groups: &[Option<Spanned<String>>],
+    ) -> Result<Palette, Error> {
+        let t = &self.desc.render.transparency;
         let mut material_names = vec!["default".to_string()];
-        let mut materials = vec![material(&Default::default(), [None; 3])];
+        let mut materials = vec![material(&Default::default(), [None; 3], t)];
         for (name, m) in &self.desc.materials {
             let find = |t: &Option<Spanned<String>>| -> Result<Option<u32>, Error> {
                 match t {
@@ -253,12 +305,28 @@ impl<'a> Build<'a> {
                 find(&m.value.reflect_texture)?,
                 find(&m.value.transmit_texture)?,
             ];
-            let mat = material(&m.value, tex);
+            let mat = material(&m.value, tex, t);
             if let Some(i) = material_names.iter().position(|n| n == name) {
                 materials[i] = mat;
             } else {
                 material_names.push(name.clone());
                 materials.push(mat);
+            }
+        }
+        let mut shadowless = vec![None; materials.len()];
+        let unshadowed = self
+            .desc
+            .objects
+            .iter()
+            .filter(|o| !o.value.shadows)
+            .map(|o| &o.value.material);
+        for name in unshadowed.chain(shadowless_groups) {
+            let m = material_index(&material_names, name)?;
+            if shadowless[m].is_none() {
+                shadowless[m] = Some(materials.len());
+                let mut copy = materials[m].clone();
+                copy.shadow = Some(Vec3A::ONE);
+                materials.push(copy);
             }
         }
         if materials.len() as u32 > MAX_MATERIALS {
@@ -267,7 +335,11 @@ impl<'a> Build<'a> {
                 materials.len()
             )));
         }
-        Ok((materials, material_names))
+        Ok(Palette {
+            materials,
+            names: material_names,
+            shadowless,
+        })
     }
 
     /// Stage: the clip groups, in render space.
@@ -327,14 +399,14 @@ impl<'a> Build<'a> {
     }
 
     /// Stage: every object, created by its primitive plugin into the native sets.
-    fn objects(&self, material_names: &[String], stored: &mut Stored) -> Result<(), Error> {
+    fn objects(&self, palette: &Palette, stored: &mut Stored) -> Result<(), Error> {
         for (i, obj) in self.desc.objects.iter().enumerate() {
             let call = &obj.value.call;
             let entry = self
                 .registry
                 .get(&call.plugin.value, PluginKind::Primitive)
                 .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
-            let material = material_index(material_names, &obj.value.material)?;
+            let material = palette.index(&obj.value.material, obj.value.shadows)?;
             stored.used[material] = true;
             let clip = self.clip_group(&obj.value.clip)?;
             let mut b = GeometryBuilder {
@@ -376,13 +448,13 @@ impl<'a> Build<'a> {
     fn imported(
         &self,
         inline: Inline,
-        material_names: &[String],
+        palette: &Palette,
         stored: &mut Stored,
     ) -> Result<(), Error> {
         let world_offset = self.world_offset;
         for (k, g) in inline.enumerate() {
             let at = || g.at.clone().unwrap_or_else(|| self.desc.camera.at.clone());
-            let material = material_index(material_names, &g.material)?;
+            let material = palette.index(&g.material, !g.shadowless)?;
             stored.used[material] = true;
             let m = pack(material as u32, self.clip_group(&g.clip)?);
             let fail = |e: String| Error::at(&at(), format!("imported geometry group {k}: {e}"));
@@ -434,6 +506,9 @@ impl<'a> Build<'a> {
 
     /// Stage: the lights, in render space.
     fn lights(&self) -> Vec<Light> {
+        // Every light's colour carries the render's light scale.
+        let scale = self.desc.render.light_scale;
+        let rgb = |color: &[f64; 3], intensity: &f64| v3(*color) * (*intensity * scale) as f32;
         let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - self.world_offset).as_vec3());
         let unit = |d: &[f64; 3]| Vec3A::from(DVec3::from(*d).normalize().as_vec3());
         let att = |a: &luxon_formats::Attenuation| {
@@ -451,7 +526,7 @@ impl<'a> Build<'a> {
                     attenuation,
                 } => Light::Point {
                     position: at(position),
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -462,7 +537,7 @@ impl<'a> Build<'a> {
                     shadows,
                 } => Light::Directional {
                     to_light: -unit(direction),
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                 },
                 LightDesc::Spot {
@@ -470,6 +545,7 @@ impl<'a> Build<'a> {
                     direction,
                     cone_deg,
                     falloff_deg,
+                    fade,
                     color,
                     intensity,
                     shadows,
@@ -479,7 +555,14 @@ impl<'a> Build<'a> {
                     axis: unit(direction),
                     cos_inner: ((cone_deg - falloff_deg) * 0.5).to_radians().cos() as f32,
                     cos_outer: (cone_deg * 0.5).to_radians().cos() as f32,
-                    color: v3(*color) * *intensity as f32,
+                    fade: match fade {
+                        SpotFade::Smooth => Fade::Smooth,
+                        SpotFade::Linear => Fade::Linear {
+                            inner: ((cone_deg - falloff_deg) * 0.5).to_radians() as f32,
+                            outer: (cone_deg * 0.5).to_radians() as f32,
+                        },
+                    },
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -495,7 +578,7 @@ impl<'a> Build<'a> {
                     center: at(center),
                     radius: *radius as f32,
                     samples: *samples,
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -514,7 +597,7 @@ impl<'a> Build<'a> {
                     edge2: v3(*edge2),
                     normal: v3(*edge1).cross(v3(*edge2)).normalize(),
                     samples: *samples,
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -528,6 +611,8 @@ impl<'a> Build<'a> {
             mode: f.mode,
             color: v3(f.color),
             planar: f.planar,
+            every_ray: f.every_ray,
+            misses: f.misses,
         });
         let ao = self.desc.ambient_occlusion.as_ref().map(|a| Ao {
             samples: a.samples,
@@ -648,12 +733,20 @@ fn features(
         .map(|(m, _)| m)
         .collect();
     let has_geometry = stored.has_geometry();
+    let transmission = used_mats.iter().any(|m| m.transmit > 0.0);
+    let every_ray = fog.as_ref().is_some_and(|f| f.every_ray);
     Features {
         shadows: has_geometry && lights.iter().any(Light::casts_shadows),
         ambient_occlusion: has_geometry && ao.is_some(),
-        fog: fog.is_some(),
+        fog: fog.is_some() && !every_ray,
+        fog_every_ray: every_ray,
         reflection: used_mats.iter().any(|m| m.reflect > 0.0),
-        transmission: used_mats.iter().any(|m| m.transmit > 0.0),
+        transmission,
+        // Transparent materials and the copies that cast no shadow.
+        shadow_filters: used_mats.iter().any(|m| m.shadow.is_some()),
+        outline: used_mats.iter().any(|m| m.outline > 0.0),
+        tachyon_lights: (r.tachyon.light_threshold || r.tachyon.plain_highlights)
+            && !lights.is_empty(),
         textures: used_mats.iter().any(|m| {
             m.texture
                 .or(m.reflect_texture)
@@ -683,6 +776,8 @@ fn settings(r: &RenderDesc) -> Settings {
         io: r.parallel.io,
         volume_skip: r.volume_skip,
         adaptive: r.adaptive,
+        light_scale: r.light_scale as f32,
+        tachyon: r.tachyon,
     }
 }
 
@@ -690,10 +785,33 @@ fn v3(a: [f64; 3]) -> Vec3A {
     Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
 }
 
-/// `textures`: the material's colour, reflect and transmit textures.
-fn material(m: &luxon_formats::MaterialDesc, textures: [Option<u32>; 3]) -> Material {
+/// `textures`: the material's colour, reflect and transmit textures; `t`: the render's
+/// transparency rules (the angle rule a material does not override, shadows' filters).
+fn material(
+    m: &luxon_formats::MaterialDesc,
+    textures: [Option<u32>; 3],
+    t: &TransparencyDesc,
+) -> Material {
+    let color = v3(m.color);
+    let transmit = m.transmit as f32;
+    let angle = match m.transparency_angle {
+        Some(TransparencyAngle::Raster3D) => AngleRule::Raster3D,
+        Some(TransparencyAngle::Constant) => AngleRule::Constant,
+        None if t.mode == TransparencyMode::AngleModulated => AngleRule::Slab,
+        None if t.angle == TransparencyAngle::Raster3D => AngleRule::Raster3D,
+        None => AngleRule::Constant,
+    };
+    let shadow = if transmit <= 0.0 {
+        None
+    } else {
+        Some(match t.shadows {
+            TransparentShadows::Tinted => transmit * color,
+            TransparentShadows::Untinted => Vec3A::splat(transmit),
+            TransparentShadows::Off => Vec3A::ONE,
+        })
+    };
     Material {
-        color: v3(m.color),
+        color,
         texture: textures[0],
         reflect_texture: textures[1],
         transmit_texture: textures[2],
@@ -701,9 +819,15 @@ fn material(m: &luxon_formats::MaterialDesc, textures: [Option<u32>; 3]) -> Mate
         diffuse: m.diffuse as f32,
         specular: m.specular as f32,
         shininess: m.shininess as f32,
-        blinn: m.highlight == Highlight::Blinn,
+        highlight: m.highlight,
+        highlight_surface: m.highlight_color == HighlightColor::Surface,
         reflect: m.reflect as f32,
-        transmit: m.transmit as f32,
+        transmit,
         ior: m.ior as f32,
+        angle,
+        shadow,
+        outline: m.outline as f32,
+        outline_power: 32.0 * (1.0 - m.outline_width as f32),
+        fog: m.fog,
     }
 }

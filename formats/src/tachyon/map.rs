@@ -12,9 +12,10 @@ use super::syntax::*;
 use super::terrain::scape;
 use super::{mirror, Warnings};
 use crate::desc::{
-    AoDesc, Attenuation, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum, Highlight,
-    LightDesc, MaterialDesc, Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc,
-    TransparencyMode,
+    AoDesc, Attenuation, BeyondMax, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum,
+    Highlight, LightDesc, MaterialDesc, Projection as LuxProjection, RenderDesc, SceneDesc,
+    SpotFade, TachyonDesc, TransparencyAngle, TransparencyDesc, TransparencyMode,
+    TransparentShadows,
 };
 use crate::error::SceneError;
 use crate::origin::{Origin, Spanned};
@@ -141,18 +142,12 @@ impl Mapper {
             ),
             Kind::Fog(f) => self.fog = Some((at.clone(), f.clone())),
             Kind::Light(l) => {
-                if l.rad > 0.0 {
-                    self.notes.add(
-                        "LIGHT with RAD > 0",
-                        "lights the scene, but its sphere (drawn by Tachyon in the light's \
-                         colour) is not drawn yet",
-                        at,
-                    );
-                }
+                let color = light_color(l.color, at)?;
+                self.light_sphere(l.center, l.rad, color, at);
                 self.lights.push(Spanned {
                     value: LightDesc::Point {
                         position: mirror(l.center),
-                        color: light_color(l.color, at)?,
+                        color,
                         intensity: 1.0,
                         shadows: true,
                         attenuation: attenuation(&l.attenuation),
@@ -407,17 +402,10 @@ impl Mapper {
             let m = &mut m.value;
             match h {
                 Highlights::Phong => m.highlight = Highlight::Phong,
-                Highlights::Blinn | Highlights::BlinnFast => m.highlight = Highlight::Blinn,
+                Highlights::Blinn => m.highlight = Highlight::Blinn,
+                Highlights::BlinnFast => m.highlight = Highlight::BlinnFast,
                 Highlights::None => m.specular = 0.0,
             }
-        }
-        if h == Highlights::BlinnFast && materials.iter().any(|(_, m)| m.value.specular > 0.0) {
-            self.notes.add(
-                "-shade_blinn_fast",
-                "(Tachyon's fast approximation of Blinn highlights) is rendered with Blinn \
-                 highlights",
-                &self.options.at.clone(),
-            );
         }
     }
 
@@ -452,14 +440,18 @@ impl Mapper {
         }
     }
 
-    fn spotlight(&mut self, l: &Spotlight, at: &Origin) -> Result<()> {
-        if l.rad > 0.0 {
-            self.notes.add(
-                "SPOTLIGHT with RAD > 0",
-                "lights the scene, but its sphere is not drawn yet",
-                at,
-            );
+    /// A light with RAD > 0 is also a sphere in its colour, unlit and unfogged, casting no
+    /// shadow (Tachyon's light object).
+    fn light_sphere(&mut self, center: V3, rad: f64, color: V3, at: &Origin) {
+        if rad > 0.0 {
+            let m = self.materials.light(color, at);
+            self.shapes.light_sphere(&m, center, rad, at);
         }
+    }
+
+    fn spotlight(&mut self, l: &Spotlight, at: &Origin) -> Result<()> {
+        let color = light_color(l.color, at)?;
+        self.light_sphere(l.center, l.rad, color, at);
         let end = l.falloff_end.clamp(0.0, 180.0);
         let start = l.falloff_start.clamp(0.0, end);
         self.lights.push(Spanned {
@@ -468,7 +460,8 @@ impl Mapper {
                 direction: mirror(nonzero(l.direction, "DIRECTION", at)?),
                 cone_deg: 2.0 * end,
                 falloff_deg: 2.0 * (end - start),
-                color: light_color(l.color, at)?,
+                fade: SpotFade::Linear,
+                color,
                 intensity: 1.0,
                 shadows: true,
                 attenuation: attenuation(&l.attenuation),
@@ -560,11 +553,7 @@ impl Mapper {
             }
         }
         self.highlights(&mut materials);
-        let first_transparent = materials
-            .iter()
-            .find(|(_, m)| m.value.transmit > 0.0)
-            .map(|(_, m)| m.at.clone());
-        let transparency = self.transparency(first_transparent);
+        let transparency = self.transparency();
         let mut warnings = self.warnings;
         warnings.extend(self.notes.into_warnings());
         Ok(SceneDesc {
@@ -586,6 +575,11 @@ impl Mapper {
                 samples,
                 max_depth,
                 transparency,
+                tachyon: TachyonDesc {
+                    light_threshold: true,
+                    plain_highlights: true,
+                    depth_limit_background: true,
+                },
                 ..RenderDesc::default()
             },
             plugin_path: Vec::new(),
@@ -599,46 +593,31 @@ impl Mapper {
         })
     }
 
-    /// The transparency mode, and notes where it is not Tachyon's (only when some material,
-    /// the first at `first_transparent`, is transparent).
-    fn transparency(&mut self, first_transparent: Option<Origin>) -> TransparencyDesc {
-        let (vmd, raster3d) = (self.shading.vmd, self.shading.raster3d);
-        let mode = if vmd {
-            TransparencyMode::PostMultiplied
-        } else if raster3d {
-            TransparencyMode::AngleModulated
-        } else {
-            TransparencyMode::Filter
-        };
-        let max_surfaces = self.shading.max_surfaces.clone();
-        if let Some(at) = self.shading.shadow_filter_off.clone() {
-            self.notes.add(
-                "SHADOW_FILTER_OFF",
-                "is not rendered yet: transparent surfaces cast filtered shadows",
-                &at,
-            );
-        }
-        if let Some(at) = first_transparent {
-            let what = match (vmd, raster3d) {
-                (true, true) => Some("TRANS_VMD with TRANS_RASTER3D transparency is rendered as TRANS_VMD"),
-                (false, true) => Some("TRANS_RASTER3D transparency is rendered with Luxon's angle-modulated transmittance (a different formula)"),
-                (false, false) => Some("Tachyon's default transparency (TRANS_ORIG: the surface's shading kept, what is behind added untinted) is rendered with Luxon's filter mode (shading scaled by opacity, what is behind tinted by the colour)"),
-                (true, false) => None,
-            };
-            if let Some(what) = what {
-                self.notes.add(what, "", &at);
-            }
-            if let Some((_, at)) = &max_surfaces {
-                self.notes.add(
-                    "TRANS_MAX_SURFACES",
-                    "shows the surface after the limit opaque (Tachyon leaves it out)",
-                    at,
-                );
-            }
-        }
+    /// Tachyon's transparency: TRANS_ORIG adds what is behind to the unscaled shading,
+    /// TRANS_VMD post-multiplies (the mirror reflection too), TRANS_RASTER3D changes opacity
+    /// with the angle; later surfaces past TRANS_MAX_SURFACES are skipped; shadows through
+    /// transparent surfaces are grey, or none with SHADOW_FILTER_OFF.
+    fn transparency(&mut self) -> TransparencyDesc {
+        let s = &self.shading;
         TransparencyDesc {
-            mode,
-            max_surfaces: max_surfaces.map(|(n, _)| n),
+            mode: if s.vmd {
+                TransparencyMode::PostMultiplied
+            } else {
+                TransparencyMode::Additive
+            },
+            angle: if s.raster3d {
+                TransparencyAngle::Raster3D
+            } else {
+                TransparencyAngle::Constant
+            },
+            max_surfaces: s.max_surfaces.as_ref().map(|(n, _)| *n),
+            beyond_max: BeyondMax::Skip,
+            shadows: if s.shadow_filter_off.is_some() {
+                TransparentShadows::Off
+            } else {
+                TransparentShadows::Untinted
+            },
+            scale_reflection: s.vmd,
         }
     }
 
@@ -664,32 +643,35 @@ impl Mapper {
                 }
             }
             FogMode::Exp | FogMode::Exp2 => {
-                if f.start != 0.0 {
+                if f.density <= 0.0 {
+                    // Tachyon's visibility, clamped to 1: no fog.
+                    return Ok(None);
+                }
+                // Tachyon's visibility is 1 before START: a negative START is fog from the eye
+                // on, thicker.
+                let (density, start) = (f.density, f.start.max(0.0));
+                if f.start < 0.0 {
                     self.notes.add(
-                        "FOG EXP/EXP2 with START",
-                        "starts at the eye (Luxon's exponential fog has no start distance)",
+                        "FOG START below 0",
+                        "starts at the eye (Tachyon's fog is already thicker there)",
                         &at,
                     );
                 }
                 if f.mode.value == FogMode::Exp {
-                    LuxFog::Exp { density: f.density }
+                    LuxFog::Exp { density, start }
                 } else {
-                    LuxFog::Exp2 { density: f.density }
+                    LuxFog::Exp2 { density, start }
                 }
             }
         };
-        if !self.shading.fog_vmd {
-            self.notes.add(
-                "FOG",
-                "leaves the background unfogged (Tachyon's radial fog turns it into the fog \
-                 colour)",
-                &at,
-            );
-        }
+        // Tachyon fogs every ray over its own segment; radial fog turns misses into the fog
+        // colour, FOG_VMD (planar for camera rays) leaves the background alone.
         Ok(Some(FogDesc {
             mode,
             color: light_color(f.color, &at)?,
             planar: self.shading.fog_vmd,
+            every_ray: true,
+            misses: !self.shading.fog_vmd,
         }))
     }
 
