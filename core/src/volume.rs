@@ -256,6 +256,26 @@ pub struct VolumeBuilder {
     skipped: Given,
     /// The first error; it stops the volume.
     failed: Option<String>,
+    /// The divisor of each typed format's blocks, once one came (by `Format`).
+    divisors: [Option<f32>; 3],
+}
+
+/// The voxel formats of typed dense blocks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    U8 = 0,
+    U16 = 1,
+    F32 = 2,
+}
+
+impl Format {
+    fn name(self) -> &'static str {
+        match self {
+            Format::U8 => "u8",
+            Format::U16 => "u16",
+            Format::F32 => "f32",
+        }
+    }
 }
 
 /// What a block carries.
@@ -275,6 +295,7 @@ impl VolumeBuilder {
             partial: BrickMap::default(),
             skipped: Given::Set(BrickMap::default()),
             failed: None,
+            divisors: [None; 3],
         }
     }
 
@@ -401,6 +422,89 @@ impl VolumeBuilder {
         self.usable()?;
         let r = self.add_checked(origin, dims, Source::Dense(values));
         self.track(r)
+    }
+
+    /// A dense block of bytes: voxel value `byte as f32 / divisor` (one divisor for every u8
+    /// block of the volume).
+    pub fn add_dense_u8(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u8],
+        divisor: f32,
+    ) -> Result<(), String> {
+        self.usable()?;
+        let r = self.check_divisor(Format::U8, divisor, origin, dims);
+        self.track(r)?;
+        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
+        self.add_dense(origin, dims, &values)
+    }
+
+    /// A dense block of `u16`: voxel value `v as f32 / divisor` (one divisor for every u16
+    /// block of the volume).
+    pub fn add_dense_u16(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u16],
+        divisor: f32,
+    ) -> Result<(), String> {
+        self.usable()?;
+        let r = self.check_divisor(Format::U16, divisor, origin, dims);
+        self.track(r)?;
+        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
+        self.add_dense(origin, dims, &values)
+    }
+
+    /// A dense block of `f32` whose voxel values are `v / divisor` (`add_dense_typed` of the
+    /// ABI with f32 data; divisor 1 is [`Self::add_dense`]).
+    pub fn add_dense_f32(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[f32],
+        divisor: f32,
+    ) -> Result<(), String> {
+        self.usable()?;
+        let r = self.check_divisor(Format::F32, divisor, origin, dims);
+        self.track(r)?;
+        if divisor == 1.0 {
+            return self.add_dense(origin, dims, values);
+        }
+        let values: Vec<f32> = values.iter().map(|&v| v / divisor).collect();
+        self.add_dense(origin, dims, &values)
+    }
+
+    /// The divisor of a typed block: finite and positive, and the one this format's earlier
+    /// blocks used.
+    fn check_divisor(
+        &mut self,
+        format: Format,
+        divisor: f32,
+        origin: [i64; 3],
+        dims: [u64; 3],
+    ) -> Result<(), String> {
+        let name = format.name();
+        let what = format!(
+            "dense block at {origin:?} of {}x{}x{} {name} voxels",
+            dims[0], dims[1], dims[2]
+        );
+        if !(divisor.is_finite() && divisor > 0.0) {
+            return Err(format!(
+                "{what} has the divisor {divisor}; expected a finite number greater than 0"
+            ));
+        }
+        let slot = &mut self.divisors[format as usize];
+        match *slot {
+            Some(d) if d.to_bits() != divisor.to_bits() => Err(format!(
+                "{what} mixes divisors {d} and {divisor} for {name} blocks; expected one \
+                 divisor per format for the whole volume"
+            )),
+            _ => {
+                *slot = Some(divisor);
+                Ok(())
+            }
+        }
     }
 
     /// A box of `dims` voxels from `origin`, all `value`.

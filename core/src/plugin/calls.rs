@@ -85,12 +85,21 @@ pub fn call_plugin(
     ))
 }
 
+/// The bytes a plugin call may allocate for what it produces or keeps
+/// ([`abi::CallContext::memory_budget`]); every call context takes it from here. 0: unknown
+/// (Luxon has no memory budget yet, so plugins allocate what their data needs).
+pub fn memory_budget_for_plugins() -> u64 {
+    0
+}
+
 pub fn call_context<'a>(scene_dir: &'a str, instance: &'a str) -> abi::CallContext {
     abi::CallContext {
         scene_dir: abi::Str::new(scene_dir),
         instance: abi::Str::new(instance),
+        // No render setting for the texture cache yet: 0 lets the plugin choose (1 GiB).
         texture_cache_bytes: 0,
         threads: rayon::current_num_threads() as u32,
+        memory_budget: memory_budget_for_plugins(),
     }
 }
 

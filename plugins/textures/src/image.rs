@@ -125,7 +125,12 @@ impl Texture for ImageTexture {
         Self::create_in(p, ctx, cache)
     }
 
+    /// Magenta where the image cannot be decoded (the host calls `try_eval`, which fails).
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        self.try_eval(q).unwrap_or(MAGENTA)
+    }
+
+    fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
         let l = self.mapping.lookup(q);
         let (wrap, img) = (self.wrap, &*self.image);
         let got = match self.filter {
@@ -144,11 +149,7 @@ impl Texture for ImageTexture {
                     .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
             }
         };
-        got.unwrap_or_else(|| {
-            // The cache logged why, once; the host stops the render.
-            luxon_plugin::texture_failed();
-            MAGENTA
-        })
+        got.map_err(Error::new)
     }
 }
 
@@ -406,7 +407,7 @@ mod tests {
     }
 
     #[test]
-    fn decode_failure_on_first_use_is_magenta() {
+    fn decode_failure_on_first_use_fails_the_lookup_with_its_reason() {
         let dir = TempDir::new("img-corrupt");
         fixture(&dir);
         let seen = Arc::new(Mutex::new(Vec::<String>::new()));
@@ -424,9 +425,24 @@ mod tests {
             0, 0, 0, 10, b'I', b'D', b'A', b'T', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0,
         ]);
         std::fs::write(dir.path("ramp.png"), bad).unwrap();
+        let q = |u: f32| TexQuery {
+            uv: [u, 0.5],
+            ..Default::default()
+        };
+        let e = t.try_eval(&q(0.5)).unwrap_err().message;
+        let path = dir.path("ramp.png");
+        assert!(
+            e.starts_with(&format!("cannot decode image `{}`: ", path.display())),
+            "{e}"
+        );
+        assert_eq!(t.try_eval(&q(0.1)).unwrap_err().message, e);
+        // `eval` gives a stand-in; nothing is logged (the message goes to the host).
         assert_eq!(at_uv(&t, [0.5, 0.5], 0.0), MAGENTA);
-        assert_eq!(at_uv(&t, [0.1, 0.5], 0.0), MAGENTA);
-        assert_eq!(seen.lock().unwrap().len(), 1, "{:?}", seen.lock().unwrap());
+        assert!(
+            seen.lock().unwrap().is_empty(),
+            "{:?}",
+            seen.lock().unwrap()
+        );
     }
 
     #[test]

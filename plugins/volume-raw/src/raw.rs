@@ -670,6 +670,8 @@ mod tests {
         /// Times each voxel was given.
         given: Vec<u32>,
         blocks: Vec<([i64; 3], [u64; 3])>,
+        /// Format and divisor of each typed block.
+        divisors: Vec<(u32, f32)>,
     }
 
     // The sink below stands in for the host's. The reader calls it during `read`, on the test's
@@ -699,6 +701,26 @@ mod tests {
         abi::STATUS_OK
     }
 
+    impl Got {
+        /// Stores a block's values (x fastest) in the dense copy.
+        fn put(&mut self, o: [i64; 3], d: [u64; 3], value: impl Fn(usize) -> f32) {
+            self.blocks.push((o, d));
+            let [sx, sy, _] = self.index_max.map(|m| (m + 1) as usize);
+            let mut i = 0;
+            for z in 0..d[2] as usize {
+                for y in 0..d[1] as usize {
+                    for x in 0..d[0] as usize {
+                        let at =
+                            ((o[2] as usize + z) * sy + o[1] as usize + y) * sx + o[0] as usize + x;
+                        self.values[at] = value(i);
+                        self.given[at] += 1;
+                        i += 1;
+                    }
+                }
+            }
+        }
+    }
+
     /// # Safety
     /// See the comment above `begin`; `values` holds `dims[0] * dims[1] * dims[2]` values.
     unsafe extern "C" fn add_dense(
@@ -710,22 +732,45 @@ mod tests {
     ) -> abi::Status {
         // SAFETY: see the comment above `begin`.
         let (g, o, d) = unsafe { (&mut *(ctx as *mut Got), *origin, *dims) };
-        g.blocks.push((o, d));
         let n = (d[0] * d[1] * d[2]) as usize;
         // SAFETY: the reader's promise: `n` values, borrowed for the call.
         let v = unsafe { std::slice::from_raw_parts(values, n) };
-        let [sx, sy, _] = g.index_max.map(|m| (m + 1) as usize);
-        let mut i = 0;
-        for z in 0..d[2] as usize {
-            for y in 0..d[1] as usize {
-                for x in 0..d[0] as usize {
-                    let at =
-                        ((o[2] as usize + z) * sy + o[1] as usize + y) * sx + o[0] as usize + x;
-                    g.values[at] = v[i];
-                    g.given[at] += 1;
-                    i += 1;
-                }
+        g.put(o, d, |i| v[i]);
+        abi::STATUS_OK
+    }
+
+    /// # Safety
+    /// See the comment above `begin`; `data` holds `len` bytes: `dims[0] * dims[1] * dims[2]`
+    /// voxels of `format`, aligned for it.
+    #[allow(clippy::too_many_arguments)]
+    unsafe extern "C" fn add_dense_typed(
+        ctx: *mut c_void,
+        origin: *const [i64; 3],
+        dims: *const [u64; 3],
+        format: u32,
+        data: *const u8,
+        len: usize,
+        divisor: f32,
+        _err: *const abi::ErrorSink,
+    ) -> abi::Status {
+        // SAFETY: see the comment above `begin`.
+        let (g, o, d) = unsafe { (&mut *(ctx as *mut Got), *origin, *dims) };
+        let n = (d[0] * d[1] * d[2]) as usize;
+        g.divisors.push((format, divisor));
+        match format {
+            abi::VOXEL_U8 => {
+                assert_eq!(len, n);
+                // SAFETY: the reader's promise: `n` bytes, borrowed for the call.
+                let v = unsafe { std::slice::from_raw_parts(data, n) };
+                g.put(o, d, |i| f32::from(v[i]) / divisor);
             }
+            abi::VOXEL_U16 => {
+                assert_eq!(len, 2 * n);
+                // SAFETY: the reader's promise: `n` aligned u16, borrowed for the call.
+                let v = unsafe { std::slice::from_raw_parts(data as *const u16, n) };
+                g.put(o, d, |i| f32::from(v[i]) / divisor);
+            }
+            other => panic!("the raw reader sends f32 through `add_dense`, not format {other}"),
         }
         abi::STATUS_OK
     }
@@ -758,6 +803,7 @@ mod tests {
             ctx: &mut got as *mut Got as *mut c_void,
             begin,
             add_dense,
+            add_dense_typed,
             add_tile,
         };
         let mut message: Option<String> = None;
