@@ -3,7 +3,7 @@
 //! ## The API
 //!
 //! [`load`] reads any supported file, [`load_ron_str`] RON text; both give a [`SceneDesc`]
-//! (module [`desc`]) or a [`SceneError`]. The importers are [`nff`] and [`obj`]; [`spd`]
+//! (module [`desc`]) or a [`SceneError`]. The importers are [`nff`], [`obj`] and [`tachyon`]; [`spd`]
 //! generates the SPD scenes; [`geometry`] holds the inline arrays importers hand the core.
 //!
 //! Modules import only modules of lower layers (bottom first; `tests/layers.rs` keeps this):
@@ -17,8 +17,9 @@
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
 //! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
-//! | importers   | `nff`, `obj`                                     |
-//! | formats     | `includes`, `ron_scene`, `spd`                   |
+//! | importers   | `nff`, `obj`, `tachyon`                          |
+//! | includes    | `includes`                                       |
+//! | formats     | `ron_scene`, `spd`                               |
 //! | front door  | `load`                                           |
 
 #![forbid(unsafe_code)]
@@ -41,6 +42,7 @@ mod ron_scene;
 mod scanner;
 mod spans;
 pub mod spd;
+pub mod tachyon;
 mod validate;
 mod volume_render;
 

@@ -5,11 +5,11 @@ use std::path::Path;
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
 use crate::input::{DiskSource, LoadOptions};
-use crate::{nff, obj, ron_scene};
+use crate::{nff, obj, ron_scene, tachyon};
 
 /// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
 /// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
-/// any case), within the default [`LoadOptions`].
+/// `.dat` through the [`tachyon`] importer; any case), within the default [`LoadOptions`].
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
     load_with(path, &LoadOptions::default())
 }
@@ -22,6 +22,9 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneE
     if obj::is_obj_path(path) {
         return obj::load(path);
     }
+    if tachyon::is_tachyon_path(path) {
+        return tachyon::load(path);
+    }
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !extension.eq_ignore_ascii_case("ron") {
         let found = match extension {
@@ -29,7 +32,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneE
             e => format!("unsupported scene file extension `.{e}`"),
         };
         let message = format!(
-            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`",
+            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`, `.dat` (Tachyon)",
             ron_scene::supported_extensions()
         );
         return Err(SceneError::Io {

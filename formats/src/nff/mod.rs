@@ -402,6 +402,7 @@ impl Assembler {
             self.inline.push(InlineGeometry {
                 material,
                 at: Some(self.origin(b.first)),
+                clip: None,
                 spheres: b.spheres,
                 cones: b.cones,
                 discs: Vec::new(),

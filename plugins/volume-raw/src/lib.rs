@@ -14,7 +14,7 @@
 //! | `format`    | `"u8"`, `"u16"` or `"f32"`   | `"u8"`      | type of one voxel: unsigned 8 or 16 bits, or IEEE 754 single precision |
 //! | `endian`    | `"little"` or `"big"`        | `"little"`  | byte order of `u16` and `f32` voxels (ignored for `u8`) |
 //! | `header`    | whole number                 | `0`         | bytes to skip at the start of the file |
-//! | `spacing`   | `(sx, sy, sz)`               | `(1, 1, 1)` | size of a voxel in world units along each axis, each > 0 |
+//! | `spacing`   | `(sx, sy, sz)`               | `(1, 1, 1)` | size of a voxel in world units along each axis, each non-zero (a negative one runs that axis backwards from `origin`: a mirrored grid) |
 //! | `origin`    | `(x, y, z)`                  | `(0, 0, 0)` | world position of voxel `(0, 0, 0)` |
 //! | `normalize` | bool                         | `true`      | map `u8` to [0, 1] by dividing by 255 and `u16` by dividing by 65535; `f32` values are always kept as they are |
 //!

@@ -122,7 +122,7 @@ dims: (x, y, z) = required  voxels along each axis, each >= 1
 format: \"u8\" | \"u16\" | \"f32\" = \"u8\"  type of one voxel
 endian: \"little\" | \"big\" = \"little\"  byte order of u16 and f32 voxels
 header: u64 = 0  bytes to skip at the start of the file
-spacing: (sx, sy, sz) = (1, 1, 1)  voxel size in world units, each > 0
+spacing: (sx, sy, sz) = (1, 1, 1)  voxel step in world units, each non-zero (negative: the axis runs backwards)
 origin: (x, y, z) = (0, 0, 0)  world position of voxel (0, 0, 0)
 normalize: bool = true  u8 / 255 and u16 / 65535 into [0, 1] (f32 kept)";
 }
@@ -283,9 +283,10 @@ impl Checked {
     fn new(p: &RawParams) -> Result<Checked, Error> {
         let (layout, expected) = Layout::new(p)?;
         let spacing = finite("spacing", p.spacing)?;
-        if spacing.iter().any(|&s| s <= 0.0) {
+        // A negative step mirrors its axis (Tachyon scenes, mirrored into Luxon's world).
+        if spacing.contains(&0.0) {
             return Err(invalid(format!(
-                "parameter `spacing` must be greater than 0 on every axis, got {spacing:?}"
+                "parameter `spacing` must not be 0 on any axis, got {spacing:?}"
             )));
         }
         let origin = finite("origin", p.origin)?;
@@ -869,6 +870,16 @@ mod tests {
         let want: Vec<f32> = bytes.iter().map(|&b| b as f32 / 255.0).collect();
         assert_eq!(got.values, want);
 
+        // A negative step runs the axis backwards from `origin`.
+        let got = read(&format!(
+            r#"(file: "{file}", dims: (3, 2, 2), spacing: (0.5, 2, -3), origin: (1, -1, 10))"#
+        ))
+        .unwrap();
+        assert_eq!(
+            got.world_from_index,
+            [0.5, 0., 0., 1., 0., 2., 0., -1., 0., 0., -3., 10.]
+        );
+
         let got = read(&format!(
             r#"(file: "{file}", dims: (3, 2, 2), normalize: false)"#
         ))
@@ -1041,7 +1052,7 @@ mod tests {
         let e = read(r#"(file: "x.raw", dims: (4294967296, 4294967296, 2))"#).unwrap_err();
         assert!(e.contains("overflows"), "{e}");
         let e = read(r#"(file: "x.raw", dims: (1, 1, 1), spacing: (1, 0, 1))"#).unwrap_err();
-        assert!(e.contains("`spacing` must be greater than 0"), "{e}");
+        assert!(e.contains("`spacing` must not be 0"), "{e}");
         let e = read(r#"(file: "x.raw", dims: (1, 1, 1), gzip: true)"#).unwrap_err();
         assert!(e.contains("unknown parameter `gzip`"), "{e}");
         let e = read(r#"(dims: (1, 1, 1))"#).unwrap_err();
