@@ -174,6 +174,25 @@ fn panic_in_a_texture_stops_the_render_with_an_error() {
     );
 }
 
+/// A texture whose `try_eval` fails stops the render with one error: the texture's place,
+/// name and plugin, and the plugin's own message.
+#[test]
+fn a_failing_texture_stops_the_render_with_its_message() {
+    let dir = temp_dir("fail-texture");
+    install(&dir, "testplug_panics", "luxon_panics");
+    let e = render_error(
+        &dir,
+        r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")"#,
+        r#"textures: { "t": (plugin: "fail_texture") }, materials: { "m": (texture: "t") },"#,
+    );
+    let want = format!(
+        "{}:5:22: texture `t` (plugin `fail_texture`) failed during the render: deliberate \
+         failure: no value where x < 0",
+        dir.join("scene.ron").display()
+    );
+    assert_eq!(e, want);
+}
+
 #[test]
 fn a_plugin_file_named_in_plugin_path_is_loaded_whatever_its_name() {
     let dir = temp_dir("explicit");

@@ -25,8 +25,10 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
+mod brick;
 mod builder;
 
+pub use brick::{Brick, Codes};
 pub use builder::{Format, VolumeBuilder};
 
 /// Edge length of a brick in voxels.
@@ -36,15 +38,6 @@ const BRICK_SHIFT: u32 = 3;
 pub const BRICK_VOXELS: usize = 512;
 /// The largest index box a volume may declare, in voxels (2^34: 64 GiB of dense f32 data).
 pub const MAX_VOXELS: u64 = 1 << 34;
-
-/// The storage of one 8³ brick; voxel `(x, y, z)` of the brick is element `x + 8y + 64z`.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Brick {
-    /// Every voxel has this value.
-    Constant(f32),
-    /// One value per voxel, x fastest (voxels no data reached hold the background).
-    Dense(Box<[f32; BRICK_VOXELS]>),
-}
 
 /// A fast hasher for brick coordinates (three `i64`s), which are not attacker-controlled in a
 /// way that matters here: the default SipHash would dominate voxel lookups.
@@ -119,6 +112,8 @@ pub struct Volume {
     table: Vec<u32>,
     table_min: [i64; 3],
     table_dims: [usize; 3],
+    /// The values of the codes of u8 and u16 bricks.
+    codes: Codes,
     /// Voxels given by the reader.
     voxels: u64,
     /// Smallest and largest value given, `None` when no voxel was.
@@ -136,9 +131,14 @@ impl Volume {
         let key = ijk.map(|c| c >> BRICK_SHIFT);
         match self.brick(key) {
             None => self.background,
-            Some(Brick::Constant(v)) => *v,
-            Some(Brick::Dense(values)) => values[local_index(ijk)],
+            Some(b) => b.value(local_index(ijk), &self.codes),
         }
+    }
+
+    /// How the codes of the volume's u8 and u16 bricks become values.
+    #[inline]
+    pub fn codes(&self) -> &Codes {
+        &self.codes
     }
 
     /// Moves the bricks read into their final storage and builds the slot table.
@@ -178,19 +178,16 @@ impl Volume {
         self.range.unwrap_or((self.background, self.background))
     }
 
-    /// Bytes held by the volume's storage: the brick table and the dense bricks (approximate:
-    /// the table's control bytes and the allocator's overhead are not counted).
+    /// Bytes held by the volume's storage: the brick table and the dense bricks at their
+    /// precision (approximate: the table's control bytes and the allocator's overhead are not
+    /// counted).
     pub fn memory_bytes(&self) -> usize {
-        let dense = self
-            .store
-            .iter()
-            .filter(|b| matches!(b, Brick::Dense(_)))
-            .count();
         std::mem::size_of::<Volume>()
             + self.store.capacity() * std::mem::size_of::<Brick>()
             + self.slots.capacity() * std::mem::size_of::<([i64; 3], u32)>()
             + self.table.capacity() * 4
-            + dense * std::mem::size_of::<[f32; BRICK_VOXELS]>()
+            + self.store.iter().map(Brick::heap_bytes).sum::<usize>()
+            + std::mem::size_of::<[f32; 256]>()
             + self.name.capacity()
             + self.grid_name.capacity()
             + self.plugin.capacity()
@@ -198,12 +195,22 @@ impl Volume {
 
     /// Number of (dense, constant) bricks stored (bricks of background voxels are not).
     pub fn brick_counts(&self) -> (usize, usize) {
-        let dense = self
-            .store
-            .iter()
-            .filter(|b| matches!(b, Brick::Dense(_)))
-            .count();
+        let dense = self.store.iter().filter(|b| b.is_dense()).count();
         (dense, self.store.len() - dense)
+    }
+
+    /// Number of dense bricks stored as u8, u16 and f32.
+    pub fn dense_counts(&self) -> [usize; 3] {
+        let mut n = [0; 3];
+        for b in &self.store {
+            match b {
+                Brick::Constant(_) => {}
+                Brick::U8(_) => n[0] += 1,
+                Brick::U16(_) => n[1] += 1,
+                Brick::F32(_) => n[2] += 1,
+            }
+        }
+        n
     }
 
     /// The brick with brick coordinate `key` (voxel `ijk` lies in brick `ijk >> 3`, i.e.
@@ -306,7 +313,7 @@ mod tests {
         b.add_dense([0, 0, 0], [16, 8, 8], &values).unwrap();
         let v = b.finish().unwrap();
         assert_eq!(v.brick([0, 0, 0]), Some(&Brick::Constant(0.0)));
-        assert!(matches!(v.brick([1, 0, 0]), Some(Brick::Dense(_))));
+        assert!(matches!(v.brick([1, 0, 0]), Some(Brick::F32(_))));
         assert_eq!(v.value([8, 0, 0]), 1.0);
         assert!(v.memory_bytes() >= 2048);
     }
@@ -453,6 +460,129 @@ mod tests {
         assert!(b
             .begin(IDENTITY, 0.0, [0; 3], [2047, 2047, 4096], "g")
             .is_err());
+    }
+
+    /// Whether every voxel of `v` in `0..n` on each axis reads `want(ijk)` (same bits).
+    fn reads(v: &Volume, n: i64, want: impl Fn([i64; 3]) -> f32) {
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    let ijk = [x, y, z];
+                    assert_eq!(v.value(ijk).to_bits(), want(ijk).to_bits(), "{ijk:?}");
+                }
+            }
+        }
+    }
+
+    fn byte(ijk: [i64; 3]) -> u8 {
+        (ijk[0] * 7 + ijk[1] * 31 + ijk[2] * 101) as u8
+    }
+
+    #[test]
+    fn u8_and_u16_blocks_are_kept_at_their_precision() {
+        // Background 0 has the code 0, so partial bricks stay u8 too.
+        let mut b = VolumeBuilder::new("v", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [11; 3], "g").unwrap();
+        let bytes: Vec<u8> = (0..12 * 12 * 12)
+            .map(|i| byte([i % 12, i / 12 % 12, i / 144]))
+            .collect();
+        b.add_dense_u8([0; 3], [12; 3], &bytes, 255.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.dense_counts(), [8, 0, 0]);
+        reads(&v, 12, |ijk| f32::from(byte(ijk)) / 255.0);
+        assert_eq!(v.min_max(), (0.0, 1.0));
+        // A byte per voxel: 8 bricks of 512 bytes, not 2 KiB each.
+        assert!(v.memory_bytes() < 8 * 2048, "{}", v.memory_bytes());
+
+        let mut b = VolumeBuilder::new("w", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [7; 3], "g").unwrap();
+        let words: Vec<u16> = (0..512).map(|i| i * 100).collect();
+        b.add_dense_u16([0; 3], [8; 3], &words, 65535.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.dense_counts(), [0, 1, 0]);
+        reads(&v, 8, |ijk| f32::from(words[local_index(ijk)]) / 65535.0);
+    }
+
+    #[test]
+    fn a_brick_without_a_code_for_the_background_or_given_other_data_becomes_f32() {
+        // Background -1 has no u8 code: a partial u8 brick starts as f32, a whole one is u8.
+        let mut b = builder([0; 3], [15, 7, 7]);
+        b.add_dense_u8(
+            [0; 3],
+            [8, 8, 8],
+            &[3; 511].iter().chain(&[4]).copied().collect::<Vec<_>>(),
+            1.0,
+        )
+        .unwrap();
+        b.add_dense_u8([8, 0, 0], [2, 2, 2], &[5; 8], 1.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.dense_counts(), [1, 0, 1]);
+        assert_eq!((v.value([7, 7, 7]), v.value([9, 1, 1])), (4.0, 5.0));
+        assert_eq!(v.value([10, 0, 0]), -1.0);
+
+        // Another format or a value without a code promotes a u8 brick, keeping its values;
+        // a tile whose value has a code does not.
+        let fill = |last: &dyn Fn(&mut VolumeBuilder)| {
+            let mut b = VolumeBuilder::new("v", "test");
+            b.begin(IDENTITY, 0.0, [0; 3], [7; 3], "g").unwrap();
+            b.add_dense_u8([0; 3], [8, 8, 4], &[200; 256], 255.0)
+                .unwrap();
+            b.add_tile([0, 0, 4], [8, 8, 2], 10.0 / 255.0).unwrap();
+            last(&mut b);
+            b.finish().unwrap()
+        };
+        let v = fill(&|_| {});
+        assert_eq!(v.dense_counts(), [1, 0, 0]);
+        let bg = |ijk: [i64; 3]| match ijk[2] {
+            0..4 => 200.0 / 255.0,
+            4..6 => 10.0 / 255.0,
+            _ => 0.0,
+        };
+        reads(&v, 8, bg);
+        let v = fill(&|b| b.add_tile([0, 0, 6], [8, 8, 1], 0.3).unwrap());
+        assert_eq!(v.dense_counts(), [0, 0, 1]);
+        reads(&v, 8, |ijk| if ijk[2] == 6 { 0.3 } else { bg(ijk) });
+        let v = fill(&|b| b.add_dense([0, 0, 7], [8, 8, 1], &[0.25; 64]).unwrap());
+        assert_eq!(v.dense_counts(), [0, 0, 1]);
+        reads(&v, 8, |ijk| if ijk[2] == 7 { 0.25 } else { bg(ijk) });
+        let v = fill(&|b| {
+            b.add_dense_u16([0, 0, 7], [8, 8, 1], &[9; 64], 3.0)
+                .unwrap()
+        });
+        assert_eq!(v.dense_counts(), [0, 0, 1]);
+        reads(&v, 8, |ijk| if ijk[2] == 7 { 3.0 } else { bg(ijk) });
+    }
+
+    #[test]
+    fn typed_bricks_collapse_and_check_their_values() {
+        // Complete u8 bricks of one code are constants; of the background's, nothing.
+        let mut b = VolumeBuilder::new("v", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [15, 7, 7], "g").unwrap();
+        let mut bytes = vec![0u8; 16 * 8 * 8];
+        for (i, c) in bytes.iter_mut().enumerate() {
+            if i % 16 >= 8 {
+                *c = 51;
+            }
+        }
+        for z in 0..8 {
+            b.add_dense_u8(
+                [0, 0, z],
+                [16, 8, 1],
+                &bytes[z as usize * 128..][..128],
+                255.0,
+            )
+            .unwrap();
+        }
+        let v = b.finish().unwrap();
+        assert_eq!(v.brick([0, 0, 0]), None);
+        assert_eq!(v.brick([1, 0, 0]), Some(&Brick::Constant(0.2)));
+
+        // A divisor so small that a code's value overflows is a non-finite value.
+        let mut b = builder([0; 3], [7; 3]);
+        let e = b
+            .add_dense_u16([0; 3], [2, 1, 1], &[0, 60000], 1e-35)
+            .unwrap_err();
+        assert!(e.contains("non-finite value inf at voxel [1, 0, 0]"), "{e}");
     }
 
     #[test]

@@ -60,11 +60,12 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
     for v in &scene.volumes {
         let (lo, hi) = v.min_max();
         println!(
-            "volume     `{}` ({}): {} voxels, values {lo}..{hi}, {:.1} MiB",
+            "volume     `{}` ({}): {} voxels, values {lo}..{hi}, {:.1} MiB ({})",
             v.name,
             v.plugin,
             v.voxel_count(),
-            v.memory_bytes() as f64 / (1024.0 * 1024.0)
+            v.memory_bytes() as f64 / (1024.0 * 1024.0),
+            brick_summary(v)
         );
     }
     for (i, v) in desc.volumes.iter().enumerate() {
@@ -107,5 +108,27 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
             o.desc.path.display(),
             o.writer.name
         );
+    }
+}
+
+/// "bricks: 1200 u8, 40 constant": the stored bricks by kind (at the precision the reader
+/// gave), the kinds with none left out.
+fn brick_summary(v: &luxon::volume::Volume) -> String {
+    let [u8s, u16s, f32s] = v.dense_counts();
+    let (_, constant) = v.brick_counts();
+    let kinds: Vec<String> = [
+        (u8s, "u8"),
+        (u16s, "u16"),
+        (f32s, "f32"),
+        (constant, "constant"),
+    ]
+    .iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, kind)| format!("{n} {kind}"))
+    .collect();
+    if kinds.is_empty() {
+        "no bricks stored".into()
+    } else {
+        format!("bricks: {}", kinds.join(", "))
     }
 }

@@ -1,7 +1,7 @@
 //! Building a [`Volume`] from what a reader sends: every check, and the cutting of blocks and
 //! tiles into bricks (see the parent module for the rules).
 
-use super::{local_index, Brick, BrickMap, Volume, BRICK_SHIFT, BRICK_SIZE, BRICK_VOXELS};
+use super::{local_index, Brick, BrickMap, Codes, Volume, BRICK_SHIFT, BRICK_SIZE, BRICK_VOXELS};
 use super::{MAX_TABLE, MAX_VOXELS};
 
 /// Collects what a reader sends and checks it (the host side of `VolumeSink`).
@@ -39,11 +39,36 @@ impl Format {
     }
 }
 
-/// What a block carries.
+/// What a block carries: voxels (x fastest) in one of the formats, or one value.
 #[derive(Clone, Copy)]
 enum Source<'a> {
-    Dense(&'a [f32]),
+    F32(&'a [f32]),
+    U8(&'a [u8]),
+    U16(&'a [u16]),
     Tile(f32),
+}
+
+impl Source<'_> {
+    /// The value of voxel `i` of the block.
+    #[inline]
+    fn value(&self, i: usize, codes: &Codes) -> f32 {
+        match self {
+            Source::F32(v) => v[i],
+            Source::U8(v) => codes.u8(v[i]),
+            Source::U16(v) => codes.u16(v[i]),
+            Source::Tile(v) => *v,
+        }
+    }
+
+    /// Voxels in the block (`None` for a tile).
+    fn len(&self) -> Option<usize> {
+        match self {
+            Source::F32(v) => Some(v.len()),
+            Source::U8(v) => Some(v.len()),
+            Source::U16(v) => Some(v.len()),
+            Source::Tile(_) => None,
+        }
+    }
 }
 
 impl VolumeBuilder {
@@ -167,6 +192,7 @@ impl VolumeBuilder {
             table: Vec::new(),
             table_min: [0; 3],
             table_dims: [0; 3],
+            codes: Codes::default(),
             voxels: 0,
             range: None,
         });
@@ -181,12 +207,12 @@ impl VolumeBuilder {
         values: &[f32],
     ) -> Result<(), String> {
         self.usable()?;
-        let r = self.add_checked(origin, dims, Source::Dense(values));
+        let r = self.add_checked(origin, dims, Source::F32(values));
         self.track(r)
     }
 
     /// A dense block of bytes: voxel value `byte as f32 / divisor` (one divisor for every u8
-    /// block of the volume).
+    /// block of the volume). Its bricks keep the bytes (see the module `brick`).
     pub fn add_dense_u8(
         &mut self,
         origin: [i64; 3],
@@ -197,12 +223,15 @@ impl VolumeBuilder {
         self.usable()?;
         let r = self.check_divisor(Format::U8, divisor, origin, dims);
         self.track(r)?;
-        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
-        self.add_dense(origin, dims, &values)
+        if let Some(v) = self.volume.as_mut() {
+            v.codes.set_u8_divisor(divisor);
+        }
+        let r = self.add_checked(origin, dims, Source::U8(values));
+        self.track(r)
     }
 
     /// A dense block of `u16`: voxel value `v as f32 / divisor` (one divisor for every u16
-    /// block of the volume).
+    /// block of the volume). Its bricks keep the words.
     pub fn add_dense_u16(
         &mut self,
         origin: [i64; 3],
@@ -213,8 +242,11 @@ impl VolumeBuilder {
         self.usable()?;
         let r = self.check_divisor(Format::U16, divisor, origin, dims);
         self.track(r)?;
-        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
-        self.add_dense(origin, dims, &values)
+        if let Some(v) = self.volume.as_mut() {
+            v.codes.set_u16_divisor(divisor);
+        }
+        let r = self.add_checked(origin, dims, Source::U16(values));
+        self.track(r)
     }
 
     /// A dense block of `f32` whose voxel values are `v / divisor` (`add_dense_typed` of the
@@ -283,7 +315,8 @@ impl VolumeBuilder {
     ) -> Result<(), String> {
         let what = block_name(&source, origin, dims);
         let call = match source {
-            Source::Dense(_) => "add_dense",
+            Source::F32(_) => "add_dense",
+            Source::U8(_) | Source::U16(_) => "add_dense_typed",
             Source::Tile(_) => "add_tile",
         };
         let Some(volume) = self.volume.as_mut() else {
@@ -314,25 +347,39 @@ impl VolumeBuilder {
         }
         // Inside the box, so every coordinate fits i64 and `count` is at most MAX_VOXELS.
         let last = last.map(|c| c as i64);
+        if let Some(len) = source.len() {
+            if len as u64 != count {
+                return Err(format!("{what} comes with {len} values"));
+            }
+        }
+        let codes = &volume.codes;
+        let non_finite = |i: usize| {
+            let v = source.value(i, codes);
+            let ijk = voxel_of(origin, dims, i);
+            format!("{what} has the non-finite value {v} at voxel {ijk:?}; expected finite values")
+        };
         let (lo, hi) = match source {
-            Source::Dense(values) => {
-                if values.len() as u64 != count {
-                    return Err(format!("{what} comes with {} values", values.len()));
-                }
+            Source::F32(values) => {
                 let mut lo = f32::INFINITY;
                 let mut hi = f32::NEG_INFINITY;
                 for (i, &v) in values.iter().enumerate() {
                     if !v.is_finite() {
-                        let ijk = voxel_of(origin, dims, i);
-                        return Err(format!(
-                            "{what} has the non-finite value {v} at voxel {ijk:?}; expected \
-                             finite values"
-                        ));
+                        return Err(non_finite(i));
                     }
                     lo = lo.min(v);
                     hi = hi.max(v);
                 }
                 (lo, hi)
+            }
+            // Codes decode monotonically, so their extremes give the values' (and a value
+            // that overflows to infinity, with a tiny divisor, is the largest).
+            Source::U8(values) => {
+                let (a, b) = min_max(values);
+                (codes.u8(a), codes.u8(b))
+            }
+            Source::U16(values) => {
+                let (a, b) = min_max(values);
+                (codes.u16(a), codes.u16(b))
             }
             Source::Tile(v) => {
                 if !v.is_finite() {
@@ -341,6 +388,12 @@ impl VolumeBuilder {
                 (v, v)
             }
         };
+        if !hi.is_finite() {
+            let i = (0..count as usize)
+                .find(|&i| !source.value(i, codes).is_finite())
+                .unwrap_or(0);
+            return Err(non_finite(i));
+        }
         let sets = Sets {
             partial: &mut self.partial,
             skipped: &mut self.skipped,
@@ -369,12 +422,10 @@ impl VolumeBuilder {
             );
         };
         // Voxels nothing reached hold the background, so this keeps every value.
+        let codes = &volume.codes;
         for brick in volume.bricks.values_mut() {
-            if let Brick::Dense(values) = brick {
-                let first = values[0];
-                if values.iter().all(|&v| v == first) {
-                    *brick = Brick::Constant(first);
-                }
+            if let Some(v) = brick.uniform(codes) {
+                *brick = Brick::Constant(v);
             }
         }
         volume.seal();
@@ -389,8 +440,8 @@ fn box_extent(min: [i64; 3], max: [i64; 3]) -> [u128; 3] {
 
 fn block_name(source: &Source, origin: [i64; 3], dims: [u64; 3]) -> String {
     let kind = match source {
-        Source::Dense(_) => "dense block",
         Source::Tile(_) => "tile",
+        _ => "dense block",
     };
     format!(
         "{kind} at {origin:?} of {}x{}x{} voxels",
@@ -481,15 +532,58 @@ fn uniform(values: impl IntoIterator<Item = f32>) -> Option<f32> {
     it.all(|v| v.to_bits() == first.to_bits()).then_some(first)
 }
 
+/// Smallest and largest of a non-empty slice of codes.
+fn min_max<T: Copy + Ord>(values: &[T]) -> (T, T) {
+    let first = values[0];
+    values
+        .iter()
+        .fold((first, first), |(a, b), &v| (a.min(v), b.max(v)))
+}
+
 /// Stores a complete brick whose voxels all hold `v`: nothing for the background, else a
 /// constant brick.
-fn store_uniform(volume: &mut Volume, skipped: &mut Given, key: [i64; 3], v: f32) {
-    if v.to_bits() == volume.background.to_bits() {
-        volume.bricks.remove(&key);
+fn store_uniform(
+    bricks: &mut BrickMap<Brick>,
+    skipped: &mut Given,
+    background: f32,
+    key: [i64; 3],
+    v: f32,
+) {
+    if v.to_bits() == background.to_bits() {
+        bricks.remove(&key);
         skipped.insert(key);
     } else {
-        volume.bricks.insert(key, Brick::Constant(v));
+        bricks.insert(key, Brick::Constant(v));
     }
+}
+
+/// A new dense brick for data from `source`: in the source's format, its voxels set to the
+/// background when `partial` (so the format needs a code for it; otherwise f32).
+fn new_brick(source: Source, background: f32, codes: &Codes, partial: bool) -> Brick {
+    match source {
+        Source::U8(_) => {
+            let code = if partial {
+                codes.u8_code(background)
+            } else {
+                Some(0)
+            };
+            if let Some(c) = code {
+                return Brick::U8(Box::new([c; BRICK_VOXELS]));
+            }
+        }
+        Source::U16(_) => {
+            let code = if partial {
+                codes.u16_code(background)
+            } else {
+                Some(0)
+            };
+            if let Some(c) = code {
+                return Brick::U16(Box::new([c; BRICK_VOXELS]));
+            }
+        }
+        Source::F32(_) | Source::Tile(_) => {}
+    }
+    Brick::F32(Box::new([background; BRICK_VOXELS]))
 }
 
 /// Bits `from..from + n` of a 64-bit word (`n` in 1..=8).
@@ -498,7 +592,10 @@ fn run_bits(from: usize, n: usize) -> u64 {
     ((1u64 << n) - 1) << from
 }
 
-/// Cuts a checked block (inside the box, `last` its inclusive end) into bricks.
+/// Cuts a checked block (inside the box, `last` its inclusive end) into bricks. A brick keeps
+/// the format of the data that created it while later data has the same format (or is a tile
+/// whose value has a code in it); other data first turns it into an f32 brick, which keeps
+/// every value (the codes' values are f32s).
 fn store(
     volume: &mut Volume,
     sets: Sets,
@@ -511,7 +608,18 @@ fn store(
     let first_key = origin.map(|c| c >> BRICK_SHIFT);
     let last_key = last.map(|c| c >> BRICK_SHIFT);
     let Sets { partial, skipped } = sets;
-    let background = volume.background;
+    let Volume {
+        bricks,
+        codes,
+        background,
+        ..
+    } = volume;
+    let (codes, background) = (&*codes, *background);
+    // A tile's value as a code of u8 and u16 bricks, when it has one.
+    let (tile_u8, tile_u16) = match source {
+        Source::Tile(v) => (codes.u8_code(v), codes.u16_code(v)),
+        _ => (None, None),
+    };
     for bz in first_key[2]..=last_key[2] {
         for by in first_key[1]..=last_key[1] {
             for bx in first_key[0]..=last_key[0] {
@@ -522,7 +630,7 @@ fn store(
                 let hi = [0, 1, 2].map(|a| last[a].min(brick_lo[a] + BRICK_SIZE - 1));
                 let whole =
                     (0..3).all(|a| lo[a] == brick_lo[a] && hi[a] == brick_lo[a] + BRICK_SIZE - 1);
-                let existing = volume.bricks.contains_key(&key);
+                let existing = bricks.contains_key(&key);
                 if (existing && !partial.contains_key(&key)) || skipped.contains(key) {
                     return Err(format!(
                         "{what} gives voxel {lo:?} again (it was given before); expected every \
@@ -539,23 +647,21 @@ fn store(
                     if whole {
                         let one = match source {
                             Source::Tile(v) => Some(v),
-                            Source::Dense(src) => uniform(
+                            _ => uniform(
                                 (lo[2]..=hi[2])
                                     .flat_map(|z| (lo[1]..=hi[1]).map(move |y| (y, z)))
-                                    .flat_map(|(y, z)| src[src_at(y, z)..src_at(y, z) + n].iter())
-                                    .copied(),
+                                    .flat_map(|(y, z)| src_at(y, z)..src_at(y, z) + n)
+                                    .map(|i| source.value(i, codes)),
                             ),
                         };
                         if let Some(v) = one {
-                            store_uniform(volume, skipped, key, v);
+                            store_uniform(bricks, skipped, background, key, v);
                             continue;
                         }
                     } else {
                         partial.insert(key, [0; 8]);
                     }
-                    volume
-                        .bricks
-                        .insert(key, Brick::Dense(Box::new([background; BRICK_VOXELS])));
+                    bricks.insert(key, new_brick(source, background, codes, !whole));
                 }
                 let mask = partial.get_mut(&key);
                 // Check the whole part first so a rejected block leaves the brick unchanged.
@@ -581,19 +687,47 @@ fn store(
                         }
                     }
                 }
-                let Some(Brick::Dense(values)) = volume.bricks.get_mut(&key) else {
-                    unreachable!("a brick given in part is dense");
+                let Some(brick) = bricks.get_mut(&key) else {
+                    unreachable!("the brick was found or inserted above");
                 };
+                let keeps = match (&*brick, source) {
+                    (Brick::F32(_), _)
+                    | (Brick::U8(_), Source::U8(_))
+                    | (Brick::U16(_), Source::U16(_)) => true,
+                    (Brick::U8(_), Source::Tile(_)) => tile_u8.is_some(),
+                    (Brick::U16(_), Source::Tile(_)) => tile_u16.is_some(),
+                    _ => false,
+                };
+                if !keeps {
+                    *brick = Brick::F32(brick.to_f32(codes));
+                }
                 for z in lo[2]..=hi[2] {
                     for y in lo[1]..=hi[1] {
                         let dst = local_index([lo[0], y, z]);
-                        let run = &mut values[dst..dst + n];
-                        match source {
-                            Source::Tile(v) => run.fill(v),
-                            Source::Dense(src) => {
-                                let at = src_at(y, z);
-                                run.copy_from_slice(&src[at..at + n]);
+                        let at = src_at(y, z);
+                        match (&mut *brick, source) {
+                            (Brick::F32(b), Source::F32(s)) => {
+                                b[dst..dst + n].copy_from_slice(&s[at..at + n]);
                             }
+                            (Brick::F32(b), Source::Tile(v)) => b[dst..dst + n].fill(v),
+                            (Brick::F32(b), _) => {
+                                for k in 0..n {
+                                    b[dst + k] = source.value(at + k, codes);
+                                }
+                            }
+                            (Brick::U8(b), Source::U8(s)) => {
+                                b[dst..dst + n].copy_from_slice(&s[at..at + n]);
+                            }
+                            (Brick::U8(b), Source::Tile(_)) => {
+                                b[dst..dst + n].fill(tile_u8.unwrap_or_default());
+                            }
+                            (Brick::U16(b), Source::U16(s)) => {
+                                b[dst..dst + n].copy_from_slice(&s[at..at + n]);
+                            }
+                            (Brick::U16(b), Source::Tile(_)) => {
+                                b[dst..dst + n].fill(tile_u16.unwrap_or_default());
+                            }
+                            _ => unreachable!("a brick that cannot hold the data became f32"),
                         }
                     }
                 }
@@ -606,8 +740,8 @@ fn store(
                     }
                     if mask.iter().all(|&w| w == u64::MAX) {
                         partial.remove(&key);
-                        if let Some(v) = uniform(values.iter().copied()) {
-                            store_uniform(volume, skipped, key, v);
+                        if let Some(v) = brick.uniform(codes) {
+                            store_uniform(bricks, skipped, background, key, v);
                         }
                     }
                 }

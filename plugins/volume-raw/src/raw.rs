@@ -182,39 +182,42 @@ impl Layout {
         Ok((layout, size))
     }
 
-    /// Converts `raw` (whole voxels of this format) into `out` (normalising by division, so that
-    /// `v / 255` is exactly what a reader of the file computes).
-    fn convert(&self, raw: &[u8], out: &mut Vec<f32>) {
+    /// The divisor of integer voxels: the format's largest value when normalising (so that
+    /// `v / 255` is exactly what a reader of the file computes), else 1.
+    fn divisor(&self) -> f32 {
+        match (self.format, self.normalize) {
+            (Format::U8, true) => 255.0,
+            (Format::U16, true) => 65535.0,
+            _ => 1.0,
+        }
+    }
+
+    /// Converts `raw` (whole u16 voxels in the file's byte order) into native words.
+    fn words(&self, raw: &[u8], out: &mut Vec<u16>) {
         out.clear();
         let big = self.endian == Endian::Big;
-        match self.format {
-            Format::U8 => {
-                let scale = if self.normalize { 255.0 } else { 1.0 };
-                out.extend(raw.iter().map(|&b| f32::from(b) / scale));
+        out.extend(raw.chunks_exact(2).map(|c| {
+            let b = [c[0], c[1]];
+            if big {
+                u16::from_be_bytes(b)
+            } else {
+                u16::from_le_bytes(b)
             }
-            Format::U16 => {
-                let scale = if self.normalize { 65535.0 } else { 1.0 };
-                out.extend(raw.chunks_exact(2).map(|c| {
-                    let b = [c[0], c[1]];
-                    let v = if big {
-                        u16::from_be_bytes(b)
-                    } else {
-                        u16::from_le_bytes(b)
-                    };
-                    f32::from(v) / scale
-                }));
+        }));
+    }
+
+    /// Converts `raw` (whole f32 voxels in the file's byte order) into `out`.
+    fn floats(&self, raw: &[u8], out: &mut Vec<f32>) {
+        out.clear();
+        let big = self.endian == Endian::Big;
+        out.extend(raw.chunks_exact(4).map(|c| {
+            let b = [c[0], c[1], c[2], c[3]];
+            if big {
+                f32::from_be_bytes(b)
+            } else {
+                f32::from_le_bytes(b)
             }
-            Format::F32 => {
-                out.extend(raw.chunks_exact(4).map(|c| {
-                    let b = [c[0], c[1], c[2], c[3]];
-                    if big {
-                        f32::from_be_bytes(b)
-                    } else {
-                        f32::from_le_bytes(b)
-                    }
-                }));
-            }
-        }
+        }));
     }
 }
 
@@ -259,6 +262,31 @@ pub trait Blocks {
     fn begin(&mut self, info: &GridInfo) -> Result<(), Error>;
     /// A dense block, x fastest.
     fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error>;
+
+    /// A dense block of bytes, voxel value `byte as f32 / divisor` (by default converted and
+    /// given to [`dense`](Self::dense); the host keeps the bytes).
+    fn dense_u8(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u8],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
+        self.dense(origin, dims, &values)
+    }
+
+    /// A dense block of `u16` (native byte order), voxel value `v as f32 / divisor`.
+    fn dense_u16(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u16],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
+        self.dense(origin, dims, &values)
+    }
 }
 
 impl Blocks for VolumeOut<'_> {
@@ -268,6 +296,26 @@ impl Blocks for VolumeOut<'_> {
 
     fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error> {
         VolumeOut::dense(self, origin, dims, values)
+    }
+
+    fn dense_u8(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u8],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        VolumeOut::dense_u8(self, origin, dims, values, divisor)
+    }
+
+    fn dense_u16(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u16],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        VolumeOut::dense_u16(self, origin, dims, values, divisor)
     }
 }
 
@@ -554,11 +602,23 @@ fn stream(
     let bpv = layout.format.bytes();
     input.skip(layout.header)?;
     let path = input.path;
-    let mut values: Vec<f32> = Vec::new();
+    let (mut floats, mut words) = (Vec::new(), Vec::new());
+    let divisor = layout.divisor();
+    // Integer voxels go to the host as they are (it stores them at their precision).
     let mut send = |raw: &[u8], origin: [u64; 3], dims: [u64; 3]| -> Result<(), Error> {
-        layout.convert(raw, &mut values);
-        check_finite(&values, origin, dims, layout, path)?;
-        out.dense(origin.map(|c| c as i64), dims, &values)
+        let at = origin.map(|c| c as i64);
+        match layout.format {
+            Format::U8 => out.dense_u8(at, dims, raw, divisor),
+            Format::U16 => {
+                layout.words(raw, &mut words);
+                out.dense_u16(at, dims, &words, divisor)
+            }
+            Format::F32 => {
+                layout.floats(raw, &mut floats);
+                check_finite(&floats, origin, dims, layout, path)?;
+                out.dense(at, dims, &floats)
+            }
+        }
     };
     let slab_bytes = nx.saturating_mul(ny).saturating_mul(SLAB * bpv);
     if slab_bytes <= max_slab {
@@ -625,9 +685,6 @@ fn check_finite(
     layout: &Layout,
     path: &Path,
 ) -> Result<(), Error> {
-    if layout.format != Format::F32 {
-        return Ok(());
-    }
     let Some(i) = values.iter().position(|v| !v.is_finite()) else {
         return Ok(());
     };
@@ -869,6 +926,8 @@ mod tests {
         assert_eq!(got.name, "small.raw");
         let want: Vec<f32> = bytes.iter().map(|&b| b as f32 / 255.0).collect();
         assert_eq!(got.values, want);
+        // The bytes go to the host as they are, with the divisor that normalises them.
+        assert_eq!(got.divisors, [(abi::VOXEL_U8, 255.0)]);
 
         // A negative step runs the axis backwards from `origin`.
         let got = read(&format!(
@@ -885,6 +944,7 @@ mod tests {
         ))
         .unwrap();
         assert_eq!(got.values[11], 220.0);
+        assert_eq!(got.divisors, [(abi::VOXEL_U8, 1.0)]);
         assert_eq!(
             got.world_from_index,
             [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.]
@@ -903,11 +963,13 @@ mod tests {
         .unwrap();
         let want: Vec<f32> = words.iter().map(|&w| w as f32).collect();
         assert_eq!(got.values, want);
+        assert_eq!(got.divisors, [(abi::VOXEL_U16, 1.0)]);
         let got = read(&format!(
             r#"(file: "{file}", dims: (4, 3, 2), format: "u16", endian: "big")"#
         ))
         .unwrap();
         assert_eq!(got.values[23], 23.0 * 2731.0 / 65535.0);
+        assert_eq!(got.divisors, [(abi::VOXEL_U16, 65535.0)]);
         // Read as little-endian, the same bytes mean something else.
         let got = read(&format!(
             r#"(file: "{file}", dims: (4, 3, 2), format: "u16")"#
