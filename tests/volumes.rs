@@ -194,6 +194,7 @@ fn only_volume_readers_are_called() {
         &call.params_at,
         &dir,
         "volume 0",
+        &std::sync::Arc::new(luxon::budget::Budget::unlimited()),
     )
     .unwrap_err();
     assert_eq!(at, call.params_at);

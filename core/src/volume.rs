@@ -27,9 +27,13 @@ use std::hash::{BuildHasherDefault, Hasher};
 
 mod brick;
 mod builder;
+mod charge;
 
 pub use brick::{Brick, Codes};
 pub use builder::{Format, VolumeBuilder};
+
+use crate::budget::try_vec;
+use charge::{entry_bytes, Charger};
 
 /// Edge length of a brick in voxels.
 pub const BRICK_SIZE: i64 = 8;
@@ -141,22 +145,44 @@ impl Volume {
         &self.codes
     }
 
-    /// Moves the bricks read into their final storage and builds the slot table.
-    fn seal(&mut self) {
-        let mut all: Vec<([i64; 3], Brick)> =
-            std::mem::take(&mut self.bricks).into_iter().collect();
+    /// Moves the bricks read into their final storage and builds the slot table, charging
+    /// both first (and giving back the map the bricks were read into).
+    fn seal(&mut self, charger: &mut Charger) -> Result<(), String> {
+        let n = self.bricks.len();
+        let lo = self.index_min.map(|c| c >> BRICK_SHIFT);
+        let hi = self.index_max.map(|c| c >> BRICK_SHIFT);
+        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
+        let cells = dims.iter().product::<u64>();
+        let table_len = if cells <= MAX_TABLE {
+            cells as usize
+        } else {
+            0
+        };
+        let sorting = (n * std::mem::size_of::<([i64; 3], Brick)>()) as u64;
+        let sealed = (n * std::mem::size_of::<Brick>()) as u64
+            + n as u64 * entry_bytes::<u32>() * 8 / 7
+            + table_len as u64 * 4;
+        charger.add(sorting + sealed)?;
+        let mut all: Vec<([i64; 3], Brick)> = Vec::new();
+        let ok = all.try_reserve_exact(n).is_ok()
+            && self.store.try_reserve_exact(n).is_ok()
+            && self.slots.try_reserve(n).is_ok();
+        if !ok {
+            return Err(charger.refused(sorting + sealed));
+        }
+        let map_bytes = self.bricks.capacity() as u64 * entry_bytes::<Brick>();
+        all.extend(std::mem::take(&mut self.bricks));
+        charger.sub(map_bytes);
         all.sort_unstable_by_key(|(k, _)| *k);
-        self.store.reserve_exact(all.len());
         for (key, brick) in all {
             self.slots.insert(key, self.store.len() as u32);
             self.store.push(brick);
         }
-        let lo = self.index_min.map(|c| c >> BRICK_SHIFT);
-        let hi = self.index_max.map(|c| c >> BRICK_SHIFT);
-        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
-        if dims.iter().product::<u64>() <= MAX_TABLE {
+        charger.sub(sorting);
+        if table_len > 0 {
             let dims = dims.map(|d| d as usize);
-            let mut table = vec![NO_BRICK; dims[0] * dims[1] * dims[2]];
+            let mut table = try_vec(table_len, NO_BRICK)
+                .ok_or_else(|| charger.refused(table_len as u64 * 4))?;
             for (key, &slot) in &self.slots {
                 let r = [0, 1, 2].map(|a| (key[a] - lo[a]) as usize);
                 table[(r[2] * dims[1] + r[1]) * dims[0] + r[0]] = slot;
@@ -165,6 +191,7 @@ impl Volume {
             self.table_min = lo;
             self.table_dims = dims;
         }
+        Ok(())
     }
 
     /// Number of voxels the reader gave (in dense blocks and tiles), not counting background.

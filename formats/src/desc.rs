@@ -463,6 +463,68 @@ pub struct RenderDesc {
     pub volume_skip: bool,
     /// Adaptive supersampling; `None`: every pixel gets `samples` samples.
     pub adaptive: Option<AdaptiveDesc>,
+    /// The memory budget (`memory: "6 GiB"` or `"50%"`); `None`: the default share of the
+    /// machine's memory (the core works it out).
+    pub memory: Option<MemorySize>,
+    /// Bytes of decoded texture data kept at once (`texture_cache: "1 GiB"`); `None`: 1 GiB,
+    /// or a quarter of the memory budget when that is less.
+    pub texture_cache: Option<u64>,
+}
+
+/// A memory size as a scene (`render: (memory: ...)`) or the command line (`--memory`) gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MemorySize {
+    Bytes(u64),
+    /// A share of the machine's memory limit, in percent (above 0, at most 100).
+    Percent(f64),
+}
+
+impl std::fmt::Display for MemorySize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MemorySize::Bytes(n) => write!(f, "{n} bytes"),
+            MemorySize::Percent(p) => write!(f, "{p}%"),
+        }
+    }
+}
+
+/// What a size looks like, for messages.
+pub const MEMORY_SIZE_EXAMPLES: &str = "a size such as 512M, 6G, \"1.5 GiB\" or 50%";
+
+/// Parses a memory size: a number with a binary unit (`K`, `M`, `G`, `T`, also written `KiB`,
+/// `MiB`, `GiB`, `TiB`, or `KB`... with the same binary meaning; `B` for bytes), or a
+/// percentage of the machine's memory (`50%`). Spaces between number and unit are allowed.
+/// The error says what is wrong, without the text itself (callers quote it with its place).
+pub fn parse_memory_size(text: &str) -> Result<MemorySize, String> {
+    let t = text.trim();
+    let end = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = (&t[..end], t[end..].trim());
+    let value: f64 = match number.parse() {
+        Ok(v) if number.chars().next().is_some_and(|c| c.is_ascii_digit()) => v,
+        _ => return Err("it does not start with a number".into()),
+    };
+    if unit == "%" {
+        if !(value > 0.0 && value <= 100.0) {
+            return Err("a percentage must be above 0 and at most 100".into());
+        }
+        return Ok(MemorySize::Percent(value));
+    }
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" => return Err("it has no unit".into()),
+        "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        "T" | "TB" | "TIB" => 40,
+        _ => return Err(format!("`{}` is not a unit", crate::error::shown(unit))),
+    };
+    let bytes = value * (1u64 << shift) as f64;
+    if !(bytes >= 1.0 && bytes < 2f64.powi(63)) {
+        return Err("the size must be at least 1 byte and below 8 EiB".into());
+    }
+    Ok(MemorySize::Bytes(bytes as u64))
 }
 
 /// Adaptive supersampling (Stone's thesis, II.E): a pixel starts with a jittered 2x2 grid per
@@ -527,6 +589,8 @@ impl Default for RenderDesc {
             volume_step: 1.0,
             volume_skip: true,
             adaptive: None,
+            memory: None,
+            texture_cache: None,
         }
     }
 }

@@ -383,6 +383,8 @@ pub(crate) struct Render {
     pub volume_step: Option<f64>,
     pub volume_skip: Option<bool>,
     pub adaptive: Option<Adaptive>,
+    pub memory: Option<String>,
+    pub texture_cache: Option<String>,
 }
 
 #[derive(Deserialize)]

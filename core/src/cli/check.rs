@@ -1,16 +1,19 @@
 //! `luxon check`: validate a scene and describe it.
 
+use luxon::budget::Budget;
 use luxon::plugin::Registry;
 use luxon::{Error, Scene};
-use luxon_formats::SceneDesc;
+use luxon_formats::{MemorySize, SceneDesc};
 use std::path::Path;
+use std::sync::Arc;
 
-pub fn run(path: &Path) -> Result<(), Error> {
+pub fn run(path: &Path, memory: Option<MemorySize>) -> Result<(), Error> {
     let desc = luxon_formats::load(path)?;
     super::warn_scene(&desc);
     let registry = Registry::discover(&desc.plugin_path);
     super::warn_skipped(&registry);
-    let scene = Scene::build(&desc, &registry)?;
+    let budget = Arc::new(Budget::for_render(&desc.render, memory, 1));
+    let scene = Scene::build_with(&desc, &registry, budget)?;
     let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
     describe(&desc, &scene, &outputs);
     Ok(())
@@ -102,6 +105,14 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
         }
     );
     println!("effects    {}", scene.features);
+    // What the image will take is charged when rendering; here it is only counted.
+    let image = u64::from(s.width) * u64::from(s.height) * 16;
+    println!(
+        "memory     budget {}; the scene holds {}; the image will take {}",
+        scene.budget.describe(),
+        scene.budget.in_use(),
+        luxon::budget::bytes(image)
+    );
     for o in outputs {
         println!(
             "output     {} (writer `{}`)",

@@ -2,6 +2,7 @@
 
 use super::calls::{call_context, call_plugin, wrong_kind};
 use super::registry::{Entry, PluginKind, Registry, Table};
+use crate::budget::Budget;
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
@@ -92,6 +93,8 @@ impl Drop for TextureInstance {
     }
 }
 
+/// Creates a texture instance; `budget` gives the plugin its memory budget and texture cache
+/// share (the caller charges the cache).
 pub fn create_texture(
     registry: &Registry,
     entry: &Entry,
@@ -99,12 +102,13 @@ pub fn create_texture(
     params_at: &Origin,
     scene_dir: &Path,
     instance: &str,
+    budget: &Budget,
 ) -> Result<TextureInstance, (Origin, String)> {
     let Table::Texture(vt) = entry.table else {
         return Err(wrong_kind(registry, entry, PluginKind::Texture, params_at));
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, instance);
+    let ctx = call_context(&dir, instance, Some(budget));
     let mut out = abi::TextureObject {
         object: std::ptr::null_mut(),
         vtable: std::ptr::null(),

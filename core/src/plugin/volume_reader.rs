@@ -3,16 +3,19 @@
 
 use super::calls::{call_context, call_plugin, fail, plugin_label, slice, wrong_kind};
 use super::registry::{Entry, PluginKind, Registry, Table};
+use crate::budget::Budget;
 use crate::volume::{Volume, VolumeBuilder};
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Reads one volume with a volume-reader plugin. `instance` is the scene's name for the volume
-/// (it becomes [`Volume::name`] and is passed to the plugin for its messages). Errors carry the
-/// scene position: inside `params` when the plugin reports one, otherwise `params_at`.
+/// (it becomes [`Volume::name`] and is passed to the plugin for its messages); its storage is
+/// charged to `budget`. Errors carry the scene position: inside `params` when the plugin
+/// reports one, otherwise `params_at`.
 pub fn read_volume(
     registry: &Registry,
     entry: &Entry,
@@ -20,8 +23,10 @@ pub fn read_volume(
     params_at: &Origin,
     scene_dir: &Path,
     instance: &str,
+    budget: &Arc<Budget>,
 ) -> Result<Volume, (Origin, String)> {
     let mut builder = VolumeBuilder::new(instance, &entry.name);
+    builder.charge_to(budget.clone());
     read_volume_into(
         registry,
         entry,
@@ -291,7 +296,7 @@ pub fn read_volume_into(
         add_tile: volume_add_tile,
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, instance);
+    let ctx = call_context(&dir, instance, Some(builder.budget()));
     call_plugin(registry, entry, params_at, |err| {
         // SAFETY: the calling contract: `params`, `ctx`, `sink` and `err` live across the
         // call; `sink.ctx` is `builder`, which this function borrows mutably and does not touch
@@ -433,6 +438,35 @@ mod tests {
         r
     }
 
+    /// A volume's storage is charged to the budget: one that does not fit is an error naming
+    /// the volume and the budget, and gives back what it had taken; one that fits stays charged.
+    #[test]
+    fn a_volume_over_the_budget_is_an_error_naming_it() {
+        let reg = sloppy_registry();
+        let entry = &reg.entries[0];
+        let at = Origin {
+            file: std::sync::Arc::new("scene.ron".into()),
+            line: 4,
+            col: 9,
+        };
+        let tight = Arc::new(Budget::new(1000, "test".into(), None));
+        let (o, m) = read_volume(&reg, entry, "ok", &at, Path::new("."), "v", &tight).unwrap_err();
+        assert_eq!(o, at);
+        assert!(
+            m.contains(
+                "volume `v` (its storage so far: 0 bytes) needs 2 KiB more, but the memory \
+                 budget of 1000 bytes (test) has 1000 bytes left"
+            ),
+            "{m}"
+        );
+        assert_eq!(tight.remaining(), 1000);
+        let roomy = Arc::new(Budget::new(1 << 20, "test".into(), None));
+        let v = read_volume(&reg, entry, "ok", &at, Path::new("."), "v", &roomy).unwrap();
+        let used = roomy.used(crate::budget::Use::Volumes);
+        assert!((2048..1 << 16).contains(&used), "{used}");
+        drop(v);
+    }
+
     #[test]
     fn sink_errors_reach_the_scene_position_and_stick() {
         let reg = sloppy_registry();
@@ -442,7 +476,8 @@ mod tests {
             line: 4,
             col: 9,
         };
-        let read = |params: &str| read_volume(&reg, entry, params, &at, Path::new("."), "v");
+        let free = Arc::new(Budget::unlimited());
+        let read = |params: &str| read_volume(&reg, entry, params, &at, Path::new("."), "v", &free);
 
         let v = read("ok").unwrap();
         assert_eq!((v.value([3, 3, 3]), v.value([1, 1, 1])), (1.0, 0.5));
@@ -480,7 +515,8 @@ mod tests {
             line: 4,
             col: 9,
         };
-        let read = |params: &str| read_volume(&reg, entry, params, &at, Path::new("."), "v");
+        let free = Arc::new(Budget::unlimited());
+        let read = |params: &str| read_volume(&reg, entry, params, &at, Path::new("."), "v", &free);
         let v = read("typed").unwrap();
         // Voxel (x, y, z) of the u8 block at (2, 2, 2) is byte x + 2y + 4z, divided by 2.
         for (ijk, want) in [([2, 2, 2], 0.0), ([3, 2, 2], 0.5), ([3, 3, 3], 3.5)] {

@@ -8,6 +8,7 @@
 //! through a table of their 256 values; words are divided when read.
 
 use super::BRICK_VOXELS;
+use crate::budget::try_vec;
 
 /// The storage of one 8³ brick; voxel `(x, y, z)` of the brick is element `x + 8y + 64z`.
 /// Voxels no data reached hold the background (as a code of the brick's format, which
@@ -94,13 +95,30 @@ impl Brick {
         !matches!(self, Brick::Constant(_))
     }
 
-    /// The brick as f32 values (lossless: every code's value is an f32).
-    pub fn to_f32(&self, codes: &Codes) -> Box<[f32; BRICK_VOXELS]> {
-        match self {
-            Brick::F32(v) => v.clone(),
-            _ => Box::new(std::array::from_fn(|i| self.value(i, codes))),
+    /// The brick as f32 values (lossless: every code's value is an f32); `None` when the
+    /// system refuses the memory.
+    pub fn to_f32(&self, codes: &Codes) -> Option<Box<[f32; BRICK_VOXELS]>> {
+        let mut out = array(0.0)?;
+        for (i, v) in out.iter_mut().enumerate() {
+            *v = self.value(i, codes);
         }
+        Some(out)
     }
+
+    /// The heap bytes of a dense brick of each format: u8, u16, f32.
+    pub const BYTES: [u64; 3] = [
+        BRICK_VOXELS as u64,
+        2 * BRICK_VOXELS as u64,
+        4 * BRICK_VOXELS as u64,
+    ];
+}
+
+/// A brick's array of `fill`, or `None` when the system refuses the memory (never an abort).
+pub fn array<T: Copy>(fill: T) -> Option<Box<[T; BRICK_VOXELS]>> {
+    try_vec(BRICK_VOXELS, fill)?
+        .into_boxed_slice()
+        .try_into()
+        .ok()
 }
 
 /// How the codes of u8 and u16 bricks become values: `code as f32 / divisor`, one divisor per
@@ -213,7 +231,7 @@ mod tests {
         assert_eq!(brick.uniform(&c), None);
         assert_eq!(brick.range(&c), (0.5, 4.5));
         assert_eq!(brick.value(7, &c), 4.5);
-        assert_eq!(brick.to_f32(&c)[9], 0.5);
+        assert_eq!(brick.to_f32(&c).unwrap()[9], 0.5);
         assert_eq!(brick.heap_bytes(), 512);
         let w = Brick::U16(Box::new([3; BRICK_VOXELS]));
         assert_eq!((w.uniform(&c), w.heap_bytes()), (Some(3.0), 1024));

@@ -1,8 +1,12 @@
 //! Building a [`Volume`] from what a reader sends: every check, and the cutting of blocks and
 //! tiles into bricks (see the parent module for the rules).
 
-use super::{local_index, Brick, BrickMap, Codes, Volume, BRICK_SHIFT, BRICK_SIZE, BRICK_VOXELS};
+use super::brick;
+use super::charge::Charger;
+use super::{local_index, Brick, BrickMap, Codes, Volume, BRICK_SHIFT, BRICK_SIZE};
 use super::{MAX_TABLE, MAX_VOXELS};
+use crate::budget::Budget;
+use std::sync::Arc;
 
 /// Collects what a reader sends and checks it (the host side of `VolumeSink`).
 pub struct VolumeBuilder {
@@ -19,6 +23,8 @@ pub struct VolumeBuilder {
     failed: Option<String>,
     /// The divisor of each typed format's blocks, once one came (by `Format`).
     divisors: [Option<f32>; 3],
+    /// The memory budget's account of what the volume stores.
+    charger: Charger,
 }
 
 /// The voxel formats of typed dense blocks.
@@ -82,7 +88,19 @@ impl VolumeBuilder {
             skipped: Given::Set(BrickMap::default()),
             failed: None,
             divisors: [None; 3],
+            charger: Charger::new(Arc::new(Budget::unlimited()), name),
         }
+    }
+
+    /// Charges what the volume stores to `budget` (by default, an unlimited one). Call it
+    /// before the reader sends anything.
+    pub fn charge_to(&mut self, budget: Arc<Budget>) {
+        self.charger = Charger::new(budget, &self.name);
+    }
+
+    /// The budget the volume is charged to.
+    pub fn budget(&self) -> &Budget {
+        self.charger.budget()
     }
 
     /// Records the first error; later calls fail with it.
@@ -397,6 +415,7 @@ impl VolumeBuilder {
         let sets = Sets {
             partial: &mut self.partial,
             skipped: &mut self.skipped,
+            charger: &mut self.charger,
         };
         store(volume, sets, origin, dims, last, source, &what)?;
         volume.voxels += count;
@@ -409,13 +428,13 @@ impl VolumeBuilder {
 
     /// The finished volume, or the first error. Dense bricks whose voxels all have one value
     /// (given or background) become constant bricks (complete bricks already are).
-    pub fn finish(self) -> Result<Volume, String> {
-        if let Some(first) = self.failed {
+    pub fn finish(mut self) -> Result<Volume, String> {
+        if let Some(first) = self.failed.take() {
             return Err(format!(
                 "ignored an error from the host and returned success: {first}"
             ));
         }
-        let Some(mut volume) = self.volume else {
+        let Some(mut volume) = self.volume.take() else {
             return Err(
                 "returned without reading a grid (it never called `begin` on the volume sink)"
                     .into(),
@@ -425,10 +444,12 @@ impl VolumeBuilder {
         let codes = &volume.codes;
         for brick in volume.bricks.values_mut() {
             if let Some(v) = brick.uniform(codes) {
+                self.charger.sub(brick.heap_bytes() as u64);
                 *brick = Brick::Constant(v);
             }
         }
-        volume.seal();
+        volume.seal(&mut self.charger)?;
+        self.charger.keep();
         Ok(volume)
     }
 }
@@ -522,6 +543,7 @@ impl Given {
 struct Sets<'a> {
     partial: &'a mut BrickMap<[u64; 8]>,
     skipped: &'a mut Given,
+    charger: &'a mut Charger,
 }
 
 /// The one value of a complete brick, if all its voxels hold the same bits (`-0.0` and `0.0`
@@ -541,25 +563,39 @@ fn min_max<T: Copy + Ord>(values: &[T]) -> (T, T) {
 }
 
 /// Stores a complete brick whose voxels all hold `v`: nothing for the background, else a
-/// constant brick.
+/// constant brick (a dense brick it replaces gives its bytes back).
 fn store_uniform(
     bricks: &mut BrickMap<Brick>,
-    skipped: &mut Given,
+    sets: (&mut Given, &mut Charger),
     background: f32,
     key: [i64; 3],
     v: f32,
-) {
-    if v.to_bits() == background.to_bits() {
-        bricks.remove(&key);
+) -> Result<(), String> {
+    let (skipped, charger) = sets;
+    let old = if v.to_bits() == background.to_bits() {
         skipped.insert(key);
+        bricks.remove(&key)
     } else {
-        bricks.insert(key, Brick::Constant(v));
+        if !bricks.contains_key(&key) {
+            charger.room_for_one(bricks)?;
+        }
+        bricks.insert(key, Brick::Constant(v))
+    };
+    if let Some(old) = old {
+        charger.sub(old.heap_bytes() as u64);
     }
+    Ok(())
 }
 
-/// A new dense brick for data from `source`: in the source's format, its voxels set to the
-/// background when `partial` (so the format needs a code for it; otherwise f32).
-fn new_brick(source: Source, background: f32, codes: &Codes, partial: bool) -> Brick {
+/// A new dense brick for data from `source`, charged: in the source's format, its voxels set to
+/// the background when `partial` (so the format needs a code for it; otherwise f32).
+fn new_brick(
+    source: Source,
+    background: f32,
+    codes: &Codes,
+    partial: bool,
+    charger: &mut Charger,
+) -> Result<Brick, String> {
     match source {
         Source::U8(_) => {
             let code = if partial {
@@ -568,7 +604,7 @@ fn new_brick(source: Source, background: f32, codes: &Codes, partial: bool) -> B
                 Some(0)
             };
             if let Some(c) = code {
-                return Brick::U8(Box::new([c; BRICK_VOXELS]));
+                return charger.brick(|| brick::array(c).map(Brick::U8), Brick::BYTES[0]);
             }
         }
         Source::U16(_) => {
@@ -578,12 +614,12 @@ fn new_brick(source: Source, background: f32, codes: &Codes, partial: bool) -> B
                 Some(0)
             };
             if let Some(c) = code {
-                return Brick::U16(Box::new([c; BRICK_VOXELS]));
+                return charger.brick(|| brick::array(c).map(Brick::U16), Brick::BYTES[1]);
             }
         }
         Source::F32(_) | Source::Tile(_) => {}
     }
-    Brick::F32(Box::new([background; BRICK_VOXELS]))
+    charger.brick(|| brick::array(background).map(Brick::F32), Brick::BYTES[2])
 }
 
 /// Bits `from..from + n` of a 64-bit word (`n` in 1..=8).
@@ -607,7 +643,11 @@ fn store(
 ) -> Result<(), String> {
     let first_key = origin.map(|c| c >> BRICK_SHIFT);
     let last_key = last.map(|c| c >> BRICK_SHIFT);
-    let Sets { partial, skipped } = sets;
+    let Sets {
+        partial,
+        skipped,
+        charger,
+    } = sets;
     let Volume {
         bricks,
         codes,
@@ -655,13 +695,16 @@ fn store(
                             ),
                         };
                         if let Some(v) = one {
-                            store_uniform(bricks, skipped, background, key, v);
+                            store_uniform(bricks, (skipped, charger), background, key, v)?;
                             continue;
                         }
-                    } else {
+                    }
+                    let brick = new_brick(source, background, codes, !whole, charger)?;
+                    charger.room_for_one(bricks)?;
+                    bricks.insert(key, brick);
+                    if !whole {
                         partial.insert(key, [0; 8]);
                     }
-                    bricks.insert(key, new_brick(source, background, codes, !whole));
                 }
                 let mask = partial.get_mut(&key);
                 // Check the whole part first so a rejected block leaves the brick unchanged.
@@ -699,7 +742,13 @@ fn store(
                     _ => false,
                 };
                 if !keeps {
-                    *brick = Brick::F32(brick.to_f32(codes));
+                    let more = Brick::BYTES[2] - brick.heap_bytes() as u64;
+                    charger.add(more)?;
+                    let Some(values) = brick.to_f32(codes) else {
+                        charger.sub(more);
+                        return Err(charger.refused(Brick::BYTES[2]));
+                    };
+                    *brick = Brick::F32(values);
                 }
                 for z in lo[2]..=hi[2] {
                     for y in lo[1]..=hi[1] {
@@ -741,7 +790,7 @@ fn store(
                     if mask.iter().all(|&w| w == u64::MAX) {
                         partial.remove(&key);
                         if let Some(v) = brick.uniform(codes) {
-                            store_uniform(bricks, skipped, background, key, v);
+                            store_uniform(bricks, (skipped, charger), background, key, v)?;
                         }
                     }
                 }

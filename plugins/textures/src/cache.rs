@@ -421,8 +421,8 @@ impl Cache {
                 &format!(
                     "the texture cache is thrashing: the scene's image textures need {} \
                      (with their MIP levels) but the cache budget is {}; images are evicted \
-                     and decoded again (`{}` just now), which is slow. Raise the texture cache \
-                     budget in the render settings.",
+                     and decoded again (`{}` just now), which is slow. Raise the budget with \
+                     the render setting `texture_cache` (e.g. `render: (texture_cache: \"2 GiB\")`).",
                     size(data),
                     size(self.budget()),
                     img.path.display()

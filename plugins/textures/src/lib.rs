@@ -161,8 +161,9 @@
 //! **Loading and the cache.** `create` checks that the file exists and reads its header
 //! (errors name the resolved path); the texels are decoded on the first lookup. Every image of
 //! the library lives in one LRU cache bounded by the call context's texture cache budget
-//! (`texture_cache_bytes`; 0, what Luxon passes today: 1 GiB), counted per MIP level; lookups
-//! that hit take no lock.
+//! (`texture_cache_bytes`: the render setting `texture_cache`, by default 1 GiB or a quarter of
+//! the memory budget when that is less; 0, from a host that gives none: 1 GiB), counted per MIP
+//! level; lookups that hit take no lock.
 //! Least recently used levels are evicted when the budget is exceeded and decoded again when
 //! needed, so scenes with more texture data than the budget still render; a warning says once
 //! when that happens (the cache is thrashing), with the budget and the data size. An image

@@ -546,7 +546,7 @@ impl VolumeReader for Raw {
             checked.size(&path, meta.len())?;
         }
         let mut input = Input::new(file, gzip, &path, &checked);
-        checked.decode(name, &mut input, out, Sizes::DEFAULT)
+        checked.decode(name, &mut input, out, Sizes::within(ctx.memory_budget))
     }
 }
 
@@ -565,6 +565,16 @@ impl Sizes {
         slab_bytes: 64 << 20,
         block_voxels: BLOCK_VOXELS,
     };
+
+    /// The default sizes, with slabs of at most a quarter of the memory budget the host gave
+    /// (0: none given): a tighter budget reads rows or parts of rows instead.
+    fn within(memory_budget: u64) -> Sizes {
+        let mut s = Sizes::DEFAULT;
+        if memory_budget > 0 {
+            s.slab_bytes = s.slab_bytes.min(memory_budget / 4);
+        }
+        s
+    }
 }
 
 /// A buffer of `n` bytes, or an error naming what needed it (never an abort).
@@ -1350,6 +1360,14 @@ mod tests {
             "{}",
             e.message
         );
+    }
+
+    #[test]
+    fn slabs_keep_to_a_quarter_of_the_memory_budget() {
+        assert_eq!(Sizes::within(0).slab_bytes, 64 << 20);
+        assert_eq!(Sizes::within(1 << 40).slab_bytes, 64 << 20);
+        assert_eq!(Sizes::within(100 << 20).slab_bytes, 25 << 20);
+        assert_eq!(Sizes::within(1).slab_bytes, 0);
     }
 
     #[test]
