@@ -480,9 +480,19 @@ pub enum MemorySize {
 }
 
 impl std::fmt::Display for MemorySize {
+    /// As a scene writes it, in the largest unit that divides it ("6 GiB", "100 B", "50%"):
+    /// [`parse_memory_size`] reads it back.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            MemorySize::Bytes(n) => write!(f, "{n} bytes"),
+        match *self {
+            MemorySize::Bytes(n) => {
+                let unit = [(40, "TiB"), (30, "GiB"), (20, "MiB"), (10, "KiB")]
+                    .into_iter()
+                    .find(|&(shift, _)| n >= 1 << shift && n % (1 << shift) == 0);
+                match unit {
+                    Some((shift, name)) => write!(f, "{} {name}", n >> shift),
+                    None => write!(f, "{n} B"),
+                }
+            }
             MemorySize::Percent(p) => write!(f, "{p}%"),
         }
     }

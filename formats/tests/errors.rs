@@ -546,6 +546,16 @@ fn memory_sizes_parse_with_binary_units_or_as_percentages() {
         );
     }
     assert_eq!(parse_memory_size("50%"), Ok(MemorySize::Percent(50.0)));
+    // Written back as a scene writes them, they read back the same.
+    for m in [
+        MemorySize::Bytes(6 << 30),
+        MemorySize::Bytes(3 << 29),
+        MemorySize::Bytes(100),
+        MemorySize::Percent(12.5),
+    ] {
+        assert_eq!(parse_memory_size(&m.to_string()), Ok(m), "{m}");
+    }
+    assert_eq!(MemorySize::Bytes(3 << 29).to_string(), "1536 MiB");
     for (text, why) in [
         ("1.5 X", "`X` is not a unit"),
         ("1024", "no unit"),
