@@ -81,14 +81,17 @@ filter: nearest|bilinear|mip = mip  mip: trilinear, level chosen from the ray's 
 /// It is the texture cache budget (`texture_cache_bytes`), or when that is 0 the cache's
 /// default of 1 GiB ([`cache::DEFAULT_BUDGET`]): levels that do not fit the cache cannot stay
 /// resident anyway (they would be evicted after each decode and decoded again), and 1 GiB holds
-/// the full pyramid of a 7000×7000 image, more than a 4K or 8K render resolves.
-///
-/// Once plugin ABI v2 gives the call context the host's memory budget (`memory_budget`, 0 when
-/// unknown), the cap is the smaller of the two.
+/// the full pyramid of a 7000×7000 image, more than a 4K or 8K render resolves. When the host
+/// gives a memory budget (`memory_budget`, 0 when unknown), the cap is at most what is left of
+/// it, so a decode never takes memory the rest of the scene was promised.
 pub fn decode_cap(ctx: &Context) -> u64 {
-    match ctx.texture_cache_bytes {
+    let cache = match ctx.texture_cache_bytes {
         0 => cache::DEFAULT_BUDGET,
         bytes => bytes,
+    };
+    match ctx.memory_budget {
+        0 => cache,
+        left => cache.min(left),
     }
 }
 
@@ -509,6 +512,31 @@ mod tests {
         let full: ImageTexture = make_in(r#"(file: "wide.png")"#, &ctx_in(dir.dir())).unwrap();
         assert_eq!(full.image.width(), 64);
         assert_eq!(decode_cap(&ctx_in(dir.dir())), 1 << 30);
+    }
+
+    /// The host's memory budget bounds the cap too: what is left of it, when less than the
+    /// texture cache.
+    #[test]
+    fn the_decode_cap_keeps_to_the_memory_budget() {
+        let dir = TempDir::new("img-budget");
+        let mut ctx = ctx_in(dir.dir());
+        ctx.memory_budget = 1 << 20;
+        assert_eq!(decode_cap(&ctx), 1 << 20);
+        ctx.texture_cache_bytes = 4096;
+        assert_eq!(decode_cap(&ctx), 4096);
+        ctx.memory_budget = 0;
+        ctx.texture_cache_bytes = 0;
+        assert_eq!(decode_cap(&ctx), 1 << 30);
+        // An image over the budget's cap is used smaller, as over the cache's.
+        write_png(&dir.path("wide.png"), 64, 64, |x, _| {
+            let v = (x * 4) as u8;
+            [v, v, v, 255]
+        });
+        let cache = Arc::new(Cache::new(0, quiet()));
+        ctx.memory_budget = 5_456 + 128 * 64;
+        let p: ImageParams = luxon_plugin::parse_params(r#"(file: "wide.png")"#).unwrap();
+        let t = ImageTexture::create_in(p, &ctx, cache).unwrap();
+        assert_eq!((t.image.width(), t.image.height()), (16, 16));
     }
 
     #[test]

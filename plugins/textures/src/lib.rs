@@ -170,6 +170,12 @@
 //! that cannot be decoded makes its lookups fail (`try_eval`) with the decoder's reason, which
 //! the host reports as the render's one error, naming the texture. See `cache.rs`.
 //!
+//! **Large images.** Each image is decoded within a cap: the texture cache budget, at most what
+//! is left of the host's memory budget (`memory_budget`). An image whose MIP pyramid does not
+//! fit is used from the first level that does, with a warning (a PNG is streamed, so only those
+//! levels are ever held); a format decoded whole whose buffer does not fit is refused at
+//! create. See `decode.rs`.
+//!
 //! ## Scene
 //!
 //! ```ron
