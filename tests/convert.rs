@@ -361,6 +361,16 @@ fn nff_and_ron_scenes_convert_too() {
     // A RON scene with an include, an OBJ mesh file and outputs: merged into one file.
     assert!(round_trip(&root().join("scenes/obj-mesh.ron"), &dir) > 40);
     assert!(round_trip(&root().join("scenes/spheres.ron"), &dir) > 40);
+    // The memory settings are carried over.
+    let text = std::fs::read_to_string(root().join("scenes/spheres.ron")).unwrap();
+    let text = text.replacen(
+        "render: (",
+        "render: (memory: \"1536M\", texture_cache: \"100 MiB\", ",
+        1,
+    );
+    let budgeted = dir.join("budgeted.ron");
+    std::fs::write(&budgeted, text).unwrap();
+    assert!(round_trip(&budgeted, &dir) > 40);
 }
 
 /// Distinct colours of an image, and the share of its pixels that are black.

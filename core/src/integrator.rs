@@ -162,11 +162,11 @@ impl Whitted<'_> {
         self.trace(ray, depth, weight, media, width, c)
     }
 
-    /// Texture `t` at a surface point; a panicking plugin raises the scene's fault.
+    /// Texture `t` at a surface point; a texture that fails or panics raises the scene's fault.
     fn texture(&self, t: u32, q: &TexQuery) -> [f32; 4] {
         let tex = &self.scene.textures[t as usize];
-        tex.eval(q).unwrap_or_else(|status| {
-            self.scene.customs.fault.raise(tex.failure(status));
+        tex.eval(q).unwrap_or_else(|f| {
+            self.scene.customs.fault.raise(tex.failure(&f));
             [0.0; 4]
         })
     }

@@ -39,12 +39,16 @@
 //! | camera | [`camera`], [`adaptive`] | camera rays; where a pixel's samples go |
 //! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks; PPM bytes; image error measures; files written whole |
 //! | ray | [`ray`] | rays and robust ray spawning |
+//! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
 //! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
 
 // Unsafe code only in the modules that allow it by name below (each block says why it is sound).
 #![deny(unsafe_code)]
 
 pub mod adaptive;
+// The process's resource limits (getrlimit, sysconf).
+#[allow(unsafe_code)]
+pub mod budget;
 pub mod bvh;
 // The memory-mapped cache file.
 #[allow(unsafe_code)]

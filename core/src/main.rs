@@ -40,7 +40,13 @@ enum Command {
         args: cli::sweep::Args,
     },
     /// Validate a scene and print what it contains; renders nothing.
-    Check { scene: PathBuf },
+    Check {
+        scene: PathBuf,
+        /// Memory budget to build the scene within (as for `render`); `check` prints it and
+        /// what the scene holds of it.
+        #[arg(long, value_name = "SIZE", value_parser = cli::parse_memory)]
+        memory: Option<luxon_formats::MemorySize>,
+    },
     /// List every plugin found: file, kind, names, ABI version, parameters.
     Plugins {
         /// Extra directories or files to search first.
@@ -132,7 +138,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render { scene, overrides } => cli::render::run(&scene, &overrides),
         Command::Sweep { scene, args } => cli::sweep::run(&scene, &args),
-        Command::Check { scene } => cli::check::run(&scene),
+        Command::Check { scene, memory } => cli::check::run(&scene, memory),
         Command::Plugins { plugin_path } => {
             cli::plugins::run(&plugin_path);
             Ok(())

@@ -340,6 +340,28 @@ impl Checker<'_> {
                 None => d.volume_step,
             },
             volume_skip: r.volume_skip.unwrap_or(d.volume_skip),
+            memory: match &r.memory {
+                Some(text) => Some(self.memory_size(field("memory"), "memory", text)?),
+                None => None,
+            },
+            texture_cache: match &r.texture_cache {
+                Some(text) => {
+                    match self.memory_size(field("texture_cache"), "texture_cache", text)? {
+                        MemorySize::Bytes(n) => Some(n),
+                        MemorySize::Percent(_) => {
+                            return Err(self.error(
+                                field("texture_cache"),
+                                format!(
+                                "`texture_cache` is {}; expected a size in bytes such as \"512M\" \
+                                 or \"1 GiB\" (not a percentage)",
+                                self.literal(field("texture_cache"))
+                            ),
+                            ))
+                        }
+                    }
+                }
+                None => None,
+            },
             adaptive: match r.adaptive {
                 Some(a) => {
                     let at = field("adaptive");

@@ -524,6 +524,12 @@ pub struct RenderDesc {
     pub light_scale: f64,
     /// Rules of Tachyon's shading that Tachyon scenes render with (all off by default).
     pub tachyon: TachyonDesc,
+    /// The memory budget (`memory: "6 GiB"` or `"50%"`); `None`: the default share of the
+    /// machine's memory (the core works it out).
+    pub memory: Option<MemorySize>,
+    /// Bytes of decoded texture data kept at once (`texture_cache: "1 GiB"`); `None`: 1 GiB,
+    /// or a quarter of the memory budget when that is less.
+    pub texture_cache: Option<u64>,
 }
 
 /// Tachyon's shading rules that have no other use: the Tachyon importer turns them on.
@@ -541,6 +547,72 @@ pub struct TachyonDesc {
     /// A reflected or transmitted ray past `max_depth` adds the background colour unscaled
     /// (not times the mirror or transmission coefficient).
     pub depth_limit_background: bool,
+}
+
+/// A memory size as a scene (`render: (memory: ...)`) or the command line (`--memory`) gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MemorySize {
+    Bytes(u64),
+    /// A share of the machine's memory limit, in percent (above 0, at most 100).
+    Percent(f64),
+}
+
+impl std::fmt::Display for MemorySize {
+    /// As a scene writes it, in the largest unit that divides it ("6 GiB", "100 B", "50%"):
+    /// [`parse_memory_size`] reads it back.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            MemorySize::Bytes(n) => {
+                let unit = [(40, "TiB"), (30, "GiB"), (20, "MiB"), (10, "KiB")]
+                    .into_iter()
+                    .find(|&(shift, _)| n >= 1 << shift && n % (1 << shift) == 0);
+                match unit {
+                    Some((shift, name)) => write!(f, "{} {name}", n >> shift),
+                    None => write!(f, "{n} B"),
+                }
+            }
+            MemorySize::Percent(p) => write!(f, "{p}%"),
+        }
+    }
+}
+
+/// What a size looks like, for messages.
+pub const MEMORY_SIZE_EXAMPLES: &str = "a size such as 512M, 6G, \"1.5 GiB\" or 50%";
+
+/// Parses a memory size: a number with a binary unit (`K`, `M`, `G`, `T`, also written `KiB`,
+/// `MiB`, `GiB`, `TiB`, or `KB`... with the same binary meaning; `B` for bytes), or a
+/// percentage of the machine's memory (`50%`). Spaces between number and unit are allowed.
+/// The error says what is wrong, without the text itself (callers quote it with its place).
+pub fn parse_memory_size(text: &str) -> Result<MemorySize, String> {
+    let t = text.trim();
+    let end = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = (&t[..end], t[end..].trim());
+    let value: f64 = match number.parse() {
+        Ok(v) if number.chars().next().is_some_and(|c| c.is_ascii_digit()) => v,
+        _ => return Err("it does not start with a number".into()),
+    };
+    if unit == "%" {
+        if !(value > 0.0 && value <= 100.0) {
+            return Err("a percentage must be above 0 and at most 100".into());
+        }
+        return Ok(MemorySize::Percent(value));
+    }
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" => return Err("it has no unit".into()),
+        "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        "T" | "TB" | "TIB" => 40,
+        _ => return Err(format!("`{}` is not a unit", crate::error::shown(unit))),
+    };
+    let bytes = value * (1u64 << shift) as f64;
+    if !(bytes >= 1.0 && bytes < 2f64.powi(63)) {
+        return Err("the size must be at least 1 byte and below 8 EiB".into());
+    }
+    Ok(MemorySize::Bytes(bytes as u64))
 }
 
 /// Adaptive supersampling (Stone's thesis, II.E): a pixel starts with a jittered 2x2 grid per
@@ -653,6 +725,8 @@ impl Default for RenderDesc {
             adaptive: None,
             light_scale: 1.0,
             tachyon: TachyonDesc::default(),
+            memory: None,
+            texture_cache: None,
         }
     }
 }

@@ -424,6 +424,8 @@ pub(crate) struct Render {
     pub adaptive: Option<Adaptive>,
     pub light_scale: Option<f64>,
     pub tachyon: Option<Tachyon>,
+    pub memory: Option<String>,
+    pub texture_cache: Option<String>,
 }
 
 #[derive(Deserialize)]

@@ -727,6 +727,8 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path) {
         adaptive,
         light_scale,
         tachyon,
+        memory,
+        texture_cache,
     } = r;
     let _ = writeln!(w, "    render: (");
     let _ = writeln!(w, "        width: {width},\n        height: {height},");
@@ -829,6 +831,12 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path) {
             num(a.threshold),
             a.max_depth
         );
+    }
+    if let Some(m) = memory {
+        let _ = writeln!(w, "        memory: \"{m}\",");
+    }
+    if let Some(n) = texture_cache {
+        let _ = writeln!(w, "        texture_cache: \"{}\",", MemorySize::Bytes(*n));
     }
     w.extend_from_slice(b"    ),\n");
 }

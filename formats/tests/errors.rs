@@ -561,3 +561,76 @@ fn echoed_names_cannot_drive_the_terminal() {
         ],
     );
 }
+
+// ---- Memory sizes (`render: (memory: ..., texture_cache: ...)`) ----
+
+#[test]
+fn memory_sizes_parse_with_binary_units_or_as_percentages() {
+    use luxon_formats::{parse_memory_size, MemorySize};
+    for (text, bytes) in [
+        ("6 GiB", 6u64 << 30),
+        ("512M", 512 << 20),
+        ("1.5G", 3 << 29),
+        ("64 kb", 64 << 10),
+        ("2T", 2 << 40),
+        ("100 B", 100),
+    ] {
+        assert_eq!(
+            parse_memory_size(text),
+            Ok(MemorySize::Bytes(bytes)),
+            "{text}"
+        );
+    }
+    assert_eq!(parse_memory_size("50%"), Ok(MemorySize::Percent(50.0)));
+    // Written back as a scene writes them, they read back the same.
+    for m in [
+        MemorySize::Bytes(6 << 30),
+        MemorySize::Bytes(3 << 29),
+        MemorySize::Bytes(100),
+        MemorySize::Percent(12.5),
+    ] {
+        assert_eq!(parse_memory_size(&m.to_string()), Ok(m), "{m}");
+    }
+    assert_eq!(MemorySize::Bytes(3 << 29).to_string(), "1536 MiB");
+    for (text, why) in [
+        ("1.5 X", "`X` is not a unit"),
+        ("1024", "no unit"),
+        ("G", "does not start with a number"),
+        ("-1G", "does not start with a number"),
+        ("0M", "at least 1 byte"),
+        ("0%", "above 0 and at most 100"),
+        ("150%", "above 0 and at most 100"),
+        ("99999999T", "below 8 EiB"),
+    ] {
+        let e = parse_memory_size(text).unwrap_err();
+        assert!(e.contains(why), "{text}: {e}");
+    }
+}
+
+#[test]
+fn a_memory_size_without_a_unit_is_an_error_at_its_value() {
+    let found = scene_error("    render: (width: 8, memory: \"1.5 X\"),");
+    check(
+        found,
+        3,
+        32,
+        &["`memory` is \"1.5 X\": `X` is not a unit; expected a size such as 512M"],
+    );
+    let found = scene_error("    render: (texture_cache: \"25%\"),");
+    check(
+        found,
+        3,
+        29,
+        &["`texture_cache` is \"25%\"", "not a percentage"],
+    );
+    let desc = load_ron_str(
+        &format!("(\n{CAMERA}\n    render: (memory: \"50%\", texture_cache: \"1 GiB\"),\n)"),
+        Path::new("ok.ron"),
+    )
+    .unwrap();
+    assert_eq!(
+        desc.render.memory,
+        Some(luxon_formats::MemorySize::Percent(50.0))
+    );
+    assert_eq!(desc.render.texture_cache, Some(1 << 30));
+}

@@ -33,6 +33,12 @@ pub fn warn_scene(desc: &luxon_formats::SceneDesc) {
     }
 }
 
+/// `--memory SIZE`: "6G", "512M", "1.5 GiB", "50%" (of the machine's memory).
+pub fn parse_memory(s: &str) -> Result<luxon_formats::MemorySize, String> {
+    luxon_formats::parse_memory_size(s)
+        .map_err(|why| format!("expected {} ({why})", luxon_formats::MEMORY_SIZE_EXAMPLES))
+}
+
 /// `--res WIDTHxHEIGHT`.
 pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

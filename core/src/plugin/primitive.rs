@@ -3,6 +3,7 @@
 
 use super::calls::{call_context, call_plugin, checked_len, fail, slice, wrong_kind};
 use super::registry::{Entry, PluginKind, Registry, Table};
+use crate::budget::Budget;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::{CustomObject, Customs};
 use crate::geometry::disc::Discs;
@@ -30,6 +31,19 @@ pub struct GeometryBuilder<'a> {
     pub plugin: String,
     /// Degenerate triangles dropped.
     pub dropped: u64,
+    /// Charged for what is stored, before it is stored.
+    pub budget: &'a Budget,
+    /// The object, for messages: "object 3 (plugin `mesh`, scene.ron:20:9)".
+    pub object: String,
+}
+
+impl GeometryBuilder<'_> {
+    /// "object 3 (plugin `mesh`, scene.ron:20:9): 40000000 triangles", for budget messages.
+    fn describe(&self, n: usize, kind: &str) -> impl Fn() -> String {
+        let object = self.object.clone();
+        let kind = kind.to_string();
+        move || format!("{object}: {n} {kind}")
+    }
 }
 
 // The host side of `GeometrySink`. The plugin calls these during `create_primitive`, on its
@@ -56,7 +70,12 @@ unsafe fn guard(
     }
 }
 
-/// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`.
+/// How a batch makes room for `n` records in its set, within the budget (the message names
+/// what needed it).
+type Reserve = fn(&mut GeometryBuilder, usize, &dyn Fn() -> String) -> Result<(), String>;
+
+/// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`,
+/// after `reserve` made room for them.
 ///
 /// # Safety
 /// As for [`guard`]; `data` is null or points to `count * N` values.
@@ -66,11 +85,14 @@ unsafe fn add_batch<const N: usize>(
     count: u64,
     err: *const abi::ErrorSink,
     what: &str,
+    reserve: Reserve,
     push: impl Fn(&mut GeometryBuilder, usize, [f64; N]) -> Result<(), String>,
 ) -> abi::Status {
     let store = |b: &mut GeometryBuilder| {
         // SAFETY: the caller's promise about `data` (the length is checked to fit memory).
         let v = unsafe { slice(data, checked_len(count, N as u64, what)?) };
+        let describe = b.describe(v.len() / N, &format!("{what}s"));
+        reserve(b, v.len() / N, &describe)?;
         for (i, r) in v.chunks_exact(N).enumerate() {
             push(b, i, r.try_into().expect("chunk of N"))?;
         }
@@ -90,9 +112,16 @@ unsafe extern "C" fn add_spheres(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "sphere", |b, i, r: [f64; 4]| {
-            b.spheres.push_world(i, r, b.world_offset, b.material)
-        })
+        let reserve: Reserve = |b, n, what| b.spheres.reserve(n, b.budget, what);
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "sphere",
+            reserve,
+            |b, i, r: [f64; 4]| b.spheres.push_world(i, r, b.world_offset, b.material),
+        )
     }
 }
 
@@ -106,9 +135,16 @@ unsafe extern "C" fn add_planes(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "plane", |b, i, r: [f64; 6]| {
-            b.planes.push_world(i, r, b.world_offset, b.material)
-        })
+        let reserve: Reserve = |b, n, what| b.planes.reserve(n, b.budget, what);
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "plane",
+            reserve,
+            |b, i, r: [f64; 6]| b.planes.push_world(i, r, b.world_offset, b.material),
+        )
     }
 }
 
@@ -122,9 +158,16 @@ unsafe extern "C" fn add_cones(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
-            b.cones.push_world(i, r, b.world_offset, b.material)
-        })
+        let reserve: Reserve = |b, n, what| b.cones.reserve(n, b.budget, what);
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "cone",
+            reserve,
+            |b, i, r: [f64; 8]| b.cones.push_world(i, r, b.world_offset, b.material),
+        )
     }
 }
 
@@ -138,9 +181,16 @@ unsafe extern "C" fn add_discs(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
-            b.discs.push_world(i, r, b.world_offset, b.material)
-        })
+        let reserve: Reserve = |b, n, what| b.discs.reserve(n, b.budget, what);
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "disc",
+            reserve,
+            |b, i, r: [f64; 8]| b.discs.push_world(i, r, b.world_offset, b.material),
+        )
     }
 }
 
@@ -167,6 +217,11 @@ unsafe extern "C" fn add_mesh(
                 uvs: slice(m.uvs, optional(m.uvs.is_null(), 2)),
             }
         };
+        let attrs = !(input.normals.is_empty() && input.colors.is_empty() && input.uvs.is_empty());
+        let triangles = input.indices.len() / 3;
+        let describe = b.describe(triangles, "triangles");
+        b.triangles
+            .reserve_mesh(triangles, nv, attrs, b.budget, &describe)?;
         b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
         Ok(())
     };
@@ -198,6 +253,9 @@ unsafe extern "C" fn add_custom(
                 g.count
             ));
         }
+        let describe = b.describe(object.count as usize, "custom primitives");
+        b.customs
+            .reserve(object.count as usize, b.budget, &describe)?;
         let o = b.customs.objects.len() as u32;
         for i in 0..object.count {
             b.customs.refs.push((o, i));
@@ -238,7 +296,7 @@ pub fn create_primitive(
         ));
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, instance);
+    let ctx = call_context(&dir, instance, Some(builder.budget));
     call_plugin(registry, entry, params_at, |err| {
         // SAFETY: the calling contract: `params`, `ctx`, `sink` and `err` live across the
         // call; `sink.ctx` is `builder`, which this function borrows mutably and does not touch

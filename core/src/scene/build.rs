@@ -4,6 +4,8 @@
 //! for. A new kind of scene content gets a stage of its own here.
 
 use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
+use crate::budget::{Budget, Use};
+use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
 use crate::error::Error;
 use crate::geometry::cone::Cones;
@@ -25,6 +27,7 @@ use luxon_formats::{
 };
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A scene's native geometry with its BVHs built, as a geometry cache gives it back
@@ -43,11 +46,22 @@ pub struct Prebuilt {
 type Inline<'g> = Box<dyn Iterator<Item = Cow<'g, InlineGeometry>> + 'g>;
 
 impl Scene {
-    /// Resolves plugins, instantiates every object and builds the BVHs.
+    /// Resolves plugins, instantiates every object and builds the BVHs, within the scene's
+    /// memory budget (its `render: (memory: ...)`, else the machine's default).
     pub fn build(desc: &SceneDesc, registry: &Registry) -> Result<Scene, Error> {
+        let budget = Budget::for_render(&desc.render, None, 1);
+        Scene::build_with(desc, registry, Arc::new(budget))
+    }
+
+    /// `build` within `budget`.
+    pub fn build_with(
+        desc: &SceneDesc,
+        registry: &Registry,
+        budget: Arc<Budget>,
+    ) -> Result<Scene, Error> {
         let groups = desc.inline.iter().map(Cow::Borrowed);
         let shadowless = shadowless_groups(desc);
-        Scene::build_from(desc, Box::new(groups), shadowless, None, registry)
+        Scene::build_from(desc, Box::new(groups), shadowless, None, registry, budget)
     }
 
     /// Builds with the native geometry and BVHs of a geometry cache (`desc` holds the rest of
@@ -56,29 +70,25 @@ impl Scene {
         desc: &SceneDesc,
         geometry: Prebuilt,
         registry: &Registry,
+        budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
-        let none = Vec::new();
-        Scene::build_from(
-            desc,
-            Box::new(std::iter::empty()),
-            none,
-            Some(geometry),
-            registry,
-        )
+        let none = Box::new(std::iter::empty());
+        Scene::build_from(desc, none, Vec::new(), Some(geometry), registry, budget)
     }
 
-    /// Like `build`, but takes the imported geometry (`desc.inline`) out of `desc` and frees
-    /// each group once it is stored, so a large import is not held twice while the BVHs are
-    /// built and the image rendered.
+    /// Like `build_with`, but takes the imported geometry (`desc.inline`) out of `desc` and
+    /// frees each group once it is stored, so a large import is not held twice while the BVHs
+    /// are built and the image rendered.
     pub fn build_taking_geometry(
         desc: &mut SceneDesc,
         registry: &Registry,
+        budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
         // Which groups cast no shadow is needed before they are taken: their materials get a
         // shadowless copy in the palette.
         let shadowless = shadowless_groups(desc);
         let groups = std::mem::take(&mut desc.inline).into_iter().map(Cow::Owned);
-        Scene::build_from(desc, Box::new(groups), shadowless, None, registry)
+        Scene::build_from(desc, Box::new(groups), shadowless, None, registry, budget)
     }
 
     /// The build, stage after stage (errors are reported in this order too).
@@ -88,8 +98,9 @@ impl Scene {
         shadowless: Vec<Option<Spanned<String>>>,
         prebuilt: Option<Prebuilt>,
         registry: &Registry,
+        budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
-        let b = Build::new(desc, registry);
+        let b = Build::new(desc, registry, budget);
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
@@ -107,11 +118,15 @@ impl Scene {
         let native_built = prebuilt.is_some();
         if let Some(p) = prebuilt {
             stored.take_prebuilt(p, b.world_offset)?;
+            let held = stored.geometry_bytes();
+            b.budget.reserve(Use::Geometry, held, || {
+                "the geometry read from the geometry cache".into()
+            })?;
         }
         let plugin_time = t0.elapsed();
 
         let t1 = Instant::now();
-        stored.build_bvhs(!native_built)?;
+        stored.build_bvhs(!native_built, &b.budget)?;
         let bvh_time = t1.elapsed();
 
         let lights = b.lights();
@@ -158,6 +173,7 @@ impl Scene {
             degenerate_triangles: stored.dropped,
             bvh_time,
             plugin_time,
+            budget: b.budget,
         })
     }
 }
@@ -169,6 +185,7 @@ struct Build<'a> {
     registry: &'a Registry,
     scene_dir: PathBuf,
     world_offset: DVec3,
+    budget: Arc<Budget>,
 }
 
 /// The materials of the imported geometry groups that cast no shadow.
@@ -214,10 +231,11 @@ struct Stored {
 }
 
 impl<'a> Build<'a> {
-    fn new(desc: &'a SceneDesc, registry: &'a Registry) -> Build<'a> {
+    fn new(desc: &'a SceneDesc, registry: &'a Registry, budget: Arc<Budget>) -> Build<'a> {
         Build {
             desc,
             registry,
+            budget,
             scene_dir: desc
                 .source
                 .parent()
@@ -227,10 +245,20 @@ impl<'a> Build<'a> {
         }
     }
 
-    /// Stage: an instance of every texture, through its plugin; and their names.
+    /// Stage: an instance of every texture, through its plugin; and their names. A scene with
+    /// textures reserves the texture cache's share of the budget (what texture plugins may keep
+    /// decoded; they are told its size).
     fn textures(&self) -> Result<(Vec<TextureInstance>, Vec<String>), Error> {
         let mut texture_names = Vec::new();
         let mut textures = Vec::new();
+        if let Some((name, call)) = self.desc.textures.first() {
+            let cache = self.budget.texture_cache();
+            self.budget
+                .reserve(Use::Textures, cache, || {
+                    format!("the texture cache (for texture `{name}` and the others)")
+                })
+                .map_err(|e| Error::at(&call.at, e.0))?;
+        }
         for (name, call) in &self.desc.textures {
             let entry = self
                 .registry
@@ -243,6 +271,7 @@ impl<'a> Build<'a> {
                 &call.value.params_at,
                 &self.scene_dir,
                 name,
+                &self.budget,
             )
             .map_err(|(at, m)| Error::at(&at, m))?;
             texture_names.push(name.clone());
@@ -271,6 +300,7 @@ impl<'a> Build<'a> {
                 &call.params_at,
                 &self.scene_dir,
                 &name,
+                &self.budget,
             )
             .map_err(|(at, m)| Error::at(&at, m))?;
             volumes.push(volume);
@@ -420,6 +450,8 @@ impl<'a> Build<'a> {
                 world_offset: self.world_offset,
                 plugin: entry.name.clone(),
                 dropped: 0,
+                budget: &self.budget,
+                object: format!("object {i} (plugin `{}`, {})", entry.name, obj.at),
             };
             create_primitive(
                 self.registry,
@@ -458,6 +490,7 @@ impl<'a> Build<'a> {
             stored.used[material] = true;
             let m = pack(material as u32, self.clip_group(&g.clip)?);
             let fail = |e: String| Error::at(&at(), format!("imported geometry group {k}: {e}"));
+            stored.reserve_group(&g, &self.budget).map_err(fail)?;
             for (i, s) in g.spheres.iter().enumerate() {
                 stored
                     .spheres
@@ -666,6 +699,37 @@ impl Stored {
         }
     }
 
+    /// Room for an imported group's primitives, charged to `budget`.
+    fn reserve_group(&mut self, g: &InlineGeometry, budget: &Budget) -> Result<(), String> {
+        let n = |n: usize, kind: &'static str| move || format!("{n} {kind}");
+        let (s, c, d, p) = (
+            g.spheres.len(),
+            g.cones.len(),
+            g.discs.len(),
+            g.planes.len(),
+        );
+        self.spheres.reserve(s, budget, &n(s, "spheres"))?;
+        self.cones.reserve(c, budget, &n(c, "cones"))?;
+        self.discs.reserve(d, budget, &n(d, "discs"))?;
+        self.planes.reserve(p, budget, &n(p, "planes"))?;
+        let m = &g.mesh;
+        let attrs = !(m.normals.is_empty() && m.uvs.is_empty());
+        let t = m.indices.len();
+        let describe = n(t, "triangles");
+        self.triangles
+            .reserve_mesh(t, m.positions.len(), attrs, budget, &describe)
+    }
+
+    /// Bytes of the stored geometry (its arrays' capacities).
+    fn geometry_bytes(&self) -> u64 {
+        self.spheres.bytes()
+            + self.triangles.bytes()
+            + self.planes.bytes()
+            + self.cones.bytes()
+            + self.discs.bytes()
+            + self.customs.bytes()
+    }
+
     /// Stage (with a geometry cache): its native sets and BVHs replace the (empty) ones here.
     fn take_prebuilt(&mut self, p: Prebuilt, world_offset: DVec3) -> Result<(), Error> {
         if p.used.len() != self.used.len() || p.world_offset != world_offset {
@@ -685,7 +749,36 @@ impl Stored {
 
     /// Stage: the BVHs of every set, in parallel; the native ones only when `native` (a
     /// cache's come built).
-    fn build_bvhs(&mut self, native: bool) -> Result<(), Error> {
+    /// Builds every set's BVH. The build's working memory is charged first (for the sets it
+    /// builds at once) and given back after, keeping the BVHs' own bytes; the geometry's
+    /// charge is brought down to what the sets hold once built (they grew by doubling).
+    fn build_bvhs(&mut self, native: bool, budget: &Budget) -> Result<(), Error> {
+        let n = if native {
+            self.spheres.len() + self.triangles.len() + self.cones.len() + self.discs.len()
+        } else {
+            0
+        } + self.customs.len();
+        let work = n as u64 * BUILD_BYTES_PER_PRIM;
+        budget.reserve(Use::Bvh, work, || {
+            format!("building the BVHs over {n} primitives")
+        })?;
+        let built = self.build_sets(native);
+        budget.release(Use::Bvh, work);
+        built?;
+        let bvhs = self.spheres.bvh_bytes()
+            + self.triangles.set.bvh_bytes()
+            + self.cones.bvh_bytes()
+            + self.discs.bvh_bytes()
+            + self.customs.bvh_bytes();
+        budget.reserve(Use::Bvh, bvhs, || format!("the BVHs over {n} primitives"))?;
+        let (charged, held) = (budget.used(Use::Geometry), self.geometry_bytes());
+        if charged > held {
+            budget.release(Use::Geometry, charged - held);
+        }
+        Ok(())
+    }
+
+    fn build_sets(&mut self, native: bool) -> Result<(), Error> {
         let Stored {
             spheres,
             triangles,

@@ -6,6 +6,7 @@ mod build;
 
 pub use build::Prebuilt;
 
+use crate::budget::Budget;
 use crate::camera::Camera;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
@@ -21,6 +22,7 @@ use crate::volume::Volume;
 use crate::volume_render::RenderVolume;
 use luxon_formats::OutputDesc;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(Clone, Debug)]
@@ -330,6 +332,9 @@ pub struct Scene {
     /// Instantiating the objects through their plugins and storing all geometry natively
     /// (after reading the scene, before the BVH build).
     pub plugin_time: Duration,
+    /// The memory budget the build charged (geometry, BVHs, volumes, texture cache) and the
+    /// render charges (images).
+    pub budget: Arc<Budget>,
 }
 
 impl Scene {

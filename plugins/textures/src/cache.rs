@@ -30,7 +30,8 @@
 //!
 //! **Thrashing.** When an image has to be decoded a second time (its data was evicted and is
 //! needed again), the cache logs once, with the budget and the size of all registered texture
-//! data. A decode failure logs once per image; lookups then fail (the render stops with an error).
+//! data. A decode failure is kept with the image: every lookup then fails with its message
+//! (the texture's `try_eval` hands it to the host, which stops the render with it).
 
 use crate::decode::{decode, size, Header, Plan};
 use crate::mipmap::{level_sizes, Level};
@@ -101,8 +102,8 @@ pub struct CachedImage {
     readers: [Stripe; STRIPES],
     /// Held while decoding and installing this image.
     loading: Mutex<()>,
-    /// The decode failed; lookups fail without trying again.
-    failed: AtomicBool,
+    /// Why the decode failed; lookups fail with it without trying again.
+    failed: OnceLock<String>,
     /// How many times the file was decoded.
     decodes: AtomicU64,
 }
@@ -311,7 +312,7 @@ impl Cache {
             slots,
             readers: Default::default(),
             loading: Mutex::new(()),
-            failed: AtomicBool::new(false),
+            failed: OnceLock::new(),
             decodes: AtomicU64::new(0),
         });
         st.images.push(img.clone());
@@ -338,14 +339,14 @@ impl Cache {
     }
 
     /// Runs `f` on levels `a` and `b` of `img` (equal indices allowed), loading them first when
-    /// they are not resident. `None` when the image cannot be decoded.
+    /// they are not resident. The error says why the image cannot be decoded.
     pub fn with_levels<R>(
         &self,
         img: &CachedImage,
         a: usize,
         b: usize,
         f: impl FnOnce(&Level, &Level) -> R,
-    ) -> Option<R> {
+    ) -> Result<R, String> {
         {
             let _reading = img.enter();
             let pa = img.slots[a].data.load(SeqCst);
@@ -355,18 +356,23 @@ impl Cache {
                 self.touch(&img.slots[b]);
                 // SAFETY: non-null pointers from `Arc::into_raw`; an evictor that swaps them out
                 // waits for our reader counter to drop before freeing them.
-                return Some(f(unsafe { &*pa }, unsafe { &*pb }));
+                return Ok(f(unsafe { &*pa }, unsafe { &*pb }));
             }
         }
         // Miss: no reader counter held from here on (the loader may wait for readers).
-        if img.failed.load(Acquire) {
-            return None;
+        if let Some(e) = img.failed.get() {
+            return Err(e.clone());
         }
         let (la, lb) = self.load(img, a, b)?;
-        Some(f(&la, &lb))
+        Ok(f(&la, &lb))
     }
 
-    fn load(&self, img: &CachedImage, a: usize, b: usize) -> Option<(Arc<Level>, Arc<Level>)> {
+    fn load(
+        &self,
+        img: &CachedImage,
+        a: usize,
+        b: usize,
+    ) -> Result<(Arc<Level>, Arc<Level>), String> {
         let _loading = img.loading.lock().unwrap_or_else(PoisonError::into_inner);
         {
             // Another thread may have loaded them while we waited.
@@ -374,11 +380,11 @@ impl Cache {
             if let (Some(la), Some(lb)) = (img.slots[a].get(&st), img.slots[b].get(&st)) {
                 self.touch(&img.slots[a]);
                 self.touch(&img.slots[b]);
-                return Some((la, lb));
+                return Ok((la, lb));
             }
         }
-        if img.failed.load(Acquire) {
-            return None;
+        if let Some(e) = img.failed.get() {
+            return Err(e.clone());
         }
         let decoded = decode(&img.path, &img.header, img.srgb, &img.plan).and_then(|levels| {
             if levels.len() == img.slots.len() {
@@ -394,13 +400,8 @@ impl Cache {
         let levels = match decoded {
             Ok(levels) => levels,
             Err(e) => {
-                if !img.failed.swap(true, AcqRel) {
-                    (self.log)(
-                        0,
-                        &format!("cannot decode image `{}`: {e}", img.path.display()),
-                    );
-                }
-                return None;
+                let e = format!("cannot decode image `{}`: {e}", img.path.display());
+                return Err(img.failed.get_or_init(|| e).clone());
             }
         };
         self.decodes.fetch_add(1, Relaxed);
@@ -442,15 +443,21 @@ impl Cache {
                 &format!(
                     "the texture cache is thrashing: the scene's image textures need {} \
                      (with their MIP levels) but the cache budget is {}; images are evicted \
-                     and decoded again (`{}` just now), which is slow. Raise the texture cache \
-                     budget in the render settings.",
+                     and decoded again (`{}` just now), which is slow. Raise the budget with \
+                     the render setting `texture_cache` (e.g. `render: (texture_cache: \"2 GiB\")`).",
                     size(data),
                     size(self.budget()),
                     img.path.display()
                 ),
             );
         }
-        Some((out_a?, out_b?))
+        match (out_a, out_b) {
+            (Some(la), Some(lb)) => Ok((la, lb)),
+            _ => Err(format!(
+                "MIP level {a} or {b} of `{}` is missing after decoding",
+                img.path.display()
+            )),
+        }
     }
 
     /// Evicts least recently used levels until the resident bytes fit the budget, sparing
@@ -517,7 +524,7 @@ mod tests {
         p
     }
 
-    fn level0(cache: &Cache, img: &CachedImage) -> Option<f32> {
+    fn level0(cache: &Cache, img: &CachedImage) -> Result<f32, String> {
         cache.with_levels(img, 0, 0, |l, _| l.texels[0][0])
     }
 
@@ -536,13 +543,13 @@ mod tests {
         // Nothing decoded at registration.
         assert_eq!(cache.stats().decodes, 0);
         assert!(!img.is_resident(0));
-        assert_eq!(level0(&cache, &img), Some(1.0));
+        assert_eq!(level0(&cache, &img), Ok(1.0));
         assert_eq!(cache.stats().decodes, 1);
         // The whole pyramid (8, 4, 2, 1) is resident: 85 texels of 16 bytes.
         assert_eq!(img.levels(), 4);
         assert!((0..4).all(|i| img.is_resident(i)));
         assert_eq!(cache.stats().resident, 85 * 16);
-        assert_eq!(level0(&cache, &img), Some(1.0));
+        assert_eq!(level0(&cache, &img), Ok(1.0));
         assert_eq!(cache.stats().decodes, 1, "a hit decodes nothing");
         cache.release(&same);
         drop(same);
@@ -600,7 +607,7 @@ mod tests {
         let (log, _) = recorder();
         let cache = Cache::new(100, log);
         let img = cache.register(&p, probe(&p).unwrap(), true, FULL);
-        assert_eq!(level0(&cache, &img), Some(1.0));
+        assert_eq!(level0(&cache, &img), Ok(1.0));
         // Only the level in use stays (it alone exceeds the budget).
         assert!(img.is_resident(0));
         assert!(!img.is_resident(1) && !img.is_resident(3));
@@ -624,10 +631,10 @@ mod tests {
             cache.register(&p, probe(&p).unwrap(), true, FULL)
         };
         let (a, b, c) = (mk("a.png", 10), mk("b.png", 20), mk("c.png", 30));
-        level0(&cache, &a);
-        level0(&cache, &b);
-        level0(&cache, &a); // a is now more recent than b
-        level0(&cache, &c); // evicts b's level 0, not a's
+        level0(&cache, &a).unwrap();
+        level0(&cache, &b).unwrap();
+        level0(&cache, &a).unwrap(); // a is now more recent than b
+        level0(&cache, &c).unwrap(); // evicts b's level 0, not a's
         assert!(a.is_resident(0) && c.is_resident(0), "{:?}", cache.stats());
         assert!(!b.is_resident(0));
         assert_eq!(cache.stats().decodes, 3);
@@ -635,7 +642,7 @@ mod tests {
     }
 
     #[test]
-    fn decode_failure_is_reported_once() {
+    fn a_decode_failure_is_kept_and_every_lookup_fails_with_it() {
         let dir = TempDir::new("cache-broken");
         let p = flat(&dir, "broken.png", 128);
         let h = probe(&p).unwrap();
@@ -645,17 +652,19 @@ mod tests {
         let (log, seen) = recorder();
         let cache = Cache::new(0, log);
         let img = cache.register(&p, h, true, FULL);
-        for _ in 0..3 {
-            assert_eq!(level0(&cache, &img), None);
-        }
-        let seen = seen.lock().unwrap();
-        assert_eq!(seen.len(), 1, "{seen:?}");
-        assert_eq!(seen[0].0, 0);
+        let e = level0(&cache, &img).unwrap_err();
         assert!(
-            seen[0].1.contains("cannot decode image") && seen[0].1.contains("broken.png"),
-            "{}",
-            seen[0].1
+            e.starts_with("cannot decode image `") && e.contains("broken.png`: "),
+            "{e}"
         );
+        // The file is not decoded again: even a good file there now fails the same way.
+        flat(&dir, "broken.png", 128);
+        for _ in 0..3 {
+            assert_eq!(level0(&cache, &img), Err(e.clone()));
+        }
+        assert_eq!(cache.stats().decodes, 0);
+        // The message travels with the lookups; nothing is logged.
+        assert!(seen.lock().unwrap().is_empty());
     }
 
     #[test]

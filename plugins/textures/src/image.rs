@@ -81,14 +81,17 @@ filter: nearest|bilinear|mip = mip  mip: trilinear, level chosen from the ray's 
 /// It is the texture cache budget (`texture_cache_bytes`), or when that is 0 the cache's
 /// default of 1 GiB ([`cache::DEFAULT_BUDGET`]): levels that do not fit the cache cannot stay
 /// resident anyway (they would be evicted after each decode and decoded again), and 1 GiB holds
-/// the full pyramid of a 7000×7000 image, more than a 4K or 8K render resolves.
-///
-/// Once plugin ABI v2 gives the call context the host's memory budget (`memory_budget`, 0 when
-/// unknown), the cap is the smaller of the two.
+/// the full pyramid of a 7000×7000 image, more than a 4K or 8K render resolves. When the host
+/// gives a memory budget (`memory_budget`, 0 when unknown), the cap is at most what is left of
+/// it, so a decode never takes memory the rest of the scene was promised.
 pub fn decode_cap(ctx: &Context) -> u64 {
-    match ctx.texture_cache_bytes {
+    let cache = match ctx.texture_cache_bytes {
         0 => cache::DEFAULT_BUDGET,
         bytes => bytes,
+    };
+    match ctx.memory_budget {
+        0 => cache,
+        left => cache.min(left),
     }
 }
 
@@ -145,7 +148,12 @@ impl Texture for ImageTexture {
         Self::create_in(p, ctx, cache)
     }
 
+    /// Magenta where the image cannot be decoded (the host calls `try_eval`, which fails).
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        self.try_eval(q).unwrap_or(MAGENTA)
+    }
+
+    fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
         let l = self.mapping.lookup(q);
         let (wrap, img) = (self.wrap, &*self.image);
         let got = match self.filter {
@@ -164,11 +172,7 @@ impl Texture for ImageTexture {
                     .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
             }
         };
-        got.unwrap_or_else(|| {
-            // The cache logged why, once; the host stops the render.
-            luxon_plugin::texture_failed();
-            MAGENTA
-        })
+        got.map_err(Error::new)
     }
 }
 
@@ -426,7 +430,7 @@ mod tests {
     }
 
     #[test]
-    fn decode_failure_on_first_use_is_magenta() {
+    fn decode_failure_on_first_use_fails_the_lookup_with_its_reason() {
         let dir = TempDir::new("img-corrupt");
         fixture(&dir);
         let seen = Arc::new(Mutex::new(Vec::<String>::new()));
@@ -444,9 +448,24 @@ mod tests {
             0, 0, 0, 10, b'I', b'D', b'A', b'T', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0,
         ]);
         std::fs::write(dir.path("ramp.png"), bad).unwrap();
+        let q = |u: f32| TexQuery {
+            uv: [u, 0.5],
+            ..Default::default()
+        };
+        let e = t.try_eval(&q(0.5)).unwrap_err().message;
+        let path = dir.path("ramp.png");
+        assert!(
+            e.starts_with(&format!("cannot decode image `{}`: ", path.display())),
+            "{e}"
+        );
+        assert_eq!(t.try_eval(&q(0.1)).unwrap_err().message, e);
+        // `eval` gives a stand-in; nothing is logged (the message goes to the host).
         assert_eq!(at_uv(&t, [0.5, 0.5], 0.0), MAGENTA);
-        assert_eq!(at_uv(&t, [0.1, 0.5], 0.0), MAGENTA);
-        assert_eq!(seen.lock().unwrap().len(), 1, "{:?}", seen.lock().unwrap());
+        assert!(
+            seen.lock().unwrap().is_empty(),
+            "{:?}",
+            seen.lock().unwrap()
+        );
     }
 
     #[test]
@@ -493,6 +512,31 @@ mod tests {
         let full: ImageTexture = make_in(r#"(file: "wide.png")"#, &ctx_in(dir.dir())).unwrap();
         assert_eq!(full.image.width(), 64);
         assert_eq!(decode_cap(&ctx_in(dir.dir())), 1 << 30);
+    }
+
+    /// The host's memory budget bounds the cap too: what is left of it, when less than the
+    /// texture cache.
+    #[test]
+    fn the_decode_cap_keeps_to_the_memory_budget() {
+        let dir = TempDir::new("img-budget");
+        let mut ctx = ctx_in(dir.dir());
+        ctx.memory_budget = 1 << 20;
+        assert_eq!(decode_cap(&ctx), 1 << 20);
+        ctx.texture_cache_bytes = 4096;
+        assert_eq!(decode_cap(&ctx), 4096);
+        ctx.memory_budget = 0;
+        ctx.texture_cache_bytes = 0;
+        assert_eq!(decode_cap(&ctx), 1 << 30);
+        // An image over the budget's cap is used smaller, as over the cache's.
+        write_png(&dir.path("wide.png"), 64, 64, |x, _| {
+            let v = (x * 4) as u8;
+            [v, v, v, 255]
+        });
+        let cache = Arc::new(Cache::new(0, quiet()));
+        ctx.memory_budget = 5_456 + 128 * 64;
+        let p: ImageParams = luxon_plugin::parse_params(r#"(file: "wide.png")"#).unwrap();
+        let t = ImageTexture::create_in(p, &ctx, cache).unwrap();
+        assert_eq!((t.image.width(), t.image.height()), (16, 16));
     }
 
     #[test]

@@ -19,6 +19,7 @@ pub mod post;
 
 use super::progress::Progress;
 use args::{split, usage};
+use luxon::budget::Budget;
 use luxon::plugin::Registry;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{Origin, OutputDesc, Spanned};
@@ -161,7 +162,9 @@ fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
     luxon::output::resolve(std::slice::from_ref(&probe), &registry)?;
     let t1 = Instant::now();
     let camera = desc.camera.value.clone();
-    let mut scene = Scene::build_taking_geometry(&mut desc, &registry)?;
+    // Tachyon's options have no memory budget: the machine's default share applies.
+    let budget = Arc::new(Budget::for_render(&desc.render, None, 1));
+    let mut scene = Scene::build_taking_geometry(&mut desc, &registry, budget)?;
     println!("Scene contains {} primitives.", scene.primitive_count());
     println!("Preprocessing Time: {:10.4} seconds", seconds(t1.elapsed()));
     if plan.verbose {
