@@ -13,9 +13,18 @@ fn first_lane(mask: u32) -> usize {
     mask.trailing_zeros() as usize & (LANES - 1)
 }
 
+/// Whether a ray's coordinates are all finite. Others meet nothing: a NaN (from a zero-length
+/// direction, say) or an infinity makes the box tests enter empty lanes too, whose link is the
+/// root's, so their traversal would never end (and would overrun its stack).
+#[inline(always)]
+fn finite(origin: Vec3A, dir: Vec3A) -> bool {
+    (origin.is_finite_mask() & dir.is_finite_mask()).all()
+}
+
 impl Bvh {
     /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
-    /// `t_max` (and records whatever it needs). Returns the final `t_max`.
+    /// `t_max` (and records whatever it needs). Returns the final `t_max`. A ray with a NaN or
+    /// infinite coordinate meets nothing.
     // Only this dispatch is inlined; the loops (`intersect_avx`, `intersect_base`) are not, or
     // their 14 KB stack would sit in every frame of the recursive integrator, and deep
     // reflections (max_depth in the hundreds) would overflow the thread's stack. The primitive
@@ -28,6 +37,9 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
+        if !finite(origin, dir) {
+            return t_max;
+        }
         self.intersect_dispatch(origin, dir, t_max, test)
     }
 
@@ -107,7 +119,8 @@ impl Bvh {
         }
     }
 
-    /// Any-hit traversal: stops as soon as `test(prim)` returns true.
+    /// Any-hit traversal: stops as soon as `test(prim)` returns true. A ray with a NaN or
+    /// infinite coordinate meets nothing.
     #[inline]
     pub fn any<F: FnMut(usize) -> bool>(
         &self,
@@ -116,6 +129,9 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
+        if !finite(origin, dir) {
+            return false;
+        }
         self.any_dispatch(origin, dir, t_max, test)
     }
 
@@ -324,6 +340,37 @@ mod tests {
             tested > 500,
             "the rays should meet many boxes, met {tested}"
         );
+    }
+
+    /// NaN or infinite coordinates (a zero-length direction normalised, a point at infinity)
+    /// made the box tests enter every lane, empty ones included, whose link leads back to the
+    /// root: the traversal never ended. Such rays meet nothing.
+    #[test]
+    fn rays_with_nan_or_infinite_coordinates_meet_nothing() {
+        let b = boxes(5000);
+        let (bvh, _) = Bvh::build(&b);
+        let (nan, inf) = (f32::NAN, f32::INFINITY);
+        // Aimed at a box.
+        let o = b[0].centroid() - Vec3A::new(200.0, 0.0, 0.0);
+        for (o, d) in [
+            (Vec3A::splat(nan), Vec3A::X),
+            (o, Vec3A::ZERO / 0.0),
+            (o, Vec3A::new(1.0, nan, 0.0)),
+            (Vec3A::splat(inf), -Vec3A::ONE.normalize()),
+            (Vec3A::new(-inf, o.y, o.z), Vec3A::X),
+        ] {
+            for t_max in [1e3, inf] {
+                let mut tests = 0;
+                let t = bvh.intersect(o, d, t_max, |_, _| {
+                    tests += 1;
+                    None
+                });
+                assert_eq!((t, tests), (t_max, 0), "closest hit, {o} {d}");
+                assert!(!bvh.any(o, d, t_max, |_| true), "any hit, {o} {d}");
+            }
+        }
+        // The same tree meets a finite ray along that line.
+        assert!(bvh.any(o, Vec3A::X, inf, |_| true));
     }
 
     #[test]
