@@ -106,6 +106,10 @@ impl Customs {
         self.refs.is_empty()
     }
 
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
     pub fn len(&self) -> usize {
         self.refs.len()
     }
