@@ -27,6 +27,7 @@ mod wide;
 
 use crate::math::Aabb;
 use build::{build_node, BuildPrim, PARALLEL_CUTOFF};
+use simd::Loops;
 use wide::{Line, WIDE16};
 
 /// Leaves hold at most this many primitives.
@@ -81,10 +82,8 @@ pub struct Bvh {
     root: u64,
     /// The most entries a traversal's stack holds at once ([`Bvh::stack_need`]).
     stack: usize,
-    /// Some node is 16 wide: trees without get loops that never look for one.
-    wide: bool,
-    /// The box tests this CPU has (a field is cheaper to read per ray than the feature checks).
-    level: u8,
+    /// The traversal loops this tree gets on this CPU (chosen once, in `Bvh::new`).
+    loops: Loops,
 }
 
 impl Bvh {
@@ -127,11 +126,10 @@ impl Bvh {
             nodes,
             root,
             stack: 0,
-            wide: false,
-            level: simd::level(),
+            loops: Loops::default(),
         };
         bvh.stack = bvh.stack_need();
-        bvh.wide = bvh.node_counts().1 > 0;
+        bvh.loops = Loops::choose(bvh.node_counts().1 > 0, bvh.stack);
         bvh
     }
 

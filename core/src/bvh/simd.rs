@@ -3,6 +3,7 @@
 //! for the widest instruction set the CPU has, and the unchecked float-to-index conversion of
 //! the build's binning.
 
+use super::stack::{stack_space, SMALL_STACK};
 use super::wide::Wide;
 use super::{Bvh, NARROW, WIDEST};
 use crate::math::{gamma, Vec3A};
@@ -242,10 +243,39 @@ pub(super) fn clamped_index(v: Vec3A, max: u8) -> [usize; 3] {
     x.map(|x| x.max(0.0).min(f32::from(max)) as usize)
 }
 
-/// The traversal loops (`Bvh::closest` and `Bvh::first`) compiled for the widest instruction
-/// set the CPU has, one loop per function and per width of tree: a function holding the loops
-/// of both widths was twice the code, and its 8-wide path 5–8 % slower in a render. Trees
-/// without 16-wide nodes get loops that never look for one.
+/// The traversal loops a tree gets: compiled for the widest instruction set this CPU has, one
+/// loop per function and per width of tree (a function holding the loops of both widths was
+/// twice the code, and its 8-wide path 5–8 % slower in a render), so trees without 16-wide
+/// nodes get loops that never look for one; `Deep` for trees whose stack does not fit the
+/// frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) enum Loops {
+    #[default]
+    Base8,
+    Base16,
+    Avx8,
+    Avx16,
+    Avx512,
+    Deep,
+}
+
+impl Loops {
+    /// The loops for a tree with or without 16-wide nodes whose traversal needs `stack`
+    /// entries, on this CPU. The `Avx` loops are chosen only here, and only when the CPU has
+    /// the instructions they are compiled for.
+    pub(super) fn choose(wide: bool, stack: usize) -> Loops {
+        match (level(), wide) {
+            _ if stack > SMALL_STACK => Loops::Deep,
+            (AVX512, true) => Loops::Avx512,
+            (AVX512 | AVX, false) => Loops::Avx8,
+            (AVX, true) => Loops::Avx16,
+            (_, true) => Loops::Base16,
+            (_, false) => Loops::Base8,
+        }
+    }
+}
+
+/// Each traversal through the loops its tree got ([`Loops`]).
 impl Bvh {
     #[inline(always)]
     pub(super) fn intersect_dispatch<F: FnMut(usize, f32) -> Option<f32>>(
@@ -255,36 +285,33 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
-        match (self.level, self.wide) {
+        match self.loops {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX-512F: `level` is `level()`'s answer, set in `Bvh::new`.
-            (AVX512, true) => unsafe {
-                self.intersect_avx512::<WIDEST, F>(origin, dir, t_max, test)
-            },
+            // SAFETY: the CPU has AVX-512F (`Loops::choose`, the only maker of `Avx512`).
+            Loops::Avx512 => unsafe { self.intersect_avx512(origin, dir, t_max, test) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (as above; every CPU with AVX-512F has AVX).
-            (AVX512 | AVX, false) => unsafe {
-                self.intersect_avx::<NARROW, F>(origin, dir, t_max, test)
-            },
+            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx8`).
+            Loops::Avx8 => unsafe { self.intersect_avx::<NARROW, F>(origin, dir, t_max, test) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (as above).
-            (AVX, true) => unsafe { self.intersect_avx::<WIDEST, F>(origin, dir, t_max, test) },
-            (_, true) => self.intersect_base::<WIDEST, F>(origin, dir, t_max, test),
-            (_, false) => self.intersect_base::<NARROW, F>(origin, dir, t_max, test),
+            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx16`).
+            Loops::Avx16 => unsafe { self.intersect_avx::<WIDEST, F>(origin, dir, t_max, test) },
+            Loops::Deep => self.intersect_deep(origin, dir, t_max, test),
+            Loops::Base16 => self.intersect_base::<WIDEST, F>(origin, dir, t_max, test),
+            _ => self.intersect_base::<NARROW, F>(origin, dir, t_max, test),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     #[inline(never)]
-    fn intersect_avx512<const MAXW: usize, F: FnMut(usize, f32) -> Option<f32>>(
+    fn intersect_avx512<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
         t_max: f32,
         test: F,
     ) -> f32 {
-        self.closest::<AVX512, MAXW, F>(origin, dir, t_max, test)
+        self.closest::<AVX512, WIDEST, F>(origin, dir, t_max, test, &mut stack_space())
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -297,7 +324,7 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
-        self.closest::<AVX, MAXW, F>(origin, dir, t_max, test)
+        self.closest::<AVX, MAXW, F>(origin, dir, t_max, test, &mut stack_space())
     }
 
     #[inline(always)]
@@ -308,32 +335,33 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
-        match (self.level, self.wide) {
+        match self.loops {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX-512F: `level` is `level()`'s answer, set in `Bvh::new`.
-            (AVX512, true) => unsafe { self.any_avx512::<WIDEST, F>(origin, dir, t_max, test) },
+            // SAFETY: the CPU has AVX-512F (`Loops::choose`, the only maker of `Avx512`).
+            Loops::Avx512 => unsafe { self.any_avx512(origin, dir, t_max, test) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (as above; every CPU with AVX-512F has AVX).
-            (AVX512 | AVX, false) => unsafe { self.any_avx::<NARROW, F>(origin, dir, t_max, test) },
+            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx8`).
+            Loops::Avx8 => unsafe { self.any_avx::<NARROW, F>(origin, dir, t_max, test) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (as above).
-            (AVX, true) => unsafe { self.any_avx::<WIDEST, F>(origin, dir, t_max, test) },
-            (_, true) => self.any_base::<WIDEST, F>(origin, dir, t_max, test),
-            (_, false) => self.any_base::<NARROW, F>(origin, dir, t_max, test),
+            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx16`).
+            Loops::Avx16 => unsafe { self.any_avx::<WIDEST, F>(origin, dir, t_max, test) },
+            Loops::Deep => self.any_deep(origin, dir, t_max, test),
+            Loops::Base16 => self.any_base::<WIDEST, F>(origin, dir, t_max, test),
+            _ => self.any_base::<NARROW, F>(origin, dir, t_max, test),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     #[inline(never)]
-    fn any_avx512<const MAXW: usize, F: FnMut(usize) -> bool>(
+    fn any_avx512<F: FnMut(usize) -> bool>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
         t_max: f32,
         test: F,
     ) -> bool {
-        self.first::<AVX512, MAXW, F>(origin, dir, t_max, test)
+        self.first::<AVX512, WIDEST, F>(origin, dir, t_max, test, &mut stack_space())
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -346,7 +374,7 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
-        self.first::<AVX, MAXW, F>(origin, dir, t_max, test)
+        self.first::<AVX, MAXW, F>(origin, dir, t_max, test, &mut stack_space())
     }
 }
 
@@ -361,13 +389,23 @@ pub(super) mod tests {
         Box<dyn Fn(Vec3A, Vec3A, f32, &mut dyn FnMut(usize) -> bool) -> bool + 'a>;
 
     impl Bvh {
-        /// Every traversal loop this CPU can run on this tree: (name, closest hit, any hit).
+        /// Every traversal loop this CPU can run on this tree: (name, closest hit, any hit);
+        /// the AVX-512 loop and the deep one on trees of either width.
         pub(in super::super) fn loops(&self) -> Vec<(&'static str, Closest<'_>, AnyHit<'_>)> {
-            if self.wide {
+            let mut v = if self.stack > SMALL_STACK {
+                // The others' stacks are too small for the tree.
+                Vec::new()
+            } else if self.node_counts().1 > 0 {
                 self.loops_of::<WIDEST>()
             } else {
                 self.loops_of::<NARROW>()
-            }
+            };
+            v.push((
+                "deep",
+                Box::new(|o, d, t, f| self.intersect_deep(o, d, t, f)),
+                Box::new(|o, d, t, f| self.any_deep(o, d, t, f)),
+            ));
+            v
         }
 
         fn loops_of<const W: usize>(&self) -> Vec<(&'static str, Closest<'_>, AnyHit<'_>)> {
@@ -391,9 +429,9 @@ pub(super) mod tests {
                     v.push((
                         "avx512",
                         // SAFETY: the CPU has AVX-512F (just checked).
-                        Box::new(|o, d, t, f| unsafe { self.intersect_avx512::<W, _>(o, d, t, f) }),
+                        Box::new(|o, d, t, f| unsafe { self.intersect_avx512(o, d, t, f) }),
                         // SAFETY: as above.
-                        Box::new(|o, d, t, f| unsafe { self.any_avx512::<W, _>(o, d, t, f) }),
+                        Box::new(|o, d, t, f| unsafe { self.any_avx512(o, d, t, f) }),
                     ));
                 }
             }

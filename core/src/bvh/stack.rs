@@ -14,7 +14,7 @@ use std::mem::MaybeUninit;
 /// case (15 entries per level of a `MAX_DEPTH` tree of 16-wide nodes, 30 KB) had every call
 /// touch (stack-probe) its eight pages, which cost 10–20 % of a ray's time.
 pub(super) struct Stack<'a, T> {
-    /// At least `Bvh::stack_need` entries.
+    /// `Bvh::stack_need` entries.
     entries: &'a mut [MaybeUninit<T>],
     /// Entries below `len` are initialised (private, so only `push` and `insert_sorted` raise
     /// it, each after writing the entry).
@@ -22,7 +22,8 @@ pub(super) struct Stack<'a, T> {
 }
 
 /// Entries of the stack in the traversal's frame (3 KB for closest-hit, so the frame stays
-/// within a page). The SPD scenes need 34–102 (teapot153).
+/// within a page). The SPD scenes need 34–102 (teapot153); trees that need more take loops
+/// with a stack on the heap (`Loops::Deep`).
 pub(super) const SMALL_STACK: usize = 192;
 
 /// The in-frame storage of a [`Stack`].
@@ -31,22 +32,20 @@ pub(super) fn stack_space<T: Copy>() -> [MaybeUninit<T>; SMALL_STACK] {
     [const { MaybeUninit::uninit() }; SMALL_STACK]
 }
 
+/// The heap storage of a [`Stack`] for a tree that needs more than [`SMALL_STACK`].
+pub(super) fn stack_vec<T: Copy>(bvh: &Bvh) -> Vec<MaybeUninit<T>> {
+    vec![MaybeUninit::uninit(); bvh.stack]
+}
+
 impl<'a, T: Copy> Stack<'a, T> {
-    /// A stack for a traversal of `bvh`: in `small`, or in `big` (sized here) when the tree
-    /// needs more.
+    /// A stack for a traversal of `bvh` in `space`, which must hold its `stack_need` entries
+    /// (checked).
     #[inline(always)]
-    pub(super) fn new(
-        bvh: &Bvh,
-        small: &'a mut [MaybeUninit<T>; SMALL_STACK],
-        big: &'a mut Vec<MaybeUninit<T>>,
-    ) -> Self {
-        let entries = if bvh.stack <= SMALL_STACK {
-            &mut small[..]
-        } else {
-            big.resize(bvh.stack, MaybeUninit::uninit());
-            &mut big[..]
-        };
-        Stack { entries, len: 0 }
+    pub(super) fn new(bvh: &Bvh, space: &'a mut [MaybeUninit<T>]) -> Self {
+        Stack {
+            entries: &mut space[..bvh.stack],
+            len: 0,
+        }
     }
 
     #[inline(always)]
@@ -102,9 +101,9 @@ impl Bvh {
     /// is below a node it holds at most the sum of (children − 1) of the nodes on the path
     /// down to it, and pushing a node's children reaches that sum plus one. The links a
     /// traversal follows are the tree's: an empty lane's inverted box is never hit by a ray
-    /// with finite coordinates, the only rays `Bvh::intersect` and `Bvh::any` trace. Nodes
-    /// form a tree (`collapse` makes one, and `from_words` checks that every node has one
-    /// parent), so the sums are taken down every path.
+    /// with finite coordinates, the only rays the loops (`Bvh::closest`, `Bvh::first`)
+    /// trace. Nodes form a tree (`collapse` makes one, and `from_words` checks that every
+    /// node has one parent), so the sums are taken down every path.
     pub(super) fn stack_need(&self) -> usize {
         let mut order = Vec::new();
         self.walk(|i, wide| order.push((i, wide)));
@@ -158,8 +157,8 @@ mod tests {
 
     /// A binary tree that is one long path (each inner node a leaf and an inner node, as
     /// the SAH makes of boxes spaced ever wider apart) collapses into a wide tree whose
-    /// traversal needs more stack than the frame holds; every loop finds the closest box and
-    /// any-hit tests every box once.
+    /// traversal needs more stack than the frame holds, so it gets the loops with a stack on
+    /// the heap: closest-hit finds the nearest box and any-hit tests every box once.
     #[test]
     fn a_deep_tree_gets_a_stack_large_enough() {
         let n = 600;
@@ -186,7 +185,12 @@ mod tests {
                 "{widest}: stack need {}",
                 bvh.stack
             );
+            assert_eq!(bvh.loops, super::super::Loops::Deep);
             let o = Vec3A::new(-1.0, 0.0, 0.0);
+            let t = bvh.intersect(o, Vec3A::X, f32::INFINITY, |p, tm| {
+                Some(b[p].min.x + 1.0).filter(|&t| t < tm)
+            });
+            assert_eq!(t, 1.0, "{widest}");
             for (name, closest, any) in bvh.loops() {
                 let t = closest(o, Vec3A::X, f32::INFINITY, &mut |p, tm| {
                     Some(b[p].min.x + 1.0).filter(|&t| t < tm)
