@@ -288,3 +288,60 @@ fn shading_switches_change_what_is_traced() {
     assert_eq!(count(&[], "occlusion"), 0);
     assert!(count(&["--ao", "4"], "occlusion") > 0);
 }
+
+/// Command-line errors are one `luxon: error:` line with status 1, like every other error;
+/// help and version print with status 0.
+#[test]
+fn command_line_errors_are_one_line_and_exit_1() {
+    for (args, want) in [
+        (
+            &["render", "--samples", "x", "s.ron"][..],
+            "luxon: error: invalid value 'x' for '--samples",
+        ),
+        (&["rendr"][..], "did you mean `render`?"),
+        (&["render"][..], "<SCENE>"),
+    ] {
+        let out = run(args);
+        let e = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: {e}");
+        assert!(
+            e.contains(want) && e.starts_with("luxon: error: "),
+            "{args:?}: {e}"
+        );
+    }
+    for args in [&["--help"][..], &["--version"], &["render", "--help"]] {
+        let out = run(args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(!out.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn loader_warnings_are_printed_by_render_and_check() {
+    let dir = temp_dir("loader-warnings");
+    // An OBJ polyline is defined by the format but not drawn: a warning, not an error.
+    let obj = dir.join("lines.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nl 1 2 3\n").unwrap();
+    let png = dir.join("lines.png");
+    for args in [
+        vec!["check", obj.to_str().unwrap()],
+        vec![
+            "render",
+            obj.to_str().unwrap(),
+            "--res",
+            "16x16",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+    ] {
+        let out = run(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let e = stderr(&out);
+        let line = e
+            .lines()
+            .find(|l| l.starts_with("luxon: warning: ") && l.contains("lines.obj:5:"))
+            .unwrap_or_else(|| panic!("no warning at lines.obj:5 in:\n{e}"));
+        assert!(line.contains("`l`"), "{line}");
+    }
+}

@@ -36,13 +36,15 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("origin", &["origin"]),
     ("leaves", &["error", "geometry", "spans", "raw"]),
     ("description", &["desc"]),
+    ("input", &["input"]),
     ("scanner", &["scanner"]),
     ("checks", &["validate", "ron_error"]),
     (
         "conversion",
         &["convert", "camera", "effects", "volume_render"],
     ),
-    ("importers", &["nff", "obj"]),
+    ("importers", &["nff", "obj", "tachyon"]),
+    ("includes", &["includes"]),
     ("formats", &["ron_scene", "spd"]),
     ("front door", &["load"]),
 ];
@@ -56,6 +58,57 @@ fn assert_layered(crate_dir: &str, layers: &[(&str, &[&str])]) {
         problems.len(),
         problems.join("\n")
     );
+}
+
+/// The layer table in a crate's documentation (rows `//! | layer | modules | ...`, in either
+/// order), as (layer, modules) bottom to top; module names are the words in backquotes or
+/// brackets, `main.rs` left out.
+fn documented_layers(lib_rs: &str) -> Vec<(String, Vec<String>)> {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(lib_rs))
+        .unwrap_or_else(|e| panic!("{lib_rs}: {e}"));
+    let mut rows: Vec<(String, Vec<String>)> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("//! |"))
+        .filter_map(|row| {
+            let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+            let (layer, modules) = (*cells.first()?, *cells.get(1)?);
+            if layer == "layer" || layer.starts_with('-') {
+                return None;
+            }
+            let names = modules
+                .split(',')
+                .filter_map(|m| {
+                    let m = m.split_whitespace().next()?;
+                    let m = m.trim_matches(|c| "`[]".contains(c));
+                    (m != "main.rs" && !m.is_empty()).then(|| m.to_string())
+                })
+                .collect();
+            Some((layer.to_string(), names))
+        })
+        .collect();
+    // core lists its layers top first, formats bottom first.
+    if rows.first().is_some_and(|(l, _)| l == "cli") {
+        rows.reverse();
+    }
+    rows
+}
+
+fn assert_documented(lib_rs: &str, layers: &[(&str, &[&str])]) {
+    let want: Vec<(String, Vec<String>)> = layers
+        .iter()
+        .map(|(l, ms)| (l.to_string(), ms.iter().map(|m| m.to_string()).collect()))
+        .collect();
+    assert_eq!(
+        documented_layers(lib_rs),
+        want,
+        "the layer table of {lib_rs} and this test's table differ"
+    );
+}
+
+#[test]
+fn the_documented_layer_tables_are_the_checked_ones() {
+    assert_documented("core/src/lib.rs", CORE);
+    assert_documented("formats/src/lib.rs", FORMATS);
 }
 
 #[test]

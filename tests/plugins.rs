@@ -209,3 +209,105 @@ fn plugins_command_lists_every_plugin_and_its_parameters() {
         assert!(s.contains(want), "missing `{want}` in:\n{s}");
     }
 }
+
+/// A library cut short (an interrupted copy) used to kill every run with SIGBUS inside `dlopen`,
+/// even runs that never used it: now it is skipped with its reason, and the run goes on.
+#[test]
+fn a_truncated_library_on_the_search_path_is_skipped_by_name() {
+    let dir = temp_dir("truncated");
+    let lib = install(&dir, "luxon_shapes", "luxon_trunc");
+    let full = std::fs::read(&lib).unwrap();
+    let scene = dir.join("scene.ron");
+    std::fs::write(
+        &scene,
+        "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), lights: [Point(position: (0, 5, -5))], \
+         objects: [(plugin: \"sphere\", params: (center: (0, 0, 0), radius: 1))], \
+         render: (width: 8, height: 8))",
+    )
+    .unwrap();
+    let out = dir.join("out.png");
+    for cut in [10, 1_000, 10_000, full.len() / 2, full.len() - 1] {
+        std::fs::write(&lib, &full[..cut]).unwrap();
+        let r = luxon()
+            .env("LUXON_PLUGIN_PATH", &dir)
+            .args([
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        let err = stderr(&r);
+        assert_eq!(r.status.code(), Some(0), "cut at {cut}: {err}");
+        assert!(
+            err.contains(&format!(
+                "luxon: warning: skipped plugin file {}: is ",
+                lib.display()
+            )) && err.contains("truncated"),
+            "cut at {cut}: {err}"
+        );
+        let r = luxon()
+            .env("LUXON_PLUGIN_PATH", &dir)
+            .arg("plugins")
+            .output()
+            .unwrap();
+        let listed = String::from_utf8_lossy(&r.stdout);
+        assert_eq!(r.status.code(), Some(0), "cut at {cut}: {}", stderr(&r));
+        assert!(
+            listed.contains(&format!(
+                "skipped {}: is a truncated ELF file: ",
+                lib.display()
+            )),
+            "cut at {cut}: {listed}"
+        );
+        assert!(listed.contains("primitive `sphere`"), "{listed}");
+    }
+}
+
+/// A FIFO or a directory named like a plugin is refused by its type (opening a FIFO would block).
+#[cfg(unix)]
+#[test]
+fn special_files_named_like_plugins_are_refused_by_type() {
+    let dir = temp_dir("special");
+    let name = |n: &str| {
+        dir.join(format!(
+            "{}{n}{}",
+            std::env::consts::DLL_PREFIX,
+            std::env::consts::DLL_SUFFIX
+        ))
+    };
+    let fifo = name("luxon_fifo");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    std::fs::create_dir(name("luxon_dir")).unwrap();
+    let mut child = luxon()
+        .env("LUXON_PLUGIN_PATH", &dir)
+        .arg("plugins")
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() > 20 {
+            let _ = child.kill();
+            panic!("`luxon plugins` hung on a FIFO");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let r = child.wait_with_output().unwrap();
+    let listed = String::from_utf8_lossy(&r.stdout);
+    assert!(r.status.success(), "{listed}");
+    assert!(
+        listed.contains(&format!(
+            "skipped {}: is a FIFO (named pipe); expected a plugin library (a regular file)",
+            fifo.display()
+        )),
+        "{listed}"
+    );
+    assert!(
+        listed.contains("luxon_dir") && listed.contains("is a directory"),
+        "{listed}"
+    );
+}

@@ -86,3 +86,46 @@ fn a_texture_drives_reflectivity() {
         "red {red}, black {black} of 4096"
     );
 }
+
+/// An image that turns out not to decode (its header is fine, its data cut short) used to render
+/// magenta with exit status 0, replacing the output; now the render fails naming the texture,
+/// and the existing output stays as it was.
+#[test]
+fn a_truncated_image_fails_the_render_and_keeps_the_output() {
+    let dir = temp_dir("truncated-texture");
+    let img = image::RgbImage::from_fn(64, 64, |x, y| {
+        image::Rgb([(x * 4) as u8, (y * 4) as u8, ((x * y) % 251) as u8])
+    });
+    img.save(dir.join("full.png")).unwrap();
+    let bytes = std::fs::read(dir.join("full.png")).unwrap();
+    std::fs::write(dir.join("half.png"), &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::write(dir.join("out.png"), b"earlier image").unwrap();
+    std::fs::write(
+        dir.join("t.ron"),
+        r#"Scene(
+    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),
+    lights: [Point(position: (0, 5, -5))],
+    textures: { "t": (plugin: "image", params: (file: "half.png", mapping: spherical, center: (0, 0, 0))) },
+    materials: { "m": (texture: "t") },
+    objects: [(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")],
+    render: (width: 16, height: 16, outputs: [(path: "out.png")]),
+)"#,
+    )
+    .unwrap();
+    let out = run(&["render", dir.join("t.ron").to_str().unwrap()]);
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("cannot decode image") && e.contains("half.png"),
+        "{e}"
+    );
+    assert!(
+        e.contains("t.ron:4:")
+            && e.contains("texture `t` (plugin `image`) failed during the render"),
+        "{e}"
+    );
+    assert_eq!(
+        std::fs::read(dir.join("out.png")).unwrap(),
+        b"earlier image"
+    );
+}

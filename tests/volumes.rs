@@ -263,11 +263,10 @@ fn real_mri_head() {
     assert_eq!(v.value([256, 0, 0]), 0.0);
     assert_eq!(v.value([0, 0, 109]), 0.0);
 
-    // Air around the head is stored as constant bricks, so the volume is smaller than the
-    // 256 x 256 x 112 voxels of its bricks stored densely.
+    // Air around the head (the background, 0) is not stored at all, so fewer bricks than the
+    // 32 x 32 x 14 of the grid are, and the volume is smaller than its bricks stored densely.
     let (dense, constant) = v.brick_counts();
-    assert_eq!(dense + constant, 32 * 32 * 14);
-    assert!(constant > 0, "no constant bricks");
+    assert!(dense + constant < 32 * 32 * 14, "{dense} + {constant}");
     assert!(
         v.memory_bytes() < 256 * 256 * 112 * 4,
         "{}",

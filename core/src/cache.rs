@@ -266,10 +266,13 @@ fn write_to(
     skeleton: &str,
     scene: &Scene,
 ) -> std::io::Result<()> {
-    let tmp = crate::files::temp_path(path, std::process::id())
-        .map_err(|e| std::io::Error::other(e.to_string()))?;
+    let mut tmp = crate::files::TempFile::create(path).map_err(|e| match e {
+        crate::Error::Io { source, .. } => source,
+        e => std::io::Error::other(e.to_string()),
+    })?;
+    // Removed on any error when `tmp` drops.
     let result = (|| {
-        let file = std::fs::File::create(&tmp)?;
+        let file = tmp.file().try_clone()?;
         let head_len = header(stamp, scene.world_offset, 0, 0).len() + 8;
         let mut o = Out {
             file: std::io::BufWriter::new(file),
@@ -331,13 +334,13 @@ fn write_to(
         let mut file = o.file.into_inner().map_err(|e| e.into_error())?;
         file.rewind()?;
         file.write_all(&head)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
+        file.sync_all()
     })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    result?;
+    tmp.rename().map_err(|e| match e {
+        crate::Error::Io { source, .. } => source,
+        e => std::io::Error::other(e.to_string()),
+    })
 }
 
 /// Looks for a current cache of `source`.

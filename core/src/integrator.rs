@@ -109,9 +109,8 @@ impl Whitted<'_> {
     /// Texture `t` at a surface point; a panicking plugin raises the scene's fault.
     fn texture(&self, t: u32, q: &TexQuery) -> [f32; 4] {
         let tex = &self.scene.textures[t as usize];
-        tex.eval(q).unwrap_or_else(|| {
-            let message = format!("plugin `{}` panicked evaluating a texture", tex.plugin);
-            self.scene.customs.fault.raise(message);
+        tex.eval(q).unwrap_or_else(|status| {
+            self.scene.customs.fault.raise(tex.failure(status));
             [0.0; 4]
         })
     }

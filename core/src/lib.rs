@@ -25,7 +25,7 @@
 //! | layer | modules | what they hold |
 //! |---|---|---|
 //! | cli | `main.rs`, `cli` (the binary) | the command line |
-//! | output | [`output`], [`sweep`] | writer plugins, asynchronous PPM output; accuracy sweeps |
+//! | output | [`output`], [`sweep`] | writer plugins, outputs committed all or nothing, asynchronous PPM output; accuracy sweeps |
 //! | render | [`render`] | a whole image in this process |
 //! | schedule | [`schedule`] | which thread or MPI rank renders which pixels |
 //! | integrator | [`integrator`] | a pixel's value: Whitted shading, volume marching, the pixel kernel |
@@ -51,6 +51,8 @@ pub mod bvh;
 pub mod cache;
 pub mod camera;
 pub mod error;
+// Locks on temporary output files (flock) and whether their process lives (kill 0).
+#[allow(unsafe_code)]
 pub mod files;
 pub mod framebuffer;
 pub mod geometry;

@@ -5,6 +5,7 @@
 
 mod cli;
 
+use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -91,15 +92,21 @@ fn check_cpu() {
             "luxon: error: this build needs an x86-64-v3 CPU (AVX2, FMA, BMI2), which this one is \
              not; rebuild for any x86-64 with RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release"
         );
-        std::process::exit(2);
+        std::process::exit(1);
     }
 }
 
+/// Exit statuses: 0 success (and `--help`, `--version`), 1 any error (command line included),
+/// 128 + n killed by signal n (see `cli::signals`).
 fn main() -> ExitCode {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     check_cpu();
     keep_large_blocks_returnable();
-    let cli = Cli::parse();
+    cli::signals::install();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(e),
+    };
     let result = match cli.command {
         Command::Render { scene, overrides } => cli::render::run(&scene, &overrides),
         Command::Sweep { scene, args } => cli::sweep::run(&scene, &args),
@@ -118,5 +125,38 @@ fn main() -> ExitCode {
             luxon::error::print_error(&e.to_string());
             ExitCode::FAILURE
         }
+    }
+}
+
+/// A command-line error as one `luxon: error:` line and status 1, like every other error;
+/// `--help` and `--version` print as usual with status 0, and `luxon` alone prints the help to
+/// stderr with status 1.
+fn usage_error(e: clap::Error) -> ExitCode {
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            eprint!("{}", e.render());
+            ExitCode::FAILURE
+        }
+        _ => {
+            let sub = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+            let sub = sub.filter(|a| Cli::command_names().any(|n| n == *a));
+            luxon::error::print_error(&cli::usage::one_line(&e.to_string(), sub.as_deref()));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+impl Cli {
+    fn command_names() -> impl Iterator<Item = String> {
+        use clap::CommandFactory;
+        Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect::<Vec<_>>()
+            .into_iter()
     }
 }

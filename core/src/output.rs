@@ -1,15 +1,18 @@
-//! Writing finished images through writer plugins. Every file is written to a temporary file in
-//! the same directory and renamed over the target, so an existing file is never left half-written.
+//! Writing finished images through writer plugins, all outputs or none ([`commit`]): every
+//! file is written to a temporary file beside its target, and the temporary files are renamed
+//! over their targets only when every one is complete, so a failed run leaves every existing
+//! file as it was.
 
 use crate::error::Error;
-use crate::files::write_atomic;
 use crate::framebuffer::Framebuffer;
-use crate::plugin::writer::encode_image;
 use crate::plugin::{Entry, PluginKind, Registry};
 use luxon_formats::OutputDesc;
 use std::path::{Path, PathBuf};
 
+pub mod commit;
 pub mod stream;
+
+pub use commit::OutputSet;
 
 /// An output with its writer resolved.
 #[derive(Clone)]
@@ -57,28 +60,16 @@ pub fn resolve<'r>(
         .collect()
 }
 
-/// Encodes and writes every output; returns the paths written.
+/// Encodes and writes every output, all or none; returns the paths written.
 pub fn write_all(
     outputs: &[Output],
     fb: &Framebuffer,
     registry: &Registry,
     scene_dir: &Path,
 ) -> Result<Vec<PathBuf>, Error> {
-    let mut written = Vec::new();
-    for o in outputs {
-        let bytes = encode_image(
-            registry,
-            o.writer,
-            &o.desc.params,
-            &o.desc.params_at,
-            scene_dir,
-            fb.width,
-            fb.height,
-            &fb.rgba,
-        )
-        .map_err(|(at, m)| Error::at(&at, m))?;
-        write_atomic(&o.desc.path, &bytes)?;
-        written.push(o.desc.path.clone());
+    let mut set = OutputSet::prepare(outputs, registry, scene_dir)?;
+    for (i, o) in outputs.iter().enumerate() {
+        set.encode(i, o, fb, registry, scene_dir)?;
     }
-    Ok(written)
+    set.commit()
 }

@@ -7,6 +7,11 @@
 //! trees (leaves and tiles) fit the same structure. Voxels no block or tile gave read as the
 //! background value.
 //!
+//! A brick is collapsed as soon as it is complete: one whose voxels all hold one value becomes a
+//! constant brick, and one whose voxels all hold the background is not stored at all (it reads
+//! as the background anyway). So memory follows the data's content, not the grid's size: an
+//! empty 1024³ grid costs its slot table (8 MiB), not the 4 GiB of its voxels.
+//!
 //! Everything a reader sends is checked before it is stored: `begin` exactly once and before any
 //! data, finite numbers only, an invertible transform, blocks inside the index box, no voxel
 //! given twice, and an index box of at most [`MAX_VOXELS`] voxels (checked before anything is
@@ -187,7 +192,7 @@ impl Volume {
             + self.plugin.capacity()
     }
 
-    /// Number of (dense, constant) bricks stored.
+    /// Number of (dense, constant) bricks stored (bricks of background voxels are not).
     pub fn brick_counts(&self) -> (usize, usize) {
         let dense = self
             .store
@@ -198,7 +203,8 @@ impl Volume {
     }
 
     /// The brick with brick coordinate `key` (voxel `ijk` lies in brick `ijk >> 3`, i.e.
-    /// `floor(ijk / 8)`), if any data reached it.
+    /// `floor(ijk / 8)`), if it is stored: `None` reads as the background (no data reached the
+    /// brick, or all of its voxels were given the background value).
     #[inline]
     pub fn brick(&self, key: [i64; 3]) -> Option<&Brick> {
         if !self.table.is_empty() {
@@ -213,7 +219,8 @@ impl Volume {
         self.slots.get(&key).map(|&s| &self.store[s as usize])
     }
 
-    /// Every stored brick with its brick coordinate, in no particular order.
+    /// Every stored brick with its brick coordinate, in no particular order; bricks that read
+    /// as the background are omitted.
     pub fn bricks(&self) -> impl Iterator<Item = ([i64; 3], &Brick)> {
         self.slots
             .iter()
@@ -244,6 +251,9 @@ pub struct VolumeBuilder {
     /// Which voxels were given, for bricks that are only partly given so far (bit `i` of the
     /// 512-bit mask is voxel `i` of the brick). A stored brick without a mask is complete.
     partial: BrickMap<[u64; 8]>,
+    /// Complete bricks of background voxels, which are not stored (`Given` remembers them so
+    /// that a voxel given twice is still an error).
+    skipped: Given,
     /// The first error; it stops the volume.
     failed: Option<String>,
 }
@@ -263,6 +273,7 @@ impl VolumeBuilder {
             plugin: plugin.to_string(),
             volume: None,
             partial: BrickMap::default(),
+            skipped: Given::Set(BrickMap::default()),
             failed: None,
         }
     }
@@ -359,6 +370,7 @@ impl VolumeBuilder {
                 extent.map(|e| e.to_string()).join("x")
             ));
         }
+        self.skipped = Given::new(index_min, index_max);
         self.volume = Some(Volume {
             name: self.name.clone(),
             grid_name: grid_name.to_string(),
@@ -464,7 +476,11 @@ impl VolumeBuilder {
                 (v, v)
             }
         };
-        store(volume, &mut self.partial, origin, dims, last, source, &what)?;
+        let sets = Sets {
+            partial: &mut self.partial,
+            skipped: &mut self.skipped,
+        };
+        store(volume, sets, origin, dims, last, source, &what)?;
         volume.voxels += count;
         volume.range = Some(match volume.range {
             Some((a, b)) => (a.min(lo), b.max(hi)),
@@ -474,7 +490,7 @@ impl VolumeBuilder {
     }
 
     /// The finished volume, or the first error. Dense bricks whose voxels all have one value
-    /// (given or background) become constant bricks.
+    /// (given or background) become constant bricks (complete bricks already are).
     pub fn finish(self) -> Result<Volume, String> {
         if let Some(first) = self.failed {
             return Err(format!(
@@ -530,6 +546,87 @@ fn voxel_of(origin: [i64; 3], dims: [u64; 3], i: usize) -> [i128; 3] {
     ]
 }
 
+/// A set of brick coordinates: a bitmap over the index box's bricks when they are few enough
+/// for a slot table (at most 2 MiB of bits), a hash set for sparse giants.
+enum Given {
+    Bits {
+        min: [i64; 3],
+        dims: [usize; 3],
+        words: Vec<u64>,
+    },
+    Set(BrickMap<()>),
+}
+
+impl Given {
+    fn new(index_min: [i64; 3], index_max: [i64; 3]) -> Given {
+        let lo = index_min.map(|c| c >> BRICK_SHIFT);
+        let hi = index_max.map(|c| c >> BRICK_SHIFT);
+        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
+        let n = dims.iter().product::<u64>();
+        if n > MAX_TABLE {
+            return Given::Set(BrickMap::default());
+        }
+        Given::Bits {
+            min: lo,
+            dims: dims.map(|d| d as usize),
+            words: vec![0; n.div_ceil(64) as usize],
+        }
+    }
+
+    /// Bit index of `key`, a brick of the index box.
+    fn bit(min: [i64; 3], dims: [usize; 3], key: [i64; 3]) -> usize {
+        let r = [0, 1, 2].map(|a| (key[a] - min[a]) as usize);
+        (r[2] * dims[1] + r[1]) * dims[0] + r[0]
+    }
+
+    fn contains(&self, key: [i64; 3]) -> bool {
+        match self {
+            Given::Bits { min, dims, words } => {
+                let i = Given::bit(*min, *dims, key);
+                words[i / 64] & (1 << (i % 64)) != 0
+            }
+            Given::Set(set) => set.contains_key(&key),
+        }
+    }
+
+    fn insert(&mut self, key: [i64; 3]) {
+        match self {
+            Given::Bits { min, dims, words } => {
+                let i = Given::bit(*min, *dims, key);
+                words[i / 64] |= 1 << (i % 64);
+            }
+            Given::Set(set) => {
+                set.insert(key, ());
+            }
+        }
+    }
+}
+
+/// The builder's bookkeeping that `store` updates besides the volume.
+struct Sets<'a> {
+    partial: &'a mut BrickMap<[u64; 8]>,
+    skipped: &'a mut Given,
+}
+
+/// The one value of a complete brick, if all its voxels hold the same bits (`-0.0` and `0.0`
+/// differ: a collapsed brick must read exactly as the voxels given).
+fn uniform(values: impl IntoIterator<Item = f32>) -> Option<f32> {
+    let mut it = values.into_iter();
+    let first = it.next()?;
+    it.all(|v| v.to_bits() == first.to_bits()).then_some(first)
+}
+
+/// Stores a complete brick whose voxels all hold `v`: nothing for the background, else a
+/// constant brick.
+fn store_uniform(volume: &mut Volume, skipped: &mut Given, key: [i64; 3], v: f32) {
+    if v.to_bits() == volume.background.to_bits() {
+        volume.bricks.remove(&key);
+        skipped.insert(key);
+    } else {
+        volume.bricks.insert(key, Brick::Constant(v));
+    }
+}
+
 /// Bits `from..from + n` of a 64-bit word (`n` in 1..=8).
 #[inline]
 fn run_bits(from: usize, n: usize) -> u64 {
@@ -539,7 +636,7 @@ fn run_bits(from: usize, n: usize) -> u64 {
 /// Cuts a checked block (inside the box, `last` its inclusive end) into bricks.
 fn store(
     volume: &mut Volume,
-    partial: &mut BrickMap<[u64; 8]>,
+    sets: Sets,
     origin: [i64; 3],
     dims: [u64; 3],
     last: [i64; 3],
@@ -548,6 +645,7 @@ fn store(
 ) -> Result<(), String> {
     let first_key = origin.map(|c| c >> BRICK_SHIFT);
     let last_key = last.map(|c| c >> BRICK_SHIFT);
+    let Sets { partial, skipped } = sets;
     let background = volume.background;
     for bz in first_key[2]..=last_key[2] {
         for by in first_key[1]..=last_key[1] {
@@ -560,16 +658,31 @@ fn store(
                 let whole =
                     (0..3).all(|a| lo[a] == brick_lo[a] && hi[a] == brick_lo[a] + BRICK_SIZE - 1);
                 let existing = volume.bricks.contains_key(&key);
-                if existing && !partial.contains_key(&key) {
+                if (existing && !partial.contains_key(&key)) || skipped.contains(key) {
                     return Err(format!(
                         "{what} gives voxel {lo:?} again (it was given before); expected every \
                          voxel at most once"
                     ));
                 }
+                // Offset in a dense source of voxel (lo[0], y, z).
+                let src_at = |y: i64, z: i64| {
+                    (((z - origin[2]) as u64 * dims[1] + (y - origin[1]) as u64) * dims[0]
+                        + (lo[0] - origin[0]) as u64) as usize
+                };
+                let n = (hi[0] - lo[0] + 1) as usize;
                 if !existing {
                     if whole {
-                        if let Source::Tile(v) = source {
-                            volume.bricks.insert(key, Brick::Constant(v));
+                        let one = match source {
+                            Source::Tile(v) => Some(v),
+                            Source::Dense(src) => uniform(
+                                (lo[2]..=hi[2])
+                                    .flat_map(|z| (lo[1]..=hi[1]).map(move |y| (y, z)))
+                                    .flat_map(|(y, z)| src[src_at(y, z)..src_at(y, z) + n].iter())
+                                    .copied(),
+                            ),
+                        };
+                        if let Some(v) = one {
+                            store_uniform(volume, skipped, key, v);
                             continue;
                         }
                     } else {
@@ -579,7 +692,6 @@ fn store(
                         .bricks
                         .insert(key, Brick::Dense(Box::new([background; BRICK_VOXELS])));
                 }
-                let n = (hi[0] - lo[0] + 1) as usize;
                 let mask = partial.get_mut(&key);
                 // Check the whole part first so a rejected block leaves the brick unchanged.
                 if let Some(mask) = mask.as_deref() {
@@ -614,11 +726,7 @@ fn store(
                         match source {
                             Source::Tile(v) => run.fill(v),
                             Source::Dense(src) => {
-                                let at = (((z - origin[2]) as u64 * dims[1]
-                                    + (y - origin[1]) as u64)
-                                    * dims[0]
-                                    + (lo[0] - origin[0]) as u64)
-                                    as usize;
+                                let at = src_at(y, z);
                                 run.copy_from_slice(&src[at..at + n]);
                             }
                         }
@@ -633,6 +741,9 @@ fn store(
                     }
                     if mask.iter().all(|&w| w == u64::MAX) {
                         partial.remove(&key);
+                        if let Some(v) = uniform(values.iter().copied()) {
+                            store_uniform(volume, skipped, key, v);
+                        }
                     }
                 }
             }
@@ -703,6 +814,58 @@ mod tests {
         assert!(matches!(v.brick([1, 0, 0]), Some(Brick::Dense(_))));
         assert_eq!(v.value([8, 0, 0]), 1.0);
         assert!(v.memory_bytes() >= 2048);
+    }
+
+    #[test]
+    fn background_bricks_are_not_stored_and_uniform_ones_are_constant() {
+        // 4x4x8 bricks: the lower half (z < 32) all background, the upper half all 0.5, sent
+        // as dense blocks of one slice of bricks each.
+        let fill = || {
+            let mut b = builder([0, 0, 0], [31, 31, 63]);
+            for z in (0..64).step_by(8) {
+                let v = if z < 32 { -1.0 } else { 0.5 };
+                b.add_dense([0, 0, z], [32, 32, 8], &vec![v; 32 * 32 * 8])
+                    .unwrap();
+            }
+            b
+        };
+        let e = fill().add_tile([3, 4, 5], [1, 1, 1], 2.0).unwrap_err();
+        assert!(e.contains("voxel [3, 4, 5] again"), "{e}");
+        let v = fill().finish().unwrap();
+        assert_eq!(v.brick_counts(), (0, 64));
+        assert_eq!(v.brick([0, 0, 0]), None);
+        assert!(v.memory_bytes() < 64 * 2048, "{}", v.memory_bytes());
+        for (ijk, want) in [([0, 0, 0], -1.0), ([31, 31, 31], -1.0), ([0, 0, 32], 0.5)] {
+            assert_eq!(v.value(ijk), want, "{ijk:?}");
+        }
+        assert_eq!(v.voxel_count(), 32 * 32 * 64);
+        assert_eq!(v.min_max(), (-1.0, 0.5));
+    }
+
+    #[test]
+    fn a_brick_completed_in_parts_collapses_when_complete() {
+        let fill = || {
+            let mut b = builder([0, 0, 0], [15, 7, 7]);
+            for z in 0..8 {
+                b.add_dense([0, 0, z], [16, 8, 1], &[-1.0; 128]).unwrap();
+            }
+            b
+        };
+        let e = fill().add_dense([9, 1, 1], [1, 1, 1], &[-1.0]).unwrap_err();
+        assert!(e.contains("voxel [9, 1, 1] again"), "{e}");
+        let v = fill().finish().unwrap();
+        assert_eq!(v.brick_counts(), (0, 0));
+        assert_eq!(v.value([9, 1, 1]), -1.0);
+    }
+
+    #[test]
+    fn negative_zero_is_not_the_background_zero() {
+        let mut b = VolumeBuilder::new("v", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [7; 3], "g").unwrap();
+        b.add_dense([0; 3], [8; 3], &[-0.0; 512]).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.brick_counts(), (0, 1));
+        assert!(v.value([1, 2, 3]).is_sign_negative());
     }
 
     #[test]

@@ -265,8 +265,8 @@ impl Checker<'_> {
                     return Err(self.error(
                         field(node, "fov"),
                         format!(
-                            "`fov` is {fov_deg}; expected degrees for a fisheye from 0 \
-                             (excluded) to 360"
+                            "`fov` is {}; expected degrees for a fisheye from 0 (excluded) to 360",
+                            self.literal(field(node, "fov"))
                         ),
                     ));
                 }
@@ -303,7 +303,8 @@ impl Checker<'_> {
                     return Err(self.error(
                         field(node, "fov"),
                         format!(
-                            "`fov` is {fov_deg}; expected degrees between 0 and 180 (both excluded)"
+                            "`fov` is {}; expected degrees between 0 and 180 (both excluded)",
+                            self.literal(field(node, "fov"))
                         ),
                     ));
                 }

@@ -1,8 +1,10 @@
 //! One file's serde values plus its span tree into checked `desc` values with positions.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use crate::desc::*;
+use crate::error::shown;
 use crate::raw;
 use crate::spans::Node;
 use crate::validate::Checker;
@@ -67,6 +69,9 @@ impl Checker<'_> {
             let node = field("lights").item(i).unwrap_or(root);
             part.lights.push(self.light(light, node)?);
         }
+        self.names_once(field("textures"), "texture", &scene.textures.0)?;
+        self.names_once(field("materials"), "material", &scene.materials.0)?;
+        self.names_once(field("clip_groups"), "clip group", &scene.clip_groups.0)?;
         for (i, (name, texture)) in scene.textures.0.into_iter().enumerate() {
             let (key, node) = field("textures").entry(i).unwrap_or((root, root));
             let plugin = self.plugin_name(
@@ -151,6 +156,31 @@ impl Checker<'_> {
             part.outputs = outputs;
         }
         Ok(part)
+    }
+
+    /// Each name of a map (`node`, holding `entries`) once: a second definition in the same
+    /// file is an error at its key, naming the first (a file that includes this one may still
+    /// redefine the name: later files win).
+    fn names_once<T>(&self, node: &Node, what: &str, entries: &[(String, T)]) -> Result<()> {
+        let mut seen: HashMap<&str, usize> = HashMap::new();
+        for (i, (name, _)) in entries.iter().enumerate() {
+            if let Some(&first) = seen.get(name.as_str()) {
+                let at = |k| node.entry(k).map_or(node, |(key, _)| key);
+                let first = self.origin(at(first));
+                return Err(self.error(
+                    at(i),
+                    format!(
+                        "{what} `{}` is defined twice in this file (first at {}:{}); expected \
+                         each name once (a file that includes this one may redefine it)",
+                        shown(name),
+                        first.line,
+                        first.col
+                    ),
+                ));
+            }
+            seen.insert(name, i);
+        }
+        Ok(())
     }
 
     /// A plugin name and its `params` text, verbatim; "()" at the entry when absent.
@@ -259,9 +289,10 @@ impl Checker<'_> {
         }
         let min_weight = r.min_weight.unwrap_or(d.min_weight);
         if !(0.0..1.0).contains(&min_weight) {
+            let written = self.literal(field("min_weight"));
             return Err(self.error(
                 field("min_weight"),
-                format!("`min_weight` is {min_weight}; expected at least 0 and less than 1"),
+                format!("`min_weight` is {written}; expected at least 0 and less than 1"),
             ));
         }
         let mut outputs = Vec::new();
@@ -318,7 +349,7 @@ impl Checker<'_> {
                             sub("threshold"),
                             format!(
                                 "`threshold` is {}; expected a number of at least 0 (a colour difference, e.g. 0.05)",
-                                a.threshold
+                                self.literal(sub("threshold"))
                             ),
                         ));
                     }

@@ -5,6 +5,7 @@
 
 use std::path::PathBuf;
 
+pub use crate::error::Warning;
 use crate::geometry::InlineGeometry;
 pub use crate::origin::{Origin, Spanned};
 
@@ -44,6 +45,9 @@ pub struct SceneDesc {
     pub render: RenderDesc,
     /// Extra plugin directories (or files), already resolved against the scene file's directory.
     pub plugin_path: Vec<PathBuf>,
+    /// Problems that did not stop the load (an OBJ's missing material library, an NFF sphere
+    /// with a negative radius...), in the order found. The CLI prints them.
+    pub warnings: Vec<Warning>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -10,6 +10,9 @@ use crate::origin::{Origin, Spanned};
 pub struct InlineGeometry {
     /// Material name; `None`: the built-in default material.
     pub material: Option<Spanned<String>>,
+    /// Clip group name (the scene's `clip_groups`): the geometry is cut away on the far side of
+    /// its planes; `None`: not clipped.
+    pub clip: Option<Spanned<String>>,
     /// Where the geometry came from (first primitive), for messages.
     pub at: Option<Origin>,
     /// x, y, z, radius.

@@ -3,7 +3,7 @@
 //! ## The API
 //!
 //! [`load`] reads any supported file, [`load_ron_str`] RON text; both give a [`SceneDesc`]
-//! (module [`desc`]) or a [`SceneError`]. The importers are [`nff`] and [`obj`]; [`spd`]
+//! (module [`desc`]) or a [`SceneError`]. The importers are [`nff`], [`obj`] and [`tachyon`]; [`spd`]
 //! generates the SPD scenes; [`geometry`] holds the inline arrays importers hand the core.
 //!
 //! Modules import only modules of lower layers (bottom first; `tests/layers.rs` keeps this):
@@ -13,10 +13,12 @@
 //! | origin      | `origin`                                         |
 //! | leaves      | `error`, `geometry`, `spans`, `raw`              |
 //! | description | `desc`                                           |
+//! | input       | `input`                                          |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
 //! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
-//! | importers   | `nff`, `obj`                                     |
+//! | importers   | `nff`, `obj`, `tachyon`                          |
+//! | includes    | `includes`                                       |
 //! | formats     | `ron_scene`, `spd`                               |
 //! | front door  | `load`                                           |
 
@@ -28,6 +30,8 @@ pub mod desc;
 mod effects;
 mod error;
 pub mod geometry;
+mod includes;
+pub mod input;
 mod load;
 pub mod nff;
 pub mod obj;
@@ -38,11 +42,14 @@ mod ron_scene;
 mod scanner;
 mod spans;
 pub mod spd;
+pub mod tachyon;
 mod validate;
 mod volume_render;
 
 pub use desc::*;
-pub use error::{suggest, SceneError};
+pub use error::{shown, suggest, SceneError, Warning};
 pub use geometry::{InlineGeometry, InlineMesh};
-pub use load::load;
-pub use ron_scene::load_ron_str;
+pub use includes::MAX_DEPTH as MAX_INCLUDE_DEPTH;
+pub use input::{DiskSource, LoadOptions, MemorySource, Source};
+pub use load::{load, load_with};
+pub use ron_scene::{load_ron_str, load_ron_with};

@@ -4,17 +4,26 @@ use std::path::Path;
 
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
-use crate::{nff, obj, ron_scene};
+use crate::input::{DiskSource, LoadOptions};
+use crate::{nff, obj, ron_scene, tachyon};
 
 /// Loads a scene file, choosing the format by its extension (`.ron`; `.nff` and `.nff.gz`
 /// through the [`nff`] importer; `.obj` (with its `.mtl` files) through the [`obj`] importer;
-/// any case).
+/// `.dat` through the [`tachyon`] importer; any case), within the default [`LoadOptions`].
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] within the limits of `options`.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneError> {
     if nff::is_nff_path(path) {
         return nff::load(path);
     }
     if obj::is_obj_path(path) {
         return obj::load(path);
+    }
+    if tachyon::is_tachyon_path(path) {
+        return tachyon::load(path);
     }
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !extension.eq_ignore_ascii_case("ron") {
@@ -23,7 +32,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             e => format!("unsupported scene file extension `.{e}`"),
         };
         let message = format!(
-            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`",
+            "{found}; expected one of {}, `.nff`, `.nff.gz`, `.obj`, `.dat` (Tachyon)",
             ron_scene::supported_extensions()
         );
         return Err(SceneError::Io {
@@ -31,9 +40,5 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             source: std::io::Error::new(std::io::ErrorKind::Unsupported, message),
         });
     }
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    ron_scene::load_ron_str(&text, path)
+    ron_scene::load_ron_with(&mut DiskSource, path, options)
 }

@@ -15,9 +15,13 @@
 //!   `Ns` the shininess, `d` (or `Tr`) the transmission `1 - d` (`Tr`), `Ni` the index of
 //!   refraction. Colours are taken as linear. Textures are not read.
 //! - A missing or broken `.mtl` file is a warning, not an error: its faces get Luxon's default
-//!   material (so does `usemtl` of a name no `.mtl` file defines).
-//! - Errors (missing file, bad numbers, bad faces, indices out of bounds) name the file and,
-//!   where it can be found, the line.
+//!   material (so does `usemtl` of a name no `.mtl` file defines). A material defined twice
+//!   takes its last definition, with a warning.
+//! - Lines (`l`) and points (`p`) are left out with a warning that counts them: Luxon draws
+//!   faces only.
+//! - Errors (missing file, not a regular file, not text, bad numbers, faces with fewer than 3
+//!   corners or indices out of bounds) name the file and, where it can be found, the line.
+//!   Warnings go to the import's (and the scene's) `warnings`.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -26,11 +30,14 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use luxon_plugin::files::{open_regular, TextReader};
+
 use crate::desc::{
     CameraDesc, LightDesc, MaterialDesc, Origin, Projection, RenderDesc, SceneDesc, Spanned,
 };
-use crate::error::SceneError;
+use crate::error::{shown, SceneError, Warning};
 use crate::geometry::{InlineGeometry, InlineMesh};
+use crate::input::{file_error, FileError, MTL_MAX_BYTES, OBJ_MAX_LINE};
 
 /// What an OBJ file held.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -39,8 +46,8 @@ pub struct ObjImport {
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
     /// One triangle mesh per OBJ object/group and material (empty ones left out).
     pub geometry: Vec<InlineGeometry>,
-    /// Problems that did not stop the import (a missing `.mtl` file...), as sentences.
-    pub warnings: Vec<String>,
+    /// Problems that did not stop the import (a missing `.mtl` file...).
+    pub warnings: Vec<Warning>,
 }
 
 /// True for names ending in `.obj` (any case).
@@ -63,11 +70,10 @@ pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError
         materials,
         mut warnings,
     } = file.parse()?;
-    let origin = file.origin();
-    let (names, materials) = named_materials(path, &materials, &origin);
+    let (names, materials) = named_materials(&file, &materials, &mut warnings);
     let geometry = models
         .into_iter()
-        .filter_map(|model| mesh_of_model(model, &names, &origin, path, &mut warnings))
+        .filter_map(|model| mesh_of_model(model, &names, &file, &mut warnings))
         .collect();
     Ok(ObjImport {
         materials,
@@ -76,12 +82,12 @@ pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError
     })
 }
 
-/// What tobj read: the models, the MTL materials and warnings about MTL files that could not
-/// be read.
+/// What tobj read: the models, the MTL materials and warnings (MTL files that could not be
+/// read, statements Luxon does not draw).
 struct Parsed {
     models: Vec<tobj::Model>,
     materials: Vec<tobj::Material>,
-    warnings: Vec<String>,
+    warnings: Vec<Warning>,
 }
 
 /// The OBJ file being read and where a scene names it (if one does): places its errors.
@@ -105,10 +111,12 @@ impl ObjFile<'_> {
         self.at.cloned().unwrap_or_else(|| self.line_origin(1))
     }
 
-    /// An error at `line` of the OBJ file (0: no line known).
-    fn fail(&self, line: u32, message: String) -> SceneError {
+    /// Where a problem at `line` of the OBJ file (0: no line known) is reported, and the
+    /// message saying so: at the scene's mention of the file, naming the line, if a scene
+    /// names it; else at the line.
+    fn place(&self, line: u32, message: String) -> (Origin, String) {
         match self.at {
-            Some(at) => SceneError::at(
+            Some(at) => (
                 at.clone(),
                 if line > 0 {
                     format!("in mesh file {}:{line}: {message}", self.path.display())
@@ -116,28 +124,53 @@ impl ObjFile<'_> {
                     format!("mesh file `{}`: {message}", self.path.display())
                 },
             ),
-            None => SceneError::at(self.line_origin(line.max(1)), message),
+            None => (self.line_origin(line.max(1)), message),
         }
     }
 
-    /// The file through tobj.
-    fn parse(&self) -> Result<Parsed, SceneError> {
-        let file = File::open(self.path).map_err(|e| match self.at {
-            Some(_) => self.fail(
-                0,
-                format!("cannot read it: {e}; expected a Wavefront .obj file"),
+    /// An error at `line` of the OBJ file (0: no line known).
+    fn fail(&self, line: u32, message: String) -> SceneError {
+        let (at, message) = self.place(line, message);
+        SceneError::at(at, message)
+    }
+
+    /// A warning at `line` of the OBJ file (0: no line known).
+    fn warn(&self, line: u32, message: String) -> Warning {
+        let (at, message) = self.place(line, message);
+        Warning { at, message }
+    }
+
+    /// The file could not be read (as a whole, or at a line of its text).
+    fn unreadable(&self, e: FileError) -> SceneError {
+        match (self.at, e.position()) {
+            (None, _) => file_error(e, self.path, "a Wavefront .obj file"),
+            (Some(_), Some((line, _))) => {
+                self.fail(to_u32(line), e.explain("a Wavefront .obj file"))
+            }
+            (Some(at), None) => SceneError::at(
+                at.clone(),
+                format!(
+                    "mesh file {}",
+                    e.sentence(self.path, "a Wavefront .obj file")
+                ),
             ),
-            None => SceneError::Io {
-                path: self.path.to_path_buf(),
-                source: e,
-            },
-        })?;
-        let mut reader = Counting {
-            inner: BufReader::with_capacity(1 << 16, file),
-            newlines: 0,
-            last: b'\n',
-        };
-        let warnings = RefCell::new(Vec::new());
+        }
+    }
+
+    /// The file as text, line by line: a regular file, lines of bounded length.
+    fn open(&self) -> Result<TextReader<BufReader<File>>, SceneError> {
+        let (file, _) = open_regular(self.path, u64::MAX).map_err(|e| self.unreadable(e))?;
+        Ok(TextReader::new(
+            BufReader::with_capacity(1 << 16, file),
+            OBJ_MAX_LINE,
+        ))
+    }
+
+    /// The file through tobj, after our own pass over it (`prescan`).
+    fn parse(&self) -> Result<Parsed, SceneError> {
+        let scan = self.prescan()?;
+        let mut reader = WithoutLines::new(self.open()?);
+        let warnings = RefCell::new(scan.warnings);
         let dir = self.path.parent().unwrap_or(Path::new("")).to_path_buf();
         // The update fills the fields tobj's optional features (merging, reordering) add.
         #[allow(clippy::needless_update)]
@@ -148,41 +181,36 @@ impl ObjFile<'_> {
             ignore_lines: true,
             ..Default::default()
         };
-        // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): faces
-        // are checked first by our own scan (one more pass over the file), and a panic in tobj
-        // all the same becomes an error.
-        if let Some((line, detail)) = find_bad_face(self.path) {
-            return Err(self.fail(line, detail));
-        }
+        // tobj 4.0.5 overflows on absurd face indices (`vt * 2 + 1`, found by fuzzing): the
+        // prescan rejects those first, and a panic in tobj all the same becomes an error.
         let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
+                let line = scan
+                    .mtllibs
+                    .iter()
+                    .find(|(name, _)| Path::new(name) == mtl)
+                    .map_or(0, |(_, line)| *line);
                 let full = dir.join(mtl);
-                match tobj::load_mtl(&full) {
-                    Ok(r) => Ok(r),
-                    Err(e) => {
-                        let why = match e {
-                            tobj::LoadError::OpenFileFailed => "cannot open it".to_string(),
-                            e => format!("cannot read it ({e})"),
-                        };
-                        warnings.borrow_mut().push(format!(
-                            "{}: material library `{}`: {why}; its materials are replaced by the \
-                     default material",
-                            self.path.display(),
+                Ok(read_mtl(&full).unwrap_or_else(|why| {
+                    warnings.borrow_mut().push(self.warn(
+                        line,
+                        format!(
+                            "cannot use material library `{}`: {why}; its materials are \
+                             replaced by the default material",
                             full.display()
-                        ));
-                        Ok((Vec::new(), Default::default()))
-                    }
-                }
+                        ),
+                    ));
+                    (Vec::new(), Default::default())
+                }))
             })
         }))
         .map_err(|_| {
-            let (line, detail) = find_bad_face(self.path).unwrap_or((
+            self.fail(
                 0,
                 "a face index is out of range; expected indices of defined vertices".to_string(),
-            ));
-            self.fail(line, detail)
+            )
         })?;
-        let (models, materials) = loaded.map_err(|e| self.tobj_error(e, reader.line()))?;
+        let (models, materials) = loaded.map_err(|e| self.tobj_error(e, reader.line))?;
         Ok(Parsed {
             models,
             materials: materials.unwrap_or_default(),
@@ -191,53 +219,242 @@ impl ObjFile<'_> {
     }
 
     /// tobj's error, found while reading line `line`, as ours.
-    fn tobj_error(&self, e: tobj::LoadError, line: u32) -> SceneError {
+    fn tobj_error(&self, e: tobj::LoadError, line: u64) -> SceneError {
+        // `line` counts from 1; 0 (nothing read yet) means no line is known.
+        let line = to_u32(line);
         match e {
-            tobj::LoadError::FaceVertexOutOfBounds
-            | tobj::LoadError::FaceTexCoordOutOfBounds
-            | tobj::LoadError::FaceNormalOutOfBounds
-            | tobj::LoadError::FaceColorOutOfBounds => {
-                // tobj finds these when a group ends: look for the face ourselves.
-                let (line, detail) = find_bad_face(self.path).unwrap_or((0, e.to_string()));
-                self.fail(line, detail)
+            tobj::LoadError::ReadError => {
+                self.fail(line, "cannot read it (not UTF-8 text?)".into())
             }
-            tobj::LoadError::ReadError => self.fail(0, "cannot read it (not UTF-8 text?)".into()),
             e => self.fail(
                 line,
                 format!("{e}; expected OBJ statements such as `v x y z`, `f 1 2 3`"),
             ),
         }
     }
+
+    /// One pass over the file before tobj's: the first face tobj would mishandle (an index
+    /// out of range, which tobj reports without a line or overflows on; fewer than 3
+    /// corners, which tobj drops silently) is an error at its line, and so is a line that is
+    /// not text; `l` and `p` statements (lines and points, which Luxon does not draw) are
+    /// counted for a warning; `mtllib` lines are noted to place warnings about them.
+    fn prescan(&self) -> Result<Prescan, SceneError> {
+        let mut reader = self.open()?;
+        let mut out = Prescan::default();
+        let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
+        let mut ignored: [(u64, u32); 2] = [(0, 0); 2];
+        let mut bytes = Vec::new();
+        for line in 1u32.. {
+            bytes.clear();
+            let n = reader
+                .read_until(b'\n', &mut bytes)
+                .map_err(|e| self.unreadable(FileError::from_io(e)))?;
+            if n == 0 {
+                break;
+            }
+            let Ok(text) = std::str::from_utf8(&bytes) else {
+                return Err(self.fail(line, "cannot read it: the line is not UTF-8 text".into()));
+            };
+            let mut words = text.split_whitespace();
+            match words.next() {
+                Some("v") => v += 1,
+                Some("vt") => vt += 1,
+                Some("vn") => vn += 1,
+                Some("f") => {
+                    if let Some(detail) = bad_face(words, [v, vt, vn]) {
+                        return Err(self.fail(line, detail));
+                    }
+                }
+                Some(k @ ("l" | "p")) => {
+                    let slot = &mut ignored[usize::from(k == "p")];
+                    if slot.0 == 0 {
+                        slot.1 = line;
+                    }
+                    slot.0 += 1;
+                }
+                Some("mtllib") => {
+                    // The name as tobj takes it: the rest of the line after the first space.
+                    let name = text.split_once(' ').unwrap_or_default().1.trim();
+                    out.mtllibs.push((name.to_string(), line));
+                }
+                _ => {}
+            }
+        }
+        for ((count, line), what) in ignored.into_iter().zip(["line (`l`)", "point (`p`)"]) {
+            if count > 0 {
+                out.warnings.push(self.warn(
+                    line,
+                    format!(
+                        "{count} {what} statement(s), the first here: Luxon draws faces only, \
+                         so they are left out"
+                    ),
+                ));
+            }
+        }
+        Ok(out)
+    }
 }
 
-/// The MTL materials as Luxon materials named `obj:<file stem>:<mtl name>`, with those names
-/// in MTL order (a model's `material_id` indexes them).
+/// The OBJ text as tobj reads it, a line at a time, with `l` statements blanked: tobj takes a
+/// polyline of 3 or more points for a face, and Luxon draws no lines (they are counted for a
+/// warning by the prescan). Counts the lines handed out.
+struct WithoutLines<R> {
+    inner: R,
+    buf: Vec<u8>,
+    pos: usize,
+    /// The line in `buf` (1-based; 0 before the first).
+    line: u64,
+}
+
+impl<R: BufRead> WithoutLines<R> {
+    fn new(inner: R) -> WithoutLines<R> {
+        WithoutLines {
+            inner,
+            buf: Vec::new(),
+            pos: 0,
+            line: 0,
+        }
+    }
+}
+
+impl<R: BufRead> Read for WithoutLines<R> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let n = {
+            let buf = self.fill_buf()?;
+            let n = buf.len().min(out.len());
+            out[..n].copy_from_slice(&buf[..n]);
+            n
+        };
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for WithoutLines<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if self.pos == self.buf.len() {
+            self.buf.clear();
+            self.pos = 0;
+            if self.inner.read_until(b'\n', &mut self.buf)? > 0 {
+                self.line += 1;
+                let first = self
+                    .buf
+                    .split(u8::is_ascii_whitespace)
+                    .find(|w| !w.is_empty());
+                if first == Some(b"l") {
+                    let newline = self.buf.ends_with(b"\n");
+                    self.buf.clear();
+                    if newline {
+                        self.buf.push(b'\n');
+                    }
+                }
+            }
+        }
+        Ok(&self.buf[self.pos..])
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.pos = (self.pos + amt).min(self.buf.len());
+    }
+}
+
+/// What the prescan found besides errors.
+#[derive(Default)]
+struct Prescan {
+    /// `mtllib` names and their lines.
+    mtllibs: Vec<(String, u32)>,
+    warnings: Vec<Warning>,
+}
+
+/// What is wrong with a face (the words after `f`), given the counts of vertices, texture
+/// coordinates and normals defined so far.
+fn bad_face<'a>(words: impl Iterator<Item = &'a str>, counts: [i64; 3]) -> Option<String> {
+    let mut corners = 0;
+    for word in words {
+        corners += 1;
+        for (k, part) in word.split('/').enumerate().take(3) {
+            let Ok(index) = part.parse::<i64>() else {
+                continue;
+            };
+            let count = counts[k];
+            let what = ["vertex", "texture coordinate", "normal"][k];
+            let resolved = if index < 0 { count + index + 1 } else { index };
+            if resolved < 1 || resolved > count {
+                return Some(format!(
+                    "face {what} index {index} is out of bounds; expected 1 to {count} (or -1 \
+                     to -{count}: relative to the last one) with {count} defined so far"
+                ));
+            }
+        }
+    }
+    (corners < 3).then(|| format!("a face needs at least 3 vertices, found {corners}"))
+}
+
+/// An MTL file's materials, or why it cannot be used.
+fn read_mtl(path: &Path) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), String> {
+    let text =
+        luxon_plugin::files::read_text(path, MTL_MAX_BYTES).map_err(|e| format!("it {e}"))?;
+    let mut reader = TextReader::new(text.as_bytes(), OBJ_MAX_LINE);
+    tobj::load_mtl_buf(&mut reader).map_err(|e| format!("it cannot be read ({e})"))
+}
+
+fn to_u32(n: u64) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+
+/// The MTL materials as Luxon materials named `obj:<file stem>:<mtl name>`, in MTL order,
+/// and per MTL material its name (a model's `material_id` indexes them). A name defined
+/// twice (in one library or two) keeps its first place and takes the last definition, with
+/// a warning.
 fn named_materials(
-    path: &Path,
+    file: &ObjFile,
     materials: &[tobj::Material],
-    origin: &Origin,
+    warnings: &mut Vec<Warning>,
 ) -> (Vec<String>, Vec<(String, Spanned<MaterialDesc>)>) {
-    let stem = path
+    let stem = file
+        .path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let origin = file.origin();
     let names: Vec<String> = materials
         .iter()
         .map(|m| format!("obj:{stem}:{}", m.name))
         .collect();
-    let out = materials
-        .iter()
-        .zip(&names)
-        .map(|(m, name)| {
-            (
-                name.clone(),
-                Spanned {
-                    value: material_of_mtl(m),
-                    at: origin.clone(),
-                },
-            )
-        })
-        .collect();
+    let mut out: Vec<(String, Spanned<MaterialDesc>)> = Vec::new();
+    let mut place: HashMap<&str, usize> = HashMap::new();
+    // The first name defined again, and how many more definitions repeat a name.
+    let mut repeated: Option<(&str, usize)> = None;
+    for (m, name) in materials.iter().zip(&names) {
+        let material = Spanned {
+            value: material_of_mtl(m),
+            at: origin.clone(),
+        };
+        match place.get(name.as_str()) {
+            Some(&i) => {
+                repeated.get_or_insert((&m.name, 0)).1 += 1;
+                out[i].1 = material;
+            }
+            None => {
+                place.insert(name, out.len());
+                out.push((name.clone(), material));
+            }
+        }
+    }
+    if let Some((name, count)) = repeated {
+        let more = match count {
+            1 => String::new(),
+            n => format!(" ({} more repeated definitions)", n - 1),
+        };
+        warnings.push(file.warn(
+            0,
+            format!(
+                "material `{}` is defined more than once in its material libraries; the last \
+                 definition is used{more}",
+                shown(name)
+            ),
+        ));
+    }
     (names, out)
 }
 
@@ -246,10 +463,10 @@ fn named_materials(
 fn mesh_of_model(
     model: tobj::Model,
     names: &[String],
-    origin: &Origin,
-    path: &Path,
-    warnings: &mut Vec<String>,
+    file: &ObjFile,
+    warnings: &mut Vec<Warning>,
 ) -> Option<InlineGeometry> {
+    let origin = &file.origin();
     let m = model.mesh;
     if m.indices.len() < 3 {
         return None;
@@ -271,11 +488,13 @@ fn mesh_of_model(
             .collect()
     } else {
         if !m.normals.is_empty() {
-            warnings.push(format!(
-                "{}: object `{}` gives normals for some vertices only; computed smooth \
-                 normals for all",
-                path.display(),
-                model.name
+            warnings.push(file.warn(
+                0,
+                format!(
+                    "object `{}` gives normals for some vertices only; computed smooth \
+                     normals for all",
+                    shown(&model.name)
+                ),
             ));
         }
         smooth_normals(&positions, &indices)
@@ -380,111 +599,11 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-/// The first face with an index out of range: (line, message).
-fn find_bad_face(path: &Path) -> Option<(u32, String)> {
-    let bytes = std::fs::read(path).ok()?;
-    let text = String::from_utf8_lossy(&bytes);
-    let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
-    for (i, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => v += 1,
-            Some("vt") => vt += 1,
-            Some("vn") => vn += 1,
-            Some("f") => {
-                for word in words {
-                    for (k, part) in word.split('/').enumerate().take(3) {
-                        if part.is_empty() {
-                            continue;
-                        }
-                        let Ok(index) = part.parse::<i64>() else {
-                            continue;
-                        };
-                        let (count, what) = match k {
-                            0 => (v, "vertex"),
-                            1 => (vt, "texture coordinate"),
-                            _ => (vn, "normal"),
-                        };
-                        let resolved = if index < 0 { count + index + 1 } else { index };
-                        if resolved < 1 || resolved > count {
-                            return Some((
-                                u32::try_from(i + 1).unwrap_or(u32::MAX),
-                                format!(
-                                    "face {what} index {index} is out of bounds; expected 1 to \
-                                     {count} (or -1 to -{count}: relative to the last one) with \
-                                     {count} defined so far"
-                                ),
-                            ));
-                        }
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    None
-}
-
-/// Counts the lines a `BufRead` hands out, to place tobj's parse errors.
-struct Counting<R> {
-    inner: R,
-    newlines: u64,
-    last: u8,
-}
-
-impl<R: BufRead> Counting<R> {
-    /// The line being read (the last one handed out).
-    fn line(&self) -> u32 {
-        let line = if self.last == b'\n' {
-            self.newlines
-        } else {
-            self.newlines + 1
-        };
-        u32::try_from(line.max(1)).unwrap_or(u32::MAX)
-    }
-
-    fn count(&mut self, bytes: &[u8]) {
-        self.newlines += bytes.iter().filter(|&&b| b == b'\n').count() as u64;
-        if let Some(&b) = bytes.last() {
-            self.last = b;
-        }
-    }
-}
-
-impl<R: BufRead> Read for Counting<R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.count(&buf[..n]);
-        Ok(n)
-    }
-}
-
-impl<R: BufRead> BufRead for Counting<R> {
-    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
-        self.inner.fill_buf()
-    }
-
-    fn consume(&mut self, amt: usize) {
-        if amt > 0 {
-            // The buffer is already filled: this returns it without reading.
-            if let Ok(buf) = self.inner.fill_buf() {
-                let n = amt.min(buf.len());
-                let consumed = buf[..n].to_vec();
-                self.count(&consumed);
-            }
-        }
-        self.inner.consume(amt);
-    }
-}
-
 /// Loads an OBJ file as a whole scene: the mesh seen from the front (the -z side) by a camera
-/// that fits its bounding box, one point light near the camera, 512x512. Warnings go to
-/// standard error.
+/// that fits its bounding box, one point light near the camera, 512x512. Warnings go to the
+/// scene's `warnings`.
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
     let import = load_obj(path, None)?;
-    for w in &import.warnings {
-        eprintln!("luxon: warning: {w}");
-    }
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for g in &import.geometry {
@@ -560,5 +679,6 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             ..RenderDesc::default()
         },
         plugin_path: Vec::new(),
+        warnings: import.warnings,
     })
 }

@@ -452,7 +452,8 @@ pub(crate) enum Decomposition {
     Dynamic,
 }
 
-/// A `{ "name": value }` map in file order, duplicates kept (the merge decides who wins).
+/// A `{ "name": value }` map in file order, duplicates kept (the checker reports them at their
+/// place, which a map type would lose).
 pub(crate) struct Named<T>(pub Vec<(String, T)>);
 
 impl<T> Default for Named<T> {

@@ -2,8 +2,8 @@
 
 use ron::error::SpannedError;
 
-use crate::error::{suggest, unknown_name, SceneError};
-use crate::scanner::{scan, skip_blank};
+use crate::error::{printable, suggest, unknown_name, SceneError};
+use crate::scanner::{scan, skip_blank, RECURSION_LIMIT};
 use crate::spans::SourceMap;
 
 /// ron's error, with "did you mean" for names.
@@ -26,7 +26,8 @@ pub(crate) fn ron_error(e: &SpannedError, src: &SourceMap) -> SceneError {
             at = node.start;
         }
     }
-    let mut message = ron_message(&e.code);
+    // ron's messages quote what it found: make that safe to print.
+    let mut message = printable(&ron_message(&e.code)).into_owned();
     if at >= src.text.len() && !message.starts_with("unexpected end") {
         message = format!("unexpected end of file; {message}");
     }
@@ -88,6 +89,10 @@ fn ron_message(code: &ron::Error) -> String {
         E::Eof => "unexpected end of file; expected more of the scene".to_string(),
         E::ExpectedStringEnd => "unclosed string; expected a closing `\"`".to_string(),
         E::ExpectedIdentifier => "expected a name (a field name or an identifier)".to_string(),
+        E::ExceededRecursionLimit => format!(
+            "values are nested more than {RECURSION_LIMIT} levels deep; expected at most \
+             {RECURSION_LIMIT} levels of brackets"
+        ),
         E::TrailingCharacters => {
             "unexpected text after the end of the scene; expected nothing".to_string()
         }

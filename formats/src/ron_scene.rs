@@ -1,26 +1,48 @@
-//! The RON scene format: one file through ron and the span scanner, then its includes, merged.
+//! The RON scene format: the root file and its includes (see `includes`) merged, then the
+//! `meshes:` it names.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use ron::extensions::Extensions;
-
-use crate::convert::{MeshRef, Part};
+use crate::convert::MeshRef;
 use crate::desc::SceneDesc;
 use crate::error::{quoted_list, unknown_name, SceneError};
+use crate::includes::{resolve, upsert, Names};
+use crate::input::{file_error, DiskSource, LoadOptions, Source};
 use crate::obj::{is_obj_path, load_obj};
-use crate::raw;
-use crate::ron_error::ron_error;
-use crate::scanner::scan;
 use crate::spans::SourceMap;
-use crate::validate::{references, Checker};
+use crate::validate::references;
 
 /// Loads a scene from RON text; `path` names it in messages and anchors relative paths.
+/// Included files are read from disk, within the default [`LoadOptions`].
 pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
-    let mut chain = vec![Visit {
-        key: identity(path),
-        shown: path.to_path_buf(),
-    }];
-    let mut part = load_part(text.to_string(), path, &mut chain)?;
+    let options = LoadOptions::default();
+    // As read from a file: without a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    load_root(text.to_string(), path, &mut DiskSource, &options)
+}
+
+/// Loads the RON scene at `path`, reading it and its includes through `source` (files in
+/// memory, for tests and fuzzing; [`DiskSource`] for the disk).
+pub fn load_ron_with(
+    source: &mut dyn Source,
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<SceneDesc, SceneError> {
+    let text = source
+        .read(path, options.max_scene_bytes)
+        .map_err(|e| file_error(e, path, "a scene file"))?;
+    load_root(text, path, source, options)
+}
+
+fn load_root(
+    text: String,
+    path: &Path,
+    source: &mut dyn Source,
+    options: &LoadOptions,
+) -> Result<SceneDesc, SceneError> {
+    let read = text.len() as u64;
+    let merged = resolve(text, path, source, options, read)?;
+    let mut part = merged.part;
     let origin = SourceMap::new(path.to_path_buf(), String::new()).origin_at(1, 1);
     let camera = part.camera.ok_or_else(|| {
         SceneError::at(
@@ -46,6 +68,7 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
         volumes: part.volumes,
         render,
         plugin_path: part.plugin_path,
+        warnings: merged.warnings,
     };
     references(&scene)?;
     add_meshes(&mut scene, meshes)?;
@@ -53,11 +76,17 @@ pub fn load_ron_str(text: &str, path: &Path) -> Result<SceneDesc, SceneError> {
 }
 
 /// Reads the `meshes:` files into `inline` geometry (and their materials, unless the entry
-/// names one), in file order; warnings go to standard error.
+/// names one), in file order, and their warnings into the scene's.
 fn add_meshes(scene: &mut SceneDesc, meshes: Vec<MeshRef>) -> Result<(), SceneError> {
+    let mut names: Names = scene
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(i, (n, _))| (n.clone(), i))
+        .collect();
     for mesh in &meshes {
         if let Some(material) = &mesh.material {
-            if !scene.materials.iter().any(|(n, _)| *n == material.value) {
+            if !names.contains_key(&material.value) {
                 let names = scene.materials.iter().map(|(n, _)| n.as_str());
                 let message = unknown_name("material", &material.value, "", names);
                 return Err(SceneError::at(material.at.clone(), message));
@@ -75,9 +104,7 @@ fn add_meshes(scene: &mut SceneDesc, meshes: Vec<MeshRef>) -> Result<(), SceneEr
             ));
         }
         let import = load_obj(&mesh.file.value, Some(mesh.file.at.clone()))?;
-        for w in &import.warnings {
-            eprintln!("luxon: warning: {}: {w}", mesh.file.at);
-        }
+        scene.warnings.extend(import.warnings);
         match mesh.material {
             Some(material) => {
                 for mut g in import.geometry {
@@ -86,125 +113,12 @@ fn add_meshes(scene: &mut SceneDesc, meshes: Vec<MeshRef>) -> Result<(), SceneEr
                 }
             }
             None => {
-                upsert(&mut scene.materials, import.materials);
+                upsert(&mut scene.materials, &mut names, import.materials);
                 scene.inline.extend(import.geometry);
             }
         }
     }
     Ok(())
-}
-
-/// A file on the include chain: `key` to compare, `shown` for messages.
-struct Visit {
-    key: PathBuf,
-    shown: PathBuf,
-}
-
-fn identity(path: &Path) -> PathBuf {
-    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
-}
-
-/// One file and, before it, everything it includes.
-fn load_part(text: String, path: &Path, chain: &mut Vec<Visit>) -> Result<Part, SceneError> {
-    let src = SourceMap::new(path.to_path_buf(), text);
-    let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
-    let scene: raw::Scene = options
-        .from_str(&src.text)
-        .map_err(|e| ron_error(&e, &src))?;
-    let root = scan(&src.text).map_err(|e| SceneError::at(src.origin(e.at), e.message))?;
-    let check = Checker { src: &src };
-    check.finite_numbers(&root)?;
-    let includes = scene.include.clone();
-    let own = check.part(scene, &root)?;
-
-    let dir = path.parent().unwrap_or(Path::new(""));
-    let mut merged = Part::default();
-    for (i, include) in includes.iter().enumerate() {
-        let node = root
-            .field("include")
-            .and_then(|n| n.item(i))
-            .unwrap_or(&root);
-        let at = check.origin(node);
-        let file = dir.join(include);
-        let key = identity(&file);
-        if chain.iter().any(|v| v.key == key) {
-            let names: Vec<String> = chain
-                .iter()
-                .map(|v| v.shown.display().to_string())
-                .chain([file.display().to_string()])
-                .collect();
-            return Err(SceneError::at(
-                at,
-                format!(
-                    "include cycle: {}; expected included files not to include each other back",
-                    names.join(" -> ")
-                ),
-            ));
-        }
-        let text = std::fs::read_to_string(&file).map_err(|e| {
-            SceneError::at(
-                at.clone(),
-                format!(
-                    "cannot read included file `{}`: {e}; expected a scene file path relative to `{}`",
-                    file.display(),
-                    path.display()
-                ),
-            )
-        })?;
-        chain.push(Visit {
-            key,
-            shown: file.clone(),
-        });
-        let part = load_part(text, &file, chain)?;
-        chain.pop();
-        merged.absorb(part);
-    }
-    merged.absorb(own);
-    Ok(merged)
-}
-
-impl Part {
-    /// Adds a later part: lists append, names are replaced in place, singles are overridden.
-    fn absorb(&mut self, later: Part) {
-        if later.camera.is_some() {
-            self.camera = later.camera;
-        }
-        if later.background.is_some() {
-            self.background = later.background;
-        }
-        if later.fog.is_some() {
-            self.fog = later.fog;
-        }
-        if later.ambient_occlusion.is_some() {
-            self.ambient_occlusion = later.ambient_occlusion;
-        }
-        if later.render.is_some() {
-            self.render = later.render;
-        }
-        self.lights.extend(later.lights);
-        self.objects.extend(later.objects);
-        self.volumes.extend(later.volumes);
-        self.meshes.extend(later.meshes);
-        // Outputs belong to the file that renders: an including file that names any replaces
-        // those of its includes (including a scene must not also write that scene's image).
-        if !later.outputs.is_empty() {
-            self.outputs = later.outputs;
-        }
-        self.plugin_path.extend(later.plugin_path);
-        upsert(&mut self.textures, later.textures);
-        upsert(&mut self.materials, later.materials);
-        upsert(&mut self.clip_groups, later.clip_groups);
-    }
-}
-
-/// Later definitions replace earlier ones of the same name, keeping the first one's place.
-fn upsert<T>(into: &mut Vec<(String, T)>, later: Vec<(String, T)>) {
-    for (name, value) in later {
-        match into.iter_mut().find(|(n, _)| *n == name) {
-            Some(slot) => slot.1 = value,
-            None => into.push((name, value)),
-        }
-    }
 }
 
 /// Extensions this crate reads, for messages.

@@ -31,6 +31,9 @@ pub(crate) fn scan(src: &str) -> Result<Node, ScanError> {
 }
 
 const MAX_DEPTH: usize = 256;
+/// How deep ron lets values nest (its default `recursion_limit`, which guards its stack): the
+/// limit a scene meets first.
+pub(crate) const RECURSION_LIMIT: usize = 128;
 
 struct Scanner<'a> {
     src: &'a str,
@@ -125,7 +128,10 @@ impl<'a> Scanner<'a> {
 
     fn value(&mut self) -> Result<Node, ScanError> {
         if self.depth >= MAX_DEPTH {
-            return Err(self.error("values are nested too deeply"));
+            return Err(self.error(&format!(
+                "values are nested more than {MAX_DEPTH} levels deep; expected at most \
+                 {RECURSION_LIMIT} levels of brackets"
+            )));
         }
         self.depth += 1;
         let node = self.value_inner();

@@ -3,7 +3,7 @@
 //! add their parts to it) and `references` (names used but never defined, after merging).
 
 use crate::desc::{Origin, SceneDesc, Spanned};
-use crate::error::{unknown_name, SceneError};
+use crate::error::{shown, unknown_name, SceneError};
 use crate::spans::{Node, SourceMap};
 
 /// Reads positions and builds errors for one file.
@@ -18,6 +18,12 @@ impl Checker<'_> {
 
     pub fn error(&self, node: &Node, message: impl Into<String>) -> SceneError {
         SceneError::at(self.origin(node), message)
+    }
+
+    /// A value as written in the file (not as parsed: `18446744073709551615` stays that, not
+    /// `18446744073709552000`), safe to echo (see `shown`).
+    pub fn literal(&self, node: &Node) -> String {
+        shown(self.src.slice(node).trim()).into_owned()
     }
 
     pub fn spanned<T>(&self, value: T, node: &Node) -> Spanned<T> {
@@ -66,7 +72,8 @@ impl Checker<'_> {
         } else {
             format!("expected a value from {min} to {max}")
         };
-        Err(self.error(node, format!("`{name}` is {value}; {expected}")))
+        let written = self.literal(node);
+        Err(self.error(node, format!("`{name}` is {written}; {expected}")))
     }
 
     /// `value > 0`.
@@ -74,9 +81,10 @@ impl Checker<'_> {
         if value > 0.0 {
             Ok(value)
         } else {
+            let written = self.literal(node);
             Err(self.error(
                 node,
-                format!("`{name}` is {value}; expected a number greater than 0"),
+                format!("`{name}` is {written}; expected a number greater than 0"),
             ))
         }
     }
@@ -93,9 +101,10 @@ impl Checker<'_> {
         if value.fract() == 0.0 && value >= f64::from(min) && value <= f64::from(max) {
             return Ok(value as u32);
         }
+        let written = self.literal(node);
         Err(self.error(
             node,
-            format!("`{name}` is {value}; expected a whole number from {min} to {max}"),
+            format!("`{name}` is {written}; expected a whole number from {min} to {max}"),
         ))
     }
 
@@ -104,10 +113,12 @@ impl Checker<'_> {
         for (i, &c) in rgb.iter().enumerate() {
             if c < 0.0 {
                 let at = node.item(i).unwrap_or(node);
+                let written = self.literal(at);
                 return Err(self.error(
                     at,
                     format!(
-                        "`{name}` has a negative component {c}; expected components of 0 or more"
+                        "`{name}` has a negative component {written}; expected components of 0 \
+                         or more"
                     ),
                 ));
             }

@@ -444,3 +444,84 @@ fn render_limits() {
         &["`threads` is 5000", "1 to 4096"],
     );
 }
+
+// ---- Hostile and careless input ----
+
+/// ron's recursion limit, in words for a scene's author (not ron's options).
+#[test]
+fn values_nested_too_deeply() {
+    let deep = format!(
+        "    objects: [(plugin: \"x\", params: (v: {}1{}))],",
+        "[".repeat(200),
+        "]".repeat(200)
+    );
+    let (line, _, message) = scene_error(&deep);
+    assert_eq!(line, 3);
+    assert_eq!(
+        message,
+        "values are nested more than 128 levels deep; expected at most 128 levels of brackets"
+    );
+}
+
+/// A name defined twice in one file is a slip: an error at the second key, naming the first.
+#[test]
+fn a_name_defined_twice_in_one_file() {
+    for (map, what) in [
+        ("materials", "material"),
+        ("textures", "texture"),
+        ("clip_groups", "clip group"),
+    ] {
+        let value = match map {
+            "materials" => "(ior: 1.5)",
+            "textures" => "(plugin: \"checker\")",
+            _ => "[]",
+        };
+        let found = scene_error(&format!(
+            "    {map}: {{\n        \"m\": {value},\n        \"n\": {value},\n        \"m\": {value},\n    }},"
+        ));
+        check(
+            found,
+            6,
+            9,
+            &[&format!(
+                "{what} `m` is defined twice in this file (first at 4:9); expected each name \
+                 once (a file that includes this one may redefine it)"
+            )],
+        );
+    }
+}
+
+/// Numbers in messages as written: 2^64 - 1 is not 18446744073709552000.
+#[test]
+fn values_are_quoted_as_written() {
+    let found = scene_error("    render: (width: 18446744073709551615),");
+    check(
+        found,
+        3,
+        21,
+        &["`width` is 18446744073709551615; expected a whole number from 1 to 65536"],
+    );
+    let found = scene_error("    render: (samples: 1e30),");
+    check(found, 3, 23, &["`samples` is 1e30;"]);
+    let found = scene_error("    materials: { \"m\": (color: (1, -0.50, 0)) },");
+    check(found, 3, 35, &["negative component -0.50;"]);
+}
+
+/// Names from the file are echoed with their control characters escaped.
+#[test]
+fn echoed_names_cannot_drive_the_terminal() {
+    let found = scene_error(
+        "    materials: { \"\\u{1b}[31m\": () },\n    objects: [(plugin: \"sphere\", material: \"\\u{1b}[32m\")],",
+    );
+    let (_, _, message) = &found;
+    assert!(!message.chars().any(char::is_control), "{message:?}");
+    check(
+        found,
+        4,
+        44,
+        &[
+            "unknown material `\\u{1b}[32m`",
+            "expected one of `\\u{1b}[31m`",
+        ],
+    );
+}

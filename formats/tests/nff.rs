@@ -183,6 +183,39 @@ fn spheres_and_negative_radii() {
     let g = &i.desc.inline[0];
     let at = g.at.as_ref().unwrap();
     assert_eq!((at.line, at.col), (8, 1));
+    // NFF's inside-only sphere: accepted (NFF defines it), drawn two-sided with a warning at
+    // the radius, written as in the file.
+    assert_eq!(i.desc.warnings.len(), 1, "{:?}", i.desc.warnings);
+    let w = &i.desc.warnings[0];
+    assert_eq!((w.at.line, w.at.col), (9, 9));
+    assert_eq!(
+        w.message,
+        "sphere radius -2 is negative (NFF's inside-only sphere); Luxon's spheres are \
+         two-sided, so it is drawn with radius 2"
+    );
+}
+
+/// A warning per kind and file: the first one, with a count of the others.
+#[test]
+fn repeated_warnings_are_counted() {
+    let mut text = VIEW.to_string();
+    for k in 0..1000 {
+        text.push_str(&format!("s {k} 0 0 -0.50\n"));
+    }
+    text.push_str("c 0 0 0 -1 0 0 1 -1\n");
+    for block in [64, 1 << 20] {
+        let i = nff::import_reader_blocks(text.as_bytes(), path(), block).unwrap();
+        let w: Vec<String> = i.desc.warnings.iter().map(|w| w.to_string()).collect();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert_eq!(
+            w[0],
+            "dir/scene.nff:8:9: sphere radius -0.50 is negative (NFF's inside-only sphere); \
+             Luxon's spheres are two-sided, so it is drawn with radius 0.50 (999 more like it in \
+             this file)"
+        );
+        assert!(w[1].starts_with("dir/scene.nff:1008:9: cone radius -1 is negative"));
+        assert!(w[1].ends_with("(1 more like it in this file)"), "{}", w[1]);
+    }
 }
 
 #[test]
@@ -866,4 +899,40 @@ fn shared_gears_are_concave_and_clipped() {
     let i = nff::import(&dir.join("gears.nff.gz")).unwrap();
     // 9217 quads (2 triangles each) and 128 gear faces of 144 vertices (142 each).
     assert_eq!(i.stats.triangles, 9217 * 2 + 128 * 142);
+}
+
+/// One polygon of 100,000 corners at random angles (it intersects itself everywhere): the
+/// ear search stops at its work budget and the rest becomes a fan, with a warning at the `p`.
+/// (It took over a minute.)
+#[test]
+fn a_huge_tangled_polygon_falls_back_to_a_fan_with_a_warning() {
+    let m = 100_000;
+    let mut text = format!("{VIEW}f 1 1 1 1 0 0 0 1\n  p {m}\n");
+    let mut state = 7u64;
+    let mut unit = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..m {
+        let a = unit() * std::f64::consts::TAU;
+        let r = 1.0 + unit();
+        text.push_str(&format!("{} 0 {}\n", r * a.cos(), r * a.sin()));
+    }
+    let i = parse(&text);
+    assert_eq!(i.stats.triangles, m as u64 - 2);
+    assert_eq!(i.desc.warnings.len(), 1, "{:?}", i.desc.warnings);
+    let w = &i.desc.warnings[0];
+    assert_eq!((w.at.line, w.at.col), (9, 3));
+    assert!(
+        w.message.starts_with(&format!(
+            "`p` polygon of {m} vertices could not be cut into ears within its time budget"
+        )),
+        "{w}"
+    );
+    assert!(
+        w.message.contains("triangles are a fan from one corner"),
+        "{w}"
+    );
 }

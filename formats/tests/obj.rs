@@ -132,7 +132,13 @@ fn a_missing_mtl_is_a_warning() {
     let text = format!("mtllib gone.mtl\nusemtl red\n{QUAD}");
     let obj = load_obj(&write(&dir, "a.obj", &text), None).unwrap();
     assert_eq!(obj.warnings.len(), 1, "{:?}", obj.warnings);
-    assert!(obj.warnings[0].contains("gone.mtl"), "{}", obj.warnings[0]);
+    let w = obj.warnings[0].to_string();
+    // At the `mtllib` line, naming the library and saying what happened.
+    assert!(
+        w.starts_with(&format!("{}:1:1: ", dir.join("a.obj").display())),
+        "{w}"
+    );
+    assert!(w.contains("gone.mtl`: it does not exist"), "{w}");
     assert!(obj.materials.is_empty());
     assert!(only(&obj.geometry).material.is_none());
 }
@@ -213,4 +219,95 @@ fn a_missing_mesh_file_is_reported_at_its_name() {
     let e = load(&path).unwrap_err();
     assert!(matches!(e, SceneError::At { .. }));
     assert!(e.to_string().contains("unknown material `gld`"), "{e}");
+}
+
+/// Faces of 1 or 2 corners are errors at their line, in the words NFF uses for polygons
+/// (tobj would drop them silently).
+#[test]
+fn faces_with_fewer_than_three_corners_are_errors() {
+    let dir = temp_dir("short");
+    for (face, found) in [("f 1 2", 2), ("f 3", 1), ("f", 0)] {
+        let p = write(&dir, "short.obj", &format!("{QUAD}\n{face}\n"));
+        let e = load_obj(&p, None).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{}:7:1: a face needs at least 3 vertices, found {found}",
+                p.display()
+            )
+        );
+    }
+}
+
+/// Lines and points are OBJ, but Luxon draws neither: left out, with a warning per kind
+/// that counts them.
+#[test]
+fn lines_and_points_are_left_out_with_a_warning() {
+    let dir = temp_dir("lp");
+    let p = write(&dir, "lp.obj", &format!("{QUAD}l 1 2\nl 2 3 4\np 1\n"));
+    let obj = load_obj(&p, None).unwrap();
+    assert_eq!(only(&obj.geometry).mesh.indices.len(), 2);
+    let w: Vec<String> = obj.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        w,
+        [
+            format!(
+                "{}:6:1: 2 line (`l`) statement(s), the first here: Luxon draws faces only, so \
+                 they are left out",
+                p.display()
+            ),
+            format!(
+                "{}:8:1: 1 point (`p`) statement(s), the first here: Luxon draws faces only, so \
+                 they are left out",
+                p.display()
+            ),
+        ]
+    );
+}
+
+/// A material defined twice: the last definition, in the first one's place, with a warning.
+#[test]
+fn a_material_defined_twice_takes_the_last_definition() {
+    let dir = temp_dir("newmtl");
+    write(
+        &dir,
+        "m.mtl",
+        "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\nnewmtl red\nKd 0.7 0 0\nnewmtl red\nKd 0.5 0 0\n\
+         newmtl blue\n",
+    );
+    let p = write(&dir, "m.obj", &format!("mtllib m.mtl\nusemtl red\n{QUAD}"));
+    let obj = load_obj(&p, None).unwrap();
+    let names: Vec<&str> = obj.materials.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["obj:m:red", "obj:m:blue"]);
+    assert_eq!(obj.materials[0].1.value.color, [0.5, 0.0, 0.0]);
+    assert_eq!(obj.warnings.len(), 1, "{:?}", obj.warnings);
+    // One warning for all repeats.
+    assert_eq!(
+        obj.warnings[0].message,
+        "material `red` is defined more than once in its material libraries; the last \
+         definition is used (2 more repeated definitions)"
+    );
+}
+
+/// In a RON scene's `meshes:`, the OBJ's warnings join the scene's, at the `file` string.
+#[test]
+fn mesh_warnings_are_the_scene_warnings() {
+    let dir = temp_dir("meshwarn");
+    write(&dir, "w.obj", &format!("mtllib gone.mtl\n{QUAD}"));
+    let main = write(
+        &dir,
+        "main.ron",
+        "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), meshes: [(file: \"w.obj\")])",
+    );
+    let scene = load(&main).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    let w = &scene.warnings[0];
+    assert_eq!((&**w.at.file, w.at.line, w.at.col), (main.as_path(), 1, 75));
+    assert!(
+        w.message.starts_with(&format!(
+            "in mesh file {}:1: cannot use material library",
+            dir.join("w.obj").display()
+        )),
+        "{w}"
+    );
 }

@@ -216,7 +216,11 @@ fn load_reads_files_and_rejects_other_formats() {
     );
 
     let error = load(&dir.join("missing.ron")).unwrap_err();
-    assert!(matches!(error, SceneError::Io { .. }), "{error}");
+    assert!(matches!(error, SceneError::File { .. }), "{error}");
+    assert!(error.origin().is_none());
+    assert!(error
+        .to_string()
+        .ends_with("missing.ron` does not exist; expected a scene file"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -2,6 +2,9 @@
 //! running the `luxon` binary, and temporary directories.
 #![allow(dead_code)]
 
+#[cfg(unix)]
+pub mod limits;
+
 use luxon::plugin::Registry;
 use luxon::{Framebuffer, Scene};
 use luxon_formats::SceneDesc;

@@ -7,7 +7,9 @@ use std::path::Path;
 
 pub fn run(path: &Path) -> Result<(), Error> {
     let desc = luxon_formats::load(path)?;
+    super::warn_scene(&desc);
     let registry = Registry::discover(&desc.plugin_path);
+    super::warn_skipped(&registry);
     let scene = Scene::build(&desc, &registry)?;
     let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
     describe(&desc, &scene, &outputs);

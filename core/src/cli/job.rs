@@ -1,8 +1,6 @@
 //! The processes of one `luxon render`: this process alone, or the ranks of an MPI job (with
 //! the `mpi` feature). Hides the feature from the rest of the command.
 
-#[cfg(feature = "mpi")]
-use luxon::files::temp_path;
 use luxon::framebuffer::Chunk;
 use luxon::schedule::{launched_ranks, render_local, threads_for, RankStats, Sink};
 use luxon::{Error, Scene};
@@ -137,32 +135,27 @@ impl Job {
         }
     }
 
-    /// Every rank writes its `chunks` of the 8-bit PPM `path` with MPI-IO; rank 0 then renames
-    /// the file into place.
+    /// Every rank writes its `chunks` of an 8-bit PPM with MPI-IO into the temporary file `tmp`
+    /// that rank 0 created (and gives here; other ranks `None`); it is committed with the other
+    /// outputs afterwards.
     pub fn write_concurrent(
         &self,
-        path: &Path,
+        tmp: Option<&Path>,
         width: u32,
         height: u32,
         chunks: &[Chunk],
     ) -> Result<(), Error> {
         match self {
             Job::Local => {
-                let _ = (path, width, height, chunks);
+                let _ = (tmp, width, height, chunks);
                 Err(Error::Render("MPI-IO needs an MPI job".into()))
             }
             #[cfg(feature = "mpi")]
             Job::Mpi(c) => {
-                let tmp = temp_path(path, c.root_pid())?;
+                let tmp = c.broadcast_path(tmp);
                 c.barrier();
                 c.write_ppm(&tmp, width, height, chunks);
                 c.barrier();
-                if c.rank() == 0 {
-                    std::fs::rename(&tmp, path).map_err(|source| Error::Io {
-                        path: path.to_path_buf(),
-                        source,
-                    })?;
-                }
                 Ok(())
             }
             #[cfg(not(feature = "mpi"))]

@@ -6,8 +6,30 @@ pub mod plugins;
 pub mod progress;
 pub mod render;
 pub mod shading;
+// The signal handlers and their pipe (libc).
+#[allow(unsafe_code)]
+pub mod signals;
 pub mod spd;
 pub mod sweep;
+pub mod usage;
+
+use luxon::plugin::Registry;
+
+/// Warns about every file on the plugin search path that was skipped (a truncated library, a
+/// FIFO named like a plugin...): the run goes on without it, but the user should know.
+pub fn warn_skipped(registry: &Registry) {
+    for p in &registry.problems {
+        luxon::error::print_warning(&format!("skipped plugin file {p}"));
+    }
+}
+
+/// Prints the scene's warnings (what the loaders accepted but want the user to know: an OBJ
+/// `l` statement not drawn, an NFF negative radius...), one line each.
+pub fn warn_scene(desc: &luxon_formats::SceneDesc) {
+    for w in &desc.warnings {
+        luxon::error::print_warning(&w.to_string());
+    }
+}
 
 /// `--res WIDTHxHEIGHT`.
 pub fn parse_res(s: &str) -> Result<(u32, u32), String> {

@@ -6,12 +6,14 @@ use super::progress::Progress;
 use luxon::cache::{self, Lookup};
 use luxon::framebuffer::Chunk;
 use luxon::output::stream::{is_ppm8, AsyncOutput};
-use luxon::output::Output;
+use luxon::output::{Output, OutputSet};
 use luxon::plugin::Registry;
 use luxon::render::RenderStats;
 use luxon::schedule::RankStats;
 use luxon::{Error, Framebuffer, Scene};
-use luxon_formats::{Decomposition, Origin, OutputDesc, OutputIo, ParallelMode, SceneDesc};
+use luxon_formats::{
+    Decomposition, Origin, OutputDesc, OutputIo, ParallelMode, RenderDesc, SceneDesc,
+};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
@@ -156,28 +158,47 @@ fn load(path: &Path, o: &Overrides, skeleton: Option<&str>) -> Result<SceneDesc,
     Ok(desc)
 }
 
-/// How rank 0 writes: outputs split between its writer (async or after the render) and MPI-IO.
+/// How rank 0 writes: outputs split between its writer (async or after the render) and MPI-IO,
+/// each with its index in the output set.
 struct Plan<'r> {
-    written_by_root: Vec<Output<'r>>,
-    concurrent: Vec<Output<'r>>,
-    /// Created before rendering, so an unwritable path fails at once.
+    written_by_root: Vec<(usize, Output<'r>)>,
+    concurrent: Vec<(usize, Output<'r>)>,
+    /// Rank 0: every output's temporary file, created before anything is built or rendered (so
+    /// an unwritable path fails at once); `None` while the stream writer has it.
+    files: Option<OutputSet>,
     streams: Option<AsyncOutput<'r>>,
 }
 
-fn plan<'r>(scene: &Scene, outputs: Vec<Output<'r>>, job: &Job) -> Result<Plan<'r>, Error> {
-    let s = &scene.settings;
-    let mpi_io = s.io == OutputIo::MpiIo && matches!(job, Job::Mpi(_));
-    let (concurrent, written_by_root): (Vec<_>, Vec<_>) =
-        outputs.into_iter().partition(|o| mpi_io && is_ppm8(o));
-    let streams = match (job.rank(), s.io) {
-        (0, OutputIo::Async | OutputIo::MpiIo) if !written_by_root.is_empty() => {
-            Some(AsyncOutput::new(&written_by_root, s.width, s.height)?)
-        }
+fn plan<'r>(
+    r: &RenderDesc,
+    outputs: Vec<Output<'r>>,
+    job: &Job,
+    registry: &Registry,
+    scene_dir: &Path,
+) -> Result<Plan<'r>, Error> {
+    let io = r.parallel.io;
+    let mpi_io = io == OutputIo::MpiIo && matches!(job, Job::Mpi(_));
+    let mut files = match job.rank() {
+        0 => Some(OutputSet::prepare(&outputs, registry, scene_dir)?),
         _ => None,
+    };
+    let (concurrent, written_by_root): (Vec<_>, Vec<_>) = outputs
+        .into_iter()
+        .enumerate()
+        .partition(|(_, o)| mpi_io && is_ppm8(o));
+    let streams = match (files.take(), io) {
+        (Some(set), OutputIo::Async | OutputIo::MpiIo) if !written_by_root.is_empty() => Some(
+            AsyncOutput::new(written_by_root.clone(), set, r.width, r.height)?,
+        ),
+        (set, _) => {
+            files = set;
+            None
+        }
     };
     Ok(Plan {
         written_by_root,
         concurrent,
+        files,
         streams,
     })
 }
@@ -195,6 +216,12 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     };
     let empty = Vec::new();
     let registry = Registry::discover(desc.as_ref().map_or(&empty, |d| &d.plugin_path));
+    if job.rank() == 0 {
+        super::warn_skipped(&registry);
+        if let Ok(d) = &desc {
+            super::warn_scene(d);
+        }
+    }
     let load_time = t0.elapsed();
     let ready = desc.and_then(|desc| prepare(path, o, desc, cached, &registry, &job, &mut cache));
     let (ready, status) = match ready {
@@ -217,6 +244,7 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let Plan {
         written_by_root,
         concurrent,
+        files,
         streams,
     } = plan;
     let gather = !written_by_root.is_empty();
@@ -229,22 +257,26 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let r = render(&scene, &job, &shares, streams, &registry, scene_dir)?;
 
     let t_write = Instant::now();
-    let mut written = r.written;
-    for out in &concurrent {
-        job.write_concurrent(&out.desc.path, s.width, s.height, &r.kept)?;
-        written.push(out.desc.path.clone());
+    // Rank 0's output files: kept here, or back from the stream writer.
+    let files = files.or(r.files);
+    for (i, _) in &concurrent {
+        if let Some(f) = &files {
+            f.unlock(*i);
+        }
+        let tmp = files.as_ref().map(|f| f.temp_path(*i));
+        job.write_concurrent(tmp, s.width, s.height, &r.kept)?;
     }
     if job.rank() != 0 {
         return Ok(());
     }
+    let mut files = files.ok_or_else(|| Error::Render("the output files are missing".into()))?;
     if let Some(fb) = r.sync_fb {
-        written.extend(luxon::output::write_all(
-            &written_by_root,
-            &fb,
-            &registry,
-            scene_dir,
-        )?);
+        for (i, o) in &written_by_root {
+            files.encode(*i, o, &fb, &registry, scene_dir)?;
+        }
     }
+    // The commit point: every output complete, all renamed together.
+    let written = files.commit()?;
     let write_time = r.tail + t_write.elapsed();
     let stats = RenderStats::of(r.ranks, r.render_time);
     let total = t0.elapsed();
@@ -261,10 +293,10 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         eprintln!("luxon: wrote geometry cache {}", p.display());
     }
     if stats.counters.nan_pixels > 0 {
-        eprintln!(
-            "luxon: warning: {} pixel(s) came out NaN or infinite and were set to black",
+        luxon::error::print_warning(&format!(
+            "{} pixel(s) came out NaN or infinite and were set to black",
             stats.counters.nan_pixels
-        );
+        ));
     }
     Ok(())
 }
@@ -296,10 +328,10 @@ impl CacheUse {
             Lookup::Hit(c) => Some(c),
             Lookup::Miss => None,
             Lookup::Corrupt(p, why) => {
-                eprintln!(
-                    "luxon: warning: geometry cache {} is unusable ({why}); rebuilding it",
+                luxon::error::print_warning(&format!(
+                    "geometry cache {} is unusable ({why}); rebuilding it",
                     p.display()
-                );
+                ));
                 None
             }
         }
@@ -337,6 +369,10 @@ fn prepare<'r>(
     job: &Job,
     cache: &mut CacheUse,
 ) -> Result<(SceneDesc, Scene, Plan<'r>), Error> {
+    // Outputs first: an unwritable path or a writer's bad parameter fails before any work.
+    let outputs = luxon::output::resolve(&desc.render.outputs, registry)?;
+    let scene_dir = desc.source.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let plan = plan(&desc.render, outputs, job, registry, &scene_dir)?;
     let had_objects = !desc.objects.is_empty();
     let from_cache = cached.is_some();
     let prebuilt = match cached {
@@ -365,8 +401,6 @@ fn prepare<'r>(
             scene
         }
     };
-    let outputs = luxon::output::resolve(&scene.outputs, registry)?;
-    let plan = plan(&scene, outputs, job)?;
     Ok((desc, scene, plan))
 }
 
@@ -379,12 +413,13 @@ struct Shares<'a> {
 }
 
 /// What the render phase leaves: every rank's work (on rank 0), this rank's chunks when kept,
-/// the files the writer thread finished, the image for a synchronous write, and how long the
+/// the output files the writer thread completed, the image for a synchronous write, and how long the
 /// render took and the writer went on after it.
 struct Rendered {
     ranks: Vec<RankStats>,
     kept: Vec<Chunk>,
-    written: Vec<PathBuf>,
+    /// The output files, back from the stream writer (which completed them).
+    files: Option<OutputSet>,
     sync_fb: Option<Framebuffer>,
     render_time: Duration,
     tail: Duration,
@@ -441,11 +476,11 @@ fn render(
     let render_time = start.elapsed() - tail;
     bar.finish();
     let (ranks, kept) = rendered?;
-    let written = streamed.transpose()?.unwrap_or_default();
+    let files = streamed.transpose()?;
     Ok(Rendered {
         ranks,
         kept,
-        written,
+        files,
         sync_fb: sync.then(|| sync_fb.into_inner().unwrap_or_else(|e| e.into_inner())),
         render_time,
         tail,

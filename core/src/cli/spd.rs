@@ -35,18 +35,20 @@ pub fn run(name: Option<&str>, size: Option<u32>, output: Option<&Path>) -> Resu
             output.display()
         ))
     })?;
-    let tmp = luxon::files::temp_path(output, std::process::id())?;
+    // Removed on any error when `tmp` drops.
+    let mut tmp = luxon::files::TempFile::create(output)?;
     let result = (|| -> Result<spd::Counts, spd::SpdError> {
-        let mut file = std::fs::File::create(&tmp)?;
-        let counts = spd::generate_as(scene.name, size, format, &mut file)?;
+        let file = tmp.file();
+        let counts = spd::generate_as(scene.name, size, format, file)?;
         file.sync_all()?;
-        std::fs::rename(&tmp, output)?;
         Ok(counts)
     })();
     let c = match result {
-        Ok(c) => c,
+        Ok(c) => {
+            tmp.rename()?;
+            c
+        }
         Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
             return Err(match e {
                 spd::SpdError::Io(source) => Error::Io {
                     path: output.to_path_buf(),

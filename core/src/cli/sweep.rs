@@ -56,6 +56,7 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
         }
     }
     let mut desc = luxon_formats::load(path)?;
+    super::warn_scene(&desc);
     if let Some((w, h)) = a.res {
         desc.render.width = w;
         desc.render.height = h;
@@ -75,6 +76,7 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
     // The sweep writes its own files, not the scene's outputs.
     desc.render.outputs.clear();
     let registry = Registry::discover(&desc.plugin_path);
+    super::warn_skipped(&registry);
     let options = Options {
         curves,
         reference: a.reference.clone(),

@@ -1,16 +1,14 @@
 //! Asynchronous output (the thesis's asynchronous I/O): render threads hand finished chunks to a
 //! writer thread, which assembles the image and writes every completed row of 8-bit PPM outputs
 //! into their temporary files while rendering goes on. Other formats are encoded from the
-//! assembled image at the end. Every file appears atomically (temporary file + rename).
+//! assembled image at the end. The files are committed together afterwards ([`super::commit`]).
 
-use super::{write_all, Output};
+use super::{Output, OutputSet};
 use crate::error::Error;
-use crate::files::{pending, temp_path};
 use crate::framebuffer::Chunk;
 use crate::framebuffer::Framebuffer;
 use crate::plugin::Registry;
 use crate::ppm::{ppm_header, srgb8};
-use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError};
@@ -22,113 +20,86 @@ pub fn is_ppm8(o: &Output) -> bool {
     o.writer.name == "ppm" && (params == "()" || params == "(bits:8)")
 }
 
-/// A PPM written row by row into its temporary file.
+/// A PPM written row by row into its temporary file: its index in the output set, and the first
+/// write error (reported when the render is done).
 struct RowFile {
+    index: usize,
     path: PathBuf,
-    tmp: PathBuf,
-    file: File,
     error: Option<std::io::Error>,
-    renamed: bool,
-}
-
-impl Drop for RowFile {
-    fn drop(&mut self) {
-        pending(&self.tmp, false);
-        if !self.renamed {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
 }
 
 impl RowFile {
-    fn create(path: &Path, width: u32, height: u32) -> Result<RowFile, Error> {
-        let tmp = temp_path(path, std::process::id())?;
-        let io = |source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        pending(&tmp, true);
-        let mut file = File::create(&tmp).map_err(io)?;
-        file.write_all(&ppm_header(width, height)).map_err(io)?;
-        Ok(RowFile {
-            path: path.to_path_buf(),
-            tmp,
-            file,
-            error: None,
-            renamed: false,
-        })
-    }
-
-    fn write_row(&mut self, offset: u64, bytes: &[u8]) {
+    fn write_row(&mut self, set: &mut OutputSet, offset: u64, bytes: &[u8]) {
         if self.error.is_none() {
-            let r = self
-                .file
+            let f = set.file(self.index);
+            let r = f
                 .seek(SeekFrom::Start(offset))
-                .and_then(|_| self.file.write_all(bytes));
+                .and_then(|_| f.write_all(bytes));
             self.error = r.err();
         }
-    }
-
-    fn finish(mut self) -> Result<PathBuf, Error> {
-        let r = match self.error.take() {
-            Some(e) => Err(e),
-            None => self
-                .file
-                .sync_all()
-                .and_then(|_| std::fs::rename(&self.tmp, &self.path)),
-        };
-        self.renamed = r.is_ok();
-        r.map(|_| self.path.clone()).map_err(|source| Error::Io {
-            path: self.path.clone(),
-            source,
-        })
     }
 }
 
 /// How often the writer looks for finished chunks while rendering goes on.
 const POLL: Duration = Duration::from_millis(20);
 
-/// The outputs of a render, written as its pixels arrive. Created before rendering (so a path
-/// that cannot be written fails at once), then [`AsyncOutput::run`] on a writer thread.
+/// The outputs of a render, written as its pixels arrive into the temporary files of an
+/// [`OutputSet`] (created before rendering), by [`AsyncOutput::run`] on a writer thread.
 pub struct AsyncOutput<'r> {
+    set: OutputSet,
     rows: Vec<RowFile>,
-    encoded: Vec<Output<'r>>,
-    /// Every output path, in the scene's order.
-    order: Vec<PathBuf>,
+    /// Outputs encoded from the whole image at the end, with their index in the set.
+    encoded: Vec<(usize, Output<'r>)>,
     fb: Framebuffer,
     /// Pixels still missing per row.
     missing: Vec<u32>,
 }
 
 impl<'r> AsyncOutput<'r> {
-    pub fn new(outputs: &[Output<'r>], width: u32, height: u32) -> Result<AsyncOutput<'r>, Error> {
+    /// `outputs`: the outputs this writer produces, each with its index in `set`.
+    pub fn new(
+        outputs: Vec<(usize, Output<'r>)>,
+        mut set: OutputSet,
+        width: u32,
+        height: u32,
+    ) -> Result<AsyncOutput<'r>, Error> {
         let mut rows = Vec::new();
         let mut encoded = Vec::new();
-        for o in outputs {
-            if is_ppm8(o) {
-                rows.push(RowFile::create(&o.desc.path, width, height)?);
+        for (i, o) in outputs {
+            if is_ppm8(&o) {
+                set.file(i)
+                    .write_all(&ppm_header(width, height))
+                    .map_err(|source| Error::Io {
+                        path: o.desc.path.clone(),
+                        source,
+                    })?;
+                rows.push(RowFile {
+                    index: i,
+                    path: o.desc.path.clone(),
+                    error: None,
+                });
             } else {
-                encoded.push(o.clone());
+                encoded.push((i, o));
             }
         }
         Ok(AsyncOutput {
+            set,
             rows,
             encoded,
-            order: outputs.iter().map(|o| o.desc.path.clone()).collect(),
             fb: Framebuffer::new(width, height),
             missing: vec![width; height as usize],
         })
     }
 
-    /// Takes chunks until every sender is gone, then finishes every file; returns the paths
-    /// written. Incomplete rows (a failed render) leave no file behind. Unpark the thread
-    /// running this after dropping the last sender, or the end waits up to `POLL`.
+    /// Takes chunks until every sender is gone, then completes every file; returns the output
+    /// set, ready to commit. Incomplete rows (a failed render) leave no file behind. Unpark the
+    /// thread running this after dropping the last sender, or the end waits up to `POLL`.
     pub fn run(
         mut self,
         chunks: Receiver<Chunk>,
         registry: &Registry,
         scene_dir: &Path,
-    ) -> Result<Vec<PathBuf>, Error> {
+    ) -> Result<OutputSet, Error> {
         let w = self.fb.width as usize;
         let header = ppm_header(self.fb.width, self.fb.height).len() as u64;
         let mut row = Vec::with_capacity(w * 3);
@@ -152,7 +123,7 @@ impl<'r> AsyncOutput<'r> {
                     row.clear();
                     srgb8(&self.fb.rgba[y * w * 4..(y + 1) * w * 4], &mut row);
                     for f in &mut self.rows {
-                        f.write_row(header + (y * w * 3) as u64, &row);
+                        f.write_row(&mut self.set, header + (y * w * 3) as u64, &row);
                     }
                 }
             }
@@ -162,12 +133,17 @@ impl<'r> AsyncOutput<'r> {
                 "the render ended before every pixel was done; no file written".into(),
             ));
         }
-        let mut written = Vec::new();
-        for f in self.rows {
-            written.push(f.finish()?);
+        for f in &mut self.rows {
+            if let Some(source) = f.error.take() {
+                return Err(Error::Io {
+                    path: f.path.clone(),
+                    source,
+                });
+            }
         }
-        written.extend(write_all(&self.encoded, &self.fb, registry, scene_dir)?);
-        written.sort_by_key(|p| self.order.iter().position(|o| o == p));
-        Ok(written)
+        for (i, o) in &self.encoded {
+            self.set.encode(*i, o, &self.fb, registry, scene_dir)?;
+        }
+        Ok(self.set)
     }
 }

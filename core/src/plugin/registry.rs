@@ -2,6 +2,12 @@
 //!
 //! Libraries are never unloaded: objects created by a plugin may live anywhere in the process,
 //! and unloading libraries that have thread-local destructors crashes.
+//!
+//! Plugins are trusted code: loading one runs its initialisers. What Luxon checks first is the
+//! file: a special file (FIFO, device, directory) named like a plugin is refused by its type, and
+//! a library's ELF headers must fit in its file ([`super::elf`]), so a truncated copy is skipped
+//! with its reason instead of killing every run. Skipped files are [`Problem`]s: `luxon plugins`
+//! lists them, `render` and `check` warn about them, and a lookup that misses names them.
 
 use luxon_plugin::abi;
 use std::collections::HashMap;
@@ -195,7 +201,7 @@ unsafe extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
         _ => "debug",
     };
     if level != "debug" || std::env::var_os("LUXON_DEBUG").is_some() {
-        eprintln!("luxon: {level}: {plugin}: {message}");
+        crate::error::print_line(level, &format!("{plugin}: {message}"));
     }
 }
 
@@ -209,6 +215,45 @@ static HOST: abi::HostTable = abi::HostTable {
 pub fn is_plugin_file_name(name: &str) -> bool {
     let prefix = format!("{}luxon_", std::env::consts::DLL_PREFIX);
     name.starts_with(&prefix) && name.ends_with(std::env::consts::DLL_SUFFIX)
+}
+
+/// Refuses what is not a regular file (after symbolic links) by its type, before opening it: a
+/// FIFO would block the open, a device could be read forever.
+fn regular_file(path: &Path) -> Result<(), String> {
+    let m = std::fs::metadata(path).map_err(|e| format!("cannot be read: {e}"))?;
+    if m.is_file() {
+        return Ok(());
+    }
+    let what = if m.is_dir() {
+        "a directory"
+    } else {
+        special_file_kind(&m)
+    };
+    Err(format!(
+        "is {what}; expected a plugin library (a regular file)"
+    ))
+}
+
+#[cfg(unix)]
+fn special_file_kind(m: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = m.file_type();
+    if t.is_fifo() {
+        "a FIFO (named pipe)"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a regular file"
+    }
+}
+
+#[cfg(not(unix))]
+fn special_file_kind(_: &std::fs::Metadata) -> &'static str {
+    "not a regular file"
 }
 
 /// The default search path after `extra`: `$LUXON_PLUGIN_PATH`, then the executable's directory
@@ -247,9 +292,11 @@ impl Registry {
             return;
         }
         self.searched.push(path.to_path_buf());
-        if path.is_file() {
-            self.load(path);
-            return;
+        match std::fs::metadata(path) {
+            Ok(m) if m.is_dir() => {}
+            // A missing directory is normal (the search path lists places that may not exist).
+            Err(_) => return,
+            Ok(_) => return self.load(path),
         }
         let Ok(read) = std::fs::read_dir(path) else {
             return;
@@ -258,10 +305,9 @@ impl Registry {
             .filter_map(|e| e.ok())
             .map(|e| e.path())
             .filter(|p| {
-                p.is_file()
-                    && p.file_name()
-                        .and_then(|n| n.to_str())
-                        .is_some_and(is_plugin_file_name)
+                p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(is_plugin_file_name)
             })
             .collect();
         files.sort();
@@ -281,6 +327,9 @@ impl Registry {
         let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
         if self.libraries.iter().any(|l| l.path == canonical) {
             return;
+        }
+        if let Err(e) = regular_file(path).and_then(|()| super::elf::check_library(&canonical)) {
+            return self.problem(path, e);
         }
         // SAFETY: loading runs the library's initialisers, and from here on its code runs in
         // this process. Nothing here can check that code: plugin files are trusted by design

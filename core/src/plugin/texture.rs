@@ -13,6 +13,9 @@ pub struct TextureInstance {
     object: *mut c_void,
     vtable: &'static abi::TextureInstanceVTable,
     pub plugin: String,
+    /// The scene's name for the texture, and where its parameters are.
+    pub name: String,
+    pub at: Origin,
 }
 
 // SAFETY: the ABI requires a plugin's texture objects to take `eval` from several threads at
@@ -23,14 +26,31 @@ unsafe impl Send for TextureInstance {}
 unsafe impl Sync for TextureInstance {}
 
 impl TextureInstance {
-    /// Linear RGBA, or `None` when the plugin panicked.
+    /// Linear RGBA, or the plugin's status when it panicked or failed (see [`Self::failure`]).
     #[inline]
-    pub fn eval(&self, q: &abi::TexQuery) -> Option<[f32; 4]> {
+    pub fn eval(&self, q: &abi::TexQuery) -> Result<[f32; 4], abi::Status> {
         let mut out = [0.0f32; 4];
         // SAFETY: `object` is live until `drop`, the query and result live across the call, and
         // the ABI allows concurrent `eval`s.
         let s = unsafe { (self.vtable.eval)(self.object, q, &mut out) };
-        (s == abi::STATUS_OK).then_some(out)
+        if s == abi::STATUS_OK {
+            Ok(out)
+        } else {
+            Err(s)
+        }
+    }
+
+    /// The error of an `eval` that returned `status`. A failing texture logged its cause
+    /// before (plugin ABI 1 has no error sink for `eval`).
+    pub fn failure(&self, status: abi::Status) -> String {
+        if status == abi::STATUS_PANIC {
+            format!("plugin `{}` panicked evaluating a texture", self.plugin)
+        } else {
+            format!(
+                "{}: texture `{}` (plugin `{}`) failed during the render (its error is above)",
+                self.at, self.name, self.plugin
+            )
+        }
     }
 }
 
@@ -76,5 +96,7 @@ pub fn create_texture(
         object: out.object,
         vtable,
         plugin: entry.name.clone(),
+        name: instance.to_string(),
+        at: params_at.clone(),
     })
 }

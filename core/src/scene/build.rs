@@ -384,7 +384,7 @@ impl<'a> Build<'a> {
             let at = || g.at.clone().unwrap_or_else(|| self.desc.camera.at.clone());
             let material = material_index(material_names, &g.material)?;
             stored.used[material] = true;
-            let m = material as u32;
+            let m = pack(material as u32, self.clip_group(&g.clip)?);
             let fail = |e: String| Error::at(&at(), format!("imported geometry group {k}: {e}"));
             for (i, s) in g.spheres.iter().enumerate() {
                 stored

@@ -166,10 +166,16 @@ impl Cluster {
     }
 
     /// Collective: rank 0's process id, so every rank names the same temporary file.
-    pub fn root_pid(&self) -> u32 {
-        let mut pid = std::process::id();
-        self.world.process_at_rank(0).broadcast_into(&mut pid);
-        pid
+    /// Collective: rank 0's `path` (`Some` there), on every rank.
+    pub fn broadcast_path(&self, path: Option<&std::path::Path>) -> std::path::PathBuf {
+        use std::os::unix::ffi::OsStrExt;
+        let root = self.world.process_at_rank(0);
+        let mut bytes = path.map_or(Vec::new(), |p| p.as_os_str().as_bytes().to_vec());
+        let mut len = bytes.len() as u64;
+        root.broadcast_into(&mut len);
+        bytes.resize(len as usize, 0);
+        root.broadcast_into(&mut bytes[..]);
+        std::path::PathBuf::from(std::ffi::OsStr::from_bytes(&bytes))
     }
 
     pub fn barrier(&self) {

@@ -37,14 +37,22 @@
 //!   `hither` is read and ignored (Luxon has no near clipping plane).
 //! - **Render settings**: `resolution` (default 512x512), 1 sample per pixel, ray depth 5
 //!   (POV-Ray's default, which the SPD's POV-Ray files rely on); no outputs (`-o` gives them).
-//! - Negative radii ("only the inside is visible") are made positive: Luxon's spheres and
-//!   cones are seen from both sides.
+//! - Negative radii ("only the inside is visible") are made positive, with a warning: Luxon's
+//!   spheres and cones are seen from both sides.
 //!
 //! ## Errors
 //!
 //! Every error names `file:line:col` and what was expected: unknown keywords (with a "did you
 //! mean"), a wrong number of values on a line, bad numbers, NaN and infinities, polygons with
 //! fewer than 3 vertices, a file that ends inside an entity, a missing or incomplete view.
+//!
+//! ## Warnings
+//!
+//! What NFF defines but Luxon renders differently is accepted with a warning (in the scene's
+//! `warnings`; the first of each kind in a file, with a count of the others): negative sphere
+//! and cone radii (drawn two-sided), and a polygon whose triangulation ran out of its time
+//! budget (a self-intersecting or very irregular polygon of many thousand corners: the rest of
+//! it becomes a fan from one corner, see `polygon`).
 //!
 //! ## Speed
 //!
@@ -65,13 +73,16 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use luxon_plugin::files::{open_regular, TextReader};
+
 use crate::desc::{
     CameraDesc, Highlight, LightDesc, MaterialDesc, Origin, Projection, RenderDesc, SceneDesc,
     Spanned,
 };
-use crate::error::SceneError;
+use crate::error::{SceneError, Warning};
 use crate::geometry::{InlineGeometry, InlineMesh};
-use parse::{ChunkError, ChunkOut, Directive, Fill, View};
+use crate::input::{file_error, FileError, NFF_MAX_LINE};
+use parse::{ChunkError, ChunkOut, Directive, Fill, NoteKind, View};
 
 /// What an NFF file held.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -130,18 +141,33 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
 
 /// Loads an NFF file (plain or gzip) and counts what it held.
 pub fn import(path: &Path) -> Result<Imported, SceneError> {
-    let io = |source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = File::open(path).map_err(io)?;
-    let mut reader = BufReader::with_capacity(1 << 16, file);
-    let gzip = reader.fill_buf().map_err(io)?.starts_with(&[0x1f, 0x8b]);
-    if gzip {
-        import_reader(flate2::read::MultiGzDecoder::new(reader), path)
-    } else {
-        import_reader(reader, path)
+    let reader = open(path)?;
+    match reader {
+        Opened::Plain(r) => import_reader(r, path),
+        Opened::Gzip(r) => import_reader(r, path),
     }
+}
+
+/// An NFF file opened for reading: plain, or gzip (recognised by its magic bytes).
+enum Opened {
+    Plain(BufReader<File>),
+    Gzip(flate2::read::MultiGzDecoder<BufReader<File>>),
+}
+
+/// What an NFF file must be, for messages.
+const WHAT: &str = "an NFF scene file";
+
+fn open(path: &Path) -> Result<Opened, SceneError> {
+    let (file, _) = open_regular(path, u64::MAX).map_err(|e| file_error(e, path, WHAT))?;
+    let mut reader = BufReader::with_capacity(1 << 16, file);
+    let start = reader
+        .fill_buf()
+        .map_err(|e| file_error(FileError::from_io(e), path, WHAT))?;
+    Ok(if start.starts_with(&[0x1f, 0x8b]) {
+        Opened::Gzip(flate2::read::MultiGzDecoder::new(reader))
+    } else {
+        Opened::Plain(reader)
+    })
 }
 
 /// The lines of an NFF file that are not geometry (the view, background, lights and `f`
@@ -160,23 +186,18 @@ pub fn skeleton(path: &Path) -> Result<String, SceneError> {
         "l",
         "f",
     ];
-    let io = |source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = File::open(path).map_err(io)?;
-    let mut reader = BufReader::with_capacity(1 << 16, file);
-    let gzip = reader.fill_buf().map_err(io)?.starts_with(&[0x1f, 0x8b]);
-    let mut text: Box<dyn BufRead> = if gzip {
-        Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(reader)))
-    } else {
-        Box::new(reader)
+    let mut text: Box<dyn BufRead> = match open(path)? {
+        Opened::Plain(r) => Box::new(TextReader::new(r, NFF_MAX_LINE)),
+        Opened::Gzip(r) => Box::new(TextReader::new(BufReader::new(r), NFF_MAX_LINE)),
     };
     let mut out = String::new();
     let mut line = Vec::new();
     loop {
         line.clear();
-        if text.read_until(b'\n', &mut line).map_err(io)? == 0 {
+        let n = text
+            .read_until(b'\n', &mut line)
+            .map_err(|e| read_error(e, path))?;
+        if n == 0 {
             break;
         }
         let first = line
@@ -193,6 +214,18 @@ pub fn skeleton(path: &Path) -> Result<String, SceneError> {
     Ok(out)
 }
 
+/// A failure reading NFF text: at the line (and column) of a problem in the text (a line
+/// without an end, binary data), else about the file.
+fn read_error(e: std::io::Error, path: &Path) -> SceneError {
+    match FileError::from_io(e) {
+        FileError::Io(source) => SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        e => file_error(e, path, WHAT),
+    }
+}
+
 /// Reads NFF text (not compressed) from `reader`; `path` names it in messages.
 pub fn import_reader(reader: impl Read + Send, path: &Path) -> Result<Imported, SceneError> {
     import_reader_blocks(reader, path, stream::BLOCK)
@@ -207,19 +240,17 @@ pub fn import_reader_blocks(
 ) -> Result<Imported, SceneError> {
     let mut a = Assembler::new(path);
     stream::parse_stream(
-        reader,
+        TextReader::new(reader, NFF_MAX_LINE),
         block.max(1),
         |results| a.block(results),
-        |source| SceneError::Io {
-            path: path.to_path_buf(),
-            source,
-        },
+        |e| read_error(e, path),
     )?;
     a.finish()
 }
 
 /// Parses NFF text held in memory; `path` names it in messages.
 pub fn parse_str(text: &str, path: &Path) -> Result<Imported, SceneError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut a = Assembler::new(path);
     let block = stream::Block {
         text: text.as_bytes().to_vec(),
@@ -291,6 +322,9 @@ struct Assembler {
     /// Position and colour (`None`: white, sharing the brightness).
     lights: Vec<(Spanned<[f64; 3]>, Option<Rgb>)>,
     stats: NffStats,
+    /// The first warning of each kind, and how many more of the kind there were.
+    warnings: Vec<(Warning, u64)>,
+    warning_of_kind: HashMap<NoteKind, usize>,
 }
 
 impl Assembler {
@@ -306,6 +340,8 @@ impl Assembler {
             background: None,
             lights: Vec::new(),
             stats: NffStats::default(),
+            warnings: Vec::new(),
+            warning_of_kind: HashMap::new(),
         }
     }
 
@@ -366,6 +402,7 @@ impl Assembler {
             self.inline.push(InlineGeometry {
                 material,
                 at: Some(self.origin(b.first)),
+                clip: None,
                 spheres: b.spheres,
                 cones: b.cones,
                 discs: Vec::new(),
@@ -380,6 +417,20 @@ impl Assembler {
         }
         if let Some(l) = c.end_fill {
             self.current = Some(ids[l as usize]);
+        }
+        for note in c.notes {
+            match self.warning_of_kind.get(&note.kind) {
+                Some(&i) => self.warnings[i].1 += 1,
+                None => {
+                    self.warning_of_kind.insert(note.kind, self.warnings.len());
+                    let at = self.origin(note.at);
+                    let warning = Warning {
+                        at,
+                        message: note.message,
+                    };
+                    self.warnings.push((warning, 0));
+                }
+            }
         }
         self.stats += c.stats;
         self.stats.lines += c.lines as u64;
@@ -472,6 +523,17 @@ impl Assembler {
                 ..RenderDesc::default()
             },
             plugin_path: Vec::new(),
+            warnings: self
+                .warnings
+                .into_iter()
+                .map(|(mut w, more)| {
+                    if more > 0 {
+                        w.message
+                            .push_str(&format!(" ({more} more like it in this file)"));
+                    }
+                    w
+                })
+                .collect(),
         };
         Ok(Imported {
             desc,

@@ -9,6 +9,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 use super::lex::{parse_f64, parse_u32, Lines, NumError};
 use super::polygon::Triangulator;
 use super::NffStats;
+use crate::error::shown;
 
 /// A position in a chunk: 0-based line in the chunk, 1-based column.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -66,6 +67,22 @@ pub(crate) struct Bucket {
     pub indices: Vec<[u64; 3]>,
 }
 
+/// The kinds of warnings: a file gets the first of each kind, with a count of the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum NoteKind {
+    NegativeSphereRadius,
+    NegativeConeRadius,
+    PolygonFan,
+}
+
+/// Something accepted with a caveat: a warning.
+#[derive(Debug)]
+pub(crate) struct Note {
+    pub at: Loc,
+    pub kind: NoteKind,
+    pub message: String,
+}
+
 #[derive(Debug, Default)]
 pub(crate) struct ChunkOut {
     /// Newlines in the chunk.
@@ -77,6 +94,7 @@ pub(crate) struct ChunkOut {
     pub end_fill: Option<u32>,
     pub buckets: Vec<Bucket>,
     pub stats: NffStats,
+    pub notes: Vec<Note>,
 }
 
 /// What follows a chunk that is not the last one: the entity keyword on its first line.
@@ -168,13 +186,9 @@ pub(crate) fn parse_chunk(text: &[u8], next: Option<Next>) -> Result<ChunkOut> {
     Ok(p.out)
 }
 
+/// A token of the file as it may be echoed in a message (see `shown`).
 fn show(token: &[u8]) -> String {
-    let s = String::from_utf8_lossy(token);
-    if s.chars().count() > 40 {
-        format!("{}...", s.chars().take(40).collect::<String>())
-    } else {
-        s.into_owned()
-    }
+    shown(&String::from_utf8_lossy(token)).into_owned()
 }
 
 impl<'a> Parser<'a> {
@@ -193,6 +207,24 @@ impl<'a> Parser<'a> {
             line: self.l.line,
             col: self.l.col(k),
         }
+    }
+
+    /// A warning at token `k` of the current line.
+    fn note(&mut self, k: usize, kind: NoteKind, message: String) {
+        let at = self.loc(k);
+        self.out.notes.push(Note { at, kind, message });
+    }
+
+    /// A negative radius (token `k`): NFF's "only the inside is visible". Luxon's spheres and
+    /// cones are seen from both sides: the radius is made positive, with a warning.
+    fn negative_radius(&mut self, k: usize, shape: &str, kind: NoteKind) {
+        let written = show(self.l.tok(k));
+        let message = format!(
+            "{shape} radius {written} is negative (NFF's inside-only {shape}); Luxon's {shape}s \
+             are two-sided, so it is drawn with radius {}",
+            written.trim_start_matches('-')
+        );
+        self.note(k, kind, message);
     }
 
     /// The next line, or an error saying what was `expected` if the chunk ends first.
@@ -348,7 +380,9 @@ impl<'a> Parser<'a> {
                 "sphere radius is 0; expected a radius other than 0",
             );
         }
-        // A negative radius means only the inside is visible: Luxon's spheres have two sides.
+        if s[3] < 0.0 {
+            self.negative_radius(4, "sphere", NoteKind::NegativeSphereRadius);
+        }
         let s = [s[0], s[1], s[2], s[3].abs()];
         self.out.stats.spheres += 1;
         let b = self.bucket(false, self.loc(0));
@@ -361,7 +395,15 @@ impl<'a> Parser<'a> {
         let kw_loc = self.loc(0);
         let c: [f64; 8] = match self.l.toks.len() - 1 {
             // The one-line form the SPD programs write.
-            8 => self.numbers::<8>(1, "`c` cone", names)?,
+            8 => {
+                let c = self.numbers::<8>(1, "`c` cone", names)?;
+                for k in [3, 7] {
+                    if c[k] < 0.0 {
+                        self.negative_radius(k + 1, "cone", NoteKind::NegativeConeRadius);
+                    }
+                }
+                c
+            }
             // The two-line form of NFF.TXT.
             0 => {
                 let start = self.l.line;
@@ -375,8 +417,14 @@ impl<'a> Parser<'a> {
                 };
                 self.line_for(&expected("base"))?;
                 let b = self.numbers::<4>(0, "`c` cone base", "x y z radius")?;
+                if b[3] < 0.0 {
+                    self.negative_radius(3, "cone", NoteKind::NegativeConeRadius);
+                }
                 self.line_for(&expected("apex"))?;
                 let a = self.numbers::<4>(0, "`c` cone apex", "x y z radius")?;
+                if a[3] < 0.0 {
+                    self.negative_radius(3, "cone", NoteKind::NegativeConeRadius);
+                }
                 [b[0], b[1], b[2], b[3], a[0], a[1], a[2], a[3]]
             }
             n => {
@@ -404,7 +452,6 @@ impl<'a> Parser<'a> {
                         .into(),
             });
         }
-        // Negative radii (inside visible) become positive: Luxon's cones have two sides.
         let c = [c[0], c[1], c[2], rb, c[4], c[5], c[6], ra];
         self.out.stats.cones += 1;
         let b = self.bucket(false, kw_loc);
@@ -491,7 +538,19 @@ impl<'a> Parser<'a> {
             }
         }
         self.tris.clear();
-        self.tri.triangulate(&self.verts, &mut self.tris);
+        let outcome = self.tri.triangulate(&self.verts, &mut self.tris);
+        if outcome.fan > 0 {
+            self.out.notes.push(Note {
+                at: kw_loc,
+                kind: NoteKind::PolygonFan,
+                message: format!(
+                    "{what} of {count} vertices could not be cut into ears within its time \
+                     budget (it intersects itself or is very irregular); its last {} triangles \
+                     are a fan from one corner, which may cover area outside the polygon",
+                    outcome.fan
+                ),
+            });
+        }
         if patch {
             self.out.stats.patches += 1;
         } else {
@@ -536,7 +595,10 @@ impl<'a> Parser<'a> {
             if f[i] < 0.0 {
                 return self.err(
                     self.l.col(i + 1),
-                    format!("`f` {name} is {}; expected a value >= 0", f[i]),
+                    format!(
+                        "`f` {name} is {}; expected a value >= 0",
+                        show(self.l.tok(i + 1))
+                    ),
                 );
             }
         }
@@ -545,7 +607,7 @@ impl<'a> Parser<'a> {
                 self.l.col(8),
                 format!(
                     "`f` index of refraction is {}; expected a value >= 0 (0: none)",
-                    f[7]
+                    show(self.l.tok(8))
                 ),
             );
         }
@@ -576,7 +638,10 @@ impl<'a> Parser<'a> {
                 if let Some(k) = (3..6).find(|&k| v[k] < 0.0) {
                     return self.err(
                         self.l.col(k + 1),
-                        format!("light colour {} is negative; expected a value >= 0", v[k]),
+                        format!(
+                            "light colour {} is negative; expected a value >= 0",
+                            show(self.l.tok(k + 1))
+                        ),
                     );
                 }
                 ([v[0], v[1], v[2]], Some([v[3], v[4], v[5]]))
@@ -674,7 +739,10 @@ impl<'a> Parser<'a> {
         if !(a > 0.0 && a < 180.0) {
             return self.err(
                 self.l.col(1),
-                format!("`angle` is {a}; expected a field of view in (0, 180) degrees"),
+                format!(
+                    "`angle` is {}; expected a field of view in (0, 180) degrees",
+                    show(self.l.tok(1))
+                ),
             );
         }
         Ok(a)

@@ -346,7 +346,8 @@ pub struct TexQuery {
 
 #[repr(C)]
 pub struct TextureInstanceVTable {
-    /// Writes linear RGBA into `out`; returns [`STATUS_PANIC`] when the plugin panicked.
+    /// Writes linear RGBA into `out`; returns [`STATUS_PANIC`] when the plugin panicked and
+    /// [`STATUS_ERROR`] when it could give no value (it logged why through the host table).
     pub eval: unsafe extern "C" fn(
         object: *const c_void,
         query: *const TexQuery,

@@ -38,6 +38,7 @@
 #![doc = include_str!("../../README.md")]
 
 pub mod abi;
+pub mod files;
 
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -169,6 +170,11 @@ pub fn describe_ron_error(code: &ron::Error) -> String {
         }
         ron::Error::MissingStructField { field, .. } => {
             format!("missing parameter `{field}`")
+        }
+        // ron's own words point at its options, which a scene's author cannot set.
+        ron::Error::ExceededRecursionLimit => {
+            "values are nested more than 128 levels deep; expected at most 128 levels of brackets"
+                .to_string()
         }
         other => other.to_string(),
     }
@@ -489,8 +495,23 @@ unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
 pub trait Texture: Describe + Send + Sync + Sized + 'static {
     type Params: serde::de::DeserializeOwned;
     fn create(params: Self::Params, ctx: &Context) -> Result<Self, Error>;
-    /// Linear RGBA at the query point.
+    /// Linear RGBA at the query point. When no value can be given (an image that turns out not
+    /// to decode), call [`texture_failed`] and return anything.
     fn eval(&self, query: &abi::TexQuery) -> [f32; 4];
+}
+
+thread_local! {
+    /// Set by [`texture_failed`] during the `eval` call running on this thread.
+    static EVAL_FAILED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Marks the texture evaluation running on this thread as failed: the host stops the render
+/// with an error naming the texture, and the run fails (its outputs are left untouched). Log
+/// the cause first, once, with [`host_log`] at level 0: plugin ABI 1 carries no message back
+/// from `eval`, only its status ([`abi::STATUS_ERROR`]). Works from any depth of nested
+/// textures.
+pub fn texture_failed() {
+    EVAL_FAILED.with(|f| f.set(true));
 }
 
 fn texture_instance_vtable<T: Texture>() -> &'static abi::TextureInstanceVTable {
@@ -517,7 +538,9 @@ unsafe extern "C" fn texture_eval<T: Texture>(
 ) -> abi::Status {
     // SAFETY: see the comment above these functions; the host's query is valid for the call.
     let (tex, q) = unsafe { (&*(object as *const T), &*query) };
+    EVAL_FAILED.with(|f| f.set(false));
     match catch_unwind(AssertUnwindSafe(|| tex.eval(q))) {
+        Ok(_) if EVAL_FAILED.with(|f| f.replace(false)) => abi::STATUS_ERROR,
         Ok(c) => {
             // SAFETY: the host passes a writable `[f32; 4]` for the call (ABI contract).
             unsafe { *out = c };
@@ -1034,6 +1057,49 @@ macro_rules! export {
 mod tests {
     use super::*;
 
+    /// Fails when the query's `time` is negative.
+    struct Picky;
+
+    impl Describe for Picky {
+        const NAME: &'static str = "picky";
+        const DESCRIPTION: &'static str = "";
+        const PARAMS: &'static str = "";
+    }
+
+    impl Texture for Picky {
+        type Params = ();
+        fn create(_: (), _: &Context) -> Result<Self, Error> {
+            Ok(Picky)
+        }
+        fn eval(&self, q: &abi::TexQuery) -> [f32; 4] {
+            if q.time < 0.0 {
+                texture_failed();
+            }
+            [0.5; 4]
+        }
+    }
+
+    #[test]
+    fn a_failed_texture_evaluation_returns_an_error_status_once() {
+        let vt = texture_instance_vtable::<Picky>();
+        let object = Box::into_raw(Box::new(Picky)) as *mut c_void;
+        let mut out = [0.0f32; 4];
+        let q = |time| abi::TexQuery {
+            time,
+            ..Default::default()
+        };
+        // SAFETY: `object` is a live `Picky` made above for this table; queries and `out` live
+        // across each call; `destroy` is the last use of `object`.
+        unsafe {
+            assert_eq!((vt.eval)(object, &q(-1.0), &mut out), abi::STATUS_ERROR);
+            assert_eq!(out, [0.0; 4], "a failed evaluation writes no value");
+            // The mark belongs to one evaluation only.
+            assert_eq!((vt.eval)(object, &q(1.0), &mut out), abi::STATUS_OK);
+            assert_eq!(out, [0.5; 4]);
+            (vt.destroy)(object);
+        }
+    }
+
     #[derive(serde::Deserialize, Debug, PartialEq)]
     #[serde(deny_unknown_fields)]
     struct P {
@@ -1050,6 +1116,16 @@ mod tests {
                 center: [0.0, 1.0, 2.0],
                 radius: 1.0
             }
+        );
+    }
+
+    #[test]
+    fn deep_nesting_is_explained_without_rons_options() {
+        let text = format!("(v: {}1{})", "[".repeat(200), "]".repeat(200));
+        let e = parse_params::<ron::Value>(&text).unwrap_err();
+        assert_eq!(
+            e.message,
+            "values are nested more than 128 levels deep; expected at most 128 levels of brackets"
         );
     }
 

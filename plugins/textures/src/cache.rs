@@ -29,7 +29,7 @@
 //!
 //! **Thrashing.** When an image has to be decoded a second time (its data was evicted and is
 //! needed again), the cache logs once, with the budget and the size of all registered texture
-//! data. A decode failure logs once per image and the image renders magenta.
+//! data. A decode failure logs once per image; lookups then fail (the render stops with an error).
 
 use crate::decode::{decode, Header};
 use crate::mipmap::{build_pyramid, level_sizes, Level};
@@ -96,7 +96,7 @@ pub struct CachedImage {
     readers: [Stripe; STRIPES],
     /// Held while decoding and installing this image.
     loading: Mutex<()>,
-    /// The decode failed; lookups answer magenta without trying again.
+    /// The decode failed; lookups fail without trying again.
     failed: AtomicBool,
     /// How many times the file was decoded.
     decodes: AtomicU64,
@@ -373,10 +373,7 @@ impl Cache {
                 if !img.failed.swap(true, AcqRel) {
                     (self.log)(
                         0,
-                        &format!(
-                            "cannot decode image `{}`: {e}; it renders magenta",
-                            img.path.display()
-                        ),
+                        &format!("cannot decode image `{}`: {e}", img.path.display()),
                     );
                 }
                 return None;
@@ -627,7 +624,7 @@ mod tests {
         assert_eq!(seen.len(), 1, "{seen:?}");
         assert_eq!(seen[0].0, 0);
         assert!(
-            seen[0].1.contains("broken.png") && seen[0].1.contains("magenta"),
+            seen[0].1.contains("cannot decode image") && seen[0].1.contains("broken.png"),
             "{}",
             seen[0].1
         );

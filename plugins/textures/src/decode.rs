@@ -54,8 +54,17 @@ fn is_exr(path: &Path) -> std::io::Result<bool> {
 /// Checks that `path` exists, is a supported image and has a sane size; reads only the header.
 pub fn probe(path: &Path) -> Result<Header, Error> {
     let shown = path.display();
-    if !path.is_file() {
-        return Err(Error::new(format!("image file `{shown}` not found")));
+    // By type, before opening: a directory is no missing file, and a FIFO would block the open.
+    let what = match std::fs::metadata(path) {
+        Err(_) => return Err(Error::new(format!("image file `{shown}` not found"))),
+        Ok(m) if m.is_file() => None,
+        Ok(m) if m.is_dir() => Some("a directory"),
+        Ok(_) => Some("not a regular file (a FIFO, socket or device)"),
+    };
+    if let Some(what) = what {
+        return Err(Error::new(format!(
+            "image file `{shown}` is {what}; expected an image file"
+        )));
     }
     let cannot =
         |e: &dyn std::fmt::Display| Error::new(format!("cannot read image `{shown}`: {e}"));
@@ -228,4 +237,22 @@ fn decode_exr(path: &Path) -> Result<Level, String> {
         .map(|t| t.map(|x| if x.is_finite() { x } else { 0.0 }))
         .collect();
     Ok(Level::new(size.0, size.1, texels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::probe;
+
+    #[test]
+    fn a_directory_is_not_reported_as_missing() {
+        let dir = crate::testutil::TempDir::new("probe-types");
+        std::fs::create_dir(dir.path("d.png")).unwrap();
+        let e = probe(&dir.path("d.png")).unwrap_err().message;
+        assert!(
+            e.ends_with("d.png` is a directory; expected an image file"),
+            "{e}"
+        );
+        let e = probe(&dir.path("gone.png")).unwrap_err().message;
+        assert!(e.ends_with("gone.png` not found"), "{e}");
+    }
 }

@@ -66,7 +66,7 @@ srgb: bool = true  integer (8/16-bit) sources are sRGB-encoded; false: already l
 mapping: uv|planar|cylindrical|spherical = uv  mesh texture coordinates, or a projection around `center`/`axis`
 center: (x, y, z) = (0, 0, 0)  origin of the projection (not with `uv`)
 axis: (x, y, z) = (0, 1, 0)  plane normal (planar) or pole (cylindrical, spherical); not with `uv`
-scale: f64 or (u, v) = 1.0  size of one copy of the image in mapping units (> 0)
+scale: f64 or (u, v) = 1.0  size of one copy of the image in mapping units (not 0; negative mirrors)
 rotate: f64 = 0.0  turns the image counter-clockwise, degrees
 offset: (u, v) = (0, 0)  where the image's corner (0, 0) lands, mapping units
 wrap: repeat|clamp|mirror = repeat  outside the image: tile, extend the edges, or tile mirrored
@@ -144,7 +144,11 @@ impl Texture for ImageTexture {
                     .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
             }
         };
-        got.unwrap_or(MAGENTA)
+        got.unwrap_or_else(|| {
+            // The cache logged why, once; the host stops the render.
+            luxon_plugin::texture_failed();
+            MAGENTA
+        })
     }
 }
 
@@ -390,7 +394,7 @@ mod tests {
         let e = err(r#"(file: "ramp.png", filter: cubic)"#);
         assert!(e.contains("cubic"), "{e}");
         let e = err(r#"(file: "ramp.png", scale: (1, 0))"#);
-        assert!(e.contains("`scale`"), "{e}");
+        assert!(e.contains("`scale` must not be 0"), "{e}");
         let e = err(r#"(file: "ramp.png", center: (1, 0, 0))"#);
         assert!(e.contains("`center` has no effect"), "{e}");
         let e = err(r#"(file: "ramp.png", mapping: planar, axis: (0, 0, 0))"#);

@@ -136,7 +136,7 @@
 //! | `mapping` | `uv`, `planar`, `cylindrical`, `spherical` | `uv` | mesh texture coordinates, or a projection |
 //! | `center`  | `(x, y, z)` | `(0, 0, 0)` | origin of the projection (not with `uv`) |
 //! | `axis`    | `(x, y, z)` | `(0, 1, 0)` | plane normal (planar) or pole (cylindrical, spherical); not with `uv` |
-//! | `scale`   | f64 or `(u, v)`, > 0 | `1.0` | size of one copy of the image in mapping units |
+//! | `scale`   | f64 or `(u, v)`, not 0 | `1.0` | size of one copy of the image in mapping units (negative: mirrored along that direction) |
 //! | `rotate`  | f64 degrees | `0` | turns the image counter-clockwise |
 //! | `offset`  | `(u, v)` | `(0, 0)` | where the image's corner `(0, 0)` lands |
 //! | `wrap`    | `repeat`, `clamp`, `mirror` | `repeat` | outside [0, 1): tile, extend the edge texels, tile mirrored |
@@ -165,7 +165,7 @@
 //! Least recently used levels are evicted when the budget is exceeded and decoded again when
 //! needed, so scenes with more texture data than the budget still render; a warning says once
 //! when that happens (the cache is thrashing), with the budget and the data size. An image
-//! that cannot be decoded renders magenta, with one error in the log. See `cache.rs`.
+//! that cannot be decoded logs one error and makes the render fail. See `cache.rs`.
 //!
 //! ## Scene
 //!

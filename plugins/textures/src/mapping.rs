@@ -15,7 +15,8 @@
 //!
 //! The placement maps `(u, v)` to `(s, t) = R(-rotate) · ((u, v) - offset) / scale`: the image is
 //! scaled by `scale`, turned by `rotate` degrees (counter-clockwise) and moved to `offset`, in
-//! `(u, v)` units: one copy of the image covers `scale` world units under `planar` mapping.
+//! `(u, v)` units: one copy of the image covers `scale` world units under `planar` mapping. A
+//! negative scale mirrors the image along that direction (Tachyon's image maps need it).
 
 use crate::params::{direction, Factors};
 use luxon_plugin::abi::TexQuery;
@@ -90,7 +91,7 @@ impl Mapping {
         let w = direction("axis", axis)?;
         let [rotate] = finite("rotate", [rotate])?;
         let offset = finite("offset", offset)?;
-        let scale = scale.positive("scale")?;
+        let scale = scale.nonzero("scale")?;
         let x = [1.0, 0.0, 0.0];
         // World x made perpendicular to the axis; world z when the axis is (nearly) along x.
         let reference = if dot(x, w).abs() > 0.999 {
@@ -172,8 +173,8 @@ impl Mapping {
         Lookup {
             s: clean(ru / self.scale[0]),
             t: clean(rv / self.scale[1]),
-            ds: fix(du / self.scale[0]),
-            dt: fix(dv / self.scale[1]),
+            ds: fix(du / self.scale[0].abs()),
+            dt: fix(dv / self.scale[1].abs()),
         }
     }
 }
@@ -297,6 +298,23 @@ mod tests {
         )
         .unwrap();
         assert!(near(r.lookup(&q([0.0, 0.0, -1.0])), 1.0, 0.0));
+        // A negative scale mirrors: v = 2 -> 2 / -4 = -0.5; the footprint stays positive.
+        let m = Mapping::new(
+            Kind::Planar,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            Factors([2.0, -4.0]),
+            0.0,
+            [0.0; 2],
+        )
+        .unwrap();
+        let l = m.lookup(&TexQuery {
+            p: [2.0, 0.0, -2.0],
+            footprint: 1.0,
+            ..Default::default()
+        });
+        assert!(near(l, 1.0, -0.5));
+        assert_eq!((l.ds, l.dt), (0.5, 0.25));
     }
 
     #[test]

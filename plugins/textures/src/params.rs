@@ -96,6 +96,17 @@ impl<const N: usize> Factors<N> {
         }
         Ok(v)
     }
+
+    /// Every factor finite and not 0 (a negative factor mirrors).
+    pub fn nonzero(self, name: &str) -> Result<[f64; N], Error> {
+        let v = finite(name, self.0)?;
+        if v.contains(&0.0) {
+            return Err(invalid(format!(
+                "parameter `{name}` must not be 0, got {v:?}"
+            )));
+        }
+        Ok(v)
+    }
 }
 
 impl<'de, const N: usize> Deserialize<'de> for Factors<N> {

@@ -14,7 +14,7 @@
 //! | `format`    | `"u8"`, `"u16"` or `"f32"`   | `"u8"`      | type of one voxel: unsigned 8 or 16 bits, or IEEE 754 single precision |
 //! | `endian`    | `"little"` or `"big"`        | `"little"`  | byte order of `u16` and `f32` voxels (ignored for `u8`) |
 //! | `header`    | whole number                 | `0`         | bytes to skip at the start of the file |
-//! | `spacing`   | `(sx, sy, sz)`               | `(1, 1, 1)` | size of a voxel in world units along each axis, each > 0 |
+//! | `spacing`   | `(sx, sy, sz)`               | `(1, 1, 1)` | size of a voxel in world units along each axis, each non-zero (a negative one runs that axis backwards from `origin`: a mirrored grid) |
 //! | `origin`    | `(x, y, z)`                  | `(0, 0, 0)` | world position of voxel `(0, 0, 0)` |
 //! | `normalize` | bool                         | `true`      | map `u8` to [0, 1] by dividing by 255 and `u16` by dividing by 65535; `f32` values are always kept as they are |
 //!
@@ -27,12 +27,12 @@
 //!
 //! gzip-compressed files (such as `mri-head-256x256x109-u8.raw.gz`) are read transparently,
 //! recognised by their magic bytes whatever their name; `header` and the size check apply to
-//! the decompressed bytes. A compressed file is decompressed into memory first (once its
-//! decompressed size is known to be right), so it briefly costs its raw size in memory.
+//! the decompressed bytes (a stream that ends early or goes on is an error stating both sizes).
 //!
-//! An uncompressed file is streamed: slabs of at most 8 z-slices (and, for very wide slices,
-//! parts of them) are read, converted and handed to the host one at a time, so only about
-//! 1 Mi voxels are ever held besides the host's copy.
+//! Both kinds are streamed in file order: slabs of 8 z-slices (at most 64 MiB of the file; for
+//! wider slices, rows of one slice or parts of a row) are read, converted and handed to the host
+//! in blocks of about 1 Mi voxels, so the reader holds at most one slab whatever the file
+//! claims. The host stores only what is not background, so an empty volume costs almost nothing.
 //!
 //! ## Procedural volumes
 //!

@@ -1,10 +1,11 @@
-//! The `raw` reader: checks its parameters, then reads (or, gzip-compressed, decompresses) the
-//! file and hands the host slabs of converted voxels; the format is described in the crate doc.
+//! The `raw` reader: checks its parameters, then streams the file (decompressing it when it is
+//! gzip) and hands the host blocks of converted voxels; the format is described in the crate
+//! doc.
 
 use luxon_plugin::{finite, invalid, Context, Describe, Error, GridInfo, VolumeOut, VolumeReader};
 use serde::{Deserialize, Deserializer};
 use std::fs::File;
-use std::io::{Cursor, Read, Seek, SeekFrom};
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
 /// The first bytes of every gzip stream.
@@ -121,7 +122,7 @@ dims: (x, y, z) = required  voxels along each axis, each >= 1
 format: \"u8\" | \"u16\" | \"f32\" = \"u8\"  type of one voxel
 endian: \"little\" | \"big\" = \"little\"  byte order of u16 and f32 voxels
 header: u64 = 0  bytes to skip at the start of the file
-spacing: (sx, sy, sz) = (1, 1, 1)  voxel size in world units, each > 0
+spacing: (sx, sy, sz) = (1, 1, 1)  voxel step in world units, each non-zero (negative: the axis runs backwards)
 origin: (x, y, z) = (0, 0, 0)  world position of voxel (0, 0, 0)
 normalize: bool = true  u8 / 255 and u16 / 65535 into [0, 1] (f32 kept)";
 }
@@ -282,9 +283,10 @@ impl Checked {
     fn new(p: &RawParams) -> Result<Checked, Error> {
         let (layout, expected) = Layout::new(p)?;
         let spacing = finite("spacing", p.spacing)?;
-        if spacing.iter().any(|&s| s <= 0.0) {
+        // A negative step mirrors its axis (Tachyon scenes, mirrored into Luxon's world).
+        if spacing.contains(&0.0) {
             return Err(invalid(format!(
-                "parameter `spacing` must be greater than 0 on every axis, got {spacing:?}"
+                "parameter `spacing` must not be 0 on any axis, got {spacing:?}"
             )));
         }
         let origin = finite("origin", p.origin)?;
@@ -306,57 +308,28 @@ impl Checked {
         if actual == self.expected {
             return Ok(());
         }
+        Err(self.size_error(path, &actual.to_string()))
+    }
+
+    fn size_error(&self, path: &Path, actual: &str) -> Error {
         let layout = &self.layout;
-        Err(invalid(format!(
+        invalid(format!(
             "`{}`: expected {} bytes for {} {} voxels plus a {}-byte header, the file has {actual}",
             path.display(),
             self.expected,
             dims_text(layout.dims),
             layout.format.name(),
             layout.header
-        )))
+        ))
     }
 
-    /// The decompressed bytes of a gzip stream, which must be exactly the expected size
-    /// (checked without ever holding more than one byte beyond it).
-    fn gunzip(&self, source: impl Read, path: &Path) -> Result<Vec<u8>, Error> {
-        let (layout, expected) = (&self.layout, self.expected);
-        let mut bytes = Vec::new();
-        flate2::read::MultiGzDecoder::new(std::io::BufReader::new(source))
-            .take(expected.saturating_add(1))
-            .read_to_end(&mut bytes)
-            .map_err(|e| {
-                invalid(format!(
-                    "`{}` is gzip-compressed but cannot be decompressed: {e}",
-                    path.display()
-                ))
-            })?;
-        if bytes.len() as u64 != expected {
-            let actual = if bytes.len() as u64 > expected {
-                "more".to_string()
-            } else {
-                bytes.len().to_string()
-            };
-            return Err(invalid(format!(
-                "`{}` (gzip-compressed): expected {expected} decompressed bytes for {} {} voxels \
-                 plus a {}-byte header, it decompresses to {actual}",
-                path.display(),
-                dims_text(layout.dims),
-                layout.format.name(),
-                layout.header
-            )));
-        }
-        Ok(bytes)
-    }
-
-    /// Announces the grid and streams the voxels of `source` (of the expected size).
+    /// Announces the grid and streams the voxels of `input` (the file's bytes, decompressed).
     fn decode(
         &self,
         name: String,
-        source: &mut (impl Read + Seek),
-        path: &Path,
+        input: &mut Input,
         out: &mut impl Blocks,
-        budget: u64,
+        sizes: Sizes,
     ) -> Result<(), Error> {
         let (spacing, origin) = (self.spacing, self.origin);
         out.begin(&GridInfo {
@@ -370,7 +343,106 @@ impl Checked {
             index_max: self.layout.dims.map(|n| (n - 1) as i64),
             name,
         })?;
-        stream(source, path, &self.layout, out, budget)
+        stream(input, &self.layout, out, sizes)?;
+        input.at_end()
+    }
+}
+
+/// The file's bytes (decompressed when it is gzip), read in order, with the size rules: a
+/// stream that ends early or goes on too long is an error stating both sizes.
+struct Input<'a> {
+    reader: Box<dyn Read + 'a>,
+    path: &'a Path,
+    checked: &'a Checked,
+    gzip: bool,
+    /// Bytes read so far.
+    consumed: u64,
+}
+
+impl<'a> Input<'a> {
+    fn new(source: impl Read + 'a, gzip: bool, path: &'a Path, checked: &'a Checked) -> Self {
+        let reader: Box<dyn Read + 'a> = if gzip {
+            Box::new(flate2::read::MultiGzDecoder::new(std::io::BufReader::new(
+                source,
+            )))
+        } else {
+            Box::new(source)
+        };
+        Input {
+            reader,
+            path,
+            checked,
+            gzip,
+            consumed: 0,
+        }
+    }
+
+    /// Fills `buf` with the next bytes.
+    fn fill(&mut self, buf: &mut [u8]) -> Result<(), Error> {
+        let mut got = 0;
+        while got < buf.len() {
+            match self.reader.read(&mut buf[got..]) {
+                Ok(0) => return Err(self.wrong_size((self.consumed + got as u64).to_string())),
+                Ok(n) => got += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(self.read_error(e)),
+            }
+        }
+        self.consumed += got as u64;
+        Ok(())
+    }
+
+    /// Reads and drops `n` bytes (the header).
+    fn skip(&mut self, n: u64) -> Result<(), Error> {
+        let mut scratch = vec![0u8; n.min(64 << 10) as usize];
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(scratch.len() as u64) as usize;
+            self.fill(&mut scratch[..k])?;
+            left -= k as u64;
+        }
+        Ok(())
+    }
+
+    /// After the last voxel: one more byte means the file is longer than the grid.
+    fn at_end(&mut self) -> Result<(), Error> {
+        let mut one = [0u8; 1];
+        loop {
+            match self.reader.read(&mut one) {
+                Ok(0) => return Ok(()),
+                Ok(_) => return Err(self.wrong_size("more".into())),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(self.read_error(e)),
+            }
+        }
+    }
+
+    fn read_error(&self, e: std::io::Error) -> Error {
+        if self.gzip {
+            invalid(format!(
+                "`{}` is gzip-compressed but cannot be decompressed: {e}",
+                self.path.display()
+            ))
+        } else {
+            invalid(format!("error reading `{}`: {e}", self.path.display()))
+        }
+    }
+
+    fn wrong_size(&self, actual: String) -> Error {
+        if !self.gzip {
+            // Checked before reading: the file changed while it was read.
+            return self.checked.size_error(self.path, &actual);
+        }
+        let layout = &self.checked.layout;
+        invalid(format!(
+            "`{}` (gzip-compressed): expected {} decompressed bytes for {} {} voxels plus a \
+             {}-byte header, it decompresses to {actual}",
+            self.path.display(),
+            self.checked.expected,
+            dims_text(layout.dims),
+            layout.format.name(),
+            layout.header
+        ))
     }
 }
 
@@ -378,27 +450,24 @@ impl Checked {
 /// grid and messages), `bytes` the file's content. The reader's whole parsing without the
 /// plugin ABI or a file, for tools and fuzzing.
 pub fn read_bytes(params: &str, bytes: &[u8], out: &mut impl Blocks) -> Result<(), Error> {
+    read_bytes_in(params, bytes, out, Sizes::DEFAULT)
+}
+
+fn read_bytes_in(
+    params: &str,
+    bytes: &[u8],
+    out: &mut impl Blocks,
+    sizes: Sizes,
+) -> Result<(), Error> {
     let p: RawParams = luxon_plugin::parse_params(params)?;
     let checked = Checked::new(&p)?;
     let path = Path::new(&p.file);
-    if bytes.starts_with(&GZIP_MAGIC) {
-        let unzipped = checked.gunzip(bytes, path)?;
-        return checked.decode(
-            p.file.clone(),
-            &mut Cursor::new(unzipped),
-            path,
-            out,
-            BLOCK_VOXELS,
-        );
+    let gzip = bytes.starts_with(&GZIP_MAGIC);
+    if !gzip {
+        checked.size(path, bytes.len() as u64)?;
     }
-    checked.size(path, bytes.len() as u64)?;
-    checked.decode(
-        p.file.clone(),
-        &mut Cursor::new(bytes),
-        path,
-        out,
-        BLOCK_VOXELS,
-    )
+    let mut input = Input::new(bytes, gzip, path, &checked);
+    checked.decode(p.file.clone(), &mut input, out, sizes)
 }
 
 impl VolumeReader for Raw {
@@ -425,79 +494,160 @@ impl VolumeReader for Raw {
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_else(|| p.file.clone());
-        if gzip {
-            let bytes = checked.gunzip(&mut file, &path)?;
-            checked.decode(name, &mut Cursor::new(bytes), &path, out, BLOCK_VOXELS)
-        } else {
+        if !gzip {
             checked.size(&path, meta.len())?;
-            checked.decode(name, &mut file, &path, out, BLOCK_VOXELS)
         }
+        let mut input = Input::new(file, gzip, &path, &checked);
+        checked.decode(name, &mut input, out, Sizes::DEFAULT)
     }
 }
 
-/// Reads the voxels block by block and hands each to the host.
+/// How much is read and handed over at once (smaller in tests, to reach every case).
+#[derive(Clone, Copy)]
+struct Sizes {
+    /// The most bytes of the file held at once: a slab of [`SLAB`] slices when it fits, else
+    /// whole rows of one slice, else parts of one row (bricks then fill up over several blocks).
+    slab_bytes: u64,
+    /// The most voxels in one block handed to the host.
+    block_voxels: u64,
+}
+
+impl Sizes {
+    const DEFAULT: Sizes = Sizes {
+        slab_bytes: 64 << 20,
+        block_voxels: BLOCK_VOXELS,
+    };
+}
+
+/// A buffer of `n` bytes, or an error naming what needed it (never an abort).
+fn buffer(n: u64, what: impl FnOnce() -> String) -> Result<Vec<u8>, Error> {
+    let mut v = Vec::new();
+    usize::try_from(n)
+        .ok()
+        .and_then(|n| v.try_reserve_exact(n).ok().map(|()| n))
+        .map(|n| {
+            v.resize(n, 0);
+            v
+        })
+        .ok_or_else(|| {
+            invalid(format!(
+                "{} needs {n} bytes, which do not fit in memory",
+                what()
+            ))
+        })
+}
+
+/// Reads the voxels in file order, a piece at a time, and hands the host blocks of at most
+/// `sizes.block_voxels` voxels. Nothing seeks, so gzip streams and plain files take one path,
+/// and memory stays bounded whatever the file (or its decompression) claims.
 fn stream(
-    file: &mut (impl Read + Seek),
-    path: &Path,
+    input: &mut Input,
     layout: &Layout,
     out: &mut impl Blocks,
-    budget: u64,
+    sizes: Sizes,
 ) -> Result<(), Error> {
+    let Sizes {
+        slab_bytes: max_slab,
+        block_voxels,
+    } = sizes;
     let [nx, ny, nz] = layout.dims;
     let bpv = layout.format.bytes();
-    let (bx, by) = block_size(layout.dims, budget);
-    let mut raw: Vec<u8> = Vec::new();
+    input.skip(layout.header)?;
+    let path = input.path;
     let mut values: Vec<f32> = Vec::new();
-    let mut position = u64::MAX;
-    let read_error =
-        |e: std::io::Error| invalid(format!("error reading `{}`: {e}", path.display()));
-    for z0 in (0..nz).step_by(SLAB as usize) {
-        let dz = SLAB.min(nz - z0);
-        for y0 in (0..ny).step_by(by as usize) {
-            let dy = by.min(ny - y0);
-            for x0 in (0..nx).step_by(bx as usize) {
-                let dx = bx.min(nx - x0);
-                // At most `budget` voxels (or 8x8x8), so these fit in memory and usize.
-                raw.resize((dx * dy * dz * bpv) as usize, 0);
-                // Contiguous runs in the file: whole slices' rows at once when a block spans
-                // full rows, one row part at a time otherwise.
-                let (run, runs_per_slice) = if dx == nx { (dx * dy, 1) } else { (dx, dy) };
-                let run_bytes = (run * bpv) as usize;
-                let mut chunks = raw.chunks_exact_mut(run_bytes);
-                for z in z0..z0 + dz {
-                    for r in 0..runs_per_slice {
-                        let y = y0 + if runs_per_slice == 1 { 0 } else { r };
-                        let offset = layout.header + ((z * ny + y) * nx + x0) * bpv;
-                        if position != offset {
-                            file.seek(SeekFrom::Start(offset)).map_err(read_error)?;
+    let mut send = |raw: &[u8], origin: [u64; 3], dims: [u64; 3]| -> Result<(), Error> {
+        layout.convert(raw, &mut values);
+        check_finite(&values, origin, dims, layout, path)?;
+        out.dense(origin.map(|c| c as i64), dims, &values)
+    };
+    let slab_bytes = nx.saturating_mul(ny).saturating_mul(SLAB * bpv);
+    if slab_bytes <= max_slab {
+        let (bx, by) = block_size(layout.dims, block_voxels);
+        let mut raw: Vec<u8> = Vec::new();
+        for z0 in (0..nz).step_by(SLAB as usize) {
+            let dz = SLAB.min(nz - z0);
+            let mut slab = buffer(nx * ny * dz * bpv, || {
+                format!(
+                    "a slab of {dz} slices of {nx}x{ny} {} voxels",
+                    layout.format.name()
+                )
+            })?;
+            input.fill(&mut slab)?;
+            for y0 in (0..ny).step_by(by as usize) {
+                let dy = by.min(ny - y0);
+                for x0 in (0..nx).step_by(bx as usize) {
+                    let dx = bx.min(nx - x0);
+                    raw.clear();
+                    for z in 0..dz {
+                        for y in y0..y0 + dy {
+                            let at = (((z * ny + y) * nx + x0) * bpv) as usize;
+                            raw.extend_from_slice(&slab[at..at + (dx * bpv) as usize]);
                         }
-                        let chunk = chunks.next().expect("the buffer holds every run");
-                        file.read_exact(chunk).map_err(read_error)?;
-                        position = offset + run_bytes as u64;
                     }
+                    send(&raw, [x0, y0, z0], [dx, dy, dz])?;
                 }
-                layout.convert(&raw, &mut values);
-                if layout.format == Format::F32 {
-                    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-                        let i = i as u64;
-                        let ijk = [x0 + i % dx, y0 + i / dx % dy, z0 + i / dx / dy];
-                        let offset = layout.header + ((ijk[2] * ny + ijk[1]) * nx + ijk[0]) * bpv;
-                        return Err(invalid(format!(
-                            "voxel ({}, {}, {}) of `{}` (byte {offset}) is {}; expected finite \
-                             values",
-                            ijk[0],
-                            ijk[1],
-                            ijk[2],
-                            path.display(),
-                            values[i as usize]
-                        )));
-                    }
+            }
+        }
+    } else if nx <= block_voxels {
+        // Rows of one slice (a multiple of 8 when more than 8 fit).
+        let rows = block_voxels / nx;
+        let rows = if rows >= 8 { rows / 8 * 8 } else { rows };
+        let mut raw = Vec::new();
+        for z in 0..nz {
+            for y0 in (0..ny).step_by(rows as usize) {
+                let dy = rows.min(ny - y0);
+                raw.resize((nx * dy * bpv) as usize, 0);
+                input.fill(&mut raw)?;
+                send(&raw, [0, y0, z], [nx, dy, 1])?;
+            }
+        }
+    } else {
+        let mut raw = Vec::new();
+        for z in 0..nz {
+            for y in 0..ny {
+                for x0 in (0..nx).step_by(block_voxels as usize) {
+                    let dx = block_voxels.min(nx - x0);
+                    raw.resize((dx * bpv) as usize, 0);
+                    input.fill(&mut raw)?;
+                    send(&raw, [x0, y, z], [dx, 1, 1])?;
                 }
-                out.dense([x0 as i64, y0 as i64, z0 as i64], [dx, dy, dz], &values)?;
             }
         }
     }
     Ok(())
+}
+
+/// f32 files may hold NaN or infinities: the first one is an error naming its voxel and byte.
+fn check_finite(
+    values: &[f32],
+    origin: [u64; 3],
+    dims: [u64; 3],
+    layout: &Layout,
+    path: &Path,
+) -> Result<(), Error> {
+    if layout.format != Format::F32 {
+        return Ok(());
+    }
+    let Some(i) = values.iter().position(|v| !v.is_finite()) else {
+        return Ok(());
+    };
+    let [nx, ny, _] = layout.dims;
+    let [dx, dy, _] = dims;
+    let k = i as u64;
+    let ijk = [
+        origin[0] + k % dx,
+        origin[1] + k / dx % dy,
+        origin[2] + k / dx / dy,
+    ];
+    let offset = layout.header + ((ijk[2] * ny + ijk[1]) * nx + ijk[0]) * layout.format.bytes();
+    Err(invalid(format!(
+        "voxel ({}, {}, {}) of `{}` (byte {offset}) is {}; expected finite values",
+        ijk[0],
+        ijk[1],
+        ijk[2],
+        path.display(),
+        values[i]
+    )))
 }
 
 #[cfg(test)]
@@ -674,6 +824,16 @@ mod tests {
         let want: Vec<f32> = bytes.iter().map(|&b| b as f32 / 255.0).collect();
         assert_eq!(got.values, want);
 
+        // A negative step runs the axis backwards from `origin`.
+        let got = read(&format!(
+            r#"(file: "{file}", dims: (3, 2, 2), spacing: (0.5, 2, -3), origin: (1, -1, 10))"#
+        ))
+        .unwrap();
+        assert_eq!(
+            got.world_from_index,
+            [0.5, 0., 0., 1., 0., 2., 0., -1., 0., 0., -3., 10.]
+        );
+
         let got = read(&format!(
             r#"(file: "{file}", dims: (3, 2, 2), normalize: false)"#
         ))
@@ -846,7 +1006,7 @@ mod tests {
         let e = read(r#"(file: "x.raw", dims: (4294967296, 4294967296, 2))"#).unwrap_err();
         assert!(e.contains("overflows"), "{e}");
         let e = read(r#"(file: "x.raw", dims: (1, 1, 1), spacing: (1, 0, 1))"#).unwrap_err();
-        assert!(e.contains("`spacing` must be greater than 0"), "{e}");
+        assert!(e.contains("`spacing` must not be 0"), "{e}");
         let e = read(r#"(file: "x.raw", dims: (1, 1, 1), gzip: true)"#).unwrap_err();
         assert!(e.contains("unknown parameter `gzip`"), "{e}");
         let e = read(r#"(dims: (1, 1, 1))"#).unwrap_err();
@@ -959,6 +1119,129 @@ mod tests {
         assert!(e.unwrap_err().message.contains("at least 1"));
         let e = read_bytes("(dims: (1, 1, 1))", &[0], &mut Collect::default());
         assert!(e.unwrap_err().message.contains("missing parameter `file`"));
+    }
+
+    /// Every voxel of the grid, and how often each was given (checked once per voxel).
+    #[derive(Default)]
+    struct Grid {
+        dims: [u64; 3],
+        values: Vec<f32>,
+        given: Vec<u8>,
+        blocks: Vec<([i64; 3], [u64; 3])>,
+    }
+
+    impl Blocks for Grid {
+        fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
+            self.dims = info.index_max.map(|m| (m + 1) as u64);
+            let n = self.dims.iter().product::<u64>() as usize;
+            self.values = vec![f32::NAN; n];
+            self.given = vec![0; n];
+            Ok(())
+        }
+        fn dense(&mut self, o: [i64; 3], d: [u64; 3], values: &[f32]) -> Result<(), Error> {
+            self.blocks.push((o, d));
+            let [sx, sy, _] = self.dims;
+            let mut i = 0;
+            for z in 0..d[2] {
+                for y in 0..d[1] {
+                    for x in 0..d[0] {
+                        let at = (((o[2] as u64 + z) * sy + o[1] as u64 + y) * sx + o[0] as u64 + x)
+                            as usize;
+                        self.values[at] = values[i];
+                        self.given[at] += 1;
+                        i += 1;
+                    }
+                }
+            }
+            Ok(())
+        }
+    }
+
+    /// Slabs, rows of a slice and parts of rows (forced by small sizes) read the same voxels, from
+    /// a plain file and from gzip (in two members), and each voxel exactly once.
+    #[test]
+    fn every_way_of_cutting_the_file_reads_the_same_voxels() {
+        let dims = [37u64, 21, 19];
+        let mut bytes = b"HDR".to_vec();
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    bytes.push(pattern(x, y, z));
+                }
+            }
+        }
+        let mut zipped = gzip(&bytes[..1000]);
+        zipped.extend(gzip(&bytes[1000..]));
+        let params = r#"(file: "p.raw", dims: (37, 21, 19), header: 3, normalize: false)"#;
+        let slice = 37 * 21;
+        for (sizes, first_block) in [
+            (Sizes::DEFAULT, [37, 21, 8]),
+            (
+                Sizes {
+                    slab_bytes: slice * 8,
+                    block_voxels: 37 * 64,
+                },
+                [37, 8, 8],
+            ),
+            (
+                Sizes {
+                    slab_bytes: slice * 4,
+                    block_voxels: 300,
+                },
+                [37, 8, 1],
+            ),
+            (
+                Sizes {
+                    slab_bytes: slice * 4,
+                    block_voxels: 100,
+                },
+                [37, 2, 1],
+            ),
+            (
+                Sizes {
+                    slab_bytes: 100,
+                    block_voxels: 16,
+                },
+                [16, 1, 1],
+            ),
+        ] {
+            for file in [&bytes, &zipped] {
+                let mut got = Grid::default();
+                read_bytes_in(params, file, &mut got, sizes).unwrap();
+                assert!(got.given.iter().all(|&n| n == 1), "every voxel once");
+                let want: Vec<f32> = bytes[3..].iter().map(|&b| f32::from(b)).collect();
+                assert!(got.values == want, "values differ");
+                assert_eq!(got.blocks[0], ([0, 0, 0], first_block));
+                assert!(got
+                    .blocks
+                    .iter()
+                    .all(|(_, d)| d[0] * d[1] * d[2] <= sizes.block_voxels));
+            }
+        }
+    }
+
+    /// A gzip stream that ends early or goes on is found while streaming, with the sizes.
+    #[test]
+    fn gzip_of_the_wrong_size_is_reported_while_streaming() {
+        let params = r#"(file: "z.raw", dims: (16, 16, 16))"#;
+        let e = read_bytes(params, &gzip(&[0u8; 4095]), &mut Grid::default()).unwrap_err();
+        assert!(
+            e.message.contains("expected 4096 decompressed bytes")
+                && e.message.contains("decompresses to 4095"),
+            "{}",
+            e.message
+        );
+        let e = read_bytes(params, &gzip(&[0u8; 4097]), &mut Grid::default()).unwrap_err();
+        assert!(e.message.contains("decompresses to more"), "{}", e.message);
+        let mut broken = gzip(&[7u8; 4096]);
+        let n = broken.len();
+        broken[n - 8] ^= 0xff; // the CRC
+        let e = read_bytes(params, &broken, &mut Grid::default()).unwrap_err();
+        assert!(
+            e.message.contains("cannot be decompressed"),
+            "{}",
+            e.message
+        );
     }
 
     #[test]

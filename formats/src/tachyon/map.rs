@@ -1,0 +1,772 @@
+//! The syntax tree to a `SceneDesc`: statements in file order (last CAMERA, BACKGROUND and FOG
+//! win; shader options accumulate), then the render settings. What each mapping does and why
+//! is in the module documentation (`mod.rs`).
+
+use std::collections::HashSet;
+
+use super::materials::Materials;
+use super::notes::Notes;
+use super::shapes::{tpoly_vertex, volume_slices, Shapes};
+use super::syntax::*;
+use super::terrain::scape;
+use super::{mirror, Warnings};
+use crate::desc::{
+    AoDesc, Attenuation, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum, LightDesc,
+    Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc, TransparencyMode,
+};
+use crate::error::SceneError;
+use crate::origin::{Origin, Spanned};
+
+type Result<T> = std::result::Result<T, SceneError>;
+
+/// Luxon's deepest ray tree (render threads' stacks are sized for it).
+const MAX_DEPTH: u32 = 1024;
+
+/// The shading state SHADER_MODE statements build up.
+struct Shading {
+    level: ShadeLevel,
+    /// TRANS_VMD and TRANS_RASTER3D flags (TRANS_ORIG clears both).
+    vmd: bool,
+    raster3d: bool,
+    max_surfaces: Option<(u32, Origin)>,
+    fog_vmd: bool,
+    shadow_filter_off: Option<Origin>,
+}
+
+/// Everything the statements set, in order.
+struct Mapper {
+    camera: Option<(Origin, Camera)>,
+    background: V3,
+    fog: Option<(Origin, Fog)>,
+    ao: Option<AoDesc>,
+    shading: Shading,
+    lights: Vec<Spanned<LightDesc>>,
+    materials: Materials,
+    shapes: Shapes,
+    notes: Notes,
+    warnings: Warnings,
+}
+
+pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
+    let reserved: HashSet<String> = scene
+        .statements
+        .iter()
+        .filter_map(|s| match &s.kind {
+            Kind::TexDef { name, .. } | Kind::TexAlias { name, .. } => Some(name.value.clone()),
+            _ => None,
+        })
+        .collect();
+    let mut m = Mapper {
+        camera: None,
+        background: [0.0; 3],
+        fog: None,
+        ao: None,
+        shading: Shading {
+            level: ShadeLevel::Full,
+            vmd: false,
+            raster3d: false,
+            max_surfaces: None,
+            fog_vmd: false,
+            shadow_filter_off: None,
+        },
+        lights: Vec::new(),
+        materials: Materials::new(reserved),
+        shapes: Shapes::default(),
+        notes: Notes::default(),
+        warnings: scene.warnings,
+    };
+    for s in &scene.statements {
+        m.statement(s)?;
+    }
+    m.finish(&scene.source, &scene.resolution, &scene.begin)
+}
+
+fn light_color(c: V3, at: &Origin) -> Result<V3> {
+    if c.iter().any(|&x| x < 0.0) {
+        return Err(SceneError::at(
+            at.clone(),
+            format!("COLOR {c:?} has a negative component; expected components of 0 or more"),
+        ));
+    }
+    Ok(c)
+}
+
+fn attenuation(a: &Option<Spanned<V3>>) -> Attenuation {
+    match a {
+        Some(a) => Attenuation {
+            constant: a.value[0],
+            linear: a.value[1],
+            quadratic: a.value[2],
+        },
+        None => Attenuation::default(),
+    }
+}
+
+fn nonzero(v: V3, what: &str, at: &Origin) -> Result<V3> {
+    if v == [0.0; 3] {
+        return Err(SceneError::at(
+            at.clone(),
+            format!("{what} is (0, 0, 0); expected a direction"),
+        ));
+    }
+    Ok(v)
+}
+
+impl Mapper {
+    /// The material of a texture reference.
+    fn material(&mut self, tex: &TexRef) -> Result<String> {
+        self.materials
+            .resolve(tex, &mut self.notes, &mut self.warnings)
+    }
+
+    fn statement(&mut self, s: &Statement) -> Result<()> {
+        let at = &s.at;
+        match &s.kind {
+            Kind::ShaderMode(mode) => self.shader_mode(mode),
+            Kind::Camera(c) => self.camera = Some((at.clone(), c.clone())),
+            Kind::Background(c) => self.background = light_color(*c, at)?,
+            Kind::BackgroundGradient(_) => self.notes.add(
+                "BACKGROUND_GRADIENT",
+                "is not rendered yet; the solid BACKGROUND colour is shown",
+                at,
+            ),
+            Kind::Fog(f) => self.fog = Some((at.clone(), f.clone())),
+            Kind::Light(l) => {
+                if l.rad > 0.0 {
+                    self.notes.add(
+                        "LIGHT with RAD > 0",
+                        "lights the scene, but its sphere (drawn by Tachyon in the light's \
+                         colour) is not drawn yet",
+                        at,
+                    );
+                }
+                self.lights.push(Spanned {
+                    value: LightDesc::Point {
+                        position: mirror(l.center),
+                        color: light_color(l.color, at)?,
+                        intensity: 1.0,
+                        shadows: true,
+                        attenuation: attenuation(&l.attenuation),
+                    },
+                    at: at.clone(),
+                });
+            }
+            Kind::DirectionalLight { direction, color } => self.lights.push(Spanned {
+                value: LightDesc::Directional {
+                    direction: mirror(nonzero(*direction, "DIRECTION", at)?),
+                    color: light_color(*color, at)?,
+                    intensity: 1.0,
+                    shadows: true,
+                },
+                at: at.clone(),
+            }),
+            Kind::Spotlight(l) => self.spotlight(l, at)?,
+            Kind::SkyLight { samples, color } => {
+                self.ao = (*samples > 0).then_some(AoDesc {
+                    samples: *samples,
+                    max_distance: f64::INFINITY,
+                    color: *color,
+                    intensity: 1.0,
+                    direct: 1.0,
+                });
+            }
+            Kind::TexDef { name, body } => {
+                self.materials
+                    .define(name, body, &mut self.notes, &mut self.warnings)?
+            }
+            Kind::TexAlias { name, target } => self.materials.alias(name, target, &mut self.notes),
+            Kind::ImageDef(def) => self.materials.imagedef(&def.name.value),
+            Kind::Include { .. } => {}
+            Kind::Sphere { center, rad, tex } => {
+                let m = self.material(tex)?;
+                self.shapes.sphere(&m, *center, *rad, at);
+            }
+            Kind::Tri { v, tex } => {
+                let m = self.material(tex)?;
+                self.shapes.triangle(&m, *v, None, at);
+            }
+            Kind::Stri { v, n, tex } => {
+                let m = self.material(tex)?;
+                self.shapes.triangle(&m, *v, Some(*n), at);
+            }
+            Kind::Vcstri { v, n, surface, .. } => {
+                self.notes.add(
+                    "VCSTRI vertex colours",
+                    "are not rendered yet: the triangles are white",
+                    at,
+                );
+                let m = self
+                    .materials
+                    .surface_material(surface, at, &mut self.notes)?;
+                self.shapes.triangle(&m, *v, Some(*n), at);
+            }
+            Kind::VertexArray(va) => self.vertex_array(va, at)?,
+            Kind::Fcylinder {
+                base,
+                apex,
+                rad,
+                tex,
+            } => {
+                let m = self.material(tex)?;
+                self.shapes.cylinder(&m, *base, *apex, *rad, at);
+            }
+            Kind::Cylinder {
+                center,
+                axis,
+                rad,
+                tex,
+            } => {
+                let m = self.material(tex)?;
+                self.shapes
+                    .infinite_cylinder(&m, *center, *axis, *rad, at)?;
+            }
+            Kind::Ring {
+                center,
+                normal,
+                inner,
+                outer,
+                tex,
+            } => {
+                let m = self.material(tex)?;
+                self.shapes
+                    .ring(&m, *center, *normal, [*inner, *outer], at)?;
+            }
+            Kind::Plane {
+                center,
+                normal,
+                tex,
+            } => {
+                let m = self.material(tex)?;
+                self.shapes.plane(&m, *center, *normal, at)?;
+            }
+            Kind::Box { min, max, tex } => {
+                let m = self.material(tex)?;
+                self.shapes.boxed(&m, *min, *max, at, &mut self.warnings);
+            }
+            Kind::Polycylinder { points, rad, tex } => {
+                let m = self.material(tex)?;
+                self.shapes.polycylinder(&m, points, *rad, at);
+            }
+            Kind::Scape {
+                res,
+                scale,
+                center,
+                tex,
+            } => {
+                let m = self.material(tex)?;
+                let (v, n, t) = scape(*res, *scale, *center);
+                self.shapes.mesh(&m, &v, &n, &t, at);
+            }
+            Kind::ScalarVol {
+                min,
+                max,
+                dim,
+                path,
+                tex,
+                ..
+            } => {
+                let m = self.material(tex)?;
+                let density = match tex {
+                    TexRef::Body(b) => b.surface.opacity,
+                    TexRef::Name(_) => 1.0,
+                };
+                let slices = match path {
+                    Some(p) => volume_slices(p, *dim).map(|n| (p, n)),
+                    None => Err(String::new()),
+                };
+                match slices {
+                    Ok((p, n)) => {
+                        self.notes.add(
+                            "SCALARVOL",
+                            "is drawn by Luxon's emission-absorption ray casting with Tachyon's \
+                             colour ramp (Tachyon sums the samples' opacity and marches the box \
+                             twice)",
+                            at,
+                        );
+                        self.shapes.volume(*min, *max, *dim, p, n, density, at)?;
+                    }
+                    Err(why) => {
+                        // Tachyon draws the box in the texture's colour, unlit.
+                        if !why.is_empty() {
+                            self.warnings.push(Spanned {
+                                value: format!(
+                                    "{why}; Tachyon draws the volume's box in its texture's \
+                                     colour instead, and so does Luxon"
+                                ),
+                                at: at.clone(),
+                            });
+                        }
+                        let flat = self.materials.unlit(&m, at);
+                        self.shapes.boxed(&flat, *min, *max, at, &mut self.warnings);
+                    }
+                }
+            }
+            Kind::TpolyFile {
+                scale,
+                rot,
+                center,
+                triangles,
+                tex,
+                ..
+            } => {
+                let m = self.material(tex)?;
+                for t in triangles {
+                    // Each record becomes TRI (v1, v0, v2).
+                    let v = [t[1], t[0], t[2]].map(|p| tpoly_vertex(p, *scale, *rot, *center));
+                    self.shapes.triangle(&m, v, None, at);
+                }
+            }
+            Kind::StartClipGroup { planes } => self.shapes.start_clip(planes, at)?,
+            Kind::EndClipGroup => self.shapes.end_clip(),
+        }
+        Ok(())
+    }
+
+    fn shader_mode(&mut self, mode: &ShaderMode) {
+        let s = &mut self.shading;
+        s.level = mode.level.value;
+        for o in &mode.options {
+            match &o.value {
+                ShaderOption::ShadowFilter(on) => {
+                    s.shadow_filter_off = (!on).then(|| o.at.clone());
+                }
+                ShaderOption::TransMaxSurfaces(n) => s.max_surfaces = Some((*n, o.at.clone())),
+                ShaderOption::TransOrig => (s.vmd, s.raster3d) = (false, false),
+                ShaderOption::TransRaster3d => s.raster3d = true,
+                ShaderOption::TransVmd => s.vmd = true,
+                ShaderOption::FogVmd => s.fog_vmd = true,
+                ShaderOption::AmbientOcclusion {
+                    color,
+                    rescale_direct,
+                    samples,
+                } => {
+                    self.ao = (*samples > 0).then_some(AoDesc {
+                        samples: *samples,
+                        max_distance: f64::INFINITY,
+                        color: *color,
+                        intensity: 1.0,
+                        direct: *rescale_direct,
+                    });
+                }
+            }
+        }
+    }
+
+    fn spotlight(&mut self, l: &Spotlight, at: &Origin) -> Result<()> {
+        if l.rad > 0.0 {
+            self.notes.add(
+                "SPOTLIGHT with RAD > 0",
+                "lights the scene, but its sphere is not drawn yet",
+                at,
+            );
+        }
+        let end = l.falloff_end.clamp(0.0, 180.0);
+        let start = l.falloff_start.clamp(0.0, end);
+        self.lights.push(Spanned {
+            value: LightDesc::Spot {
+                position: mirror(l.center),
+                direction: mirror(nonzero(l.direction, "DIRECTION", at)?),
+                cone_deg: 2.0 * end,
+                falloff_deg: 2.0 * (end - start),
+                color: light_color(l.color, at)?,
+                intensity: 1.0,
+                shadows: true,
+                attenuation: attenuation(&l.attenuation),
+            },
+            at: at.clone(),
+        });
+        Ok(())
+    }
+
+    /// A VERTEXARRAY's meshes, each with the texture (and colours) in effect before it.
+    fn vertex_array(&mut self, va: &VertexArray, at: &Origin) -> Result<()> {
+        let mut material = None;
+        for block in &va.blocks {
+            let b_at = &block.at;
+            let triangles = match &block.value {
+                VertexBlock::Colors(_) => {
+                    self.notes.add(
+                        "VERTEXARRAY COLORS",
+                        "(vertex colours) are not rendered yet: the meshes take their \
+                         TEXTURE's colour",
+                        b_at,
+                    );
+                    continue;
+                }
+                VertexBlock::Texture(body) => {
+                    material = Some(self.material(&TexRef::Body(body.clone()))?);
+                    continue;
+                }
+                VertexBlock::TriMesh(t) => t.clone(),
+                VertexBlock::TriStrip(s) => strip(s),
+            };
+            let m = match &material {
+                Some(m) => m.clone(),
+                None => self.materials.default_material(b_at),
+            };
+            self.shapes
+                .mesh(&m, &va.coords, &va.normals, &triangles, at);
+        }
+        Ok(())
+    }
+
+    fn finish(
+        mut self,
+        source: &std::path::Path,
+        res: &Spanned<[u32; 2]>,
+        begin: &Origin,
+    ) -> Result<SceneDesc> {
+        let [width, height] = res.value;
+        if u64::from(width) * u64::from(height) > 1 << 28 {
+            return Err(SceneError::at(
+                res.at.clone(),
+                format!("RESOLUTION {width} {height} has more than 2^28 pixels"),
+            ));
+        }
+        let (camera, samples, max_depth) = self.camera(width, height, begin)?;
+        let level = self.shading.level;
+        let mut fog = self.fog()?;
+        let mut ao = self.ao.take();
+        let shadows = level == ShadeLevel::Full;
+        if !shadows {
+            ao = None;
+            for l in &mut self.lights {
+                match &mut l.value {
+                    LightDesc::Point { shadows, .. }
+                    | LightDesc::Directional { shadows, .. }
+                    | LightDesc::Spot { shadows, .. }
+                    | LightDesc::Sphere { shadows, .. }
+                    | LightDesc::Rect { shadows, .. } => *shadows = false,
+                }
+            }
+        }
+        let mut background = self.background;
+        let mut materials = std::mem::take(&mut self.materials.materials);
+        let mut textures = std::mem::take(&mut self.materials.textures);
+        // LOW: the texture colour, unlit; LOWEST: white on black.
+        if matches!(level, ShadeLevel::Low | ShadeLevel::Lowest) {
+            fog = None;
+            for (_, m) in &mut materials {
+                let m = &mut m.value;
+                (m.ambient, m.diffuse, m.specular, m.reflect, m.transmit) =
+                    (1.0, 0.0, 0.0, 0.0, 0.0);
+                if level == ShadeLevel::Lowest {
+                    m.color = [1.0; 3];
+                    m.texture = None;
+                }
+            }
+            if level == ShadeLevel::Lowest {
+                background = [0.0; 3];
+                textures.clear();
+            }
+        }
+        let first_transparent = materials
+            .iter()
+            .find(|(_, m)| m.value.transmit > 0.0)
+            .map(|(_, m)| m.at.clone());
+        let transparency = self.transparency(first_transparent);
+        let mut warnings = self.warnings;
+        warnings.extend(self.notes.into_warnings());
+        Ok(SceneDesc {
+            source: source.to_path_buf(),
+            camera,
+            background,
+            lights: self.lights,
+            fog,
+            ambient_occlusion: ao,
+            textures,
+            materials,
+            clip_groups: self.shapes.clip_groups,
+            objects: self.shapes.objects,
+            inline: self.shapes.groups,
+            volumes: self.shapes.volumes,
+            render: RenderDesc {
+                width,
+                height,
+                samples,
+                max_depth,
+                transparency,
+                ..RenderDesc::default()
+            },
+            plugin_path: Vec::new(),
+            warnings: warnings
+                .into_iter()
+                .map(|w| crate::error::Warning {
+                    at: w.at,
+                    message: w.value,
+                })
+                .collect(),
+        })
+    }
+
+    /// The transparency mode, and notes where it is not Tachyon's (only when some material,
+    /// the first at `first_transparent`, is transparent).
+    fn transparency(&mut self, first_transparent: Option<Origin>) -> TransparencyDesc {
+        let (vmd, raster3d) = (self.shading.vmd, self.shading.raster3d);
+        let mode = if vmd {
+            TransparencyMode::PostMultiplied
+        } else if raster3d {
+            TransparencyMode::AngleModulated
+        } else {
+            TransparencyMode::Filter
+        };
+        let max_surfaces = self.shading.max_surfaces.clone();
+        if let Some(at) = self.shading.shadow_filter_off.clone() {
+            self.notes.add(
+                "SHADOW_FILTER_OFF",
+                "is not rendered yet: transparent surfaces cast filtered shadows",
+                &at,
+            );
+        }
+        if let Some(at) = first_transparent {
+            let what = match (vmd, raster3d) {
+                (true, true) => Some("TRANS_VMD with TRANS_RASTER3D transparency is rendered as TRANS_VMD"),
+                (false, true) => Some("TRANS_RASTER3D transparency is rendered with Luxon's angle-modulated transmittance (a different formula)"),
+                (false, false) => Some("Tachyon's default transparency (TRANS_ORIG: the surface's shading kept, what is behind added untinted) is rendered with Luxon's filter mode (shading scaled by opacity, what is behind tinted by the colour)"),
+                (true, false) => None,
+            };
+            if let Some(what) = what {
+                self.notes.add(what, "", &at);
+            }
+            if let Some((_, at)) = &max_surfaces {
+                self.notes.add(
+                    "TRANS_MAX_SURFACES",
+                    "shows the surface after the limit opaque (Tachyon leaves it out)",
+                    at,
+                );
+            }
+        }
+        TransparencyDesc {
+            mode,
+            max_surfaces: max_surfaces.map(|(n, _)| n),
+        }
+    }
+
+    fn fog(&mut self) -> Result<Option<FogDesc>> {
+        let Some((at, f)) = self.fog.take() else {
+            return Ok(None);
+        };
+        let mode = match f.mode.value {
+            FogMode::Off => return Ok(None),
+            FogMode::Linear => {
+                if f.end <= f.start {
+                    return Err(SceneError::at(
+                        at,
+                        format!(
+                            "FOG LINEAR END {} is not beyond START {}; expected START < END",
+                            f.end, f.start
+                        ),
+                    ));
+                }
+                LuxFog::Linear {
+                    start: f.start,
+                    end: f.end,
+                }
+            }
+            FogMode::Exp | FogMode::Exp2 => {
+                if f.start != 0.0 {
+                    self.notes.add(
+                        "FOG EXP/EXP2 with START",
+                        "starts at the eye (Luxon's exponential fog has no start distance)",
+                        &at,
+                    );
+                }
+                if f.mode.value == FogMode::Exp {
+                    LuxFog::Exp { density: f.density }
+                } else {
+                    LuxFog::Exp2 { density: f.density }
+                }
+            }
+        };
+        if !self.shading.fog_vmd {
+            self.notes.add(
+                "FOG",
+                "leaves the background unfogged (Tachyon's radial fog turns it into the fog \
+                 colour)",
+                &at,
+            );
+        }
+        Ok(Some(FogDesc {
+            mode,
+            color: light_color(f.color, &at)?,
+            planar: self.shading.fog_vmd,
+        }))
+    }
+
+    /// The camera, samples per pixel and ray depth. The image window is Tachyon's (1/zoom
+    /// high at unit distance, or the FRUSTUM), moved by half a pixel right and up: Tachyon
+    /// samples each pixel at its upper-right quarter point, Luxon at its centre.
+    fn camera(
+        &mut self,
+        width: u32,
+        height: u32,
+        begin: &Origin,
+    ) -> Result<(Spanned<CameraDesc>, u32, u32)> {
+        let (at, c) = match self.camera.take() {
+            Some(c) => c,
+            None => (
+                begin.clone(),
+                Camera {
+                    projection: None,
+                    zoom: 1.0,
+                    aspect: 1.0,
+                    antialiasing: 0,
+                    raydepth: 6,
+                    center: [0.0; 3],
+                    viewdir: [0.0, 0.0, 1.0],
+                    updir: [0.0, 1.0, 0.0],
+                    frustum: None,
+                },
+            ),
+        };
+        if c.zoom <= 0.0 {
+            return Err(SceneError::at(
+                at,
+                format!("ZOOM is {}; expected a number greater than 0", c.zoom),
+            ));
+        }
+        if c.aspect <= 0.0 {
+            return Err(SceneError::at(
+                at,
+                format!(
+                    "ASPECTRATIO is {}; expected a number greater than 0",
+                    c.aspect
+                ),
+            ));
+        }
+        let view = nonzero(c.viewdir, "VIEWDIR", &at)?;
+        let up = nonzero(c.updir, "UPDIR", &at)?;
+        let cross = [
+            view[1] * up[2] - view[2] * up[1],
+            view[2] * up[0] - view[0] * up[2],
+            view[0] * up[1] - view[1] * up[0],
+        ];
+        if cross == [0.0; 3] {
+            return Err(SceneError::at(
+                at,
+                "UPDIR is parallel to VIEWDIR; expected an up direction across the view",
+            ));
+        }
+        let (w, h) = (width as f64, height as f64);
+        let window_h = 1.0 / c.zoom;
+        let window_w = (w / h) / (c.aspect * c.zoom);
+        let [l, r, b, t] = match &c.frustum {
+            Some(f) => {
+                let [l, r, b, t] = f.value;
+                if !(l < r && b < t) {
+                    return Err(SceneError::at(
+                        f.at.clone(),
+                        format!("FRUSTUM {l} {r} {b} {t}: expected left < right and bottom < top"),
+                    ));
+                }
+                f.value
+            }
+            None => [
+                -window_w / 2.0,
+                window_w / 2.0,
+                -window_h / 2.0,
+                window_h / 2.0,
+            ],
+        };
+        let (dx, dy) = ((r - l) / (2.0 * w), (t - b) / (2.0 * h));
+        let shifted = Frustum {
+            left: l + dx,
+            right: r + dx,
+            bottom: b + dy,
+            top: t + dy,
+        };
+        let kind = c.projection.as_ref().map(|p| (p.value, p.at.clone()));
+        let mut depth_of_field = None;
+        let (projection, frustum) = match kind {
+            None | Some((Projection::Perspective, _)) => (
+                LuxProjection::PerspectiveZoom { zoom: c.zoom },
+                Some(shifted),
+            ),
+            Some((Projection::Orthographic, _)) => {
+                (LuxProjection::Orthographic { height: t - b }, Some(shifted))
+            }
+            Some((Projection::Fisheye, p_at)) => {
+                self.notes.add(
+                    "PROJECTION FISHEYE",
+                    "(Tachyon's latitude/longitude window) is rendered as Luxon's circular \
+                     fisheye of the same height",
+                    &p_at,
+                );
+                let fov = (t - b).to_degrees().clamp(1e-3, 360.0);
+                (LuxProjection::Fisheye { fov_deg: fov }, None)
+            }
+            Some((
+                Projection::PerspectiveDof {
+                    focal,
+                    focal_dist,
+                    aperture,
+                },
+                p_at,
+            )) => {
+                // Tachyon 0.99b6 ignores FOCALLENGTH and focuses on the image plane (unit
+                // distance); its lens is a rectangle aperture × the window: a disc of the same
+                // area stands in for it. Without antialiasing it traces the pinhole ray only.
+                let focal_distance = if focal_dist { focal } else { 1.0 };
+                if focal_distance <= 0.0 {
+                    return Err(SceneError::at(
+                        p_at,
+                        format!("FOCALDIST is {focal}; expected a distance greater than 0"),
+                    ));
+                }
+                let radius = aperture.abs() * ((r - l) * (t - b) / std::f64::consts::PI).sqrt();
+                if c.antialiasing > 0 && radius > 0.0 {
+                    depth_of_field = Some(DepthOfField {
+                        aperture: radius,
+                        focal_distance,
+                    });
+                }
+                (
+                    LuxProjection::PerspectiveZoom { zoom: c.zoom },
+                    Some(shifted),
+                )
+            }
+        };
+        let position = mirror(c.center);
+        let v = mirror(view);
+        let camera = CameraDesc {
+            position,
+            look_at: [position[0] + v[0], position[1] + v[1], position[2] + v[2]],
+            up: mirror(up),
+            projection,
+            aspect: None,
+            frustum,
+            depth_of_field,
+            stereo: None,
+        };
+        let max_depth = c.raydepth.saturating_sub(1).min(MAX_DEPTH);
+        Ok((Spanned { value: camera, at }, c.antialiasing + 1, max_depth))
+    }
+}
+
+/// A strip's triangles: (s[t], s[t+1], s[t+2]) for even t, (s[t+1], s[t], s[t+2]) for odd t,
+/// so that all keep one winding.
+fn strip(s: &[u32]) -> Vec<[u32; 3]> {
+    (0..s.len().saturating_sub(2))
+        .map(|t| {
+            if t % 2 == 0 {
+                [s[t], s[t + 1], s[t + 2]]
+            } else {
+                [s[t + 1], s[t], s[t + 2]]
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::strip;
+
+    #[test]
+    fn strips_alternate_their_first_two_indices() {
+        assert_eq!(
+            strip(&[0, 1, 2, 3, 4]),
+            vec![[0, 1, 2], [2, 1, 3], [2, 3, 4]]
+        );
+        assert!(strip(&[0, 1]).is_empty());
+    }
+}

@@ -1,0 +1,194 @@
+//! # Tachyon scenes (`.dat`): Tachyon 0.99b6's scene language and VMD's exports
+//!
+//! [`load`] reads a Tachyon scene into a [`SceneDesc`]; [`parse_file`] gives the syntax tree
+//! (module [`syntax`]) with every statement and option as written and where. The grammar is
+//! the one `tachyon-nox` 0.99b6 (Debian) accepts, measured statement by statement; what each
+//! statement means in Luxon is below. Measurements and their scripts:
+//! `/work/notes/tachyon-mapping.md` and `/work/notes/tachyon-measure/`.
+//!
+//! ## Reading
+//!
+//! - Words are separated by whitespace; keywords are matched in any case (`Sphere`, `SPHERE`),
+//!   names and paths keep theirs (`TEXDEF red` is not `RED`). `#` starts a comment only as a
+//!   word of its own where a statement may start (`#comment` is an error, as in Tachyon).
+//! - Numbers are C's `%f`; fields Tachyon reads with `%d` (RESOLUTION, ANTIALIASING, RAYDEPTH,
+//!   TEXFUNC, counts, indices, DIM, RES, SAMPLES...) must be whole numbers: `RESOLUTION 4.0 4`
+//!   is "expected a whole number" at the `4.0` (Tachyon itself misreads it). NaN and
+//!   infinities are refused.
+//! - The file must start with `BEGIN_SCENE` (after comments) and `RESOLUTION x y`; `.dat` is a
+//!   generic extension, so a file that does not is reported as "expected `BEGIN_SCENE`".
+//!   `END_SCENE` ends the scene (the rest of the file is not read); a file may also just end.
+//! - Statements keep Tachyon's fixed word order and its optional parts in Tachyon's order.
+//!   Every error names `file:line:col`, what was expected (with the statement's form) and
+//!   what was found. Tachyon reads on after many of these mistakes and renders something
+//!   else, or exits with status 0 and no image; Luxon stops and says where.
+//! - `INCLUDE file` reads the file's statements in place (its `END_SCENE` ends only that
+//!   file); cycles and more than 32 levels are errors.
+//! - Relative paths (INCLUDE, image maps, volumes, `.tpoly` files) are looked up in the working
+//!   directory first, as Tachyon does, then beside the file that names them; an error or
+//!   warning names both places.
+//! - VMD's `PERSPECTIVE_DOF FOCALDIST f APERTURE a` is accepted beside Tachyon 0.99b6's
+//!   `FOCALLENGTH` (which 0.99b6 requires).
+//!
+//! Where Tachyon's leniency is part of what real files show, Luxon does the same and adds a
+//! warning (`SceneDesc::warnings`, printed by the command line): an undefined texture name
+//! (Tachyon's default texture: AMBIENT 0.1, DIFFUSE 0.9, white), a missing image map or
+//! undefined IMAGEDEF (white: Tachyon's message says "solid gray", its picture is white), a
+//! missing volume file (the volume's box in its texture's
+//! colour, unlit), a second TEXDEF of a name (the first stays). Features Luxon does not render as
+//! Tachyon does yet are one warning each, at their first use (see "Not yet" below).
+//!
+//! ## Coordinates
+//!
+//! Tachyon's world is left-handed: with VIEWDIR +z and UPDIR +y, +x is on the right (screen
+//! right = UPDIR × VIEWDIR). Luxon's camera is right-handed (right = forward × up). The
+//! importer mirrors the world: every point, direction and plane has its z negated (camera,
+//! lights, geometry, normals, clip planes, texture centres and axes, volume grids). The picture
+//! is then Tachyon's, and the imported scene is an ordinary Luxon scene. Mirroring reverses
+//! triangle windings, so each triangle's second and third vertices (and normals) swap, keeping
+//! vertex normals on the same side of the winding as in the file.
+//!
+//! ## Camera and image
+//!
+//! | Tachyon | Luxon |
+//! |---|---|
+//! | `RESOLUTION x y` | `render.width`, `height` |
+//! | `CENTER`, `VIEWDIR`, `UPDIR` | `position`, `look_at = position + VIEWDIR`, `up` (mirrored) |
+//! | `ZOOM z`, `ASPECTRATIO a` | a window `1/z` high and `(x/y)/(a·z)` wide at unit distance (perspective) or in world units (orthographic), given as a `frustum` |
+//! | `FRUSTUM l r b t` | that window instead (Tachyon's order: left right bottom top) |
+//! | pixel sampling | Tachyon samples pixel (i, j) at ((i+1)/x, (j+1)/y) of the window, half a pixel right of and above the centre Luxon samples: the window is moved by half a pixel right and up |
+//! | `ANTIALIASING n` | `samples: n + 1` (Tachyon: one sample at that point plus n jittered; the noise differs) |
+//! | `RAYDEPTH n` | `max_depth: n - 1` (Tachyon's primary ray counts as one level) |
+//! | `PROJECTION ORTHOGRAPHIC` | `Orthographic` with the same window |
+//! | `PERSPECTIVE_DOF FOCALLENGTH f APERTURE a` | Tachyon 0.99b6 ignores f and focuses at unit distance; its lens is a rectangle a × the window: a disc of the same area, radius `a·√(w·h/π)`, focused at distance 1; no lens without ANTIALIASING (Tachyon traces only the pinhole ray then) |
+//! | `... FOCALDIST f APERTURE a` (VMD) | the same lens, focused at distance f |
+//! | no CAMERA | zoom 1, aspect 1, no antialiasing, ray depth 6, at the origin looking along +z |
+//!
+//! The last CAMERA, BACKGROUND and FOG of the file win.
+//!
+//! ## Colours
+//!
+//! Tachyon's colours are display values: it shades with them as written and writes the result
+//! clamped, without gamma. They are imported as written (no sRGB-to-linear conversion as the
+//! NFF importer does), because Tachyon's arithmetic (ambient + diffuse sums, products of
+//! light and surface colours, mirror and transmission mixes) is on these values: converting
+//! would change every mix, and only an output written without sRGB encoding can show
+//! Tachyon's tones. Until Luxon has that output option, midtones come out brighter than
+//! Tachyon's (Luxon encodes its output as sRGB); where both are 0 or 1 they agree.
+//!
+//! ## Lights, shading settings, fog
+//!
+//! | Tachyon | Luxon |
+//! |---|---|
+//! | `LIGHT CENTER RAD COLOR` | `Point` light of that colour, intensity 1, with shadows |
+//! | `ATTENUATION CONSTANT c LINEAR l QUADRATIC q` | `attenuation: (c, l, q)`, the same 1/(c + l·d + q·d²); Luxon also attenuates highlights (Tachyon does not) |
+//! | `DIRECTIONAL_LIGHT DIRECTION d COLOR c` | `Directional` travelling along d |
+//! | `SPOTLIGHT ... FALLOFF_START s FALLOFF_END e` | `Spot` with `angle: 2e`, `falloff: 2(e − s)`: full inside s, none beyond e; Tachyon fades linearly in the angle, Luxon smoothly in its cosine |
+//! | `SKY_LIGHT NUMSAMPLES n COLOR c` | `ambient_occlusion`: n samples, unlimited distance, colour c, direct 1 |
+//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r` |
+//! | `SHADER_MODE FULL` / `MEDIUM` | everything / no shadows and no occlusion |
+//! | `SHADER_MODE LOW` / `LOWEST` | every surface shows its texture colour unlit (no fog) / white on black |
+//! | `TRANS_VMD`, `TRANS_RASTER3D`, `TRANS_ORIG` | `transparency` `PostMultiplied`, `AngleModulated`, `Filter` (see "Not yet") |
+//! | `TRANS_MAX_SURFACES n` | `max_surfaces: n` (see "Not yet") |
+//! | `FOG LINEAR START s END e` | `Linear { start, end }` |
+//! | `FOG EXP` / `EXP2 DENSITY d` | `Exp` / `Exp2 { density }` (from the eye: START is not used) |
+//! | `FOG_VMD` | `planar: true` (depth along the view direction) |
+//! | `BACKGROUND c` | `background` |
+//!
+//! ## Textures and materials
+//!
+//! A texture body `AMBIENT a DIFFUSE d SPECULAR s OPACITY o [PHONG kind p PHONG_SIZE n] COLOR c
+//! TEXFUNC ...` becomes a material: `color: c`, `ambient: a` (Tachyon's ambient term has no
+//! light colour: nor has Luxon's), `diffuse: d`, `reflect: s` (Tachyon's SPECULAR is the mirror
+//! reflectance, without Fresnel in both), `specular: p`, `shininess: n`, `highlight: Blinn`
+//! (Tachyon's default), `transmit: 1 − o` without refraction (`ior: 1`). `TEXDEF name` gives
+//! the material that name; `TEXALIAS` another name for it; inline bodies become `tachyon-N`,
+//! shared by every body that maps to the same material.
+//!
+//! | TEXFUNC | Luxon |
+//! |---|---|
+//! | 0 (and any number without a meaning) | the colour |
+//! | 1 checker | the `checker` texture, exactly Tachyon's: cells ⅓ wide with boundaries ⅙ from CENTER, odd cells (1, 0.2, 0), even (0, 0.2, 1); COLOR, ROTATE, SCALE ignored as in Tachyon |
+//! | 2 grit | the `noise` texture from 0.8·COLOR to COLOR, fine-grained (Tachyon draws a new random factor at every lookup) |
+//! | 5 gradient noise | the colour (Tachyon's noise value is clamped to 1 almost everywhere) |
+//! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: bilinear` (Tachyon's MIP blur grows with the distance travelled, not with the pixel's footprint: plain bilinear lookups look closer to it than Luxon's footprint MIP) |
+//!
+//! ## Geometry
+//!
+//! | Tachyon | Luxon |
+//! |---|---|
+//! | `SPHERE` | inline sphere |
+//! | `TRI`, `STRI` | inline triangles (flat; with vertex normals); triangles without area are left out, as Tachyon does |
+//! | `FCYLINDER BASE APEX RAD` | inline open cylinder (a cone with equal radii) |
+//! | `POLYCYLINDER` | a sphere at every point and an open cylinder between neighbours (as Tachyon builds it) |
+//! | `RING` | inline disc with a hole |
+//! | `PLANE` | inline plane |
+//! | `BOX` | the `box` plugin |
+//! | `CYLINDER` (infinite) | the `infinite_cylinder` plugin |
+//! | `VERTEXARRAY` with `TRIMESH` / `TRISTRIP` | inline meshes with vertex normals, each in the TEXTURE before it (Tachyon's default texture before the first); strips alternate their first two indices |
+//! | `SCAPE` | Tachyon's terrain generator reproduced (its random sequence and midpoint subdivision), an inline mesh with its normals |
+//! | `TPOLYFILE` | the `.tpoly` file's triangles through Tachyon's SCALE/ROT/CENTER transform (its "rotation" matrix included, which mirrors when ROT.y ≠ 0), as TRI (v1, v0, v2) |
+//! | `SCALARVOL` | a `raw` u8 volume, voxel 0 at MIN and the last at MAX, nearest-voxel samples every \|MAX − MIN\| / \|DIM\|, emitting Tachyon's red-yellow-white ramp with extinction OPACITY·s / \|MAX − MIN\| (s the voxel / 255); a file with extra whole slices is read and cropped to the box (Tachyon reads the first DIM voxels) |
+//! | `START_CLIPGROUP NUMPLANES n a b c d ...` | clip group `clip-N` of planes with normal (a, b, c) through d·(a, b, c)/\|(a, b, c)\|² cutting away a·x + b·y + c·z > d, on every object up to END_CLIPGROUP (a new group replaces the one in effect) |
+//!
+//! ## Not yet
+//!
+//! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
+//! renders them: the visible sphere of a LIGHT or SPOTLIGHT with RAD > 0; PHONG METAL's
+//! surface-coloured highlight (Luxon's is the light's colour); Tachyon's transparency
+//! formulas (TRANS_ORIG keeps the surface's shading and adds what is behind untinted, Luxon's
+//! filter mode scales and tints; RASTER3D's angle rule differs; TRANS_MAX_SURFACES leaves
+//! later surfaces out, Luxon shows one opaque; per-texture TRANSMODE R3D; SHADOW_FILTER_OFF);
+//! BACKGROUND_GRADIENT; OUTLINE; the FISHEYE projection (Tachyon's is a latitude/longitude
+//! window, rendered as Luxon's circular fisheye of the same height); fog on the background and
+//! EXP/EXP2 fog's START; vertex colours (VCSTRI, VERTEXARRAY COLORS); TEXFUNC 3 (marble), 4
+//! (wood), 6 (cylindrical checker) and 10 (IMAGEDEF volume textures), and image maps whose
+//! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
+//! Tachyon's two-pass volume compositing; the output without sRGB encoding. Also different in
+//! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
+//! windows blur more sideways in Tachyon), spot falloff shape, highlights attenuated, the 1/510 light threshold, image
+//! texel centres (Tachyon puts u = 0 and 1 on the first and last texel centres), MIP level
+//! choice, the unscaled background added when the ray depth runs out, and the noise of
+//! antialiasing, depth of field and occlusion.
+
+mod files;
+mod lex;
+mod map;
+mod materials;
+mod notes;
+mod parse;
+mod ron;
+mod shapes;
+pub mod syntax;
+mod terrain;
+
+use std::path::Path;
+
+use crate::desc::SceneDesc;
+use crate::error::SceneError;
+use crate::origin::Spanned;
+
+/// Problems that did not stop the import, each where it was found.
+type Warnings = Vec<Spanned<String>>;
+
+/// Tachyon's world to Luxon's: z negated (see "Coordinates").
+fn mirror(v: [f64; 3]) -> [f64; 3] {
+    [v[0], v[1], -v[2]]
+}
+
+/// True for names ending in `.dat` (any case).
+pub fn is_tachyon_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("dat"))
+}
+
+/// Reads a Tachyon scene file (and its INCLUDEs, `.tpoly` files) into its syntax tree.
+pub fn parse_file(path: &Path) -> Result<syntax::Scene, SceneError> {
+    parse::parse_file(path)
+}
+
+/// Loads a Tachyon scene file as a Luxon scene (no outputs: the command line gives them).
+pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
+    map::to_desc(parse::parse_file(path)?)
+}
