@@ -31,8 +31,8 @@ use std::time::UNIX_EPOCH;
 
 const MAGIC: &[u8; 8] = b"LUXGEOC\0";
 /// Raise when the layout changes, or when a new build makes better trees than the cached ones
-/// (5: the SAH looks at all three axes; 6: nodes 8 or 16 wide).
-pub const FORMAT_VERSION: u32 = 6;
+/// (5: the SAH looks at all three axes).
+pub const FORMAT_VERSION: u32 = 5;
 const LUXON_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// A cache found valid for its source.

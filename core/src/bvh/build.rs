@@ -415,7 +415,7 @@ mod tests {
     fn coincident_centroids_still_make_small_leaves() {
         let b = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 100];
         let (bvh, _) = Bvh::build(&b);
-        assert!(bvh.leaf_sizes().iter().all(|&c| c <= MAX_LEAF));
-        assert_eq!(bvh.leaf_sizes().iter().sum::<usize>(), 100);
+        assert!(bvh.leaf_sizes().all(|c| c <= MAX_LEAF));
+        assert_eq!(bvh.leaf_sizes().sum::<usize>(), 100);
     }
 }

@@ -1,31 +1,10 @@
-//! The vector arithmetic that needs `unsafe`: the box tests of a wide node (SSE, AVX or
-//! AVX-512 intrinsics, a portable loop on other targets), running the traversal loops compiled
-//! for the widest instruction set the CPU has, and the unchecked float-to-index conversion of
-//! the build's binning.
+//! The vector arithmetic that needs `unsafe`: the box tests of a wide node (SSE or AVX
+//! intrinsics, a portable loop on other targets), running the traversal loops compiled for AVX
+//! when the CPU has it, and the unchecked float-to-index conversion of the build's binning.
 
-use super::stack::{stack_space, SMALL_STACK};
 use super::wide::Wide;
-use super::{Bvh, NARROW, WIDEST};
+use super::{Bvh, LANES};
 use crate::math::{gamma, Vec3A};
-
-/// The instruction sets a traversal loop is compiled for (`level()` says which this CPU has).
-pub(super) const BASE: u8 = 0;
-pub(super) const AVX: u8 = 1;
-pub(super) const AVX512: u8 = 2;
-
-/// The widest box tests this CPU has; the checks are cached loads.
-pub(super) fn level() -> u8 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            return AVX512;
-        }
-        if std::arch::is_x86_feature_detected!("avx") {
-            return AVX;
-        }
-    }
-    BASE
-}
 
 /// What a ray precomputes for the box tests: for each axis the row of the plane it meets
 /// first (min or max, by the sign of its direction) and the row of the other.
@@ -58,93 +37,49 @@ impl BoxRay {
     }
 
     /// Which of the node's boxes the ray meets in [0, t_max] (bit l for lane l), and the entry
-    /// distances, with the instructions of `LEVEL`: one AVX-512 pass for a 16-wide node, else
-    /// passes of eight lanes (AVX) or four (SSE). Slab distances 0 · ∞ (a ray parallel to a
-    /// face and lying in its plane, which is inside that slab for every t) are NaN and are
-    /// skipped: max(t, acc) and min(t, acc) keep `acc` when t is NaN (x86's maxps/minps return
-    /// the second operand). Every instruction set gives bitwise the same results.
+    /// distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
+    /// which is inside that slab for every t) are NaN and are skipped: max(t, acc) and
+    /// min(t, acc) keep `acc` when t is NaN (x86's maxps/minps return the second operand).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(super) fn enter<const LEVEL: u8, const W: usize>(
-        &self,
-        node: &Wide<W>,
-        t_max: f32,
-    ) -> (u32, [f32; W]) {
-        let mut t = [0.0; W];
-        if LEVEL == AVX512 && W == 16 {
-            debug_assert!(level() == AVX512);
-            // SAFETY: the CPU has AVX-512F: loops with `LEVEL == AVX512` run only from
-            // `intersect_avx512` and `any_avx512`, which the dispatch below calls only when
-            // `Bvh::level` (this CPU's `level()`) says so.
-            let mask = unsafe { self.pass16(node, t_max, &mut t) };
-            return (mask, t);
-        }
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        use std::arch::x86_64::*;
+        let mut t = [0.0; LANES];
         let mut mask = 0;
-        if LEVEL >= AVX {
-            debug_assert!(level() >= AVX);
-            for h in 0..W / 8 {
-                // SAFETY: the CPU has AVX: loops with `LEVEL >= AVX` run only from the
-                // `_avx` and `_avx512` functions, called only on such CPUs (as above).
-                mask |= unsafe { self.pass8(node, 8 * h, t_max, &mut t) } << (8 * h);
-            }
-        } else {
-            for h in 0..W / 4 {
-                mask |= self.pass4(node, 4 * h, t_max, &mut t) << (4 * h);
+        for h in 0..LANES / 4 {
+            // SAFETY: SSE is part of the x86_64 baseline. Each row of `node.b` and `t` hold
+            // `LANES` = 8 floats and h < 2, so the four floats at `4 * h` are in bounds.
+            unsafe {
+                let row = |r: usize| _mm_loadu_ps(node.b[r].as_ptr().add(4 * h));
+                let mut near = _mm_setzero_ps();
+                let mut far = _mm_set1_ps(t_max * WIDEN);
+                for k in 0..3 {
+                    let o = _mm_set1_ps(self.origin[k]);
+                    let inv = _mm_set1_ps(self.inv[k]);
+                    let inv_far = _mm_set1_ps(self.inv_far[k]);
+                    let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv_far);
+                    near = _mm_max_ps(t0, near);
+                    far = _mm_min_ps(t1, far);
+                }
+                let hit = _mm_cmple_ps(near, far);
+                _mm_storeu_ps(t.as_mut_ptr().add(4 * h), near);
+                mask |= (_mm_movemask_ps(hit) as u32) << (4 * h);
             }
         }
         (mask, t)
     }
 
-    /// Lanes `lane..lane + 4` with SSE; their entry distances go to `t`.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn pass4<const W: usize>(
-        &self,
-        node: &Wide<W>,
-        lane: usize,
-        t_max: f32,
-        t: &mut [f32; W],
-    ) -> u32 {
-        use std::arch::x86_64::*;
-        let row = |r: usize| {
-            let row = &node.b[r][lane..lane + 4];
-            // SAFETY: `row` holds four floats; SSE is part of the x86_64 baseline.
-            unsafe { _mm_loadu_ps(row.as_ptr()) }
-        };
-        // SAFETY: SSE is part of the x86_64 baseline.
-        unsafe {
-            let mut near = _mm_setzero_ps();
-            let mut far = _mm_set1_ps(t_max * WIDEN);
-            for k in 0..3 {
-                let o = _mm_set1_ps(self.origin[k]);
-                let inv = _mm_set1_ps(self.inv[k]);
-                let inv_far = _mm_set1_ps(self.inv_far[k]);
-                let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
-                let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv_far);
-                near = _mm_max_ps(t0, near);
-                far = _mm_min_ps(t1, far);
-            }
-            _mm_storeu_ps(t[lane..lane + 4].as_mut_ptr(), near);
-            _mm_movemask_ps(_mm_cmple_ps(near, far)) as u32
-        }
-    }
-
-    /// Lanes `lane..lane + 8` with AVX.
+    /// The same with AVX: all eight lanes in one pass (bitwise the same results).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[inline]
-    fn pass8<const W: usize>(
-        &self,
-        node: &Wide<W>,
-        lane: usize,
-        t_max: f32,
-        t: &mut [f32; W],
-    ) -> u32 {
+    fn enter_avx(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
         use std::arch::x86_64::*;
         let row = |r: usize| {
-            let row = &node.b[r][lane..lane + 8];
-            // SAFETY: `row` holds eight floats, and this function runs with AVX enabled.
-            unsafe { _mm256_loadu_ps(row.as_ptr()) }
+            // SAFETY: a row of `node.b` holds `LANES` = 8 floats (`r` itself is bounds-checked),
+            // and this function only runs with AVX enabled.
+            unsafe { _mm256_loadu_ps(node.b[r].as_ptr()) }
         };
         let mut near = _mm256_setzero_ps();
         let mut far = _mm256_set1_ps(t_max * WIDEN);
@@ -157,60 +92,56 @@ impl BoxRay {
             near = _mm256_max_ps(t0, near);
             far = _mm256_min_ps(t1, far);
         }
-        // SAFETY: the slice holds eight floats.
-        unsafe { _mm256_storeu_ps(t[lane..lane + 8].as_mut_ptr(), near) };
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(near, far);
+        let mut t = [0.0; LANES];
+        // SAFETY: `t` holds `LANES` = 8 floats.
+        unsafe { _mm256_storeu_ps(t.as_mut_ptr(), near) };
+        (_mm256_movemask_ps(hit) as u32, t)
     }
 
-    /// All sixteen lanes of a 16-wide node with AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    #[inline]
-    fn pass16<const W: usize>(&self, node: &Wide<W>, t_max: f32, t: &mut [f32; W]) -> u32 {
-        use std::arch::x86_64::*;
-        let row = |r: usize| {
-            let row = &node.b[r][..16];
-            // SAFETY: `row` holds sixteen floats, and this function runs with AVX-512F enabled.
-            unsafe { _mm512_loadu_ps(row.as_ptr()) }
-        };
-        let mut near = _mm512_setzero_ps();
-        let mut far = _mm512_set1_ps(t_max * WIDEN);
-        for k in 0..3 {
-            let o = _mm512_set1_ps(self.origin[k]);
-            let inv = _mm512_set1_ps(self.inv[k]);
-            let inv_far = _mm512_set1_ps(self.inv_far[k]);
-            let t0 = _mm512_mul_ps(_mm512_sub_ps(row(self.near[k]), o), inv);
-            let t1 = _mm512_mul_ps(_mm512_sub_ps(row(self.far[k]), o), inv_far);
-            near = _mm512_max_ps(t0, near);
-            far = _mm512_min_ps(t1, far);
+    /// The box test of the traversal compiled for `avx` (see `Bvh::intersect`).
+    #[inline(always)]
+    pub(super) fn enter_with<const AVX: bool>(
+        &self,
+        node: &Wide,
+        t_max: f32,
+    ) -> (u32, [f32; LANES]) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            debug_assert!(avx());
+            // SAFETY: the CPU has AVX: `AVX` is true only in the loops `intersect_avx` and
+            // `any_avx` instantiate, which run only after `avx()` said so (the `_dispatch`
+            // functions below); nothing else in `bvh` passes `true`.
+            return unsafe { self.enter_avx(node, t_max) };
         }
-        // SAFETY: the slice holds sixteen floats.
-        unsafe { _mm512_storeu_ps(t[..16].as_mut_ptr(), near) };
-        u32::from(_mm512_cmp_ps_mask::<_CMP_LE_OQ>(near, far))
+        self.enter(node, t_max)
     }
 
     /// The same, lane by lane, for other targets.
     #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
-    pub(super) fn enter<const LEVEL: u8, const W: usize>(
-        &self,
-        node: &Wide<W>,
-        t_max: f32,
-    ) -> (u32, [f32; W]) {
-        let mut near = [0.0f32; W];
-        let mut far = [t_max * WIDEN; W];
+    fn enter(&self, node: &Wide, t_max: f32) -> (u32, [f32; LANES]) {
+        let mut near = [0.0f32; LANES];
+        let mut far = [t_max * WIDEN; LANES];
         for k in 0..3 {
             let (lo, hi) = (&node.b[self.near[k]], &node.b[self.far[k]]);
-            for l in 0..W {
+            for l in 0..LANES {
                 let t0 = (lo[l] - self.origin[k]) * self.inv[k];
                 let t1 = (hi[l] - self.origin[k]) * self.inv_far[k];
                 near[l] = if t0 > near[l] { t0 } else { near[l] };
                 far[l] = if t1 < far[l] { t1 } else { far[l] };
             }
         }
-        let mask = (0..W).fold(0, |m, l| m | u32::from(near[l] <= far[l]) << l);
+        let mask = (0..LANES).fold(0, |m, l| m | u32::from(near[l] <= far[l]) << l);
         (mask, near)
     }
+}
+
+/// Whether this CPU has AVX (8-wide box tests); the check is a cached load.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn avx() -> bool {
+    std::arch::is_x86_feature_detected!("avx")
 }
 
 /// The lanes of `v` clamped to `[0, max]` (NaN to 0) and truncated to indices. Clamped with
@@ -243,39 +174,8 @@ pub(super) fn clamped_index(v: Vec3A, max: u8) -> [usize; 3] {
     x.map(|x| x.max(0.0).min(f32::from(max)) as usize)
 }
 
-/// The traversal loops a tree gets: compiled for the widest instruction set this CPU has, one
-/// loop per function and per width of tree (a function holding the loops of both widths was
-/// twice the code, and its 8-wide path 5–8 % slower in a render), so trees without 16-wide
-/// nodes get loops that never look for one; `Deep` for trees whose stack does not fit the
-/// frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) enum Loops {
-    #[default]
-    Base8,
-    Base16,
-    Avx8,
-    Avx16,
-    Avx512,
-    Deep,
-}
-
-impl Loops {
-    /// The loops for a tree with or without 16-wide nodes whose traversal needs `stack`
-    /// entries, on this CPU. The `Avx` loops are chosen only here, and only when the CPU has
-    /// the instructions they are compiled for.
-    pub(super) fn choose(wide: bool, stack: usize) -> Loops {
-        match (level(), wide) {
-            _ if stack > SMALL_STACK => Loops::Deep,
-            (AVX512, true) => Loops::Avx512,
-            (AVX512 | AVX, false) => Loops::Avx8,
-            (AVX, true) => Loops::Avx16,
-            (_, true) => Loops::Base16,
-            (_, false) => Loops::Base8,
-        }
-    }
-}
-
-/// Each traversal through the loops its tree got ([`Loops`]).
+/// The traversal loops (`Bvh::closest` and `Bvh::first`) compiled for AVX where the CPU has it,
+/// else for the baseline.
 impl Bvh {
     #[inline(always)]
     pub(super) fn intersect_dispatch<F: FnMut(usize, f32) -> Option<f32>>(
@@ -285,46 +185,25 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
-        match self.loops {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX-512F (`Loops::choose`, the only maker of `Avx512`).
-            Loops::Avx512 => unsafe { self.intersect_avx512(origin, dir, t_max, test) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx8`).
-            Loops::Avx8 => unsafe { self.intersect_avx::<NARROW, F>(origin, dir, t_max, test) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx16`).
-            Loops::Avx16 => unsafe { self.intersect_avx::<WIDEST, F>(origin, dir, t_max, test) },
-            Loops::Deep => self.intersect_deep(origin, dir, t_max, test),
-            Loops::Base16 => self.intersect_base::<WIDEST, F>(origin, dir, t_max, test),
-            _ => self.intersect_base::<NARROW, F>(origin, dir, t_max, test),
+        #[cfg(target_arch = "x86_64")]
+        if avx() {
+            // SAFETY: the CPU has AVX (just checked), the feature `intersect_avx` is built for.
+            return unsafe { self.intersect_avx(origin, dir, t_max, test) };
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    #[inline(never)]
-    fn intersect_avx512<F: FnMut(usize, f32) -> Option<f32>>(
-        &self,
-        origin: Vec3A,
-        dir: Vec3A,
-        t_max: f32,
-        test: F,
-    ) -> f32 {
-        self.closest::<AVX512, WIDEST, F>(origin, dir, t_max, test, &mut stack_space())
+        self.intersect_base(origin, dir, t_max, test)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[inline(never)]
-    fn intersect_avx<const MAXW: usize, F: FnMut(usize, f32) -> Option<f32>>(
+    fn intersect_avx<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
         t_max: f32,
         test: F,
     ) -> f32 {
-        self.closest::<AVX, MAXW, F>(origin, dir, t_max, test, &mut stack_space())
+        self.closest::<true, F>(origin, dir, t_max, test)
     }
 
     #[inline(always)]
@@ -335,107 +214,24 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
-        match self.loops {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX-512F (`Loops::choose`, the only maker of `Avx512`).
-            Loops::Avx512 => unsafe { self.any_avx512(origin, dir, t_max, test) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx8`).
-            Loops::Avx8 => unsafe { self.any_avx::<NARROW, F>(origin, dir, t_max, test) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX (`Loops::choose`, the only maker of `Avx16`).
-            Loops::Avx16 => unsafe { self.any_avx::<WIDEST, F>(origin, dir, t_max, test) },
-            Loops::Deep => self.any_deep(origin, dir, t_max, test),
-            Loops::Base16 => self.any_base::<WIDEST, F>(origin, dir, t_max, test),
-            _ => self.any_base::<NARROW, F>(origin, dir, t_max, test),
+        #[cfg(target_arch = "x86_64")]
+        if avx() {
+            // SAFETY: the CPU has AVX (just checked), the feature `any_avx` is built for.
+            return unsafe { self.any_avx(origin, dir, t_max, test) };
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    #[inline(never)]
-    fn any_avx512<F: FnMut(usize) -> bool>(
-        &self,
-        origin: Vec3A,
-        dir: Vec3A,
-        t_max: f32,
-        test: F,
-    ) -> bool {
-        self.first::<AVX512, WIDEST, F>(origin, dir, t_max, test, &mut stack_space())
+        self.any_base(origin, dir, t_max, test)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[inline(never)]
-    fn any_avx<const MAXW: usize, F: FnMut(usize) -> bool>(
+    fn any_avx<F: FnMut(usize) -> bool>(
         &self,
         origin: Vec3A,
         dir: Vec3A,
         t_max: f32,
         test: F,
     ) -> bool {
-        self.first::<AVX, MAXW, F>(origin, dir, t_max, test, &mut stack_space())
-    }
-}
-
-/// Every traversal loop of a tree, for the tests of `traversal`.
-#[cfg(test)]
-pub(super) mod tests {
-    use super::*;
-
-    pub(in super::super) type Closest<'a> =
-        Box<dyn Fn(Vec3A, Vec3A, f32, &mut dyn FnMut(usize, f32) -> Option<f32>) -> f32 + 'a>;
-    pub(in super::super) type AnyHit<'a> =
-        Box<dyn Fn(Vec3A, Vec3A, f32, &mut dyn FnMut(usize) -> bool) -> bool + 'a>;
-
-    impl Bvh {
-        /// Every traversal loop this CPU can run on this tree: (name, closest hit, any hit);
-        /// the AVX-512 loop and the deep one on trees of either width.
-        pub(in super::super) fn loops(&self) -> Vec<(&'static str, Closest<'_>, AnyHit<'_>)> {
-            let mut v = if self.stack > SMALL_STACK {
-                // The others' stacks are too small for the tree.
-                Vec::new()
-            } else if self.node_counts().1 > 0 {
-                self.loops_of::<WIDEST>()
-            } else {
-                self.loops_of::<NARROW>()
-            };
-            v.push((
-                "deep",
-                Box::new(|o, d, t, f| self.intersect_deep(o, d, t, f)),
-                Box::new(|o, d, t, f| self.any_deep(o, d, t, f)),
-            ));
-            v
-        }
-
-        fn loops_of<const W: usize>(&self) -> Vec<(&'static str, Closest<'_>, AnyHit<'_>)> {
-            let mut v: Vec<(&'static str, Closest<'_>, AnyHit<'_>)> = vec![(
-                "base",
-                Box::new(|o, d, t, f| self.intersect_base::<W, _>(o, d, t, f)),
-                Box::new(|o, d, t, f| self.any_base::<W, _>(o, d, t, f)),
-            )];
-            #[cfg(target_arch = "x86_64")]
-            {
-                if level() >= AVX {
-                    v.push((
-                        "avx",
-                        // SAFETY: the CPU has AVX (just checked).
-                        Box::new(|o, d, t, f| unsafe { self.intersect_avx::<W, _>(o, d, t, f) }),
-                        // SAFETY: as above.
-                        Box::new(|o, d, t, f| unsafe { self.any_avx::<W, _>(o, d, t, f) }),
-                    ));
-                }
-                if level() >= AVX512 {
-                    v.push((
-                        "avx512",
-                        // SAFETY: the CPU has AVX-512F (just checked).
-                        Box::new(|o, d, t, f| unsafe { self.intersect_avx512(o, d, t, f) }),
-                        // SAFETY: as above.
-                        Box::new(|o, d, t, f| unsafe { self.any_avx512(o, d, t, f) }),
-                    ));
-                }
-            }
-            v
-        }
+        self.first::<true, F>(origin, dir, t_max, test)
     }
 }

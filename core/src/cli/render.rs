@@ -591,12 +591,7 @@ fn print_stats(
         load.as_secs_f64() + scene.plugin_time.as_secs_f64(),
         scene.plugin_time.as_secs_f64()
     );
-    let (narrow, wide, bytes) = scene.bvh_nodes();
-    eprintln!(
-        "  BVH build        {:.3} s ({narrow} 8-wide + {wide} 16-wide nodes, {:.1} MB)",
-        scene.bvh_time.as_secs_f64(),
-        bytes as f64 / 1e6
-    );
+    eprintln!("  BVH build        {:.3} s", scene.bvh_time.as_secs_f64());
     eprintln!("  render           {:.3} s", secs);
     eprintln!("  write            {:.3} s", write.as_secs_f64());
     eprintln!("  total            {:.3} s", total.as_secs_f64());

@@ -106,10 +106,6 @@ impl Customs {
         self.refs.is_empty()
     }
 
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
-    }
-
     pub fn len(&self) -> usize {
         self.refs.len()
     }

@@ -63,10 +63,6 @@ impl<S: Shape> Set<S> {
         self.data.is_empty()
     }
 
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
-    }
-
     /// Primitives, packed materials and BVH, for the geometry cache.
     pub(crate) fn parts(&self) -> (&[S], &[u32], &Bvh) {
         (&self.data, &self.material, &self.bvh)

@@ -347,22 +347,6 @@ impl Scene {
         filter
     }
 
-    /// The BVH nodes of every primitive kind: (8-wide, 16-wide, bytes).
-    pub fn bvh_nodes(&self) -> (usize, usize, usize) {
-        [
-            self.spheres.bvh(),
-            self.triangles.set.bvh(),
-            self.cones.bvh(),
-            self.discs.bvh(),
-            self.customs.bvh(),
-        ]
-        .iter()
-        .fold((0, 0, 0), |(n, w, b), bvh| {
-            let (n1, w1) = bvh.node_counts();
-            (n + n1, w + w1, b + bvh.node_bytes())
-        })
-    }
-
     pub fn primitive_count(&self) -> usize {
         self.spheres.len()
             + self.triangles.len()
