@@ -15,10 +15,14 @@ fn first_lane(mask: u32) -> usize {
 
 /// Whether a ray's coordinates are all finite. Others meet nothing: a NaN (from a zero-length
 /// direction, say) or an infinity makes the box tests enter empty lanes too, whose link is the
-/// root's, so their traversal would never end (and would overrun its stack).
+/// root's, so their traversal would never end (and would overrun its stack). Checked in the
+/// loops, after the check for an empty tree, not in `Bvh::intersect` and `Bvh::any`, which are
+/// inlined into every caller (one call per primitive kind).
 #[inline(always)]
 fn finite(origin: Vec3A, dir: Vec3A) -> bool {
-    (origin.is_finite_mask() & dir.is_finite_mask()).all()
+    // x - x is 0 for finite x and NaN for the others (fewer instructions than glam's
+    // `is_finite`, which masks the sign bits and compares with infinity).
+    ((origin - origin) + (dir - dir)).cmpeq(Vec3A::ZERO).all()
 }
 
 impl Bvh {
@@ -37,9 +41,6 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
-        if !finite(origin, dir) {
-            return t_max;
-        }
         self.intersect_dispatch(origin, dir, t_max, test)
     }
 
@@ -62,7 +63,7 @@ impl Bvh {
         mut t_max: f32,
         mut test: F,
     ) -> f32 {
-        if self.nodes.is_empty() {
+        if self.nodes.is_empty() || !finite(origin, dir) {
             return t_max;
         }
         let ray = BoxRay::new(origin, dir);
@@ -129,9 +130,6 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
-        if !finite(origin, dir) {
-            return false;
-        }
         self.any_dispatch(origin, dir, t_max, test)
     }
 
@@ -154,7 +152,7 @@ impl Bvh {
         t_max: f32,
         mut test: F,
     ) -> bool {
-        if self.nodes.is_empty() {
+        if self.nodes.is_empty() || !finite(origin, dir) {
             return false;
         }
         let ray = BoxRay::new(origin, dir);
