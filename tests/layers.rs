@@ -36,6 +36,7 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("origin", &["origin"]),
     ("leaves", &["error", "geometry", "spans", "raw"]),
     ("description", &["desc"]),
+    ("text", &["ron_text"]),
     ("input", &["input"]),
     ("scanner", &["scanner"]),
     ("checks", &["validate", "ron_error"]),

@@ -5,9 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use luxon_formats::tachyon::{parse_file, syntax};
+use luxon_formats::tachyon::{parse_file, syntax, Highlights, Options, ShadeLevel, Skylight};
 use luxon_formats::{
-    load, FogMode, InlineGeometry, LightDesc, MaterialDesc, Projection, SceneDesc, TransparencyMode,
+    load, FogMode, Highlight, InlineGeometry, LightDesc, MaterialDesc, Origin, Projection,
+    SceneDesc, TransparencyMode,
 };
 
 struct TempDir(PathBuf);
@@ -258,6 +259,122 @@ fn sky_light_and_ambient_occlusion() {
     );
     let ao = d.ambient_occlusion.unwrap();
     assert_eq!((ao.samples, ao.direct), (8, 0.2));
+}
+
+/// Loads scene `body` with command-line `options` (their origin is filled in).
+fn scene_with(name: &str, body: &str, options: impl FnOnce(&mut Options)) -> SceneDesc {
+    let dir = TempDir::new(name);
+    let p = dir.write("s.dat", &format!("{HEAD}{body}\nEND_SCENE\n"));
+    let mut o = Options::new(Origin {
+        file: std::sync::Arc::new(PathBuf::from("<command line>")),
+        line: 1,
+        col: 1,
+    });
+    options(&mut o);
+    luxon_formats::tachyon::load_with(&p, &o).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn intensity(l: &LightDesc) -> f64 {
+    match l {
+        LightDesc::Point { intensity, .. } | LightDesc::Directional { intensity, .. } => *intensity,
+        other => panic!("unexpected light {other:?}"),
+    }
+}
+
+#[test]
+fn command_line_options_override_the_scene() {
+    let body = "CAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 2 RAYDEPTH 8 CENTER 0 0 0 VIEWDIR 0 0 1 \
+                UPDIR 0 1 0 END_CAMERA\n\
+                SHADER_MODE MEDIUM TRANS_VMD END_SHADER_MODE\n\
+                LIGHT CENTER 0 0 0 RAD 0 COLOR 1 1 1\n\
+                SPHERE CENTER 0 0 5 RAD 1 TEXTURE AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0 \
+                OPACITY 0.5 PHONG PLASTIC 0.5 PHONG_SIZE 20 COLOR 1 1 1 TEXFUNC 0";
+    let d = scene_with("cli-none", body, |_| {});
+    assert_eq!((d.render.width, d.render.height), (64, 32));
+    assert_eq!((d.render.samples, d.render.max_depth), (3, 7));
+    assert_eq!(d.render.transparency.mode, TransparencyMode::PostMultiplied);
+    assert!(matches!(
+        d.lights[0].value,
+        LightDesc::Point { shadows: false, .. }
+    ));
+    let d = scene_with("cli-all", body, |o| {
+        o.resolution = Some([20, 10]);
+        o.antialiasing = Some(0);
+        o.raydepth = Some(3);
+        o.shade = Some(ShadeLevel::Full);
+        o.transparency = Some((false, true));
+        o.max_surfaces = Some(1);
+        o.fog_vmd = Some(true);
+        o.highlights = Some(Highlights::Phong);
+    });
+    assert_eq!((d.render.width, d.render.height), (20, 10));
+    assert_eq!((d.render.samples, d.render.max_depth), (1, 2));
+    assert_eq!(d.render.transparency.mode, TransparencyMode::AngleModulated);
+    assert_eq!(d.render.transparency.max_surfaces, Some(1));
+    assert!(matches!(
+        d.lights[0].value,
+        LightDesc::Point { shadows: true, .. }
+    ));
+    let m = &d.materials[0].1.value;
+    assert_eq!((m.highlight, m.specular), (Highlight::Phong, 0.5));
+    // The command line's own warnings name where they come from.
+    let max = d
+        .warnings
+        .iter()
+        .find(|w| w.message.contains("TRANS_MAX_SURFACES"));
+    assert_eq!(max.unwrap().at.file.to_str(), Some("<command line>"));
+    // The window follows the new resolution: 2:1 stays 2:1.
+    let f = d.camera.value.frustum.unwrap();
+    assert!(close((f.right - f.left) / (f.top - f.bottom), 2.0));
+    let d = scene_with("cli-null", body, |o| o.highlights = Some(Highlights::None));
+    assert_eq!(d.materials[0].1.value.specular, 0.0);
+    let d = scene_with("cli-fast", body, |o| {
+        o.highlights = Some(Highlights::BlinnFast)
+    });
+    assert_eq!(d.materials[0].1.value.highlight, Highlight::Blinn);
+    assert!(warned(&d, "-shade_blinn_fast"));
+}
+
+#[test]
+fn light_scale_and_skylight_follow_tachyon() {
+    let light = "LIGHT CENTER 0 0 0 RAD 0 COLOR 1 1 1";
+    let ao = "SHADER_MODE FULL AMBIENT_OCCLUSION AMBIENT_COLOR 0.2 0.2 0.2 RESCALE_DIRECT 0.5 \
+              SAMPLES 8 END_SHADER_MODE";
+    // -rescale_lights: only factors below 1, replacing RESCALE_DIRECT; lights scale when
+    // there is no occlusion.
+    let d = scene_with("scale-up", light, |o| o.light_scale = Some(2.0));
+    assert_eq!(intensity(&d.lights[0].value), 1.0);
+    let d = scene_with("scale-down", light, |o| o.light_scale = Some(0.25));
+    assert_eq!(intensity(&d.lights[0].value), 0.25);
+    let d = scene_with("scale-ao", &format!("{ao}\n{light}"), |o| {
+        o.light_scale = Some(0.8)
+    });
+    let a = d.ambient_occlusion.unwrap();
+    assert_eq!((a.direct, intensity(&d.lights[0].value)), (0.8, 1.0));
+    // MEDIUM traces no occlusion but keeps the scene's RESCALE_DIRECT (measured: 66 -> 33).
+    let d = scene_with("scale-medium", &format!("{ao}\n{light}"), |o| {
+        o.shade = Some(ShadeLevel::Medium)
+    });
+    assert!(d.ambient_occlusion.is_none());
+    assert_eq!(intensity(&d.lights[0].value), 0.5);
+    // -auto_skylight f: occlusion of colour f, lights × (1 − f); -add_skylight keeps the scale.
+    let sky = |rescale| Skylight {
+        level: 0.25,
+        samples: 32,
+        rescale,
+    };
+    let d = scene_with("auto", &format!("{ao}\n{light}"), |o| {
+        o.skylight = Some(sky(true))
+    });
+    let a = d.ambient_occlusion.unwrap();
+    assert_eq!((a.samples, a.color, a.direct), (32, [0.25; 3], 0.75));
+    let d = scene_with("add", &format!("{ao}\n{light}"), |o| {
+        o.skylight = Some(sky(false))
+    });
+    let a = d.ambient_occlusion.unwrap();
+    assert_eq!((a.samples, a.color, a.direct), (32, [0.25; 3], 0.5));
+    let d = scene_with("add-plain", light, |o| o.skylight = Some(sky(false)));
+    assert_eq!(d.ambient_occlusion.unwrap().direct, 1.0);
 }
 
 #[test]

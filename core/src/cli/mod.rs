@@ -1,6 +1,7 @@
 //! The subcommands of `luxon`, one module each.
 
 pub mod check;
+pub mod convert;
 pub mod job;
 pub mod plugins;
 pub mod progress;
@@ -11,6 +12,7 @@ pub mod shading;
 pub mod signals;
 pub mod spd;
 pub mod sweep;
+pub mod tachyon;
 pub mod usage;
 
 use luxon::plugin::Registry;

@@ -347,6 +347,17 @@ impl Scene {
         filter
     }
 
+    /// Moves the camera without rebuilding anything (the next frame of a camera path): the
+    /// geometry stays stored relative to `world_offset` (the first camera's position) and the
+    /// new camera is placed in that space. Only the camera's position, direction and window
+    /// change what a render computes; `settings` (resolution, samples) stay as built.
+    pub fn set_camera(&mut self, desc: &luxon_formats::CameraDesc) {
+        let origin = Vec3A::from((DVec3::from(desc.position) - self.world_offset).as_vec3());
+        let s = &self.settings;
+        self.camera = Camera::new(desc, origin, s.width, s.height);
+        (self.primary_width, self.pixel_spread) = self.camera.footprint();
+    }
+
     pub fn primitive_count(&self) -> usize {
         self.spheres.len()
             + self.triangles.len()

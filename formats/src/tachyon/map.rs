@@ -6,13 +6,15 @@ use std::collections::HashSet;
 
 use super::materials::Materials;
 use super::notes::Notes;
+use super::options::{Highlights, Options};
 use super::shapes::{tpoly_vertex, volume_slices, Shapes};
 use super::syntax::*;
 use super::terrain::scape;
 use super::{mirror, Warnings};
 use crate::desc::{
-    AoDesc, Attenuation, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum, LightDesc,
-    Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc, TransparencyMode,
+    AoDesc, Attenuation, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum, Highlight,
+    LightDesc, MaterialDesc, Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc,
+    TransparencyMode,
 };
 use crate::error::SceneError;
 use crate::origin::{Origin, Spanned};
@@ -39,15 +41,19 @@ struct Mapper {
     background: V3,
     fog: Option<(Origin, Fog)>,
     ao: Option<AoDesc>,
+    /// Tachyon's direct light scale (RESCALE_DIRECT): it outlives the occlusion that set it.
+    light_scale: f64,
     shading: Shading,
     lights: Vec<Spanned<LightDesc>>,
     materials: Materials,
     shapes: Shapes,
     notes: Notes,
     warnings: Warnings,
+    /// The command line's overrides.
+    options: Options,
 }
 
-pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
+pub(super) fn to_desc(scene: Scene, options: &Options) -> Result<SceneDesc> {
     let reserved: HashSet<String> = scene
         .statements
         .iter()
@@ -61,6 +67,7 @@ pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
         background: [0.0; 3],
         fog: None,
         ao: None,
+        light_scale: 1.0,
         shading: Shading {
             level: ShadeLevel::Full,
             vmd: false,
@@ -74,10 +81,12 @@ pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
         shapes: Shapes::default(),
         notes: Notes::default(),
         warnings: scene.warnings,
+        options: options.clone(),
     };
     for s in &scene.statements {
         m.statement(s)?;
     }
+    m.command_line_shading();
     m.finish(&scene.source, &scene.resolution, &scene.begin)
 }
 
@@ -322,6 +331,96 @@ impl Mapper {
         Ok(())
     }
 
+    /// The command line's shading switches, over the scene's SHADER_MODE (Tachyon applies
+    /// them after reading the scene).
+    fn command_line_shading(&mut self) {
+        let (o, s) = (&self.options, &mut self.shading);
+        if let Some(level) = o.shade {
+            s.level = level;
+        }
+        if let Some((vmd, raster3d)) = o.transparency {
+            (s.vmd, s.raster3d) = (vmd, raster3d);
+        }
+        if let Some(n) = o.max_surfaces {
+            s.max_surfaces = Some((n, o.at.clone()));
+        }
+        if let Some(on) = o.shadow_filter {
+            s.shadow_filter_off = (!on).then(|| o.at.clone());
+        }
+        if let Some(vmd) = o.fog_vmd {
+            s.fog_vmd = vmd;
+        }
+    }
+
+    /// Ambient occlusion and the direct light scale: the scene's, then the command line's
+    /// (`-rescale_lights` below 1 replaces the scene's RESCALE_DIRECT; `-auto_skylight f`
+    /// replaces both with f and 1 − f; `-add_skylight f` only the occlusion). The scale is the
+    /// occlusion's `direct` while occlusion is on, else it scales every light.
+    fn lighting(&mut self, shadows: bool) -> Option<AoDesc> {
+        let o = &self.options;
+        let mut scale = self.light_scale;
+        if let Some(s) = o.light_scale.filter(|&s| s < 1.0) {
+            scale = s.max(0.0);
+        }
+        let mut ao = self.ao.take();
+        if let Some(sky) = o.skylight.filter(|s| s.level > 0.0) {
+            let old = ao.as_ref().map_or(1.0, |a| a.intensity);
+            ao = (sky.samples > 0).then_some(AoDesc {
+                samples: sky.samples,
+                max_distance: f64::INFINITY,
+                color: [sky.level; 3],
+                intensity: old,
+                direct: 1.0,
+            });
+            if sky.rescale {
+                scale = (1.0 - sky.level).max(0.0);
+            }
+        }
+        // MEDIUM and below trace no occlusion rays; the scale stays.
+        if !shadows {
+            ao = None;
+        }
+        match &mut ao {
+            Some(a) => a.direct = scale,
+            None if scale != 1.0 => {
+                for l in &mut self.lights {
+                    match &mut l.value {
+                        LightDesc::Point { intensity, .. }
+                        | LightDesc::Directional { intensity, .. }
+                        | LightDesc::Spot { intensity, .. }
+                        | LightDesc::Sphere { intensity, .. }
+                        | LightDesc::Rect { intensity, .. } => *intensity *= scale,
+                    }
+                }
+            }
+            None => {}
+        }
+        ao
+    }
+
+    /// `-shade_phong` and the other highlight switches, on every material.
+    fn highlights(&mut self, materials: &mut [(String, Spanned<MaterialDesc>)]) {
+        let Some(h) = self.options.highlights else {
+            return;
+        };
+        for (_, m) in materials.iter_mut() {
+            let m = &mut m.value;
+            match h {
+                Highlights::Phong => m.highlight = Highlight::Phong,
+                Highlights::Blinn | Highlights::BlinnFast => m.highlight = Highlight::Blinn,
+                Highlights::None => m.specular = 0.0,
+            }
+        }
+        if h == Highlights::BlinnFast && materials.iter().any(|(_, m)| m.value.specular > 0.0) {
+            self.notes.add(
+                "-shade_blinn_fast",
+                "(Tachyon's fast approximation of Blinn highlights) is rendered with Blinn \
+                 highlights",
+                &self.options.at.clone(),
+            );
+        }
+    }
+
     fn shader_mode(&mut self, mode: &ShaderMode) {
         let s = &mut self.shading;
         s.level = mode.level.value;
@@ -345,8 +444,9 @@ impl Mapper {
                         max_distance: f64::INFINITY,
                         color: *color,
                         intensity: 1.0,
-                        direct: *rescale_direct,
+                        direct: 1.0,
                     });
+                    self.light_scale = *rescale_direct;
                 }
             }
         }
@@ -416,7 +516,7 @@ impl Mapper {
         res: &Spanned<[u32; 2]>,
         begin: &Origin,
     ) -> Result<SceneDesc> {
-        let [width, height] = res.value;
+        let [width, height] = self.options.resolution.unwrap_or(res.value);
         if u64::from(width) * u64::from(height) > 1 << 28 {
             return Err(SceneError::at(
                 res.at.clone(),
@@ -426,10 +526,9 @@ impl Mapper {
         let (camera, samples, max_depth) = self.camera(width, height, begin)?;
         let level = self.shading.level;
         let mut fog = self.fog()?;
-        let mut ao = self.ao.take();
         let shadows = level == ShadeLevel::Full;
+        let ao = self.lighting(shadows);
         if !shadows {
-            ao = None;
             for l in &mut self.lights {
                 match &mut l.value {
                     LightDesc::Point { shadows, .. }
@@ -460,6 +559,7 @@ impl Mapper {
                 textures.clear();
             }
         }
+        self.highlights(&mut materials);
         let first_transparent = materials
             .iter()
             .find(|(_, m)| m.value.transmit > 0.0)
@@ -602,7 +702,7 @@ impl Mapper {
         height: u32,
         begin: &Origin,
     ) -> Result<(Spanned<CameraDesc>, u32, u32)> {
-        let (at, c) = match self.camera.take() {
+        let (at, mut c) = match self.camera.take() {
             Some(c) => c,
             None => (
                 begin.clone(),
@@ -619,6 +719,12 @@ impl Mapper {
                 },
             ),
         };
+        if let Some(n) = self.options.antialiasing {
+            c.antialiasing = n;
+        }
+        if let Some(n) = self.options.raydepth {
+            c.raydepth = n;
+        }
         if c.zoom <= 0.0 {
             return Err(SceneError::at(
                 at,
@@ -741,6 +847,43 @@ impl Mapper {
         let max_depth = c.raydepth.saturating_sub(1).min(MAX_DEPTH);
         Ok((Spanned { value: camera, at }, c.antialiasing + 1, max_depth))
     }
+}
+
+/// `camera` at Tachyon's CENTER, looking along VIEWDIR with UPDIR up (see `camera_at`).
+pub(super) fn moved_camera(
+    camera: &CameraDesc,
+    viewdir: V3,
+    updir: V3,
+    center: V3,
+) -> std::result::Result<CameraDesc, String> {
+    let finite = |v: V3| v.iter().all(|x| x.is_finite());
+    if !(finite(viewdir) && finite(updir) && finite(center)) {
+        return Err("a number is not finite; expected finite numbers".into());
+    }
+    if viewdir == [0.0; 3] {
+        return Err("VIEWDIR is (0, 0, 0); expected a direction".into());
+    }
+    if updir == [0.0; 3] {
+        return Err("UPDIR is (0, 0, 0); expected a direction".into());
+    }
+    let [v, u] = [viewdir, updir];
+    let cross = [
+        v[1] * u[2] - v[2] * u[1],
+        v[2] * u[0] - v[0] * u[2],
+        v[0] * u[1] - v[1] * u[0],
+    ];
+    if cross == [0.0; 3] {
+        return Err(
+            "UPDIR is parallel to VIEWDIR; expected an up direction across the view".into(),
+        );
+    }
+    let (p, v) = (mirror(center), mirror(viewdir));
+    Ok(CameraDesc {
+        position: p,
+        look_at: [p[0] + v[0], p[1] + v[1], p[2] + v[2]],
+        up: mirror(updir),
+        ..camera.clone()
+    })
 }
 
 /// A strip's triangles: (s[t], s[t+1], s[t+2]) for even t, (s[t+1], s[t], s[t+2]) for odd t,

@@ -73,8 +73,10 @@
 //! NFF importer does), because Tachyon's arithmetic (ambient + diffuse sums, products of
 //! light and surface colours, mirror and transmission mixes) is on these values: converting
 //! would change every mix, and only an output written without sRGB encoding can show
-//! Tachyon's tones. Until Luxon has that output option, midtones come out brighter than
-//! Tachyon's (Luxon encodes its output as sRGB); where both are 0 or 1 they agree.
+//! Tachyon's tones: `luxon tachyon` writes its images so (the writers' `encoding: display`:
+//! values as they are, clamped and truncated as Tachyon writes them). `luxon render` writes
+//! sRGB unless an output asks for `encoding: display`, so there midtones come out brighter
+//! than Tachyon's; where both are 0 or 1 they agree.
 //!
 //! ## Lights, shading settings, fog
 //!
@@ -85,7 +87,7 @@
 //! | `DIRECTIONAL_LIGHT DIRECTION d COLOR c` | `Directional` travelling along d |
 //! | `SPOTLIGHT ... FALLOFF_START s FALLOFF_END e` | `Spot` with `angle: 2e`, `falloff: 2(e − s)`: full inside s, none beyond e; Tachyon fades linearly in the angle, Luxon smoothly in its cosine |
 //! | `SKY_LIGHT NUMSAMPLES n COLOR c` | `ambient_occlusion`: n samples, unlimited distance, colour c, direct 1 |
-//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r` |
+//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r`; r scales direct light even where occlusion is off (MEDIUM shading, measured), there as every light's `intensity` |
 //! | `SHADER_MODE FULL` / `MEDIUM` | everything / no shadows and no occlusion |
 //! | `SHADER_MODE LOW` / `LOWEST` | every surface shows its texture colour unlit (no fog) / white on black |
 //! | `TRANS_VMD`, `TRANS_RASTER3D`, `TRANS_ORIG` | `transparency` `PostMultiplied`, `AngleModulated`, `Filter` (see "Not yet") |
@@ -94,6 +96,19 @@
 //! | `FOG EXP` / `EXP2 DENSITY d` | `Exp` / `Exp2 { density }` (from the eye: START is not used) |
 //! | `FOG_VMD` | `planar: true` (depth along the view direction) |
 //! | `BACKGROUND c` | `background` |
+//!
+//! ## Command-line options
+//!
+//! [`load_with`] takes [`Options`], Tachyon's command-line overrides (`luxon tachyon` fills
+//! them). They replace the scene's settings after the whole file is read, as Tachyon applies
+//! them, and then map like the statements they stand for (`-mediumshade` as `SHADER_MODE
+//! MEDIUM`, `-trans_vmd` as `TRANS_VMD`, `-aasamples n` as `ANTIALIASING n`, `-res` as
+//! `RESOLUTION`), with the same warnings, placed at the command line. Tachyon keeps one direct
+//! light scale: RESCALE_DIRECT sets it, `-rescale_lights f` replaces it when f < 1 (Tachyon
+//! ignores larger factors), `-auto_skylight f` sets it to 1 − f and turns on occlusion of
+//! colour f (`-add_skylight f`: occlusion only), with `-skylight_samples` rays (128 by
+//! default). `-shade_phong` gives every material Phong highlights, `-shade_nullphong` none;
+//! `-shade_blinn_fast` is rendered as Blinn (one warning).
 //!
 //! ## Textures and materials
 //!
@@ -144,7 +159,7 @@
 //! EXP/EXP2 fog's START; vertex colours (VCSTRI, VERTEXARRAY COLORS); TEXFUNC 3 (marble), 4
 //! (wood), 6 (cylindrical checker) and 10 (IMAGEDEF volume textures), and image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
-//! Tachyon's two-pass volume compositing; the output without sRGB encoding. Also different in
+//! Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
 //! windows blur more sideways in Tachyon), spot falloff shape, highlights attenuated, the 1/510 light threshold, image
 //! texel centres (Tachyon puts u = 0 and 1 on the first and last texel centres), MIP level
@@ -156,6 +171,7 @@ mod lex;
 mod map;
 mod materials;
 mod notes;
+mod options;
 mod parse;
 mod ron;
 mod shapes;
@@ -166,7 +182,10 @@ use std::path::Path;
 
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
-use crate::origin::Spanned;
+use crate::origin::{Origin, Spanned};
+
+pub use options::{Highlights, Options, Skylight};
+pub use syntax::ShadeLevel;
 
 /// Problems that did not stop the import, each where it was found.
 type Warnings = Vec<Spanned<String>>;
@@ -190,5 +209,27 @@ pub fn parse_file(path: &Path) -> Result<syntax::Scene, SceneError> {
 
 /// Loads a Tachyon scene file as a Luxon scene (no outputs: the command line gives them).
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
-    map::to_desc(parse::parse_file(path)?)
+    let at = Origin {
+        file: std::sync::Arc::new(path.to_path_buf()),
+        line: 1,
+        col: 1,
+    };
+    load_with(path, &Options::new(at))
+}
+
+/// The camera of `scene` moved to a frame of a Tachyon camera file (`-camfile`): VIEWDIR,
+/// UPDIR and CENTER as Tachyon writes them, mapped as a CAMERA's are (mirrored); zoom,
+/// window, projection and lens stay. The error says which vector is unusable.
+pub fn camera_at(
+    camera: &crate::desc::CameraDesc,
+    viewdir: [f64; 3],
+    updir: [f64; 3],
+    center: [f64; 3],
+) -> Result<crate::desc::CameraDesc, String> {
+    map::moved_camera(camera, viewdir, updir, center)
+}
+
+/// [`load`] with Tachyon's command-line overrides (`luxon tachyon`).
+pub fn load_with(path: &Path, options: &Options) -> Result<SceneDesc, SceneError> {
+    map::to_desc(parse::parse_file(path)?, options)
 }

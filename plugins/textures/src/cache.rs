@@ -11,8 +11,9 @@
 //!
 //! **Misses.** A missing level (never loaded, or evicted) is filled under the image's own load
 //! mutex, so two threads never decode the same file at once while other images keep being
-//! read: the file is decoded, its whole MIP pyramid built, and every level not already resident
-//! is installed — the wanted ones marked as just used, the others as never used, so they are
+//! read: the file is decoded, its MIP pyramid built from the plan's first level on (`decode.rs`:
+//! an image larger than the decode cap is used at a smaller size), and every level not already
+//! resident is installed — the wanted ones marked as just used, the others as never used, so they are
 //! the first to go. The missing thread samples through `Arc`s it holds itself, so it makes
 //! progress even if its levels are evicted again at once.
 //!
@@ -31,8 +32,8 @@
 //! needed again), the cache logs once, with the budget and the size of all registered texture
 //! data. A decode failure logs once per image; lookups then fail (the render stops with an error).
 
-use crate::decode::{decode, Header};
-use crate::mipmap::{build_pyramid, level_sizes, Level};
+use crate::decode::{decode, size, Header, Plan};
+use crate::mipmap::{level_sizes, Level};
 use std::path::{Path, PathBuf};
 use std::ptr;
 use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering::*};
@@ -92,6 +93,10 @@ pub struct CachedImage {
     modified: Option<SystemTime>,
     srgb: bool,
     header: Header,
+    /// From which MIP level of the file on the image is decoded: its level 0 is that one.
+    plan: Plan,
+    /// Size of the image as used (the plan's first level).
+    size: (usize, usize),
     slots: Box<[Slot]>,
     readers: [Stripe; STRIPES],
     /// Held while decoding and installing this image.
@@ -112,12 +117,13 @@ impl Drop for ReadGuard<'_> {
 }
 
 impl CachedImage {
+    /// Width of the image as used (smaller than the file's when its plan skips levels).
     pub fn width(&self) -> usize {
-        self.header.width
+        self.size.0
     }
 
     pub fn height(&self) -> usize {
-        self.header.height
+        self.size.1
     }
 
     pub fn levels(&self) -> usize {
@@ -218,17 +224,6 @@ pub fn global() -> Arc<Cache> {
         .clone()
 }
 
-/// A byte count for people.
-fn size(bytes: u64) -> String {
-    let b = bytes as f64;
-    match bytes {
-        0..1024 => format!("{bytes} bytes"),
-        1024..1_048_576 => format!("{:.1} KiB", b / 1024.0),
-        1_048_576..1_073_741_824 => format!("{:.1} MiB", b / 1_048_576.0),
-        _ => format!("{:.1} GiB", b / 1_073_741_824.0),
-    }
-}
-
 impl Cache {
     pub fn new(budget: u64, log: Log) -> Cache {
         Cache {
@@ -271,18 +266,34 @@ impl Cache {
         }
     }
 
-    /// The shared entry for an image file whose header was read at create time. Nothing is
-    /// decoded until the first lookup.
-    pub fn register(&self, path: &Path, header: Header, srgb: bool) -> Arc<CachedImage> {
+    /// The shared entry for an image file whose header was read and plan made at create time.
+    /// Nothing is decoded until the first lookup. A new entry for an image used below its full
+    /// size logs the plan's warning.
+    pub fn register(
+        &self,
+        path: &Path,
+        header: Header,
+        srgb: bool,
+        plan: Plan,
+    ) -> Arc<CachedImage> {
+        let given = path;
         let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
         let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
         let mut st = self.lock();
         if let Some(img) = st.images.iter().find(|i| {
-            i.path == path && i.srgb == srgb && i.header == header && i.modified == modified
+            i.path == path
+                && i.srgb == srgb
+                && i.header == header
+                && i.modified == modified
+                && i.plan.first_level == plan.first_level
         }) {
             return img.clone();
         }
-        let slots = level_sizes(header.width, header.height)
+        if let Some(warning) = plan.warning(&given.display().to_string(), &header) {
+            (self.log)(1, &warning);
+        }
+        let size = plan.size(&header);
+        let slots = level_sizes(size.0, size.1)
             .into_iter()
             .map(|(w, h)| Slot {
                 data: AtomicPtr::new(ptr::null_mut()),
@@ -295,6 +306,8 @@ impl Cache {
             modified,
             srgb,
             header,
+            plan,
+            size,
             slots,
             readers: Default::default(),
             loading: Mutex::new(()),
@@ -367,8 +380,19 @@ impl Cache {
         if img.failed.load(Acquire) {
             return None;
         }
-        let base = match decode(&img.path, &img.header, img.srgb) {
-            Ok(level) => level,
+        let decoded = decode(&img.path, &img.header, img.srgb, &img.plan).and_then(|levels| {
+            if levels.len() == img.slots.len() {
+                Ok(levels)
+            } else {
+                Err(format!(
+                    "{} MIP levels decoded, {} expected",
+                    levels.len(),
+                    img.slots.len()
+                ))
+            }
+        });
+        let levels = match decoded {
+            Ok(levels) => levels,
             Err(e) => {
                 if !img.failed.swap(true, AcqRel) {
                     (self.log)(
@@ -379,8 +403,6 @@ impl Cache {
                 return None;
             }
         };
-        let levels = build_pyramid(base);
-        debug_assert_eq!(levels.len(), img.slots.len());
         self.decodes.fetch_add(1, Relaxed);
         let again = img.decodes.fetch_add(1, Relaxed) > 0;
 
@@ -470,6 +492,12 @@ mod tests {
     use crate::decode::probe;
     use crate::testutil::{write_png, TempDir};
 
+    /// Every level: the decode cap is not what these tests are about.
+    const FULL: Plan = Plan {
+        first_level: 0,
+        cap: u64::MAX,
+    };
+
     /// Messages a test cache logged: (level, text).
     type Seen = Arc<Mutex<Vec<(u32, String)>>>;
 
@@ -500,10 +528,10 @@ mod tests {
         let (log, _) = recorder();
         let cache = Cache::new(0, log);
         let h = probe(&p).unwrap();
-        let img = cache.register(&p, h, true);
-        let same = cache.register(&dir.path("./a.png"), h, true);
+        let img = cache.register(&p, h, true, FULL);
+        let same = cache.register(&dir.path("./a.png"), h, true, FULL);
         assert!(Arc::ptr_eq(&img, &same), "one entry per file");
-        let linear = cache.register(&p, h, false);
+        let linear = cache.register(&p, h, false, FULL);
         assert!(!Arc::ptr_eq(&img, &linear), "srgb is part of the key");
         // Nothing decoded at registration.
         assert_eq!(cache.stats().decodes, 0);
@@ -536,7 +564,7 @@ mod tests {
             .map(|&v| {
                 let want = crate::decode::srgb_to_linear(v as f32 / 255.0);
                 let p = flat(&dir, &format!("g{v}.png"), v);
-                (cache.register(&p, probe(&p).unwrap(), true), want)
+                (cache.register(&p, probe(&p).unwrap(), true, FULL), want)
             })
             .collect();
         for round in 0..4 {
@@ -571,7 +599,7 @@ mod tests {
         let p = flat(&dir, "big.png", 255);
         let (log, _) = recorder();
         let cache = Cache::new(100, log);
-        let img = cache.register(&p, probe(&p).unwrap(), true);
+        let img = cache.register(&p, probe(&p).unwrap(), true, FULL);
         assert_eq!(level0(&cache, &img), Some(1.0));
         // Only the level in use stays (it alone exceeds the budget).
         assert!(img.is_resident(0));
@@ -593,7 +621,7 @@ mod tests {
         let cache = Cache::new(2 * 1024 + 300, log);
         let mk = |n: &str, v| {
             let p = flat(&dir, n, v);
-            cache.register(&p, probe(&p).unwrap(), true)
+            cache.register(&p, probe(&p).unwrap(), true, FULL)
         };
         let (a, b, c) = (mk("a.png", 10), mk("b.png", 20), mk("c.png", 30));
         level0(&cache, &a);
@@ -616,7 +644,7 @@ mod tests {
         std::fs::write(&p, &bytes[..40]).unwrap();
         let (log, seen) = recorder();
         let cache = Cache::new(0, log);
-        let img = cache.register(&p, h, true);
+        let img = cache.register(&p, h, true, FULL);
         for _ in 0..3 {
             assert_eq!(level0(&cache, &img), None);
         }
@@ -640,7 +668,7 @@ mod tests {
                 let v = 40 + 50 * k;
                 let p = flat(&dir, &format!("t{k}.png"), v);
                 (
-                    cache.register(&p, probe(&p).unwrap(), false),
+                    cache.register(&p, probe(&p).unwrap(), false, FULL),
                     v as f32 / 255.0,
                 )
             })

@@ -195,13 +195,16 @@
 // Levels shared through atomic pointers.
 #[allow(unsafe_code)]
 mod cache;
-mod decode;
+// Public for the `image_texture` fuzz target (tests/fuzz): probe, plan and decode from bytes.
+pub mod decode;
 mod image;
 mod mapping;
 mod mipmap;
 mod noise;
 mod params;
 mod procedural;
+mod reduce;
+mod texels;
 mod transform;
 mod tree;
 
