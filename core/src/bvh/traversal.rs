@@ -19,6 +19,7 @@ fn first_lane(mask: u32) -> usize {
 /// loops, after the check for an empty tree, not in `Bvh::intersect` and `Bvh::any`, which are
 /// inlined into every caller (one call per primitive kind).
 #[inline(always)]
+#[allow(clippy::eq_op)] // x - x on purpose (below)
 fn finite(origin: Vec3A, dir: Vec3A) -> bool {
     // x - x is 0 for finite x and NaN for the others (fewer instructions than glam's
     // `is_finite`, which masks the sign bits and compares with infinity).
