@@ -411,7 +411,7 @@ fn convert_and_render(source: &Path, dir: &Path, res: &str) -> (String, String, 
 #[test]
 fn converted_scenes_render_the_same_images_on_the_command_line() {
     let dir = temp_dir("convert-render");
-    // A Debian example with image maps, a mirror and light spheres Luxon does not draw yet.
+    // A Debian example with image maps, a mirror and light spheres.
     let debian = Path::new("/usr/share/doc/tachyon/examples/scenes/2balls.dat");
     let tachyon = match debian.is_file() {
         true => debian.to_path_buf(),
@@ -421,26 +421,32 @@ fn converted_scenes_render_the_same_images_on_the_command_line() {
             p
         }
     };
-    let (text, err, img) = convert_and_render(&tachyon, &dir, "96x72");
+    let (_, _, img) = convert_and_render(&tachyon, &dir, "96x72");
     let (colours, black) = content(&img);
     assert!(
         colours > 200 && black < 0.5,
         "{colours} colours, {black} black"
     );
-    // What the RON scene cannot hold: on stderr and at the top of the file.
-    let light = if debian.is_file() {
-        "LIGHT with RAD > 0 lights the scene, but its sphere"
-    } else {
-        "Tachyon's default transparency"
-    };
-    assert!(err.contains(light), "{err}");
+    // What the RON scene cannot hold: on stderr and at the top of the file. A missing image
+    // map is rendered white (as Tachyon does), which the RON scene cannot say.
+    let missing = dir.join("missing-map.dat");
+    let body = TACHYON[0].replace(
+        "END_SCENE",
+        "SPHERE CENTER 3 0 0 RAD 0.5 TEXTURE AMBIENT 0.1 DIFFUSE 0.8 SPECULAR 0 OPACITY 1 \
+         COLOR 1 1 1 TEXFUNC 7 no-such-map.ppm CENTER 3 0 0 ROTATE 0 0 0 SCALE 1 1 1\nEND_SCENE",
+    );
+    assert_ne!(body, TACHYON[0]);
+    std::fs::write(&missing, body).unwrap();
+    let (text, err, _) = convert_and_render(&missing, &dir, "32x24");
+    let warning = "image map `no-such-map.ppm`";
+    assert!(err.contains(warning), "{err}");
     assert!(
         err.contains("is not carried over (listed at the top of the file)"),
         "{err}"
     );
     let header: Vec<&str> = text.lines().take_while(|l| l.starts_with("//")).collect();
     assert!(header[1].starts_with("// Not carried over"), "{header:?}");
-    assert!(header.iter().any(|l| l.contains(light)), "{header:?}");
+    assert!(header.iter().any(|l| l.contains(warning)), "{header:?}");
 
     let nff = dir.join("s.nff");
     std::fs::write(&nff, NFF).unwrap();
