@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 /// layers before its own. Keep in step with the table in core/src/lib.rs.
 const CORE: &[(&str, &[&str])] = &[
     ("math", &["math", "sampler", "error"]),
+    ("motion", &["motion"]),
     ("ray", &["ray"]),
     ("image", &["framebuffer", "ppm", "metrics", "files"]),
     ("camera", &["camera", "adaptive"]),
@@ -41,7 +42,7 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("checks", &["validate", "ron_error"]),
     (
         "conversion",
-        &["convert", "camera", "effects", "volume_render"],
+        &["convert", "camera", "effects", "volume_render", "animation"],
     ),
     ("importers", &["nff", "obj", "tachyon"]),
     ("includes", &["includes"]),

@@ -39,6 +39,7 @@
 //! | camera | [`camera`], [`adaptive`] | camera rays; where a pixel's samples go |
 //! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks; PPM bytes; image error measures; files written whole |
 //! | ray | [`ray`] | rays and robust ray spawning |
+//! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |
 //! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
 
 // Unsafe code only in the modules that allow it by name below (each block says why it is sound).
@@ -59,6 +60,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod math;
 pub mod metrics;
+pub mod motion;
 pub mod output;
 // Every call across the plugin ABI.
 #[allow(unsafe_code)]

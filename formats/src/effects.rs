@@ -21,6 +21,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => LightDesc::Point {
                 position,
                 color: f.colour(color)?,
@@ -33,6 +34,7 @@ impl Checker<'_> {
                 color,
                 intensity,
                 shadows,
+                ..
             } => LightDesc::Directional {
                 direction: f.direction("direction", direction)?,
                 color: f.colour(color)?,
@@ -48,6 +50,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => {
                 let cone =
                     self.range(f.field("angle"), "angle", angle, f64::MIN_POSITIVE, 179.0)?;
@@ -74,6 +77,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => LightDesc::Sphere {
                 center,
                 radius: self.positive(f.field("radius"), "radius", radius)?,
@@ -92,6 +96,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => {
                 let (edge1, edge2) = f.rectangle(edge1, edge2)?;
                 LightDesc::Rect {

@@ -16,7 +16,7 @@
 //! | input       | `input`                                          |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
-//! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
+//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation` |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
 //! | includes    | `includes`                                       |
 //! | formats     | `ron_scene`, `spd`                               |
@@ -24,6 +24,7 @@
 
 #![forbid(unsafe_code)]
 
+mod animation;
 mod camera;
 mod convert;
 pub mod desc;

@@ -522,6 +522,7 @@ impl Assembler {
                 outputs: Vec::new(),
                 ..RenderDesc::default()
             },
+            animation: None,
             plugin_path: Vec::new(),
             warnings: self
                 .warnings

@@ -488,6 +488,7 @@ impl Mapper {
                 transparency,
                 ..RenderDesc::default()
             },
+            animation: None,
             plugin_path: Vec::new(),
             warnings: warnings
                 .into_iter()
