@@ -35,7 +35,7 @@ const CORE: &[(&str, &[&str])] = &[
 /// The layers of formats/src, bottom to top. Keep in step with the table in formats/src/lib.rs.
 const FORMATS: &[(&str, &[&str])] = &[
     ("origin", &["origin"]),
-    ("leaves", &["error", "geometry", "spans", "raw"]),
+    ("leaves", &["error", "geometry", "spans", "raw", "pattern"]),
     ("description", &["desc"]),
     ("input", &["input"]),
     ("scanner", &["scanner"]),

@@ -11,7 +11,7 @@
 //! | layer       | modules                                          |
 //! |-------------|--------------------------------------------------|
 //! | origin      | `origin`                                         |
-//! | leaves      | `error`, `geometry`, `spans`, `raw`              |
+//! | leaves      | `error`, `geometry`, `spans`, `raw`, `pattern`   |
 //! | description | `desc`                                           |
 //! | input       | `input`                                          |
 //! | scanner     | `scanner`                                        |
@@ -37,6 +37,7 @@ mod load;
 pub mod nff;
 pub mod obj;
 mod origin;
+mod pattern;
 mod raw;
 mod ron_error;
 mod ron_scene;
@@ -53,4 +54,5 @@ pub use geometry::{InlineGeometry, InlineMesh};
 pub use includes::MAX_DEPTH as MAX_INCLUDE_DEPTH;
 pub use input::{DiskSource, LoadOptions, MemorySource, Source};
 pub use load::{load, load_with};
+pub use pattern::FramePattern;
 pub use ron_scene::{load_ron_str, load_ron_with};

@@ -30,6 +30,41 @@ pub struct GeometryBuilder<'a> {
     pub plugin: String,
     /// Degenerate triangles dropped.
     pub dropped: u64,
+    /// When set, the geometry is recorded here as the plugin gives it instead of stored in the
+    /// sets (an object that moves is stored anew for every frame, see `scene::frame`).
+    pub record: Option<&'a mut Recorded>,
+}
+
+/// A plugin's geometry exactly as it gave it (f64 world coordinates), in the order it gave it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Recorded {
+    pub spheres: Vec<[f64; 4]>,
+    pub planes: Vec<[f64; 6]>,
+    pub cones: Vec<[f64; 8]>,
+    pub discs: Vec<[f64; 8]>,
+    pub meshes: Vec<RecordedMesh>,
+}
+
+/// A mesh's arrays as [`MeshInput`] takes them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RecordedMesh {
+    pub positions: Vec<f64>,
+    pub indices: Vec<u64>,
+    pub normals: Vec<f64>,
+    pub colors: Vec<f32>,
+    pub uvs: Vec<f32>,
+}
+
+impl RecordedMesh {
+    pub fn input(&self) -> MeshInput<'_> {
+        MeshInput {
+            positions: &self.positions,
+            indices: &self.indices,
+            normals: &self.normals,
+            colors: &self.colors,
+            uvs: &self.uvs,
+        }
+    }
 }
 
 // The host side of `GeometrySink`. The plugin calls these during `create_primitive`, on its
@@ -90,9 +125,20 @@ unsafe extern "C" fn add_spheres(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "sphere", |b, i, r: [f64; 4]| {
-            b.spheres.push_world(i, r, b.world_offset, b.material)
-        })
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "sphere",
+            |b, i, r: [f64; 4]| match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.spheres.push(r);
+                    Ok(())
+                }
+                None => b.spheres.push_world(i, r, b.world_offset, b.material),
+            },
+        )
     }
 }
 
@@ -106,9 +152,20 @@ unsafe extern "C" fn add_planes(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "plane", |b, i, r: [f64; 6]| {
-            b.planes.push_world(i, r, b.world_offset, b.material)
-        })
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "plane",
+            |b, i, r: [f64; 6]| match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.planes.push(r);
+                    Ok(())
+                }
+                None => b.planes.push_world(i, r, b.world_offset, b.material),
+            },
+        )
     }
 }
 
@@ -123,7 +180,13 @@ unsafe extern "C" fn add_cones(
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
         add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
-            b.cones.push_world(i, r, b.world_offset, b.material)
+            match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.cones.push(r);
+                    Ok(())
+                }
+                None => b.cones.push_world(i, r, b.world_offset, b.material),
+            }
         })
     }
 }
@@ -139,7 +202,13 @@ unsafe extern "C" fn add_discs(
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
         add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
-            b.discs.push_world(i, r, b.world_offset, b.material)
+            match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.discs.push(r);
+                    Ok(())
+                }
+                None => b.discs.push_world(i, r, b.world_offset, b.material),
+            }
         })
     }
 }
@@ -167,6 +236,16 @@ unsafe extern "C" fn add_mesh(
                 uvs: slice(m.uvs, optional(m.uvs.is_null(), 2)),
             }
         };
+        if let Some(rec) = b.record.as_deref_mut() {
+            rec.meshes.push(RecordedMesh {
+                positions: input.positions.to_vec(),
+                indices: input.indices.to_vec(),
+                normals: input.normals.to_vec(),
+                colors: input.colors.to_vec(),
+                uvs: input.uvs.to_vec(),
+            });
+            return Ok(());
+        }
         b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
         Ok(())
     };
@@ -192,6 +271,13 @@ unsafe extern "C" fn add_custom(
         // Own it first so it is destroyed even if we reject it.
         // SAFETY: the plugin hands over `object`, which `vtable` serves (ABI contract).
         let object = unsafe { CustomObject::new(g.object, vtable, b.plugin.clone(), g.count) };
+        if b.record.is_some() {
+            return Err(
+                "custom geometry (drawn by its plugin) cannot be moved by animation keys; \
+                 Luxon moves spheres, planes, cones, discs and meshes"
+                    .into(),
+            );
+        }
         if g.count > u32::MAX as u64 {
             return Err(format!(
                 "custom geometry with {} primitives is too large",

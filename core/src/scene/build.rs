@@ -3,6 +3,7 @@
 //! geometry, then a cache's prebuilt geometry), BVHs, lights, and the effects the scene calls
 //! for. A new kind of scene content gets a stage of its own here.
 
+use super::frame::{self, Animation, Keyed};
 use super::{Ao, Features, Fog, Light, Material, Scene, Settings};
 use crate::camera::Camera;
 use crate::error::Error;
@@ -14,7 +15,7 @@ use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::{MeshInput, Triangles};
 use crate::geometry::{pack, Clips, MAX_CLIP_GROUPS, MAX_MATERIALS};
 use crate::math::{DVec3, Vec3A};
-use crate::plugin::primitive::{create_primitive, GeometryBuilder};
+use crate::plugin::primitive::{create_primitive, GeometryBuilder, Recorded};
 use crate::plugin::texture::{create_texture, TextureInstance};
 use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
@@ -107,7 +108,8 @@ impl Scene {
         );
         let r = &desc.render;
         let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
-        Ok(Scene {
+        let keyed = std::mem::take(&mut stored.keyed);
+        let mut scene = Scene {
             source: desc.source.clone(),
             camera: camera.clone(),
             primary_width: camera.footprint().0,
@@ -138,13 +140,22 @@ impl Scene {
             degenerate_triangles: stored.dropped,
             bvh_time,
             plugin_time,
-        })
+            moving: Default::default(),
+            animation: None,
+        };
+        if let Some(a) = &desc.animation {
+            // An animated scene starts at its first frame.
+            let animation = Animation::new(desc, &scene.material_names, keyed)?;
+            scene.animation = Some(Box::new(animation));
+            scene.set_frame(a.value.first)?;
+        }
+        Ok(scene)
     }
 }
 
 /// What every stage reads: the description, the plugins, where relative paths start, and the
 /// world position of render space's origin (the camera).
-struct Build<'a> {
+pub(super) struct Build<'a> {
     desc: &'a SceneDesc,
     registry: &'a Registry,
     scene_dir: PathBuf,
@@ -165,6 +176,8 @@ struct Stored {
     object_counts: Vec<(String, usize)>,
     /// Degenerate triangles dropped.
     dropped: u64,
+    /// The keyed objects' geometry, recorded to be placed at each frame.
+    keyed: Vec<Keyed>,
 }
 
 impl<'a> Build<'a> {
@@ -177,7 +190,7 @@ impl<'a> Build<'a> {
                 .parent()
                 .map(Path::to_path_buf)
                 .unwrap_or_default(),
-            world_offset: DVec3::from(desc.camera.value.position),
+            world_offset: frame::world_offset(desc),
         }
     }
 
@@ -337,6 +350,11 @@ impl<'a> Build<'a> {
             let material = material_index(material_names, &obj.value.material)?;
             stored.used[material] = true;
             let clip = self.clip_group(&obj.value.clip)?;
+            let keyed = self.desc.animation.as_ref().and_then(|a| {
+                let objects = &a.value.objects;
+                objects.iter().find(|o| o.object == i)
+            });
+            let mut recorded = Recorded::default();
             let mut b = GeometryBuilder {
                 spheres: &mut stored.spheres,
                 triangles: &mut stored.triangles,
@@ -348,6 +366,7 @@ impl<'a> Build<'a> {
                 world_offset: self.world_offset,
                 plugin: entry.name.clone(),
                 dropped: 0,
+                record: keyed.map(|_| &mut recorded),
             };
             create_primitive(
                 self.registry,
@@ -360,6 +379,14 @@ impl<'a> Build<'a> {
             )
             .map_err(|(at, m)| Error::at(&at, m))?;
             stored.dropped += b.dropped;
+            if let Some(tracks) = keyed {
+                stored.keyed.push(Keyed {
+                    tracks: tracks.clone(),
+                    geometry: recorded,
+                    material: pack(material as u32, clip),
+                    at: obj.at.clone(),
+                });
+            }
             match stored
                 .object_counts
                 .iter_mut()
@@ -434,13 +461,17 @@ impl<'a> Build<'a> {
 
     /// Stage: the lights, in render space.
     fn lights(&self) -> Vec<Light> {
-        let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - self.world_offset).as_vec3());
+        Build::lights_from(&self.desc.lights, self.world_offset)
+    }
+
+    /// `lights` in render space (also each frame's, in an animated scene).
+    pub(super) fn lights_from(lights: &[Spanned<LightDesc>], world_offset: DVec3) -> Vec<Light> {
+        let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - world_offset).as_vec3());
         let unit = |d: &[f64; 3]| Vec3A::from(DVec3::from(*d).normalize().as_vec3());
         let att = |a: &luxon_formats::Attenuation| {
             [a.constant as f32, a.linear as f32, a.quadratic as f32]
         };
-        self.desc
-            .lights
+        lights
             .iter()
             .map(|l| match &l.value {
                 LightDesc::Point {
@@ -578,6 +609,7 @@ impl Stored {
             used: vec![false; materials],
             object_counts: Vec::new(),
             dropped: 0,
+            keyed: Vec::new(),
         }
     }
 
@@ -627,7 +659,8 @@ impl Stored {
         !(self.spheres.is_empty()
             && self.triangles.is_empty()
             && self.planes.planes.is_empty()
-            && self.customs.is_empty())
+            && self.customs.is_empty()
+            && self.keyed.iter().all(|k| k.geometry == Recorded::default()))
     }
 }
 

@@ -3,13 +3,16 @@
 //! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`.
 
 mod build;
+mod frame;
 
 pub use build::Prebuilt;
+pub use frame::Animation;
 
 use crate::camera::Camera;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
+use crate::geometry::group::Group;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
@@ -266,6 +269,10 @@ pub struct Scene {
     /// Instantiating the objects through their plugins and storing all geometry natively
     /// (after reading the scene, before the BVH build).
     pub plugin_time: Duration,
+    /// Keyed objects placed at the current frame (empty in a still scene).
+    pub moving: Group,
+    /// How the scene changes from frame to frame; `None`: a still scene.
+    pub animation: Option<Box<Animation>>,
 }
 
 impl Scene {
@@ -288,10 +295,17 @@ impl Scene {
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         self.customs
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        if !self.moving.is_empty() {
+            self.moving
+                .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        }
         hit
     }
 
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        if hit.moving {
+            return self.moving.surface(hit, ray, self.features.textures);
+        }
         match hit.kind {
             Kind::Sphere => self.spheres.surface(hit, ray),
             Kind::Triangle => self.triangles.surface(hit, self.features.textures),
@@ -316,7 +330,11 @@ impl Scene {
                 || self.planes.any(ray, t_max, &self.clips, c, |_, _| true)
                 || self.cones.any(ray, t_max, &self.clips, c, |_, _| true)
                 || self.discs.any(ray, t_max, &self.clips, c, |_, _| true)
-                || self.customs.any(ray, t_max, &self.clips, c, |_, _| true);
+                || self.customs.any(ray, t_max, &self.clips, c, |_, _| true)
+                || (!self.moving.is_empty()
+                    && self
+                        .moving
+                        .any(ray, t_max, &self.clips, c, &mut |_, _| true));
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
         let mut filter = Vec3A::ONE;
@@ -341,6 +359,7 @@ impl Scene {
             || self.cones.any(ray, t_max, &self.clips, c, &mut on_hit)
             || self.discs.any(ray, t_max, &self.clips, c, &mut on_hit)
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
+            || (!self.moving.is_empty() && self.moving.any(ray, t_max, &self.clips, c, &mut on_hit))
         {
             return Vec3A::ZERO;
         }
