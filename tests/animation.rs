@@ -213,7 +213,7 @@ fn a_frame_alone_equals_the_same_frame_of_a_sequence() {
             .count();
         assert!(lit > 200, "{name} is nearly black ({lit} bright values)");
     }
-    for k in 0..3 {
+    for (k, in_sequence) in seq_files.iter().enumerate() {
         let alone = dir.join(format!("alone{k}"));
         let o = run(&[
             "render",
@@ -231,7 +231,7 @@ fn a_frame_alone_equals_the_same_frame_of_a_sequence() {
         let got = files(&alone);
         assert_eq!(got.len(), 1);
         assert_eq!(
-            got[0], seq_files[k],
+            &got[0], in_sequence,
             "frame {k} alone differs from the sequence's"
         );
     }

@@ -32,9 +32,7 @@ pub fn parse_frames(s: &str) -> Result<(u32, u32), String> {
         }
     };
     if a > b {
-        return Err(format!(
-            "the first frame is after the last; expected A..B with A <= B"
-        ));
+        return Err("the first frame is after the last; expected A..B with A <= B".into());
     }
     Ok((a, b))
 }

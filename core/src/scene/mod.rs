@@ -1,6 +1,7 @@
 //! `Scene`: a `SceneDesc` with plugins resolved and called, geometry stored natively and
 //! re-centred, BVHs built, and the set of effects the scene calls for; and the queries the
-//! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`.
+//! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`;
+//! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`.
 
 mod build;
 mod frame;
