@@ -420,3 +420,86 @@ fn readme_walkthrough_scene_renders() {
         "frame 12 is dark: {bright} bright pixels"
     );
 }
+
+/// The keyed objects' geometry (recorded at the build, placed anew at every frame, with its
+/// BVHs) is charged to the memory budget: the charges stay the same from frame to frame (each
+/// frame's group gives back the last one's), and a frame whose objects do not fit is an error
+/// that leaves the scene at the frame it was.
+#[test]
+fn keyed_objects_are_charged_to_the_memory_budget() {
+    use luxon::budget::{Budget, Use};
+    use std::sync::Arc;
+    let dir = temp_dir("anim-budget");
+    let path = write_scene(&dir, SCENE);
+    let desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let budget = Arc::new(Budget::new(1 << 30, "a test".into(), None));
+    let mut scene = Scene::build_with(&desc, &registry(&desc), budget.clone())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let held = (budget.used(Use::Geometry), budget.used(Use::Bvh));
+    // All the scene's objects are keyed: its geometry is what was recorded and frame 0's.
+    assert!(
+        scene.moving.len() >= 3 && held.0 > 0 && held.1 > 0,
+        "{held:?}"
+    );
+    for k in [1, 2, 0, 2] {
+        scene.set_frame(k).unwrap();
+        assert_eq!((budget.used(Use::Geometry), budget.used(Use::Bvh)), held);
+    }
+    let two = render(&scene);
+    // With nothing left, the next frame's objects do not fit.
+    let rest = budget.remaining();
+    budget
+        .reserve(Use::Image, rest, || "a test".into())
+        .unwrap();
+    let e = scene.set_frame(1).expect_err("over budget").to_string();
+    assert!(e.contains("frame 1") && e.contains("memory budget"), "{e}");
+    assert_eq!(scene.settings.frame, 2);
+    assert_eq!((budget.used(Use::Geometry), budget.used(Use::Bvh)), held);
+    budget.release(Use::Image, rest);
+    assert_eq!(render(&scene).rgba, two.rgba);
+    scene.set_frame(1).unwrap();
+    drop(scene);
+    // What the scene keeps for good stays charged; the frame's group is given back.
+    assert!(budget.used(Use::Geometry) < held.0 && budget.used(Use::Bvh) < held.1);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A keyed colour of a transparent material tints its shadows too (`shadows: Tinted`), and
+/// the material's copy for objects that cast no shadow takes the colour but stays shadowless.
+#[test]
+fn a_keyed_colour_tints_the_shadows_of_its_material() {
+    let dir = temp_dir("anim-tint");
+    let text = SCENE
+        .replace(
+            "\"paint\": (color: (1, 0, 0), ambient: 1, diffuse: 0)",
+            "\"paint\": (color: (1, 0, 0), ambient: 1, diffuse: 0, transmit: 0.5)",
+        )
+        .replace(
+            "material: \"matte\"),",
+            "material: \"matte\"),\n        (plugin: \"sphere\", params: (center: (1.5, -0.5, 0), radius: 0.2), material: \"paint\", shadows: false),",
+        );
+    let mut scene = build(&text, &dir);
+    let paint = scene
+        .material_names
+        .iter()
+        .position(|n| n == "paint")
+        .unwrap();
+    for (k, colour) in [
+        (0, [1.0, 0.0, 0.0]),
+        (1, [0.5, 0.0, 0.5]),
+        (2, [0.0, 0.0, 1.0]),
+    ] {
+        scene.set_frame(k).unwrap();
+        let c = luxon::math::Vec3A::from(colour);
+        let m = &scene.materials[paint];
+        assert_eq!((m.color, m.shadow), (c, Some(0.5 * c)), "frame {k}");
+        // The copies that cast no shadow follow the named materials.
+        let copies: Vec<_> = scene.materials[scene.material_names.len()..]
+            .iter()
+            .filter(|m| m.transmit == 0.5)
+            .map(|m| (m.color, m.shadow))
+            .collect();
+        assert_eq!(copies, [(c, Some(luxon::math::Vec3A::ONE))], "frame {k}");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

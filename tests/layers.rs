@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 const CORE: &[(&str, &[&str])] = &[
     ("math", &["math", "sampler", "error"]),
     ("motion", &["motion"]),
+    ("memory", &["budget"]),
     ("ray", &["ray"]),
     ("image", &["framebuffer", "ppm", "metrics", "files"]),
     ("camera", &["camera", "adaptive"]),
@@ -37,6 +38,7 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("origin", &["origin"]),
     ("leaves", &["error", "geometry", "spans", "raw", "pattern"]),
     ("description", &["desc"]),
+    ("text", &["ron_text"]),
     ("input", &["input"]),
     ("scanner", &["scanner"]),
     ("checks", &["validate", "ron_error"]),

@@ -92,17 +92,15 @@ fn wrong_abi_version_names_both_versions() {
     install(&dir, "testplug_bad_abi", "luxon_old");
     let e = build_error(&dir, r#"(plugin: "old_thing")"#);
     assert!(e.contains("no primitive plugin named `old_thing`"), "{e}");
+    // A plugin built for the previous ABI, as every plugin built before the bump to 2 is.
     assert!(
-        e.contains("libluxon_old") && e.contains("built for plugin ABI 9999"),
+        e.contains(
+            "libluxon_old.so: built for plugin ABI 1 (luxon-plugin 0.1.0), but this Luxon uses \
+             ABI 2 (luxon-plugin 0.2.0); rebuild it against luxon-plugin 0.2.0"
+        ),
         "{e}"
     );
-    assert!(
-        e.contains(&format!(
-            "this Luxon uses ABI {}",
-            luxon_plugin::ABI_VERSION
-        )),
-        "{e}"
-    );
+    assert_eq!(luxon_plugin::ABI_VERSION, 2);
 }
 
 #[test]
@@ -166,7 +164,33 @@ fn panic_in_a_texture_stops_the_render_with_an_error() {
         r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")"#,
         r#"textures: { "t": (plugin: "panic_texture") }, materials: { "m": (texture: "t") },"#,
     );
-    assert!(e.contains("plugin `panic_texture` panicked"), "{e}");
+    // The panic's message travels with the failure (plugin ABI 2), with the texture's place.
+    assert!(
+        e.ends_with(
+            "scene.ron:5:22: texture `t` (plugin `panic_texture`) panicked during the render: \
+             deliberate panic in texture eval"
+        ),
+        "{e}"
+    );
+}
+
+/// A texture whose `try_eval` fails stops the render with one error: the texture's place,
+/// name and plugin, and the plugin's own message.
+#[test]
+fn a_failing_texture_stops_the_render_with_its_message() {
+    let dir = temp_dir("fail-texture");
+    install(&dir, "testplug_panics", "luxon_panics");
+    let e = render_error(
+        &dir,
+        r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")"#,
+        r#"textures: { "t": (plugin: "fail_texture") }, materials: { "m": (texture: "t") },"#,
+    );
+    let want = format!(
+        "{}:5:22: texture `t` (plugin `fail_texture`) failed during the render: deliberate \
+         failure: no value where x < 0",
+        dir.join("scene.ron").display()
+    );
+    assert_eq!(e, want);
 }
 
 #[test]
@@ -201,10 +225,10 @@ fn plugins_command_lists_every_plugin_and_its_parameters() {
         "texture `checker`",
         "writer `png` [.png]",
         "writer `exr` [.exr]",
-        "plugin ABI 1",
+        "plugin ABI 2",
         "radius",
         "skipped",
-        "built for plugin ABI 9999",
+        "built for plugin ABI 1 (luxon-plugin 0.1.0)",
     ] {
         assert!(s.contains(want), "missing `{want}` in:\n{s}");
     }

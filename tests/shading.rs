@@ -212,7 +212,7 @@ fn panes(name: &str, mode: &str, tilt: f32, second: bool, extra: &str) -> [f32; 
 
 #[test]
 fn transparency_modes() {
-    // Filter (Tachyon): ambient·opacity·base + transmit·base·behind = (0.5, 0, 0).
+    // Filter: ambient·opacity·base + transmit·base·behind = (0.5, 0, 0).
     let f = panes("t-filter", "Filter", 0.0, false, "");
     assert!(close(f, [0.5, 0.0, 0.0]), "{f:?}");
     // Post-multiplied (VMD): opacity·shaded + transmit·behind, unfiltered.
@@ -233,4 +233,183 @@ fn transparent_surface_limit_shows_the_next_one_opaque() {
     // Limit 1: the second pane is opaque: 0.5 + 0.5·red = (1.0, 0, 0).
     let limited = panes("t-limit", "Filter", 0.0, true, ", max_surfaces: 1");
     assert!(close(limited, [1.0, 0.0, 0.0]), "{limited:?}");
+}
+
+#[test]
+fn tachyons_transparency_rules() {
+    // Additive (Tachyon's TRANS_ORIG): the pane as if opaque + transmit·behind, unfiltered.
+    let a = panes("t-additive", "Additive", 0.0, false, "");
+    assert!(close(a, [1.0, 0.0, 0.5]), "{a:?}");
+    // Raster3D head-on: opacity ¼(1 + cos(π·0.5·(−1)))² = ¼, so 0.75 of the blue comes through.
+    let r = panes("t-r3d", "Additive", 0.0, false, ", angle: Raster3D");
+    assert!(close(r, [1.0, 0.0, 0.75]), "{r:?}");
+    // Post-multiplied: the same angle rule.
+    let p = panes(
+        "t-post-r3d",
+        "PostMultiplied",
+        0.0,
+        false,
+        ", angle: Raster3D",
+    );
+    assert!(close(p, [0.25, 0.0, 0.75]), "{p:?}");
+    // Skip: past the limit the second pane is not there: red + 0.5·blue.
+    let both = panes("t-add-two", "Additive", 0.0, true, "");
+    assert!(close(both, [1.5, 0.0, 0.25]), "{both:?}");
+    let skip = panes(
+        "t-skip",
+        "Additive",
+        0.0,
+        true,
+        ", max_surfaces: 1, beyond_max: Skip",
+    );
+    assert!(close(skip, [1.0, 0.0, 0.5]), "{skip:?}");
+    let none = panes(
+        "t-skip0",
+        "Additive",
+        0.0,
+        true,
+        ", max_surfaces: 0, beyond_max: Skip",
+    );
+    assert!(close(none, [0.0, 0.0, 1.0]), "{none:?}");
+}
+
+/// `under`, with render settings.
+fn under_with(name: &str, blocker: &str, material: &str, render: &str) -> [f32; 3] {
+    let scene = format!(
+        r#"Scene(
+        camera: (position: (0, 1, 0), look_at: (0, 0, 0), up: (0, 0, 1), fov: 10),
+        lights: [Directional(direction: (0, -1, 0), intensity: 1.0)],
+        materials: {{
+            "floor": (color: (1, 1, 1), ambient: 0, diffuse: 1),
+            "blocker": {material},
+        }},
+        objects: [
+            (plugin: "plane", params: (normal: (0, 1, 0)), material: "floor"),
+            {blocker}
+        ],
+        render: ({render}),
+    )"#
+    );
+    centre(name, &scene)
+}
+
+#[test]
+fn shadows_through_transparency_grey_or_none() {
+    let tinted = under_with("s-tinted", PANE, TINTED, "transparency: (shadows: Tinted)");
+    assert!(close(tinted, [0.8, 0.4, 0.2]), "{tinted:?}");
+    let grey = under_with("s-grey", BALL, TINTED, "transparency: (shadows: Untinted)");
+    assert!(close(grey, [0.64; 3]), "{grey:?}");
+    let off = under_with("s-off", BALL, TINTED, "transparency: (shadows: Off)");
+    assert!(close(off, [1.0; 3]), "{off:?}");
+    // Off spares only transparent surfaces.
+    let opaque = under_with(
+        "s-off-opaque",
+        BALL,
+        "(color: (1, 1, 1))",
+        "transparency: (shadows: Off)",
+    );
+    assert!(close(opaque, [0.0; 3]), "{opaque:?}");
+}
+
+#[test]
+fn objects_without_shadows() {
+    let ball = BALL.replace(
+        "material: \"blocker\")",
+        "material: \"blocker\", shadows: false)",
+    );
+    let c = under("no-shadow", &ball, "(color: (1, 1, 1))");
+    assert!(close(c, [1.0; 3]), "{c:?}");
+}
+
+#[test]
+fn light_scale_scales_diffuse_and_highlights_not_ambient() {
+    let scene = HEAD_ON
+        .replace("SPEC", "0.5")
+        .replace("objects:", "render: (light_scale: 0.5),\n    objects:");
+    // 0.1·c + 0.5·(0.6·c + 0.5).
+    let c = centre("light-scale", &scene);
+    assert!(close(c, [0.65, 0.45, 0.35]), "{c:?}");
+}
+
+#[test]
+fn surface_coloured_highlights() {
+    let scene = HEAD_ON
+        .replace("SPEC", "0.5")
+        .replace("shininess: 10", "shininess: 10, highlight_color: Surface");
+    // (0.1 + 0.6 + 0.5)·c.
+    let c = centre("metal", &scene);
+    assert!(close(c, [1.2, 0.6, 0.3]), "{c:?}");
+}
+
+#[test]
+fn blinn_fast_highlight() {
+    // Light from above-behind at 45°: N·L = cos 45°, x = N·H = cos 22.5°.
+    let scene = HEAD_ON
+        .replace("SPEC", "0.5")
+        .replace("shininess: 10", "shininess: 10, highlight: BlinnFast")
+        .replace("direction: (0, 0, 1)", "direction: (0, -1, 1)");
+    let (nl, x) = (45f32.to_radians().cos(), 22.5f32.to_radians().cos());
+    let h = 0.5 * x / (10.0 - 10.0 * x + x);
+    let want = [1.0f32, 0.5, 0.25].map(|k| k * (0.1 + 0.6 * nl) + h);
+    let c = centre("blinn-fast", &scene);
+    assert!(close(c, want), "{c:?} {want:?}");
+}
+
+#[test]
+fn fog_start_and_misses() {
+    // The sphere's front is 4 from the eye; exponential fog starting there leaves it clear.
+    let lit = centre("fog-none", &HEAD_ON.replace("SPEC", "0.0"));
+    let fog = |mode: &str, extra: &str| {
+        let scene = HEAD_ON.replace("SPEC", "0.0").replace(
+            "objects:",
+            &format!("fog: (mode: {mode}, color: (0, 1, 0){extra}),\n    objects:"),
+        );
+        centre("fog", &scene)
+    };
+    assert!(close(fog("Exp(density: 0.5, start: 4)", ""), lit));
+    let v = (-0.5f32 * 2.0).exp();
+    let want = [0, 1, 2].map(|k| lit[k] * v + [0.0, 1.0, 0.0][k] * (1.0 - v));
+    let c = fog("Exp(density: 0.5, start: 2)", "");
+    assert!(close(c, want), "{c:?} {want:?}");
+    // A miss shows the fog colour with `misses`, the background without.
+    let miss = |extra: &str| {
+        let scene = HEAD_ON
+            .replace("SPEC", "0.0")
+            .replace("center: (0, 0, 5)", "center: (0, 5, 5)")
+            .replace(
+                "objects:",
+                &format!("fog: (mode: Linear(start: 0, end: 10), color: (1, 0, 0){extra}),\n    objects:"),
+            );
+        centre("fog-miss", &scene)
+    };
+    assert!(close(miss(""), [0.2, 0.3, 0.4]));
+    assert!(close(miss(", misses: true"), [1.0, 0.0, 0.0]));
+}
+
+#[test]
+fn fog_on_every_ray_fogs_reflections_twice() {
+    // A mirror 2 ahead sees a red emitter 4 behind it; linear fog over 10.
+    let scene = |every: bool| {
+        format!(
+            r#"Scene(
+            camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 30),
+            background: (0, 0, 0),
+            fog: (mode: Linear(start: 0, end: 10), color: (0, 0, 1), every_ray: {every}),
+            materials: {{
+                "mirror": (color: (0, 0, 0), ambient: 0, diffuse: 0, reflect: 1),
+                "red": (color: (1, 0, 0), ambient: 1, diffuse: 0),
+            }},
+            objects: [
+                (plugin: "plane", params: (point: (0, 0, 2), normal: (0, 0, -1)), material: "mirror"),
+                (plugin: "plane", params: (point: (0, 0, -2), normal: (0, 0, 1)), material: "red"),
+            ],
+        )"#
+        )
+    };
+    // Every ray: 0.8·(0.6·red + 0.4·blue) + 0.2·blue.
+    let c = centre("fog-every", &scene(true));
+    assert!(close(c, [0.48, 0.0, 0.52]), "{c:?}");
+    // Camera rays only, on the mirror's own (black) shading: the reflection is unfogged.
+    let c = centre("fog-camera", &scene(false));
+    assert!(close(c, [1.0, 0.0, 0.2]), "{c:?}");
 }

@@ -187,3 +187,588 @@ fn flat_scenes_match_tachyon_pixel_for_pixel() {
         }
     }
 }
+
+/// A 2×2 Tachyon scene as `/work/notes/tachyon-measure/m_shade.py` writes them: the eye at the
+/// origin looking along +z, so pixel (row 1, column 0) samples the view axis exactly.
+fn probe(depth: u32, bg: [f64; 3], body: &str) -> String {
+    format!(
+        "BEGIN_SCENE\nRESOLUTION 2 2\nCAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH {depth}\n\
+         CENTER 0 0 0 VIEWDIR 0 0 1 UPDIR 0 1 0 END_CAMERA\nBACKGROUND {} {} {}\n{body}END_SCENE\n",
+        bg[0], bg[1], bg[2]
+    )
+}
+
+/// A texture body: colour, AMBIENT, DIFFUSE, SPECULAR, OPACITY, and `extra` words before COLOR.
+fn tex(c: [f64; 3], amb: f64, dif: f64, spec: f64, opacity: f64, extra: &str) -> String {
+    format!(
+        "TEXTURE AMBIENT {amb} DIFFUSE {dif} SPECULAR {spec} OPACITY {opacity} {extra} \
+         COLOR {} {} {} TEXFUNC 0",
+        c[0], c[1], c[2]
+    )
+}
+
+/// A plane facing the eye at distance `z`.
+fn wall(z: f64, t: &str) -> String {
+    format!("PLANE CENTER 0 0 {z} NORMAL 0 0 -1 {t}\n")
+}
+
+/// Scenes that each show one rule of Tachyon's shading, with the pixels Tachyon 0.99b6 draws
+/// (measured with `tachyon-nox`, `/work/notes/tachyon-mapping.md` §5): (name, scene,
+/// [((row, column), colour)]).
+type Probe = (&'static str, String, Vec<((usize, usize), [u8; 3])>);
+
+fn shading_probes() -> Vec<Probe> {
+    let black = [0.0; 3];
+    let at = |c: [u8; 3]| vec![((1, 0), c)];
+    let white = tex([1.0; 3], 0.0, 1.0, 0.0, 1.0, "");
+    let phong = |kind: &str, c: [f64; 3], p: f64| {
+        tex(
+            c,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            &format!("PHONG {kind} {p} PHONG_SIZE 10"),
+        )
+    };
+    let mirror = tex([1.0; 3], 0.1, 0.0, 0.5, 1.0, "");
+    let red = tex([1.0, 0.0, 0.0], 1.0, 0.0, 0.0, 1.0, "");
+    // A blue emitter (ambient 0.5) of opacity o at z = 2 over a red emitter at z = 4.
+    let glass = |o: f64, extra: &str| wall(2.0, &tex([0.0, 0.0, 1.0], 0.5, 0.0, 0.0, o, extra));
+    let over_red = wall(4.0, &red);
+    let mode = |words: &str| format!("SHADER_MODE FULL {words} END_SHADER_MODE\n");
+    // A light behind the eye and a small sphere of opacity o between it and the wall.
+    let light = "LIGHT CENTER 0 0 -2 RAD 0 COLOR 1 1 1\n";
+    let blocker = |z: f64, o: f64, c: [f64; 3]| {
+        format!(
+            "SPHERE CENTER 0 0 {z} RAD 0.1 {}\n",
+            tex(c, 1.0, 0.0, 0.0, o, "")
+        )
+    };
+    let green = [0.0, 1.0, 0.0];
+    let spot = |deg: f64| {
+        let a = deg.to_radians();
+        format!(
+            "SPOTLIGHT CENTER 0 0 -2 RAD 0 DIRECTION {} 0 {} FALLOFF_START 20 FALLOFF_END 45 \
+             COLOR 1 1 1\n{}",
+            a.sin(),
+            a.cos(),
+            wall(2.0, &white)
+        )
+    };
+    // A wall tilted `deg` from the view, lit along its normal, with an outline.
+    let outlined = |deg: f64, o: f64, w: f64| {
+        let t = deg.to_radians();
+        let n = [0.0, t.sin(), -t.cos()];
+        format!(
+            "DIRECTIONAL_LIGHT DIRECTION {} {} {} COLOR 1 1 1\nPLANE CENTER 0 0 2 NORMAL {} {} {} {}\n",
+            -n[0],
+            -n[1],
+            -n[2],
+            n[0],
+            n[1],
+            n[2],
+            tex(
+                [1.0; 3],
+                0.1,
+                0.8,
+                0.0,
+                1.0,
+                &format!("OUTLINE {o} OUTLINE_WIDTH {w}")
+            )
+        )
+    };
+    let fog = |words: &str| format!("FOG {words} COLOR 0 0 1\n{}", wall(2.0, &red));
+    let layers: String = [1.5, 2.0, 2.5]
+        .iter()
+        .map(|&z| wall(z, &tex([0.0, 0.0, 1.0], 0.5, 0.0, 0.0, 0.5, "")))
+        .collect();
+    let tilted = {
+        let t = 60f64.to_radians();
+        format!(
+            "PLANE CENTER 0 0 2 NORMAL 0 {} {} {}\n",
+            t.sin(),
+            -t.cos(),
+            tex([0.0, 0.0, 1.0], 0.5, 0.0, 0.0, 0.5, "")
+        )
+    };
+    vec![
+        (
+            "ambient without light colour, diffuse with it",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 3 -1 RAD 0 COLOR 0.5 1 1\n{}",
+                    wall(2.0, &tex([1.0, 0.5, 0.25], 0.2, 0.6, 0.0, 1.0, ""))
+                ),
+            ),
+            at([105, 79, 39]),
+        ),
+        (
+            "mirror",
+            probe(6, [0.2, 0.4, 0.6], &wall(2.0, &mirror)),
+            at([51, 76, 102]),
+        ),
+        (
+            "the depth limit adds the background unscaled",
+            probe(1, [0.2, 0.4, 0.6], &wall(2.0, &mirror)),
+            at([76, 127, 178]),
+        ),
+        (
+            "PHONG PLASTIC: the light's colour",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 -1 RAD 0 COLOR 0.4 0.8 1\n{}",
+                    wall(2.0, &phong("PLASTIC", [1.0, 0.5, 0.25], 0.5))
+                ),
+            ),
+            at([51, 102, 127]),
+        ),
+        (
+            "PHONG METAL: the surface's colour",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 -1 RAD 0 COLOR 0.4 0.8 1\n{}",
+                    wall(2.0, &phong("METAL", [1.0, 0.5, 0.25], 0.5))
+                ),
+            ),
+            at([127, 63, 31]),
+        ),
+        (
+            "highlights are not attenuated",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 0 RAD 0 ATTENUATION CONSTANT 0 LINEAR 0 QUADRATIC 1 \
+                     COLOR 1 1 1\n{}",
+                    wall(2.0, &phong("PLASTIC", [1.0; 3], 1.0))
+                ),
+            ),
+            at([255, 255, 255]),
+        ),
+        (
+            "a light term above 1/510 counts",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 0 RAD 0 ATTENUATION CONSTANT 500 LINEAR 0 QUADRATIC 0 \
+                     COLOR 1 1 1\n{}",
+                    wall(2.0, &phong("PLASTIC", [1.0; 3], 1.0))
+                ),
+            ),
+            at([255, 255, 255]),
+        ),
+        (
+            "a light term below 1/510 does not",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 0 RAD 0 ATTENUATION CONSTANT 520 LINEAR 0 QUADRATIC 0 \
+                     COLOR 1 1 1\n{}",
+                    wall(2.0, &phong("PLASTIC", [1.0; 3], 1.0))
+                ),
+            ),
+            at([0, 0, 0]),
+        ),
+        (
+            "highlights pass transparent blockers whole",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{light}{}{}",
+                    blocker(-1.5, 0.5, green),
+                    wall(2.0, &phong("PLASTIC", [1.0; 3], 1.0))
+                ),
+            ),
+            at([255, 255, 255]),
+        ),
+        (
+            "TRANS_ORIG",
+            probe(6, black, &format!("{}{over_red}", glass(0.5, ""))),
+            at([127, 0, 127]),
+        ),
+        (
+            "TRANS_VMD",
+            probe(
+                6,
+                black,
+                &format!("{}{}{over_red}", mode("TRANS_VMD"), glass(0.75, "")),
+            ),
+            at([63, 0, 95]),
+        ),
+        (
+            "TRANS_RASTER3D",
+            probe(
+                6,
+                black,
+                &format!("{}{}{over_red}", mode("TRANS_RASTER3D"), glass(0.5, "")),
+            ),
+            at([191, 0, 127]),
+        ),
+        (
+            "TRANS_VMD with TRANS_RASTER3D",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}{}{over_red}",
+                    mode("TRANS_VMD TRANS_RASTER3D"),
+                    glass(0.5, "")
+                ),
+            ),
+            at([191, 0, 31]),
+        ),
+        (
+            "TRANSMODE R3D",
+            probe(
+                6,
+                black,
+                &format!("{}{over_red}", glass(0.5, "TRANSMODE R3D")),
+            ),
+            at([191, 0, 127]),
+        ),
+        (
+            "TRANS_RASTER3D seen at 60°",
+            probe(
+                6,
+                black,
+                &format!("{}{tilted}{over_red}", mode("TRANS_RASTER3D")),
+            ),
+            at([69, 0, 127]),
+        ),
+        (
+            "transparency costs a level of ray depth",
+            probe(1, black, &format!("{}{over_red}", glass(0.5, ""))),
+            at([0, 0, 127]),
+        ),
+        (
+            "three transparent layers",
+            probe(6, black, &format!("{layers}{over_red}")),
+            at([31, 0, 223]),
+        ),
+        (
+            "TRANS_MAX_SURFACES 2",
+            probe(
+                6,
+                black,
+                &format!("{}{layers}{over_red}", mode("TRANS_MAX_SURFACES 2")),
+            ),
+            at([63, 0, 191]),
+        ),
+        (
+            "TRANS_MAX_SURFACES 0",
+            probe(
+                6,
+                black,
+                &format!("{}{layers}{over_red}", mode("TRANS_MAX_SURFACES 0")),
+            ),
+            at([255, 0, 0]),
+        ),
+        (
+            "an opaque blocker",
+            probe(
+                6,
+                black,
+                &format!("{light}{}{}", blocker(-1.5, 1.0, green), wall(2.0, &white)),
+            ),
+            at([0, 0, 0]),
+        ),
+        (
+            "shadows through a transparent sphere: (1 − o) per crossing, grey",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{light}{}{}",
+                    blocker(-1.5, 0.5, [1.0, 0.0, 0.0]),
+                    wall(2.0, &white)
+                ),
+            ),
+            at([63, 63, 63]),
+        ),
+        (
+            "two transparent spheres",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{light}{}{}{}",
+                    blocker(-1.5, 0.5, green),
+                    blocker(-1.0, 0.5, green),
+                    wall(2.0, &white)
+                ),
+            ),
+            at([15, 15, 15]),
+        ),
+        (
+            "SHADOW_FILTER_OFF",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}{light}{}{}",
+                    mode("SHADOW_FILTER_OFF"),
+                    blocker(-1.5, 0.25, green),
+                    wall(2.0, &white)
+                ),
+            ),
+            at([255, 255, 255]),
+        ),
+        (
+            "a light's sphere is drawn in its colour",
+            probe(6, black, "LIGHT CENTER 0 0 3 RAD 0.5 COLOR 0.3 0.6 0.9\n"),
+            at([76, 153, 229]),
+        ),
+        (
+            "a light's sphere is not fogged",
+            probe(
+                6,
+                black,
+                "FOG EXP START 0 END 10 DENSITY 0.5 COLOR 0 0 1\n\
+                 LIGHT CENTER 0 0 3 RAD 0.5 COLOR 0.3 0.6 0.9\n",
+            ),
+            at([76, 153, 229]),
+        ),
+        (
+            "a light's sphere behind a transparent pane",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}LIGHT CENTER 0 0 4 RAD 0.5 COLOR 0.3 0.6 0.9\n",
+                    glass(0.5, "")
+                ),
+            ),
+            at([38, 76, 242]),
+        ),
+        (
+            "PHONG METAL under a black light",
+            probe(
+                6,
+                black,
+                &format!(
+                    "LIGHT CENTER 0 0 -1 RAD 0 COLOR 0 0 0\n{}",
+                    wall(2.0, &phong("METAL", [1.0, 0.5, 0.25], 0.5))
+                ),
+            ),
+            at([127, 63, 31]),
+        ),
+        (
+            "TRANS_VMD scales the mirror reflection too",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}{}{over_red}",
+                    mode("TRANS_VMD"),
+                    wall(2.0, &tex([0.0, 0.0, 1.0], 0.2, 0.0, 0.5, 0.5, ""))
+                ),
+            ),
+            at([127, 63, 25]),
+        ),
+        (
+            "TRANS_ORIG keeps the mirror reflection",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}{over_red}",
+                    wall(2.0, &tex([0.0, 0.0, 1.0], 0.2, 0.0, 0.5, 0.5, ""))
+                ),
+            ),
+            at([127, 127, 51]),
+        ),
+        (
+            "surfaces past TRANS_MAX_SURFACES cost a level of ray depth",
+            probe(
+                2,
+                [0.0, 1.0, 0.0],
+                &format!("{}{layers}{over_red}", mode("TRANS_MAX_SURFACES 1")),
+            ),
+            at([0, 127, 127]),
+        ),
+        (
+            "fog past skipped surfaces: only the last segment",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{layers}{over_red}",
+                    mode("TRANS_MAX_SURFACES 0")
+                ),
+            ),
+            at([216, 0, 38]),
+        ),
+        (
+            "a mirror seeing nothing under radial fog",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{}",
+                    wall(2.0, &tex([0.0; 3], 0.0, 0.0, 1.0, 1.0, ""))
+                ),
+            ),
+            at([0, 0, 255]),
+        ),
+        (
+            "a mirror seeing nothing under FOG_VMD",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{}",
+                    mode("FOG_VMD"),
+                    wall(2.0, &tex([0.0; 3], 0.0, 0.0, 1.0, 1.0, ""))
+                ),
+            ),
+            at([0, 204, 51]),
+        ),
+        (
+            "a light's sphere casts no shadow",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{light}LIGHT CENTER 0 0 -1 RAD 0.3 COLOR 0 0 0\n{}",
+                    wall(2.0, &white)
+                ),
+            ),
+            at([255, 255, 255]),
+        ),
+        (
+            "SPOTLIGHT 25° off axis",
+            probe(6, black, &spot(25.0)),
+            at([204, 204, 204]),
+        ),
+        (
+            "SPOTLIGHT 35° off axis",
+            probe(6, black, &spot(35.0)),
+            at([101, 101, 101]),
+        ),
+        (
+            "SPOTLIGHT 44° off axis",
+            probe(6, black, &spot(44.0)),
+            at([10, 10, 10]),
+        ),
+        (
+            "OUTLINE at 80°",
+            probe(6, black, &outlined(80.0, 1.0, 0.5)),
+            at([104, 104, 104]),
+        ),
+        (
+            "OUTLINE 0.5 at 80°",
+            probe(6, black, &outlined(80.0, 0.5, 0.5)),
+            at([167, 167, 167]),
+        ),
+        (
+            "OUTLINE_WIDTH 0.9 at 60°",
+            probe(6, black, &outlined(60.0, 1.0, 0.9)),
+            at([148, 148, 148]),
+        ),
+        (
+            "FOG LINEAR, radial",
+            probe(6, black, &fog("LINEAR START 0 END 4 DENSITY 1")),
+            vec![((1, 0), [127, 0, 127]), ((0, 0), [112, 0, 142])],
+        ),
+        (
+            "FOG LINEAR, FOG_VMD",
+            probe(
+                6,
+                black,
+                &format!(
+                    "{}{}",
+                    mode("FOG_VMD"),
+                    fog("LINEAR START 0 END 4 DENSITY 1")
+                ),
+            ),
+            vec![((1, 0), [127, 0, 127]), ((0, 0), [127, 0, 127])],
+        ),
+        (
+            "FOG EXP with START",
+            probe(6, black, &fog("EXP START 1 END 10 DENSITY 0.3")),
+            vec![((1, 0), [188, 0, 66]), ((0, 0), [175, 0, 79])],
+        ),
+        (
+            "FOG EXP2 with START",
+            probe(6, black, &fog("EXP2 START 1 END 10 DENSITY 0.4")),
+            vec![((1, 0), [217, 0, 37]), ((0, 0), [199, 0, 55])],
+        ),
+        (
+            "radial fog turns the background into the fog colour",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                "FOG LINEAR START 0 END 4 DENSITY 1 COLOR 0 0 1\n",
+            ),
+            at([0, 0, 255]),
+        ),
+        (
+            "FOG_VMD leaves the background",
+            probe(
+                6,
+                [0.0, 1.0, 0.0],
+                &format!(
+                    "{}FOG LINEAR START 0 END 4 DENSITY 1 COLOR 0 0 1\n",
+                    mode("FOG_VMD")
+                ),
+            ),
+            at([0, 255, 0]),
+        ),
+        (
+            "fog on every segment: a mirror seeing a red wall",
+            probe(
+                6,
+                black,
+                &format!(
+                    "FOG LINEAR START 0 END 10 DENSITY 1 COLOR 0 0 1\n{}\
+                     PLANE CENTER 0 0 -2 NORMAL 0 0 1 {red}\n",
+                    wall(2.0, &tex([0.0; 3], 0.0, 0.0, 1.0, 1.0, ""))
+                ),
+            ),
+            at([122, 0, 132]),
+        ),
+    ]
+}
+
+/// The pixel at (row, column) of an RGB image `w` wide.
+fn pixel(px: &[u8], w: u32, (r, c): (usize, usize)) -> [u8; 3] {
+    let i = 3 * (r * w as usize + c);
+    [px[i], px[i + 1], px[i + 2]]
+}
+
+#[test]
+fn shading_rules_give_tachyons_pixels() {
+    let dir = temp_dir("tachyon-shading");
+    let tachyon = tachyon_present();
+    let mut wrong = Vec::new();
+    for (name, text, expected) in shading_probes() {
+        let (w, _, ours) = luxon_pixels(&dir, &text);
+        // Tachyon's own picture, when it is installed: the table is what it draws.
+        let theirs = if tachyon {
+            tachyon_pixels(&dir, &text).map(|(tw, _, px)| (tw, px))
+        } else {
+            None
+        };
+        for &(at, want) in &expected {
+            if let Some((tw, px)) = &theirs {
+                assert_eq!(pixel(px, *tw, at), want, "{name}: Tachyon draws otherwise");
+            }
+            // Floor of f32 against Tachyon's double arithmetic: one code either way.
+            let got = pixel(&ours, w, at);
+            if (0..3).any(|k| got[k].abs_diff(want[k]) > 1) {
+                wrong.push(format!("{name} at {at:?}: {got:?}, Tachyon {want:?}"));
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}

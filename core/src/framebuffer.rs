@@ -1,6 +1,9 @@
 //! The image being rendered: linear RGBA f32, rows top to bottom; and the pieces it arrives in
 //! from the render threads (spans of pixels, and chunks: spans with their values).
 
+use crate::budget::{Budget, BudgetError, Charge, Use};
+use std::sync::Arc;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Framebuffer {
     pub width: u32,
@@ -15,6 +18,26 @@ impl Framebuffer {
             height,
             rgba: vec![0.0; width as usize * height as usize * 4],
         }
+    }
+
+    /// A black image whose pixels are charged to `budget` while the returned guard lives: an
+    /// image over the budget, or one the system cannot hold, is an error naming its size.
+    pub fn charged(
+        width: u32,
+        height: u32,
+        budget: &Arc<Budget>,
+    ) -> Result<(Framebuffer, Charge), BudgetError> {
+        let n = width as usize * height as usize * 4;
+        let what = || format!("the image ({width}x{height}, 4 f32 channels)");
+        let (rgba, charge) = budget.alloc_vec(Use::Image, n, 0.0f32, what)?;
+        Ok((
+            Framebuffer {
+                width,
+                height,
+                rgba,
+            },
+            charge,
+        ))
     }
 
     pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {

@@ -12,9 +12,12 @@ use crate::geometry::{Counters, Hit, Surface};
 use crate::math::{gamma, reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
 use crate::sampler::{mix, pixel_sample};
-use crate::scene::{Ao, Light, Material, Scene};
-use luxon_formats::TransparencyMode;
+use crate::scene::{AngleRule, Ao, Light, Material, Scene};
+use luxon_formats::{BeyondMax, Highlight, TransparencyMode};
 use luxon_plugin::abi::TexQuery;
+
+/// Tachyon's threshold on light terms and coefficients (`TachyonDesc::light_threshold`).
+const TACHYON_FLOOR: f32 = 1.0 / 510.0;
 
 /// Media the ray is inside, innermost last: (material, index of refraction); and how many
 /// transparent surfaces the path has passed through.
@@ -72,6 +75,27 @@ pub struct Whitted<'a> {
     /// Some light or occlusion draws random numbers (more than one sample; `square` ignores
     /// the seed for one): only then is a shading point's seed worth hashing.
     draws: bool,
+    /// What rays that hit nothing show: camera rays, other rays.
+    miss: [Vec3A; 2],
+    /// Mirror and transmission coefficients at or below this are ignored.
+    floor: f32,
+    /// What a light's term is scaled by before Tachyon's threshold: the light scale, times
+    /// occlusion's `direct` when occlusion is on.
+    term_scale: f32,
+    compose: Compose,
+}
+
+/// How a transparent surface's shading and what lies behind it combine (from the mode).
+#[derive(Clone, Copy)]
+struct Compose {
+    /// Ambient and diffuse are scaled by opacity (`Filter`, `AngleModulated`).
+    scale_shading: bool,
+    /// The whole shaded colour is scaled by opacity (`PostMultiplied`)...
+    post: bool,
+    /// ...the mirror reflection too.
+    post_reflection: bool,
+    /// Light from behind is tinted by the surface colour (`Filter`, `AngleModulated`).
+    tint: bool,
 }
 
 impl<'a> Whitted<'a> {
@@ -83,7 +107,39 @@ impl<'a> Whitted<'a> {
         let draws = scene.features.ambient_occlusion
             && scene.ao.as_ref().is_some_and(|a| a.samples > 1)
             || scene.lights.iter().any(sampled);
-        Whitted { scene, draws }
+        let bg = scene.background;
+        let miss = match &scene.fog {
+            Some(f) if f.misses => [f.color, if f.every_ray { f.color } else { bg }],
+            _ => [bg, bg],
+        };
+        let settings = &scene.settings;
+        let t = settings.transparency;
+        let filtered = matches!(
+            t.mode,
+            TransparencyMode::Filter | TransparencyMode::AngleModulated
+        );
+        let post = t.mode == TransparencyMode::PostMultiplied;
+        let mut term_scale = settings.light_scale;
+        if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
+            term_scale *= ao.direct;
+        }
+        Whitted {
+            scene,
+            draws,
+            miss,
+            floor: if settings.tachyon.light_threshold {
+                TACHYON_FLOOR
+            } else {
+                0.0
+            },
+            term_scale,
+            compose: Compose {
+                scale_shading: filtered,
+                post,
+                post_reflection: post && t.scale_reflection,
+                tint: filtered,
+            },
+        }
     }
 }
 
@@ -106,11 +162,11 @@ impl Whitted<'_> {
         self.trace(ray, depth, weight, media, width, c)
     }
 
-    /// Texture `t` at a surface point; a panicking plugin raises the scene's fault.
+    /// Texture `t` at a surface point; a texture that fails or panics raises the scene's fault.
     fn texture(&self, t: u32, q: &TexQuery) -> [f32; 4] {
         let tex = &self.scene.textures[t as usize];
-        tex.eval(q).unwrap_or_else(|status| {
-            self.scene.customs.fault.raise(tex.failure(status));
+        tex.eval(q).unwrap_or_else(|f| {
+            self.scene.customs.fault.raise(tex.failure(&f));
             [0.0; 4]
         })
     }
@@ -129,10 +185,11 @@ impl Whitted<'_> {
     ) -> Vec3A {
         let scene = self.scene;
         let hit = scene.intersect(ray, f32::INFINITY, c);
+        let miss = self.miss[(depth > 0) as usize];
         if !scene.features.volumes {
             return match hit {
                 Some(hit) => self.shade(ray, &hit, depth, weight, media, width, c),
-                None => scene.background,
+                None => miss,
             };
         }
         // Volumes in front of the first surface (or the background), composited over it.
@@ -145,7 +202,7 @@ impl Whitted<'_> {
         }
         let behind = match hit {
             Some(hit) => self.shade(ray, &hit, depth, weight * through, media, width, c),
-            None => scene.background,
+            None => miss,
         };
         color + through * behind
     }
@@ -171,25 +228,41 @@ impl Whitted<'_> {
         let footprint = width + scene.pixel_spread * hit.t;
         let side = Side::of(&s, ray);
         let (base, kr, kt) = self.material_at(&s, mat, side.n, footprint, ray.time);
-        let transparency = scene.settings.transparency;
-        let kt = self.transparency(kt, ray, side.n, media);
-        let post = transparency.mode == TransparencyMode::PostMultiplied;
+        let mut kt = kt;
+        if kt > 0.0 {
+            let t = scene.settings.transparency;
+            if t.max_surfaces.is_some_and(|n| media.surfaces >= n) {
+                if t.beyond_max == BeyondMax::Skip {
+                    // Not shown at all: the ray goes on as if the surface were not there.
+                    return self.pass_through(ray, &s, &side, depth, weight, media, footprint, c);
+                }
+                kt = 0.0;
+            } else {
+                kt = angle_rule(mat.angle, kt, ray, side.n);
+            }
+        }
+        let compose = self.compose;
 
         let opacity = 1.0 - kt;
-        // Post-multiplied: shade as if opaque, then scale everything by the opacity.
-        let shade_opacity = if post { 1.0 } else { opacity };
+        // Post-multiplied and additive: shade as if opaque (then scale by the opacity).
+        let shade_opacity = if compose.scale_shading { opacity } else { 1.0 };
         let mut color = mat.ambient * shade_opacity * base;
         color += self.lighting(ray, &s, &side, mat, base, shade_opacity, c);
-        if post {
+        if compose.post {
             color *= opacity;
         }
-        let filter = if post { Vec3A::ONE } else { base };
+        let filter = if compose.tint { base } else { Vec3A::ONE };
         if depth == 0 {
-            self.fog(&mut color, ray, hit.t);
+            self.fog(&mut color, ray, hit.t, mat);
         }
 
         let next = depth + 1;
-        if features.reflection && kr > 0.0 {
+        if features.reflection && kr > self.floor {
+            let kr = if compose.post_reflection {
+                kr * opacity
+            } else {
+                kr
+            };
             let bounce = Bounce {
                 depth: next,
                 weight: weight * kr,
@@ -197,7 +270,7 @@ impl Whitted<'_> {
             };
             self.reflection(&mut color, ray, &s, &side, kr, &bounce, media, c);
         }
-        if features.transmission && kt > 0.0 {
+        if features.transmission && kt > self.floor {
             let bounce = Bounce {
                 depth: next,
                 weight: weight * kt,
@@ -206,7 +279,33 @@ impl Whitted<'_> {
             let filter = kt * filter;
             self.transmission(&mut color, ray, &s, &side, mat, filter, &bounce, media, c);
         }
+        if features.fog_every_ray {
+            self.fog_segment(&mut color, ray, hit.t, depth, mat);
+        }
         color
+    }
+
+    /// What lies behind a surface a ray skips (a transparent surface past the most a path may
+    /// show): the ray goes on, one level deeper; past the depth limit, the background.
+    #[allow(clippy::too_many_arguments)]
+    fn pass_through(
+        &self,
+        ray: &Ray,
+        s: &Surface,
+        side: &Side,
+        depth: u32,
+        weight: f32,
+        media: &IorStack,
+        footprint: f32,
+        c: &mut Counters,
+    ) -> Vec3A {
+        let next = depth + 1;
+        if next > self.scene.settings.max_depth {
+            return self.scene.background;
+        }
+        c.refraction += 1;
+        let r = spawn(s.p, s.p_error, side.ng, ray.dir, ray.time);
+        self.trace(&r, next, weight, media, footprint, c)
     }
 
     /// The material's colour and reflect and transmit coefficients at a surface point, with
@@ -250,27 +349,6 @@ impl Whitted<'_> {
         (base, kr, kt)
     }
 
-    /// The transmit coefficient after the scene's transparency rules: none past the most
-    /// transparent surfaces a path may cross, thicker at grazing angles when angle-modulated.
-    #[inline]
-    fn transparency(&self, kt: f32, ray: &Ray, n: Vec3A, media: &IorStack) -> f32 {
-        let transparency = self.scene.settings.transparency;
-        let mut kt = kt;
-        if kt > 0.0 {
-            if transparency
-                .max_surfaces
-                .is_some_and(|n| media.surfaces >= n)
-            {
-                kt = 0.0;
-            } else if transparency.mode == TransparencyMode::AngleModulated {
-                // A slab seen at angle θ is 1/|cos θ| thick: edge-on surfaces look opaque.
-                let cos = ray.dir.dot(n).abs().max(1e-3);
-                kt = kt.powf(1.0 / cos);
-            }
-        }
-        kt
-    }
-
     /// The light sources' and the sky's (ambient occlusion) light a surface point reflects.
     #[allow(clippy::too_many_arguments)]
     #[inline]
@@ -295,6 +373,12 @@ impl Whitted<'_> {
         } else {
             (s.p, s.p_error)
         };
+        // The outline darkens the diffuse light (lights and sky) toward the silhouette.
+        let opacity = if scene.features.outline && mat.outline > 0.0 {
+            opacity * mat.outline_factor(ray.dir.dot(side.n))
+        } else {
+            opacity
+        };
         let shade = Shade {
             p: light_p,
             p_error: light_error,
@@ -306,8 +390,14 @@ impl Whitted<'_> {
             time: ray.time,
         };
         let mut lit = Vec3A::ZERO;
-        for (k, light) in scene.lights.iter().enumerate() {
-            lit += self.direct(&shade, mat, light, mix(seed ^ k as u32), c);
+        if scene.features.tachyon_lights {
+            for (k, light) in scene.lights.iter().enumerate() {
+                lit += self.direct::<true>(&shade, mat, light, mix(seed ^ k as u32), c);
+            }
+        } else {
+            for (k, light) in scene.lights.iter().enumerate() {
+                lit += self.direct::<false>(&shade, mat, light, mix(seed ^ k as u32), c);
+            }
         }
         if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
             lit *= ao.direct;
@@ -318,10 +408,28 @@ impl Whitted<'_> {
 
     /// Fog over the distance `t` a camera ray travelled to its hit.
     #[inline]
-    fn fog(&self, color: &mut Vec3A, ray: &Ray, t: f32) {
+    fn fog(&self, color: &mut Vec3A, ray: &Ray, t: f32, mat: &Material) {
         let scene = self.scene;
         if let (true, Some(fog)) = (scene.features.fog, &scene.fog) {
+            if !mat.fog {
+                return;
+            }
             let d = if fog.planar {
+                t * ray.dir.dot(scene.camera.forward)
+            } else {
+                t
+            };
+            let v = fog.visibility(d);
+            *color = *color * v + fog.color * (1.0 - v);
+        }
+    }
+
+    /// Tachyon's fog: over the segment `t` of any ray (planar for camera rays when `planar`),
+    /// on the hit's whole colour.
+    fn fog_segment(&self, color: &mut Vec3A, ray: &Ray, t: f32, depth: u32, mat: &Material) {
+        let scene = self.scene;
+        if let (Some(fog), true) = (&scene.fog, mat.fog) {
+            let d = if fog.planar && depth == 0 {
                 t * ray.dir.dot(scene.camera.forward)
             } else {
                 t
@@ -348,7 +456,11 @@ impl Whitted<'_> {
     ) {
         let settings = &self.scene.settings;
         if bounce.depth > settings.max_depth {
-            *color += kr * self.scene.background;
+            *color += if settings.tachyon.depth_limit_background {
+                self.scene.background
+            } else {
+                kr * self.scene.background
+            };
         } else if bounce.weight >= settings.min_weight {
             c.reflection += 1;
             let r = spawn(s.p, s.p_error, side.ng, reflect(ray.dir, side.n), ray.time);
@@ -374,7 +486,11 @@ impl Whitted<'_> {
     ) {
         let settings = &self.scene.settings;
         if bounce.depth > settings.max_depth {
-            *color += filter * self.scene.background;
+            *color += if settings.tachyon.depth_limit_background {
+                self.scene.background
+            } else {
+                filter * self.scene.background
+            };
         } else if bounce.weight >= settings.min_weight {
             // Which media are on each side of the surface.
             let mut inside = *media;
@@ -449,6 +565,25 @@ struct Shade {
     time: f32,
 }
 
+/// A transmit coefficient `kt` after `rule`, for a surface with normal `n` (facing the
+/// viewer) seen along `ray`.
+#[inline]
+fn angle_rule(rule: AngleRule, kt: f32, ray: &Ray, n: Vec3A) -> f32 {
+    match rule {
+        AngleRule::Constant => kt,
+        AngleRule::Slab => {
+            // A slab seen at angle θ is 1/|cos θ| thick: edge-on surfaces look opaque.
+            let cos = ray.dir.dot(n).abs().max(1e-3);
+            kt.powf(1.0 / cos)
+        }
+        AngleRule::Raster3D => {
+            // Tachyon's: opacity ¼(1 + cos(π·kt·(N·D)))², more transparent edge-on.
+            let a = 1.0 + (std::f32::consts::PI * kt * ray.dir.dot(n)).cos();
+            1.0 - 0.25 * a * a
+        }
+    }
+}
+
 /// A hash of a ray's bits.
 fn ray_seed(ray: &Ray) -> u32 {
     let b = |v: f32| v.to_bits();
@@ -469,8 +604,11 @@ fn square(seed: u32, i: u32, n: u32) -> (f32, f32) {
 
 impl Whitted<'_> {
     /// Light from one source reaching a shading point: diffuse and highlight, times what the
-    /// shadow rays let through. Area lights average `samples` points on the light.
-    fn direct(
+    /// shadow rays let through. Area lights average `samples` points on the light. With `T`
+    /// (Tachyon's lights) the light's term must exceed Tachyon's threshold, and plain
+    /// highlights take the light's colour before attenuation, spot fade and filtering (or, for
+    /// a surface-coloured highlight, the surface's colour in its place).
+    fn direct<const T: bool>(
         &self,
         sh: &Shade,
         mat: &Material,
@@ -480,23 +618,52 @@ impl Whitted<'_> {
     ) -> Vec3A {
         let scene = self.scene;
         let shadows = light.casts_shadows() && scene.features.shadows;
-        // (point on the light or None for a direction, direction to it, radiance arriving)
-        let one =
-            |target: Option<Vec3A>, to_light: Vec3A, arriving: Vec3A, c: &mut Counters| -> Vec3A {
-                let ndotl = sh.n.dot(to_light);
-                if ndotl <= 0.0 || arriving == Vec3A::ZERO {
-                    return Vec3A::ZERO;
-                }
-                let mut arriving = arriving;
-                if shadows {
-                    c.shadow += 1;
-                    let (sray, t_max) = match target {
-                        Some(t) => spawn_to(sh.p, sh.p_error, sh.ng, t, sh.time),
-                        None => (
-                            spawn(sh.p, sh.p_error, sh.ng, to_light, sh.time),
-                            f32::INFINITY,
-                        ),
-                    };
+        let tachyon = scene.settings.tachyon;
+        let floor = if T && tachyon.light_threshold {
+            TACHYON_FLOOR
+        } else {
+            0.0
+        };
+        let plain = T && tachyon.plain_highlights;
+        // Tachyon's metal highlight needs no light colour: a black light still makes one.
+        let colourless = plain && mat.highlight_surface && mat.specular > 0.0;
+        // (point on the light or None for a direction, direction to it, radiance arriving;
+        // with `T`: the light's colour and its weight from attenuation and spot fade)
+        let one = |target: Option<Vec3A>,
+                   to_light: Vec3A,
+                   arriving: Vec3A,
+                   (raw, w): (Vec3A, f32),
+                   c: &mut Counters|
+         -> Vec3A {
+            let ndotl = sh.n.dot(to_light);
+            if ndotl <= 0.0 || (arriving == Vec3A::ZERO && !colourless) {
+                return Vec3A::ZERO;
+            }
+            if T && ndotl * w * self.term_scale <= floor {
+                return Vec3A::ZERO;
+            }
+            let mut arriving = arriving;
+            if shadows {
+                c.shadow += 1;
+                let (sray, t_max) = match target {
+                    Some(t) => spawn_to(sh.p, sh.p_error, sh.ng, t, sh.time),
+                    None => (
+                        spawn(sh.p, sh.p_error, sh.ng, to_light, sh.time),
+                        f32::INFINITY,
+                    ),
+                };
+                if colourless {
+                    // Blocked is what counts, not what arrives.
+                    let mut through =
+                        scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                    if scene.features.volumes && through != Vec3A::ZERO {
+                        through *= march::transmittance(scene, &sray, t_max, c);
+                    }
+                    if through == Vec3A::ZERO {
+                        return Vec3A::ZERO;
+                    }
+                    arriving *= through;
+                } else {
                     arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
                     if scene.features.volumes && arriving != Vec3A::ZERO {
                         arriving *= march::transmittance(scene, &sray, t_max, c);
@@ -505,39 +672,73 @@ impl Whitted<'_> {
                         return Vec3A::ZERO;
                     }
                 }
-                let mut lit = mat.diffuse * sh.opacity * ndotl * sh.base;
-                if mat.specular > 0.0 {
-                    let cos = if mat.blinn {
+            }
+            let mut lit = mat.diffuse * sh.opacity * ndotl * sh.base;
+            let mut highlight = Vec3A::ZERO;
+            if mat.specular > 0.0 {
+                let cos = match mat.highlight {
+                    Highlight::Phong => reflect(-to_light, sh.n).dot(sh.view),
+                    Highlight::Blinn | Highlight::BlinnFast => {
                         sh.n.dot((to_light + sh.view).normalize())
+                    }
+                };
+                if cos > floor {
+                    let h = if mat.highlight == Highlight::BlinnFast {
+                        // Tachyon's cheap stand-in for cos^s.
+                        let s = mat.shininess;
+                        cos / (s - s * cos + cos)
                     } else {
-                        reflect(-to_light, sh.n).dot(sh.view)
+                        cos.powf(mat.shininess)
                     };
-                    if cos > 0.0 {
-                        lit += Vec3A::splat(mat.specular * cos.powf(mat.shininess));
+                    if plain {
+                        highlight = Vec3A::splat(mat.specular * h);
+                    } else {
+                        // White, or the surface's colour (metal), times the light's.
+                        let tint = if mat.highlight_surface {
+                            sh.base
+                        } else {
+                            Vec3A::ONE
+                        };
+                        lit += (mat.specular * h) * tint;
                     }
                 }
+            }
+            if plain {
+                // Tachyon's metal highlight takes the surface's colour in place of the light's.
+                let tint = if mat.highlight_surface {
+                    sh.base * self.scene.settings.light_scale
+                } else {
+                    raw
+                };
+                arriving * lit + tint * highlight
+            } else {
                 arriving * lit
-            };
-        let from_point = |q: Vec3A, color: Vec3A, a: &[f32; 3], c: &mut Counters| {
-            let d = q - sh.p;
-            let dist = d.length();
-            one(Some(q), d / dist, color * Light::attenuate(a, dist), c)
+            }
         };
+        // `color` arrives at the point attenuated; `raw`, `w`: see `one`.
+        let from_point =
+            |q: Vec3A, color: Vec3A, (raw, w): (Vec3A, f32), a: &[f32; 3], c: &mut Counters| {
+                let d = q - sh.p;
+                let dist = d.length();
+                let att = Light::attenuate(a, dist);
+                one(Some(q), d / dist, color * att, (raw, w * att), c)
+            };
         match light {
             Light::Directional {
                 to_light, color, ..
-            } => one(None, *to_light, *color, c),
+            } => one(None, *to_light, *color, (*color, 1.0), c),
             Light::Point {
                 position,
                 color,
                 attenuation,
                 ..
-            } => from_point(*position, *color, attenuation, c),
+            } => from_point(*position, *color, (*color, 1.0), attenuation, c),
             Light::Spot {
                 position,
                 axis,
                 cos_inner,
                 cos_outer,
+                fade,
                 color,
                 attenuation,
                 ..
@@ -546,8 +747,8 @@ impl Whitted<'_> {
                 if cos <= *cos_outer {
                     return Vec3A::ZERO;
                 }
-                let w = Light::spot_weight(cos, *cos_inner, *cos_outer);
-                from_point(*position, *color * w, attenuation, c)
+                let w = Light::spot_weight(cos, *cos_inner, *cos_outer, *fade);
+                from_point(*position, *color * w, (*color, w), attenuation, c)
             }
             Light::Sphere {
                 center,
@@ -569,7 +770,7 @@ impl Whitted<'_> {
                     let (a, b) = square(seed, i, *samples);
                     let (r, phi) = (a.sqrt() * radius, b * std::f32::consts::TAU);
                     let q = *center + r * (phi.cos() * u + phi.sin() * v);
-                    sum += from_point(q, *color, attenuation, c);
+                    sum += from_point(q, *color, (*color, 1.0), attenuation, c);
                 }
                 sum / *samples as f32
             }
@@ -589,7 +790,8 @@ impl Whitted<'_> {
                 let mut sum = Vec3A::ZERO;
                 for i in 0..*samples {
                     let (a, b) = square(seed, i, *samples);
-                    sum += from_point(*corner + a * *edge1 + b * *edge2, *color, attenuation, c);
+                    let q = *corner + a * *edge1 + b * *edge2;
+                    sum += from_point(q, *color, (*color, 1.0), attenuation, c);
                 }
                 sum / *samples as f32
             }

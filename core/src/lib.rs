@@ -39,6 +39,7 @@
 //! | camera | [`camera`], [`adaptive`] | camera rays; where a pixel's samples go |
 //! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks; PPM bytes; image error measures; files written whole |
 //! | ray | [`ray`] | rays and robust ray spawning |
+//! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
 //! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |
 //! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
 
@@ -46,6 +47,9 @@
 #![deny(unsafe_code)]
 
 pub mod adaptive;
+// The process's resource limits (getrlimit, sysconf).
+#[allow(unsafe_code)]
+pub mod budget;
 pub mod bvh;
 // The memory-mapped cache file.
 #[allow(unsafe_code)]

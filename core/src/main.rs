@@ -40,12 +40,40 @@ enum Command {
         args: cli::sweep::Args,
     },
     /// Validate a scene and print what it contains; renders nothing.
-    Check { scene: PathBuf },
+    Check {
+        scene: PathBuf,
+        /// Memory budget to build the scene within (as for `render`); `check` prints it and
+        /// what the scene holds of it.
+        #[arg(long, value_name = "SIZE", value_parser = cli::parse_memory)]
+        memory: Option<luxon_formats::MemorySize>,
+    },
     /// List every plugin found: file, kind, names, ABI version, parameters.
     Plugins {
         /// Extra directories or files to search first.
         #[arg(long = "plugin-path")]
         plugin_path: Vec<PathBuf>,
+    },
+    /// Write any scene Luxon reads (RON, NFF, OBJ, Tachyon `.dat`) as an equivalent Luxon RON
+    /// scene, to edit and render from then on.
+    ///
+    /// `luxon convert scene.dat scene.ron` (or `-o scene.ron`). What the source says that the
+    /// RON scene cannot hold is printed as warnings and listed at the top of the file.
+    Convert {
+        scene: PathBuf,
+        /// The RON file to write.
+        #[arg(value_name = "OUT.ron")]
+        out: Option<PathBuf>,
+        /// The RON file to write (the same as OUT.ron).
+        #[arg(short, long = "output", value_name = "OUT.ron", conflicts_with = "out")]
+        output: Option<PathBuf>,
+    },
+    /// Render Tachyon scene files (`.dat`) with Tachyon's own command line, for drop-in use by
+    /// VMD: `luxon tachyon [Tachyon's options] scene.dat` (see `luxon tachyon -help`).
+    #[command(disable_help_flag = true)]
+    Tachyon {
+        /// Tachyon's options and scene files, in any order.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 0..)]
+        args: Vec<std::ffi::OsString>,
     },
     /// Generate an SPD scene (Eric Haines' Standard Procedural Databases); without a name, list
     /// them.
@@ -110,11 +138,18 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render { scene, overrides } => cli::render::run(&scene, &overrides),
         Command::Sweep { scene, args } => cli::sweep::run(&scene, &args),
-        Command::Check { scene } => cli::check::run(&scene),
+        Command::Check { scene, memory } => cli::check::run(&scene, memory),
         Command::Plugins { plugin_path } => {
             cli::plugins::run(&plugin_path);
             Ok(())
         }
+        Command::Convert { scene, out, output } => match out.or(output) {
+            Some(output) => cli::convert::run(&scene, &output),
+            None => Err(luxon::Error::Usage(
+                "luxon convert: name the RON file to write: luxon convert SCENE OUT.ron".into(),
+            )),
+        },
+        Command::Tachyon { args } => cli::tachyon::run(&args),
         Command::Spd { name, size, output } => {
             cli::spd::run(name.as_deref(), size, output.as_deref())
         }

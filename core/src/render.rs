@@ -48,7 +48,8 @@ pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
 /// told about finished pixels.
 pub fn render(scene: &Scene, progress: Progress) -> Result<(Framebuffer, RenderStats), Error> {
     let s = &scene.settings;
-    let fb = Mutex::new(Framebuffer::new(s.width, s.height));
+    let (fb, _image) = Framebuffer::charged(s.width, s.height, &scene.budget)?;
+    let fb = Mutex::new(fb);
     let total = s.width as u64 * s.height as u64;
     let done = AtomicU64::new(0);
     let start = Instant::now();

@@ -25,6 +25,16 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
+mod brick;
+mod builder;
+mod charge;
+
+pub use brick::{Brick, Codes};
+pub use builder::{Format, VolumeBuilder};
+
+use crate::budget::try_vec;
+use charge::{entry_bytes, Charger};
+
 /// Edge length of a brick in voxels.
 pub const BRICK_SIZE: i64 = 8;
 const BRICK_SHIFT: u32 = 3;
@@ -32,15 +42,6 @@ const BRICK_SHIFT: u32 = 3;
 pub const BRICK_VOXELS: usize = 512;
 /// The largest index box a volume may declare, in voxels (2^34: 64 GiB of dense f32 data).
 pub const MAX_VOXELS: u64 = 1 << 34;
-
-/// The storage of one 8³ brick; voxel `(x, y, z)` of the brick is element `x + 8y + 64z`.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Brick {
-    /// Every voxel has this value.
-    Constant(f32),
-    /// One value per voxel, x fastest (voxels no data reached hold the background).
-    Dense(Box<[f32; BRICK_VOXELS]>),
-}
 
 /// A fast hasher for brick coordinates (three `i64`s), which are not attacker-controlled in a
 /// way that matters here: the default SipHash would dominate voxel lookups.
@@ -115,6 +116,8 @@ pub struct Volume {
     table: Vec<u32>,
     table_min: [i64; 3],
     table_dims: [usize; 3],
+    /// The values of the codes of u8 and u16 bricks.
+    codes: Codes,
     /// Voxels given by the reader.
     voxels: u64,
     /// Smallest and largest value given, `None` when no voxel was.
@@ -132,27 +135,54 @@ impl Volume {
         let key = ijk.map(|c| c >> BRICK_SHIFT);
         match self.brick(key) {
             None => self.background,
-            Some(Brick::Constant(v)) => *v,
-            Some(Brick::Dense(values)) => values[local_index(ijk)],
+            Some(b) => b.value(local_index(ijk), &self.codes),
         }
     }
 
-    /// Moves the bricks read into their final storage and builds the slot table.
-    fn seal(&mut self) {
-        let mut all: Vec<([i64; 3], Brick)> =
-            std::mem::take(&mut self.bricks).into_iter().collect();
+    /// How the codes of the volume's u8 and u16 bricks become values.
+    #[inline]
+    pub fn codes(&self) -> &Codes {
+        &self.codes
+    }
+
+    /// Moves the bricks read into their final storage and builds the slot table, charging
+    /// both first (and giving back the map the bricks were read into).
+    fn seal(&mut self, charger: &mut Charger) -> Result<(), String> {
+        let n = self.bricks.len();
+        let lo = self.index_min.map(|c| c >> BRICK_SHIFT);
+        let hi = self.index_max.map(|c| c >> BRICK_SHIFT);
+        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
+        let cells = dims.iter().product::<u64>();
+        let table_len = if cells <= MAX_TABLE {
+            cells as usize
+        } else {
+            0
+        };
+        let sorting = (n * std::mem::size_of::<([i64; 3], Brick)>()) as u64;
+        let sealed = (n * std::mem::size_of::<Brick>()) as u64
+            + n as u64 * entry_bytes::<u32>() * 8 / 7
+            + table_len as u64 * 4;
+        charger.add(sorting + sealed)?;
+        let mut all: Vec<([i64; 3], Brick)> = Vec::new();
+        let ok = all.try_reserve_exact(n).is_ok()
+            && self.store.try_reserve_exact(n).is_ok()
+            && self.slots.try_reserve(n).is_ok();
+        if !ok {
+            return Err(charger.refused(sorting + sealed));
+        }
+        let map_bytes = self.bricks.capacity() as u64 * entry_bytes::<Brick>();
+        all.extend(std::mem::take(&mut self.bricks));
+        charger.sub(map_bytes);
         all.sort_unstable_by_key(|(k, _)| *k);
-        self.store.reserve_exact(all.len());
         for (key, brick) in all {
             self.slots.insert(key, self.store.len() as u32);
             self.store.push(brick);
         }
-        let lo = self.index_min.map(|c| c >> BRICK_SHIFT);
-        let hi = self.index_max.map(|c| c >> BRICK_SHIFT);
-        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
-        if dims.iter().product::<u64>() <= MAX_TABLE {
+        charger.sub(sorting);
+        if table_len > 0 {
             let dims = dims.map(|d| d as usize);
-            let mut table = vec![NO_BRICK; dims[0] * dims[1] * dims[2]];
+            let mut table = try_vec(table_len, NO_BRICK)
+                .ok_or_else(|| charger.refused(table_len as u64 * 4))?;
             for (key, &slot) in &self.slots {
                 let r = [0, 1, 2].map(|a| (key[a] - lo[a]) as usize);
                 table[(r[2] * dims[1] + r[1]) * dims[0] + r[0]] = slot;
@@ -161,6 +191,7 @@ impl Volume {
             self.table_min = lo;
             self.table_dims = dims;
         }
+        Ok(())
     }
 
     /// Number of voxels the reader gave (in dense blocks and tiles), not counting background.
@@ -174,19 +205,16 @@ impl Volume {
         self.range.unwrap_or((self.background, self.background))
     }
 
-    /// Bytes held by the volume's storage: the brick table and the dense bricks (approximate:
-    /// the table's control bytes and the allocator's overhead are not counted).
+    /// Bytes held by the volume's storage: the brick table and the dense bricks at their
+    /// precision (approximate: the table's control bytes and the allocator's overhead are not
+    /// counted).
     pub fn memory_bytes(&self) -> usize {
-        let dense = self
-            .store
-            .iter()
-            .filter(|b| matches!(b, Brick::Dense(_)))
-            .count();
         std::mem::size_of::<Volume>()
             + self.store.capacity() * std::mem::size_of::<Brick>()
             + self.slots.capacity() * std::mem::size_of::<([i64; 3], u32)>()
             + self.table.capacity() * 4
-            + dense * std::mem::size_of::<[f32; BRICK_VOXELS]>()
+            + self.store.iter().map(Brick::heap_bytes).sum::<usize>()
+            + std::mem::size_of::<[f32; 256]>()
             + self.name.capacity()
             + self.grid_name.capacity()
             + self.plugin.capacity()
@@ -194,12 +222,22 @@ impl Volume {
 
     /// Number of (dense, constant) bricks stored (bricks of background voxels are not).
     pub fn brick_counts(&self) -> (usize, usize) {
-        let dense = self
-            .store
-            .iter()
-            .filter(|b| matches!(b, Brick::Dense(_)))
-            .count();
+        let dense = self.store.iter().filter(|b| b.is_dense()).count();
         (dense, self.store.len() - dense)
+    }
+
+    /// Number of dense bricks stored as u8, u16 and f32.
+    pub fn dense_counts(&self) -> [usize; 3] {
+        let mut n = [0; 3];
+        for b in &self.store {
+            match b {
+                Brick::Constant(_) => {}
+                Brick::U8(_) => n[0] += 1,
+                Brick::U16(_) => n[1] += 1,
+                Brick::F32(_) => n[2] += 1,
+            }
+        }
+        n
     }
 
     /// The brick with brick coordinate `key` (voxel `ijk` lies in brick `ijk >> 3`, i.e.
@@ -241,515 +279,6 @@ fn local_index(ijk: [i64; 3]) -> usize {
     let mask = BRICK_SIZE - 1;
     ((ijk[0] & mask) + ((ijk[1] & mask) << BRICK_SHIFT) + ((ijk[2] & mask) << (2 * BRICK_SHIFT)))
         as usize
-}
-
-/// Collects what a reader sends and checks it (the host side of `VolumeSink`).
-pub struct VolumeBuilder {
-    name: String,
-    plugin: String,
-    volume: Option<Volume>,
-    /// Which voxels were given, for bricks that are only partly given so far (bit `i` of the
-    /// 512-bit mask is voxel `i` of the brick). A stored brick without a mask is complete.
-    partial: BrickMap<[u64; 8]>,
-    /// Complete bricks of background voxels, which are not stored (`Given` remembers them so
-    /// that a voxel given twice is still an error).
-    skipped: Given,
-    /// The first error; it stops the volume.
-    failed: Option<String>,
-}
-
-/// What a block carries.
-#[derive(Clone, Copy)]
-enum Source<'a> {
-    Dense(&'a [f32]),
-    Tile(f32),
-}
-
-impl VolumeBuilder {
-    /// A builder for the volume the scene calls `name`, read by plugin `plugin`.
-    pub fn new(name: &str, plugin: &str) -> VolumeBuilder {
-        VolumeBuilder {
-            name: name.to_string(),
-            plugin: plugin.to_string(),
-            volume: None,
-            partial: BrickMap::default(),
-            skipped: Given::Set(BrickMap::default()),
-            failed: None,
-        }
-    }
-
-    /// Records the first error; later calls fail with it.
-    pub fn fail(&mut self, message: &str) {
-        if self.failed.is_none() {
-            self.failed = Some(message.to_string());
-        }
-    }
-
-    /// Keeps the first error of `result`.
-    fn track(&mut self, result: Result<(), String>) -> Result<(), String> {
-        if let Err(m) = &result {
-            self.fail(m);
-        }
-        result
-    }
-
-    fn usable(&self) -> Result<(), String> {
-        match &self.failed {
-            Some(first) => Err(format!(
-                "the volume was already rejected by an earlier error: {first}"
-            )),
-            None => Ok(()),
-        }
-    }
-
-    /// Describes the grid; must come exactly once, before any data.
-    pub fn begin(
-        &mut self,
-        world_from_index: [f64; 12],
-        background: f32,
-        index_min: [i64; 3],
-        index_max: [i64; 3],
-        grid_name: &str,
-    ) -> Result<(), String> {
-        self.usable()?;
-        let r = self.begin_checked(
-            world_from_index,
-            background,
-            index_min,
-            index_max,
-            grid_name,
-        );
-        self.track(r)
-    }
-
-    fn begin_checked(
-        &mut self,
-        world_from_index: [f64; 12],
-        background: f32,
-        index_min: [i64; 3],
-        index_max: [i64; 3],
-        grid_name: &str,
-    ) -> Result<(), String> {
-        if self.volume.is_some() {
-            return Err("`begin` was called twice; a reader describes one grid per read".into());
-        }
-        if world_from_index.iter().any(|x| !x.is_finite()) {
-            return Err(format!(
-                "the grid's index-to-world transform has a non-finite entry: {world_from_index:?}"
-            ));
-        }
-        let m = &world_from_index;
-        let det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8])
-            + m[2] * (m[4] * m[9] - m[5] * m[8]);
-        if det == 0.0 || !det.is_finite() {
-            return Err(format!(
-                "the grid's index-to-world transform is not invertible (its 3x3 part has \
-                 determinant {det}): {world_from_index:?}"
-            ));
-        }
-        if !background.is_finite() {
-            return Err(format!(
-                "the grid's background value is {background}; expected a finite number"
-            ));
-        }
-        if (0..3).any(|a| index_min[a] > index_max[a]) {
-            return Err(format!(
-                "the grid's index box {index_min:?} to {index_max:?} is empty; expected \
-                 index_min <= index_max on every axis (both inclusive)"
-            ));
-        }
-        let extent = box_extent(index_min, index_max);
-        let voxels = extent
-            .iter()
-            .try_fold(1u128, |a, &e| a.checked_mul(e))
-            .unwrap_or(u128::MAX);
-        if voxels > u128::from(MAX_VOXELS) {
-            return Err(format!(
-                "the grid's index box {index_min:?} to {index_max:?} holds {} voxels; at most \
-                 2^34 = {MAX_VOXELS} are supported",
-                extent.map(|e| e.to_string()).join("x")
-            ));
-        }
-        self.skipped = Given::new(index_min, index_max);
-        self.volume = Some(Volume {
-            name: self.name.clone(),
-            grid_name: grid_name.to_string(),
-            plugin: self.plugin.clone(),
-            world_from_index,
-            background,
-            index_min,
-            index_max,
-            bricks: BrickMap::default(),
-            store: Vec::new(),
-            slots: BrickMap::default(),
-            table: Vec::new(),
-            table_min: [0; 3],
-            table_dims: [0; 3],
-            voxels: 0,
-            range: None,
-        });
-        Ok(())
-    }
-
-    /// A dense block of `dims` voxels from `origin`, x fastest.
-    pub fn add_dense(
-        &mut self,
-        origin: [i64; 3],
-        dims: [u64; 3],
-        values: &[f32],
-    ) -> Result<(), String> {
-        self.usable()?;
-        let r = self.add_checked(origin, dims, Source::Dense(values));
-        self.track(r)
-    }
-
-    /// A box of `dims` voxels from `origin`, all `value`.
-    pub fn add_tile(&mut self, origin: [i64; 3], dims: [u64; 3], value: f32) -> Result<(), String> {
-        self.usable()?;
-        let r = self.add_checked(origin, dims, Source::Tile(value));
-        self.track(r)
-    }
-
-    fn add_checked(
-        &mut self,
-        origin: [i64; 3],
-        dims: [u64; 3],
-        source: Source,
-    ) -> Result<(), String> {
-        let what = block_name(&source, origin, dims);
-        let call = match source {
-            Source::Dense(_) => "add_dense",
-            Source::Tile(_) => "add_tile",
-        };
-        let Some(volume) = self.volume.as_mut() else {
-            return Err(format!(
-                "{what}: `{call}` was called before `begin`; a reader must describe the grid first"
-            ));
-        };
-        if dims.contains(&0) {
-            return Err(format!(
-                "{what} is empty; expected at least one voxel per axis"
-            ));
-        }
-        let count = dims
-            .iter()
-            .try_fold(1u64, |a, &d| a.checked_mul(d))
-            .ok_or_else(|| format!("{what} has too many voxels (the count overflows)"))?;
-        // Inclusive last voxel, in i128 so that nothing overflows.
-        let last = [0, 1, 2].map(|a| i128::from(origin[a]) + i128::from(dims[a]) - 1);
-        if (0..3).any(|a| {
-            i128::from(origin[a]) < i128::from(volume.index_min[a])
-                || last[a] > i128::from(volume.index_max[a])
-        }) {
-            return Err(format!(
-                "{what} reaches from {origin:?} to {last:?}, outside the grid's index box \
-                 {:?} to {:?}",
-                volume.index_min, volume.index_max
-            ));
-        }
-        // Inside the box, so every coordinate fits i64 and `count` is at most MAX_VOXELS.
-        let last = last.map(|c| c as i64);
-        let (lo, hi) = match source {
-            Source::Dense(values) => {
-                if values.len() as u64 != count {
-                    return Err(format!("{what} comes with {} values", values.len()));
-                }
-                let mut lo = f32::INFINITY;
-                let mut hi = f32::NEG_INFINITY;
-                for (i, &v) in values.iter().enumerate() {
-                    if !v.is_finite() {
-                        let ijk = voxel_of(origin, dims, i);
-                        return Err(format!(
-                            "{what} has the non-finite value {v} at voxel {ijk:?}; expected \
-                             finite values"
-                        ));
-                    }
-                    lo = lo.min(v);
-                    hi = hi.max(v);
-                }
-                (lo, hi)
-            }
-            Source::Tile(v) => {
-                if !v.is_finite() {
-                    return Err(format!("{what} has the non-finite value {v}"));
-                }
-                (v, v)
-            }
-        };
-        let sets = Sets {
-            partial: &mut self.partial,
-            skipped: &mut self.skipped,
-        };
-        store(volume, sets, origin, dims, last, source, &what)?;
-        volume.voxels += count;
-        volume.range = Some(match volume.range {
-            Some((a, b)) => (a.min(lo), b.max(hi)),
-            None => (lo, hi),
-        });
-        Ok(())
-    }
-
-    /// The finished volume, or the first error. Dense bricks whose voxels all have one value
-    /// (given or background) become constant bricks (complete bricks already are).
-    pub fn finish(self) -> Result<Volume, String> {
-        if let Some(first) = self.failed {
-            return Err(format!(
-                "ignored an error from the host and returned success: {first}"
-            ));
-        }
-        let Some(mut volume) = self.volume else {
-            return Err(
-                "returned without reading a grid (it never called `begin` on the volume sink)"
-                    .into(),
-            );
-        };
-        // Voxels nothing reached hold the background, so this keeps every value.
-        for brick in volume.bricks.values_mut() {
-            if let Brick::Dense(values) = brick {
-                let first = values[0];
-                if values.iter().all(|&v| v == first) {
-                    *brick = Brick::Constant(first);
-                }
-            }
-        }
-        volume.seal();
-        Ok(volume)
-    }
-}
-
-/// Voxels per axis of an inclusive index box (which must not be empty).
-fn box_extent(min: [i64; 3], max: [i64; 3]) -> [u128; 3] {
-    [0, 1, 2].map(|a| (i128::from(max[a]) - i128::from(min[a]) + 1) as u128)
-}
-
-fn block_name(source: &Source, origin: [i64; 3], dims: [u64; 3]) -> String {
-    let kind = match source {
-        Source::Dense(_) => "dense block",
-        Source::Tile(_) => "tile",
-    };
-    format!(
-        "{kind} at {origin:?} of {}x{}x{} voxels",
-        dims[0], dims[1], dims[2]
-    )
-}
-
-/// Index of the voxel that is element `i` of a block (x fastest).
-fn voxel_of(origin: [i64; 3], dims: [u64; 3], i: usize) -> [i128; 3] {
-    let i = i as u64;
-    let x = i % dims[0];
-    let y = (i / dims[0]) % dims[1];
-    let z = i / dims[0] / dims[1];
-    [
-        i128::from(origin[0]) + i128::from(x),
-        i128::from(origin[1]) + i128::from(y),
-        i128::from(origin[2]) + i128::from(z),
-    ]
-}
-
-/// A set of brick coordinates: a bitmap over the index box's bricks when they are few enough
-/// for a slot table (at most 2 MiB of bits), a hash set for sparse giants.
-enum Given {
-    Bits {
-        min: [i64; 3],
-        dims: [usize; 3],
-        words: Vec<u64>,
-    },
-    Set(BrickMap<()>),
-}
-
-impl Given {
-    fn new(index_min: [i64; 3], index_max: [i64; 3]) -> Given {
-        let lo = index_min.map(|c| c >> BRICK_SHIFT);
-        let hi = index_max.map(|c| c >> BRICK_SHIFT);
-        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1) as u64);
-        let n = dims.iter().product::<u64>();
-        if n > MAX_TABLE {
-            return Given::Set(BrickMap::default());
-        }
-        Given::Bits {
-            min: lo,
-            dims: dims.map(|d| d as usize),
-            words: vec![0; n.div_ceil(64) as usize],
-        }
-    }
-
-    /// Bit index of `key`, a brick of the index box.
-    fn bit(min: [i64; 3], dims: [usize; 3], key: [i64; 3]) -> usize {
-        let r = [0, 1, 2].map(|a| (key[a] - min[a]) as usize);
-        (r[2] * dims[1] + r[1]) * dims[0] + r[0]
-    }
-
-    fn contains(&self, key: [i64; 3]) -> bool {
-        match self {
-            Given::Bits { min, dims, words } => {
-                let i = Given::bit(*min, *dims, key);
-                words[i / 64] & (1 << (i % 64)) != 0
-            }
-            Given::Set(set) => set.contains_key(&key),
-        }
-    }
-
-    fn insert(&mut self, key: [i64; 3]) {
-        match self {
-            Given::Bits { min, dims, words } => {
-                let i = Given::bit(*min, *dims, key);
-                words[i / 64] |= 1 << (i % 64);
-            }
-            Given::Set(set) => {
-                set.insert(key, ());
-            }
-        }
-    }
-}
-
-/// The builder's bookkeeping that `store` updates besides the volume.
-struct Sets<'a> {
-    partial: &'a mut BrickMap<[u64; 8]>,
-    skipped: &'a mut Given,
-}
-
-/// The one value of a complete brick, if all its voxels hold the same bits (`-0.0` and `0.0`
-/// differ: a collapsed brick must read exactly as the voxels given).
-fn uniform(values: impl IntoIterator<Item = f32>) -> Option<f32> {
-    let mut it = values.into_iter();
-    let first = it.next()?;
-    it.all(|v| v.to_bits() == first.to_bits()).then_some(first)
-}
-
-/// Stores a complete brick whose voxels all hold `v`: nothing for the background, else a
-/// constant brick.
-fn store_uniform(volume: &mut Volume, skipped: &mut Given, key: [i64; 3], v: f32) {
-    if v.to_bits() == volume.background.to_bits() {
-        volume.bricks.remove(&key);
-        skipped.insert(key);
-    } else {
-        volume.bricks.insert(key, Brick::Constant(v));
-    }
-}
-
-/// Bits `from..from + n` of a 64-bit word (`n` in 1..=8).
-#[inline]
-fn run_bits(from: usize, n: usize) -> u64 {
-    ((1u64 << n) - 1) << from
-}
-
-/// Cuts a checked block (inside the box, `last` its inclusive end) into bricks.
-fn store(
-    volume: &mut Volume,
-    sets: Sets,
-    origin: [i64; 3],
-    dims: [u64; 3],
-    last: [i64; 3],
-    source: Source,
-    what: &str,
-) -> Result<(), String> {
-    let first_key = origin.map(|c| c >> BRICK_SHIFT);
-    let last_key = last.map(|c| c >> BRICK_SHIFT);
-    let Sets { partial, skipped } = sets;
-    let background = volume.background;
-    for bz in first_key[2]..=last_key[2] {
-        for by in first_key[1]..=last_key[1] {
-            for bx in first_key[0]..=last_key[0] {
-                let key = [bx, by, bz];
-                // The part of the block inside this brick, in voxel indices.
-                let brick_lo = key.map(|k| k << BRICK_SHIFT);
-                let lo = [0, 1, 2].map(|a| origin[a].max(brick_lo[a]));
-                let hi = [0, 1, 2].map(|a| last[a].min(brick_lo[a] + BRICK_SIZE - 1));
-                let whole =
-                    (0..3).all(|a| lo[a] == brick_lo[a] && hi[a] == brick_lo[a] + BRICK_SIZE - 1);
-                let existing = volume.bricks.contains_key(&key);
-                if (existing && !partial.contains_key(&key)) || skipped.contains(key) {
-                    return Err(format!(
-                        "{what} gives voxel {lo:?} again (it was given before); expected every \
-                         voxel at most once"
-                    ));
-                }
-                // Offset in a dense source of voxel (lo[0], y, z).
-                let src_at = |y: i64, z: i64| {
-                    (((z - origin[2]) as u64 * dims[1] + (y - origin[1]) as u64) * dims[0]
-                        + (lo[0] - origin[0]) as u64) as usize
-                };
-                let n = (hi[0] - lo[0] + 1) as usize;
-                if !existing {
-                    if whole {
-                        let one = match source {
-                            Source::Tile(v) => Some(v),
-                            Source::Dense(src) => uniform(
-                                (lo[2]..=hi[2])
-                                    .flat_map(|z| (lo[1]..=hi[1]).map(move |y| (y, z)))
-                                    .flat_map(|(y, z)| src[src_at(y, z)..src_at(y, z) + n].iter())
-                                    .copied(),
-                            ),
-                        };
-                        if let Some(v) = one {
-                            store_uniform(volume, skipped, key, v);
-                            continue;
-                        }
-                    } else {
-                        partial.insert(key, [0; 8]);
-                    }
-                    volume
-                        .bricks
-                        .insert(key, Brick::Dense(Box::new([background; BRICK_VOXELS])));
-                }
-                let mask = partial.get_mut(&key);
-                // Check the whole part first so a rejected block leaves the brick unchanged.
-                if let Some(mask) = mask.as_deref() {
-                    for z in lo[2]..=hi[2] {
-                        for y in lo[1]..=hi[1] {
-                            let bits = run_bits(local_index([lo[0], y, 0]), n);
-                            if mask[(z - brick_lo[2]) as usize] & bits != 0 {
-                                let x = (0..n as i64)
-                                    .map(|d| lo[0] + d)
-                                    .find(|&x| {
-                                        mask[(z - brick_lo[2]) as usize]
-                                            & (1 << local_index([x, y, 0]))
-                                            != 0
-                                    })
-                                    .unwrap_or(lo[0]);
-                                return Err(format!(
-                                    "{what} gives voxel {:?} again (it was given before); \
-                                     expected every voxel at most once",
-                                    [x, y, z]
-                                ));
-                            }
-                        }
-                    }
-                }
-                let Some(Brick::Dense(values)) = volume.bricks.get_mut(&key) else {
-                    unreachable!("a brick given in part is dense");
-                };
-                for z in lo[2]..=hi[2] {
-                    for y in lo[1]..=hi[1] {
-                        let dst = local_index([lo[0], y, z]);
-                        let run = &mut values[dst..dst + n];
-                        match source {
-                            Source::Tile(v) => run.fill(v),
-                            Source::Dense(src) => {
-                                let at = src_at(y, z);
-                                run.copy_from_slice(&src[at..at + n]);
-                            }
-                        }
-                    }
-                }
-                if let Some(mask) = mask {
-                    for z in lo[2]..=hi[2] {
-                        for y in lo[1]..=hi[1] {
-                            mask[(z - brick_lo[2]) as usize] |=
-                                run_bits(local_index([lo[0], y, 0]), n);
-                        }
-                    }
-                    if mask.iter().all(|&w| w == u64::MAX) {
-                        partial.remove(&key);
-                        if let Some(v) = uniform(values.iter().copied()) {
-                            store_uniform(volume, skipped, key, v);
-                        }
-                    }
-                }
-            }
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -811,7 +340,7 @@ mod tests {
         b.add_dense([0, 0, 0], [16, 8, 8], &values).unwrap();
         let v = b.finish().unwrap();
         assert_eq!(v.brick([0, 0, 0]), Some(&Brick::Constant(0.0)));
-        assert!(matches!(v.brick([1, 0, 0]), Some(Brick::Dense(_))));
+        assert!(matches!(v.brick([1, 0, 0]), Some(Brick::F32(_))));
         assert_eq!(v.value([8, 0, 0]), 1.0);
         assert!(v.memory_bytes() >= 2048);
     }
@@ -958,6 +487,129 @@ mod tests {
         assert!(b
             .begin(IDENTITY, 0.0, [0; 3], [2047, 2047, 4096], "g")
             .is_err());
+    }
+
+    /// Whether every voxel of `v` in `0..n` on each axis reads `want(ijk)` (same bits).
+    fn reads(v: &Volume, n: i64, want: impl Fn([i64; 3]) -> f32) {
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    let ijk = [x, y, z];
+                    assert_eq!(v.value(ijk).to_bits(), want(ijk).to_bits(), "{ijk:?}");
+                }
+            }
+        }
+    }
+
+    fn byte(ijk: [i64; 3]) -> u8 {
+        (ijk[0] * 7 + ijk[1] * 31 + ijk[2] * 101) as u8
+    }
+
+    #[test]
+    fn u8_and_u16_blocks_are_kept_at_their_precision() {
+        // Background 0 has the code 0, so partial bricks stay u8 too.
+        let mut b = VolumeBuilder::new("v", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [11; 3], "g").unwrap();
+        let bytes: Vec<u8> = (0..12 * 12 * 12)
+            .map(|i| byte([i % 12, i / 12 % 12, i / 144]))
+            .collect();
+        b.add_dense_u8([0; 3], [12; 3], &bytes, 255.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.dense_counts(), [8, 0, 0]);
+        reads(&v, 12, |ijk| f32::from(byte(ijk)) / 255.0);
+        assert_eq!(v.min_max(), (0.0, 1.0));
+        // A byte per voxel: 8 bricks of 512 bytes, not 2 KiB each.
+        assert!(v.memory_bytes() < 8 * 2048, "{}", v.memory_bytes());
+
+        let mut b = VolumeBuilder::new("w", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [7; 3], "g").unwrap();
+        let words: Vec<u16> = (0..512).map(|i| i * 100).collect();
+        b.add_dense_u16([0; 3], [8; 3], &words, 65535.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.dense_counts(), [0, 1, 0]);
+        reads(&v, 8, |ijk| f32::from(words[local_index(ijk)]) / 65535.0);
+    }
+
+    #[test]
+    fn a_brick_without_a_code_for_the_background_or_given_other_data_becomes_f32() {
+        // Background -1 has no u8 code: a partial u8 brick starts as f32, a whole one is u8.
+        let mut b = builder([0; 3], [15, 7, 7]);
+        b.add_dense_u8(
+            [0; 3],
+            [8, 8, 8],
+            &[3; 511].iter().chain(&[4]).copied().collect::<Vec<_>>(),
+            1.0,
+        )
+        .unwrap();
+        b.add_dense_u8([8, 0, 0], [2, 2, 2], &[5; 8], 1.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.dense_counts(), [1, 0, 1]);
+        assert_eq!((v.value([7, 7, 7]), v.value([9, 1, 1])), (4.0, 5.0));
+        assert_eq!(v.value([10, 0, 0]), -1.0);
+
+        // Another format or a value without a code promotes a u8 brick, keeping its values;
+        // a tile whose value has a code does not.
+        let fill = |last: &dyn Fn(&mut VolumeBuilder)| {
+            let mut b = VolumeBuilder::new("v", "test");
+            b.begin(IDENTITY, 0.0, [0; 3], [7; 3], "g").unwrap();
+            b.add_dense_u8([0; 3], [8, 8, 4], &[200; 256], 255.0)
+                .unwrap();
+            b.add_tile([0, 0, 4], [8, 8, 2], 10.0 / 255.0).unwrap();
+            last(&mut b);
+            b.finish().unwrap()
+        };
+        let v = fill(&|_| {});
+        assert_eq!(v.dense_counts(), [1, 0, 0]);
+        let bg = |ijk: [i64; 3]| match ijk[2] {
+            0..4 => 200.0 / 255.0,
+            4..6 => 10.0 / 255.0,
+            _ => 0.0,
+        };
+        reads(&v, 8, bg);
+        let v = fill(&|b| b.add_tile([0, 0, 6], [8, 8, 1], 0.3).unwrap());
+        assert_eq!(v.dense_counts(), [0, 0, 1]);
+        reads(&v, 8, |ijk| if ijk[2] == 6 { 0.3 } else { bg(ijk) });
+        let v = fill(&|b| b.add_dense([0, 0, 7], [8, 8, 1], &[0.25; 64]).unwrap());
+        assert_eq!(v.dense_counts(), [0, 0, 1]);
+        reads(&v, 8, |ijk| if ijk[2] == 7 { 0.25 } else { bg(ijk) });
+        let v = fill(&|b| {
+            b.add_dense_u16([0, 0, 7], [8, 8, 1], &[9; 64], 3.0)
+                .unwrap()
+        });
+        assert_eq!(v.dense_counts(), [0, 0, 1]);
+        reads(&v, 8, |ijk| if ijk[2] == 7 { 3.0 } else { bg(ijk) });
+    }
+
+    #[test]
+    fn typed_bricks_collapse_and_check_their_values() {
+        // Complete u8 bricks of one code are constants; of the background's, nothing.
+        let mut b = VolumeBuilder::new("v", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [15, 7, 7], "g").unwrap();
+        let mut bytes = vec![0u8; 16 * 8 * 8];
+        for (i, c) in bytes.iter_mut().enumerate() {
+            if i % 16 >= 8 {
+                *c = 51;
+            }
+        }
+        for z in 0..8 {
+            b.add_dense_u8(
+                [0, 0, z],
+                [16, 8, 1],
+                &bytes[z as usize * 128..][..128],
+                255.0,
+            )
+            .unwrap();
+        }
+        let v = b.finish().unwrap();
+        assert_eq!(v.brick([0, 0, 0]), None);
+        assert_eq!(v.brick([1, 0, 0]), Some(&Brick::Constant(0.2)));
+
+        // A divisor so small that a code's value overflows is a non-finite value.
+        let mut b = builder([0; 3], [7; 3]);
+        let e = b
+            .add_dense_u16([0; 3], [2, 1, 1], &[0, 60000], 1e-35)
+            .unwrap_err();
+        assert!(e.contains("non-finite value inf at voxel [1, 0, 0]"), "{e}");
     }
 
     #[test]

@@ -243,12 +243,7 @@ impl RenderVolume {
                     let key = [kmin[0] + x, kmin[1] + y, kmin[2] + z];
                     ranges.push(match volume.brick(key) {
                         None => (volume.background, volume.background),
-                        Some(Brick::Constant(v)) => (*v, *v),
-                        Some(Brick::Dense(values)) => values
-                            .iter()
-                            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| {
-                                (a.min(v), b.max(v))
-                            }),
+                        Some(b) => b.range(volume.codes()),
                     });
                 }
             }
@@ -356,19 +351,32 @@ impl RenderVolume {
         let mut c = [0.0f32; 8];
         if (0..3).all(|a| i1[a] >> shift == key[a]) {
             // The common case: all eight voxels in one brick, one lookup.
+            let m = BRICK_SIZE - 1;
+            let at = |k: usize| {
+                let x = if k & 1 == 0 { i0[0] } else { i1[0] };
+                let y = if k & 2 == 0 { i0[1] } else { i1[1] };
+                let z = if k & 4 == 0 { i0[2] } else { i1[2] };
+                ((x & m) + ((y & m) << shift) + ((z & m) << (2 * shift))) as usize
+            };
+            // One match per sample, then a loop over the corners in the brick's format.
             match vol.brick(key) {
                 None => return vol.background,
                 Some(Brick::Constant(v)) => return *v,
-                Some(Brick::Dense(values)) => {
-                    let m = BRICK_SIZE - 1;
-                    let l = |x: i64, y: i64, z: i64| {
-                        values[((x & m) + ((y & m) << shift) + ((z & m) << (2 * shift))) as usize]
-                    };
+                Some(Brick::F32(values)) => {
                     for (k, v) in c.iter_mut().enumerate() {
-                        let x = if k & 1 == 0 { i0[0] } else { i1[0] };
-                        let y = if k & 2 == 0 { i0[1] } else { i1[1] };
-                        let z = if k & 4 == 0 { i0[2] } else { i1[2] };
-                        *v = l(x, y, z);
+                        *v = values[at(k)];
+                    }
+                }
+                Some(Brick::U8(values)) => {
+                    let codes = vol.codes();
+                    for (k, v) in c.iter_mut().enumerate() {
+                        *v = codes.u8(values[at(k)]);
+                    }
+                }
+                Some(Brick::U16(values)) => {
+                    let codes = vol.codes();
+                    for (k, v) in c.iter_mut().enumerate() {
+                        *v = codes.u16(values[at(k)]);
                     }
                 }
             }

@@ -45,6 +45,13 @@ pub(crate) struct MeshRef {
 
 type Result<T> = std::result::Result<T, crate::error::SceneError>;
 
+fn angle(a: raw::TransparencyAngle) -> TransparencyAngle {
+    match a {
+        raw::TransparencyAngle::Constant => TransparencyAngle::Constant,
+        raw::TransparencyAngle::Raster3D => TransparencyAngle::Raster3D,
+    }
+}
+
 impl Checker<'_> {
     /// Converts everything but `include`, which the loader follows.
     pub fn part(&self, scene: raw::Scene, root: &Node) -> Result<Part> {
@@ -141,6 +148,7 @@ impl Checker<'_> {
                     call,
                     material,
                     clip,
+                    shadows: object.shadows.unwrap_or(true),
                 },
                 node,
             ));
@@ -280,11 +288,21 @@ impl Checker<'_> {
             highlight: match m.highlight {
                 Some(raw::Highlight::Phong) => Highlight::Phong,
                 Some(raw::Highlight::Blinn) => Highlight::Blinn,
+                Some(raw::Highlight::BlinnFast) => Highlight::BlinnFast,
                 None => d.highlight,
+            },
+            highlight_color: match m.highlight_color {
+                Some(raw::HighlightColor::Light) => HighlightColor::Light,
+                Some(raw::HighlightColor::Surface) => HighlightColor::Surface,
+                None => d.highlight_color,
             },
             reflect: coefficient("reflect", m.reflect, d.reflect, 1.0)?,
             transmit: coefficient("transmit", m.transmit, d.transmit, 1.0)?,
             ior: positive("ior", m.ior, d.ior)?,
+            transparency_angle: m.transparency_angle.map(angle),
+            outline: coefficient("outline", m.outline, d.outline, 1.0)?,
+            outline_width: coefficient("outline_width", m.outline_width, d.outline_width, 1.0)?,
+            fog: m.fog.unwrap_or(d.fog),
         })
     }
 
@@ -339,25 +357,7 @@ impl Checker<'_> {
             frame: whole("frame", r.frame, d.frame, 0, u32::MAX)?,
             time: r.time.unwrap_or(d.time),
             transparency: match r.transparency {
-                Some(t) => {
-                    let at = field("transparency");
-                    let at = at.field("max_surfaces").unwrap_or(at);
-                    TransparencyDesc {
-                        mode: match t.mode {
-                            Some(raw::TransparencyMode::Filter) | None => TransparencyMode::Filter,
-                            Some(raw::TransparencyMode::AngleModulated) => {
-                                TransparencyMode::AngleModulated
-                            }
-                            Some(raw::TransparencyMode::PostMultiplied) => {
-                                TransparencyMode::PostMultiplied
-                            }
-                        },
-                        max_surfaces: match t.max_surfaces {
-                            Some(n) => Some(self.whole(at, "max_surfaces", n, 0, 1024)?),
-                            None => None,
-                        },
-                    }
-                }
+                Some(t) => self.transparency(t, field("transparency"))?,
                 None => d.transparency,
             },
             volume_step: match r.volume_step {
@@ -365,6 +365,28 @@ impl Checker<'_> {
                 None => d.volume_step,
             },
             volume_skip: r.volume_skip.unwrap_or(d.volume_skip),
+            memory: match &r.memory {
+                Some(text) => Some(self.memory_size(field("memory"), "memory", text)?),
+                None => None,
+            },
+            texture_cache: match &r.texture_cache {
+                Some(text) => {
+                    match self.memory_size(field("texture_cache"), "texture_cache", text)? {
+                        MemorySize::Bytes(n) => Some(n),
+                        MemorySize::Percent(_) => {
+                            return Err(self.error(
+                                field("texture_cache"),
+                                format!(
+                                "`texture_cache` is {}; expected a size in bytes such as \"512M\" \
+                                 or \"1 GiB\" (not a percentage)",
+                                self.literal(field("texture_cache"))
+                            ),
+                            ))
+                        }
+                    }
+                }
+                None => None,
+            },
             adaptive: match r.adaptive {
                 Some(a) => {
                     let at = field("adaptive");
@@ -390,8 +412,69 @@ impl Checker<'_> {
                 }
                 None => None,
             },
+            light_scale: match r.light_scale {
+                Some(s) => {
+                    self.range(field("light_scale"), "light_scale", s, 0.0, f64::INFINITY)?
+                }
+                None => d.light_scale,
+            },
+            tachyon: match r.tachyon {
+                Some(t) => TachyonDesc {
+                    light_threshold: t.light_threshold.unwrap_or(false),
+                    plain_highlights: t.plain_highlights.unwrap_or(false),
+                    depth_limit_background: t.depth_limit_background.unwrap_or(false),
+                },
+                None => d.tachyon,
+            },
         };
         Ok((render, outputs))
+    }
+
+    fn transparency(&self, t: raw::Transparency, node: &Node) -> Result<TransparencyDesc> {
+        let field = |name| node.field(name).unwrap_or(node);
+        let d = TransparencyDesc::default();
+        let mode = match t.mode {
+            Some(raw::TransparencyMode::Filter) | None => TransparencyMode::Filter,
+            Some(raw::TransparencyMode::AngleModulated) => TransparencyMode::AngleModulated,
+            Some(raw::TransparencyMode::PostMultiplied) => TransparencyMode::PostMultiplied,
+            Some(raw::TransparencyMode::Additive) => TransparencyMode::Additive,
+        };
+        let angle = t.angle.map_or(d.angle, angle);
+        if mode == TransparencyMode::AngleModulated && angle != TransparencyAngle::Constant {
+            return Err(self.error(
+                field("angle"),
+                "`angle` is given with `mode: AngleModulated`, which has its own angle rule; \
+                 expected one of them (e.g. `mode: Filter, angle: Raster3D`)",
+            ));
+        }
+        let scale_reflection = t.scale_reflection.unwrap_or(d.scale_reflection);
+        if scale_reflection && mode != TransparencyMode::PostMultiplied {
+            return Err(self.error(
+                field("scale_reflection"),
+                "`scale_reflection` scales the reflection by opacity in `mode: PostMultiplied` \
+                 only; expected that mode or no `scale_reflection`",
+            ));
+        }
+        Ok(TransparencyDesc {
+            mode,
+            angle,
+            max_surfaces: match t.max_surfaces {
+                Some(n) => Some(self.whole(field("max_surfaces"), "max_surfaces", n, 0, 1024)?),
+                None => None,
+            },
+            beyond_max: match t.beyond_max {
+                Some(raw::BeyondMax::Opaque) => BeyondMax::Opaque,
+                Some(raw::BeyondMax::Skip) => BeyondMax::Skip,
+                None => d.beyond_max,
+            },
+            shadows: match t.shadows {
+                Some(raw::TransparentShadows::Tinted) => TransparentShadows::Tinted,
+                Some(raw::TransparentShadows::Untinted) => TransparentShadows::Untinted,
+                Some(raw::TransparentShadows::Off) => TransparentShadows::Off,
+                None => d.shadows,
+            },
+            scale_reflection,
+        })
     }
 
     fn output(&self, o: raw::Output, entry: &Node, dir: &Path) -> Result<OutputDesc> {

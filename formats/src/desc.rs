@@ -158,12 +158,13 @@ pub enum LightDesc {
         shadows: bool,
     },
     /// A point light shining into a cone: full strength inside `cone_deg - falloff_deg`
-    /// (full angles), fading smoothly to nothing at `cone_deg`.
+    /// (full angles), fading to nothing at `cone_deg` as `fade` says.
     Spot {
         position: [f64; 3],
         direction: [f64; 3],
         cone_deg: f64,
         falloff_deg: f64,
+        fade: SpotFade,
         color: [f64; 3],
         intensity: f64,
         shadows: bool,
@@ -193,24 +194,43 @@ pub enum LightDesc {
     },
 }
 
-/// Fog over the distance a camera ray travels to its first hit.
+/// How a spot light fades across its falloff band.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SpotFade {
+    /// A smoothstep in the cosine of the angle from the axis: no visible edge.
+    #[default]
+    Smooth,
+    /// Linear in the angle from the axis (Tachyon's spot lights).
+    Linear,
+}
+
+/// Fog over the distance a camera ray travels to its first hit (`every_ray`: every ray, over
+/// its own segment).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FogDesc {
     pub mode: FogMode,
     pub color: [f64; 3],
     /// Distance measured along the view direction (VMD's planar fog) instead of along the ray
-    /// (radial).
+    /// (radial). With `every_ray`, for camera rays only.
     pub planar: bool,
+    /// Tachyon's fog: every ray's hit is fogged over that ray's own segment, and what is fogged
+    /// is the hit's whole colour, its reflection and refraction included (so light seen in a
+    /// mirror is fogged on its way to the mirror, then again on the way to the eye). Otherwise
+    /// only camera rays are fogged, and only the hit's own shading.
+    pub every_ray: bool,
+    /// Rays that hit nothing are fogged as at infinite distance: they show the fog colour
+    /// (camera rays; with `every_ray`, every ray). Otherwise they show the background.
+    pub misses: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FogMode {
     /// No fog before `start`, all fog after `end`.
     Linear { start: f64, end: f64 },
-    /// Visibility exp(-density·d).
-    Exp { density: f64 },
-    /// Visibility exp(-(density·d)²).
-    Exp2 { density: f64 },
+    /// Visibility exp(-density·(d - start)), 1 before `start`.
+    Exp { density: f64, start: f64 },
+    /// Visibility exp(-(density·(d - start))²), 1 before `start`.
+    Exp2 { density: f64, start: f64 },
 }
 
 /// Ambient occlusion: the ambient term lit by a sky of `color`, seen through `samples` rays
@@ -228,8 +248,23 @@ pub struct AoDesc {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Highlight {
+    /// (reflected light · view)^shininess.
     Phong,
+    /// (normal · half vector)^shininess.
     Blinn,
+    /// Tachyon's cheap Blinn: x / (s − s·x + x) for x = normal · half vector, s = shininess.
+    BlinnFast,
+}
+
+/// The colour a highlight takes (times the light's colour).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum HighlightColor {
+    /// White: the light's own colour (plastic; Tachyon's PHONG PLASTIC).
+    #[default]
+    Light,
+    /// The surface's colour (metal; Tachyon's PHONG METAL, where with
+    /// `TachyonDesc::plain_highlights` it replaces the light's colour).
+    Surface,
 }
 
 /// The thesis's shading model. Coefficients are in [0, 1] except `shininess` and `ior`.
@@ -249,12 +284,25 @@ pub struct MaterialDesc {
     /// Highlight exponent (> 0).
     pub shininess: f64,
     pub highlight: Highlight,
+    pub highlight_color: HighlightColor,
     /// Mirror reflection coefficient.
     pub reflect: f64,
     /// Fraction of light passing through (0 = opaque).
     pub transmit: f64,
     /// Index of refraction (1 = no bending).
     pub ior: f64,
+    /// How transmission changes with the viewing angle, for this material; `None`: the
+    /// render's `transparency.angle` (Tachyon's per-texture `TRANSMODE R3D`).
+    pub transparency_angle: Option<TransparencyAngle>,
+    /// Silhouette darkening in [0, 1] (Tachyon's OUTLINE): the diffuse light (lights and
+    /// occlusion, not ambient) is scaled by (1 − outline) + outline·(1 − (1 − (N·V)²)^k),
+    /// k = 32·(1 − outline_width).
+    pub outline: f64,
+    /// In [0, 1]: wider outlines as it grows.
+    pub outline_width: f64,
+    /// Whether fog covers the surface (false: a light's visible sphere, which Tachyon never
+    /// fogs).
+    pub fog: bool,
 }
 
 impl Default for MaterialDesc {
@@ -269,9 +317,14 @@ impl Default for MaterialDesc {
             specular: 0.0,
             shininess: 32.0,
             highlight: Highlight::Phong,
+            highlight_color: HighlightColor::Light,
             reflect: 0.0,
             transmit: 0.0,
             ior: 1.0,
+            transparency_angle: None,
+            outline: 0.0,
+            outline_width: 0.0,
+            fog: true,
         }
     }
 }
@@ -283,6 +336,9 @@ pub struct ObjectDesc {
     pub material: Option<Spanned<String>>,
     /// Clip group name: the object is cut away on the far side of the group's planes.
     pub clip: Option<Spanned<String>>,
+    /// Whether the object casts shadows (false: shadow and occlusion rays pass through it, as
+    /// through a light's visible sphere).
+    pub shadows: bool,
 }
 
 /// A clip plane: what lies on the side its normal points to is cut away.
@@ -465,6 +521,100 @@ pub struct RenderDesc {
     pub volume_skip: bool,
     /// Adaptive supersampling; `None`: every pixel gets `samples` samples.
     pub adaptive: Option<AdaptiveDesc>,
+    /// Multiplies every light's direct contribution, diffuse and highlight (not the ambient
+    /// term or occlusion): Tachyon's `-rescale_lights`.
+    pub light_scale: f64,
+    /// Rules of Tachyon's shading that Tachyon scenes render with (all off by default).
+    pub tachyon: TachyonDesc,
+    /// The memory budget (`memory: "6 GiB"` or `"50%"`); `None`: the default share of the
+    /// machine's memory (the core works it out).
+    pub memory: Option<MemorySize>,
+    /// Bytes of decoded texture data kept at once (`texture_cache: "1 GiB"`); `None`: 1 GiB,
+    /// or a quarter of the memory budget when that is less.
+    pub texture_cache: Option<u64>,
+}
+
+/// Tachyon's shading rules that have no other use: the Tachyon importer turns them on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TachyonDesc {
+    /// A light counts at a point only where its term N·L · attenuation · spot weight · light
+    /// scale exceeds 1/510 (and a highlight only where its cosine does); mirror and
+    /// transmission coefficients of 1/510 or less are ignored.
+    pub light_threshold: bool,
+    /// Highlights take the light's whole colour: no distance attenuation, spot fade or
+    /// filtering by transparent surfaces in the way (they still need the light in front of
+    /// the surface and not blocked by an opaque one); a `Surface`-coloured highlight takes the
+    /// surface's colour in place of the light's (Tachyon's METAL).
+    pub plain_highlights: bool,
+    /// A reflected or transmitted ray past `max_depth` adds the background colour unscaled
+    /// (not times the mirror or transmission coefficient).
+    pub depth_limit_background: bool,
+}
+
+/// A memory size as a scene (`render: (memory: ...)`) or the command line (`--memory`) gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MemorySize {
+    Bytes(u64),
+    /// A share of the machine's memory limit, in percent (above 0, at most 100).
+    Percent(f64),
+}
+
+impl std::fmt::Display for MemorySize {
+    /// As a scene writes it, in the largest unit that divides it ("6 GiB", "100 B", "50%"):
+    /// [`parse_memory_size`] reads it back.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            MemorySize::Bytes(n) => {
+                let unit = [(40, "TiB"), (30, "GiB"), (20, "MiB"), (10, "KiB")]
+                    .into_iter()
+                    .find(|&(shift, _)| n >= 1 << shift && n % (1 << shift) == 0);
+                match unit {
+                    Some((shift, name)) => write!(f, "{} {name}", n >> shift),
+                    None => write!(f, "{n} B"),
+                }
+            }
+            MemorySize::Percent(p) => write!(f, "{p}%"),
+        }
+    }
+}
+
+/// What a size looks like, for messages.
+pub const MEMORY_SIZE_EXAMPLES: &str = "a size such as 512M, 6G, \"1.5 GiB\" or 50%";
+
+/// Parses a memory size: a number with a binary unit (`K`, `M`, `G`, `T`, also written `KiB`,
+/// `MiB`, `GiB`, `TiB`, or `KB`... with the same binary meaning; `B` for bytes), or a
+/// percentage of the machine's memory (`50%`). Spaces between number and unit are allowed.
+/// The error says what is wrong, without the text itself (callers quote it with its place).
+pub fn parse_memory_size(text: &str) -> Result<MemorySize, String> {
+    let t = text.trim();
+    let end = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = (&t[..end], t[end..].trim());
+    let value: f64 = match number.parse() {
+        Ok(v) if number.chars().next().is_some_and(|c| c.is_ascii_digit()) => v,
+        _ => return Err("it does not start with a number".into()),
+    };
+    if unit == "%" {
+        if !(value > 0.0 && value <= 100.0) {
+            return Err("a percentage must be above 0 and at most 100".into());
+        }
+        return Ok(MemorySize::Percent(value));
+    }
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" => return Err("it has no unit".into()),
+        "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        "T" | "TB" | "TIB" => 40,
+        _ => return Err(format!("`{}` is not a unit", crate::error::shown(unit))),
+    };
+    let bytes = value * (1u64 << shift) as f64;
+    if !(bytes >= 1.0 && bytes < 2f64.powi(63)) {
+        return Err("the size must be at least 1 byte and below 8 EiB".into());
+    }
+    Ok(MemorySize::Bytes(bytes as u64))
 }
 
 /// Adaptive supersampling (Stone's thesis, II.E): a pixel starts with a jittered 2x2 grid per
@@ -482,35 +632,81 @@ pub struct AdaptiveDesc {
 /// The deepest split allowed: 4^(6+1) samples per base cell at most.
 pub const ADAPTIVE_MAX_DEPTH: u32 = 6;
 
-/// How transparent surfaces combine with what is behind them.
+/// How transparent surfaces combine with what is behind them, and shadow through them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TransparencyDesc {
     pub mode: TransparencyMode,
-    /// After this many transparent surfaces along a path, the next one is shown opaque
-    /// (Tachyon's limit: deep stacks of molecular surfaces stay legible). `None`: no limit.
+    /// How the transmit coefficient changes with the viewing angle (materials may override
+    /// it); must be `Constant` with `AngleModulated`, which has its own rule.
+    pub angle: TransparencyAngle,
+    /// The most transparent surfaces a path shows (Tachyon's limit: deep stacks of molecular
+    /// surfaces stay legible); `beyond_max` says what becomes of the next ones. `None`: no
+    /// limit.
     pub max_surfaces: Option<u32>,
+    pub beyond_max: BeyondMax,
+    /// What a shadow ray keeps through a transparent surface.
+    pub shadows: TransparentShadows,
+    /// `PostMultiplied` only: the mirror reflection is scaled by opacity too (VMD's Tachyon).
+    pub scale_reflection: bool,
 }
 
 impl Default for TransparencyDesc {
     fn default() -> Self {
         TransparencyDesc {
             mode: TransparencyMode::Filter,
+            angle: TransparencyAngle::Constant,
             max_surfaces: None,
+            beyond_max: BeyondMax::Opaque,
+            shadows: TransparentShadows::Tinted,
+            scale_reflection: false,
         }
     }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TransparencyMode {
-    /// Tachyon's original: diffuse and ambient scaled by opacity, highlights kept, light from
-    /// behind filtered by the surface colour.
+    /// Ambient and diffuse scaled by opacity, highlights kept, light from behind filtered by
+    /// the surface colour (Luxon's default).
     Filter,
-    /// Raster3D-style: a surface is more opaque seen edge-on (its transmittance t becomes
+    /// `Filter`, and a surface is more opaque seen edge-on (its transmittance t becomes
     /// t^(1/|cos θ|), a slab seen at angle θ).
     AngleModulated,
     /// VMD's post-multiplied: the fully shaded colour (highlights too) times opacity, plus the
     /// unfiltered light from behind times transmittance.
     PostMultiplied,
+    /// Tachyon's original (`TRANS_ORIG`): the surface's shading as if opaque, plus the
+    /// unfiltered light from behind times transmittance.
+    Additive,
+}
+
+/// How a surface's transmit coefficient changes with the angle it is seen at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransparencyAngle {
+    /// It does not.
+    Constant,
+    /// Tachyon's Raster3D rule: opacity o seen along D becomes ¼(1 + cos(π(1 − o)(N·D)))²,
+    /// more transparent edge-on.
+    Raster3D,
+}
+
+/// What becomes of transparent surfaces past `max_surfaces`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BeyondMax {
+    /// The next one is shown opaque.
+    Opaque,
+    /// They are not shown at all: rays pass through them (Tachyon's).
+    Skip,
+}
+
+/// What a shadow (or occlusion) ray keeps through each transparent surface it crosses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransparentShadows {
+    /// transmit × colour: coloured glass casts coloured shadows.
+    Tinted,
+    /// transmit, grey (Tachyon's).
+    Untinted,
+    /// All of it: transparent surfaces cast no shadow (Tachyon's SHADOW_FILTER_OFF).
+    Off,
 }
 
 impl Default for RenderDesc {
@@ -529,6 +725,10 @@ impl Default for RenderDesc {
             volume_step: 1.0,
             volume_skip: true,
             adaptive: None,
+            light_scale: 1.0,
+            tachyon: TachyonDesc::default(),
+            memory: None,
+            texture_cache: None,
         }
     }
 }

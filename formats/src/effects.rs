@@ -46,6 +46,7 @@ impl Checker<'_> {
                 direction,
                 angle,
                 falloff,
+                fade,
                 color,
                 intensity,
                 shadows,
@@ -63,6 +64,10 @@ impl Checker<'_> {
                     direction: f.direction("direction", direction)?,
                     cone_deg: cone,
                     falloff_deg: falloff,
+                    fade: match fade {
+                        Some(raw::SpotFade::Linear) => SpotFade::Linear,
+                        Some(raw::SpotFade::Smooth) | None => SpotFade::Smooth,
+                    },
                     color: f.colour(color)?,
                     intensity: f.intensity(intensity)?,
                     shadows: shadows.unwrap_or(true),
@@ -129,17 +134,33 @@ impl Checker<'_> {
                 }
                 FogMode::Linear { start, end }
             }
-            raw::FogMode::Exp { density } => FogMode::Exp {
+            raw::FogMode::Exp { density, start } => FogMode::Exp {
                 density: self.positive(inner("density"), "density", density)?,
+                start: self.range(
+                    inner("start"),
+                    "start",
+                    start.unwrap_or(0.0),
+                    0.0,
+                    f64::INFINITY,
+                )?,
             },
-            raw::FogMode::Exp2 { density } => FogMode::Exp2 {
+            raw::FogMode::Exp2 { density, start } => FogMode::Exp2 {
                 density: self.positive(inner("density"), "density", density)?,
+                start: self.range(
+                    inner("start"),
+                    "start",
+                    start.unwrap_or(0.0),
+                    0.0,
+                    f64::INFINITY,
+                )?,
             },
         };
         Ok(FogDesc {
             mode,
             color: self.colour(field("color"), "color", fog.color.unwrap_or([0.5; 3]))?,
             planar: fog.planar.unwrap_or(false),
+            every_ray: fog.every_ray.unwrap_or(false),
+            misses: fog.misses.unwrap_or(false),
         })
     }
 

@@ -15,6 +15,9 @@ pub struct InlineGeometry {
     pub clip: Option<Spanned<String>>,
     /// Where the geometry came from (first primitive), for messages.
     pub at: Option<Origin>,
+    /// Casts no shadows: shadow and occlusion rays pass through it (a light's visible
+    /// sphere).
+    pub shadowless: bool,
     /// x, y, z, radius.
     pub spheres: Vec<[f64; 4]>,
     /// Open cones: base x, y, z, base radius, apex x, y, z, apex radius (equal radii: cylinder).

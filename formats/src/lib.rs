@@ -13,6 +13,7 @@
 //! | origin      | `origin`                                         |
 //! | leaves      | `error`, `geometry`, `spans`, `raw`, `pattern`   |
 //! | description | `desc`                                           |
+//! | text        | `ron_text`                                       |
 //! | input       | `input`                                          |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
@@ -41,6 +42,7 @@ mod pattern;
 mod raw;
 mod ron_error;
 mod ron_scene;
+mod ron_text;
 mod scanner;
 mod spans;
 pub mod spd;
@@ -56,3 +58,4 @@ pub use input::{DiskSource, LoadOptions, MemorySource, Source};
 pub use load::{load, load_with};
 pub use pattern::FramePattern;
 pub use ron_scene::{load_ron_str, load_ron_with};
+pub use ron_text::{inline_as_objects, to_ron};

@@ -161,6 +161,8 @@ pub(crate) enum Light {
         #[serde(default)]
         falloff: Option<f64>,
         #[serde(default)]
+        fade: Option<SpotFade>,
+        #[serde(default)]
         color: Option<Vec3>,
         #[serde(default)]
         intensity: Option<f64>,
@@ -216,6 +218,13 @@ impl Light {
     }
 }
 
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "SpotFade")]
+pub(crate) enum SpotFade {
+    Smooth,
+    Linear,
+}
+
 #[derive(Deserialize)]
 #[serde(rename = "Fog", deny_unknown_fields)]
 pub(crate) struct Fog {
@@ -224,14 +233,29 @@ pub(crate) struct Fog {
     pub color: Option<Vec3>,
     #[serde(default)]
     pub planar: Option<bool>,
+    #[serde(default)]
+    pub every_ray: Option<bool>,
+    #[serde(default)]
+    pub misses: Option<bool>,
 }
 
 #[derive(Deserialize)]
 #[serde(rename = "FogMode", deny_unknown_fields)]
 pub(crate) enum FogMode {
-    Linear { start: f64, end: f64 },
-    Exp { density: f64 },
-    Exp2 { density: f64 },
+    Linear {
+        start: f64,
+        end: f64,
+    },
+    Exp {
+        density: f64,
+        #[serde(default)]
+        start: Option<f64>,
+    },
+    Exp2 {
+        density: f64,
+        #[serde(default)]
+        start: Option<f64>,
+    },
 }
 
 #[derive(Deserialize)]
@@ -270,9 +294,14 @@ pub(crate) struct Material {
     pub specular: Option<f64>,
     pub shininess: Option<f64>,
     pub highlight: Option<Highlight>,
+    pub highlight_color: Option<HighlightColor>,
     pub reflect: Option<f64>,
     pub transmit: Option<f64>,
     pub ior: Option<f64>,
+    pub transparency_angle: Option<TransparencyAngle>,
+    pub outline: Option<f64>,
+    pub outline_width: Option<f64>,
+    pub fog: Option<bool>,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -280,6 +309,14 @@ pub(crate) struct Material {
 pub(crate) enum Highlight {
     Phong,
     Blinn,
+    BlinnFast,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "HighlightColor")]
+pub(crate) enum HighlightColor {
+    Light,
+    Surface,
 }
 
 #[derive(Deserialize)]
@@ -295,6 +332,8 @@ pub(crate) struct Object {
     pub material: Option<String>,
     #[serde(default)]
     pub clip: Option<String>,
+    #[serde(default)]
+    pub shadows: Option<bool>,
 }
 
 /// Keeps the side of the plane its normal points away from; cuts away the other.
@@ -410,6 +449,18 @@ pub(crate) struct Render {
     pub volume_step: Option<f64>,
     pub volume_skip: Option<bool>,
     pub adaptive: Option<Adaptive>,
+    pub light_scale: Option<f64>,
+    pub tachyon: Option<Tachyon>,
+    pub memory: Option<String>,
+    pub texture_cache: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Tachyon", deny_unknown_fields)]
+pub(crate) struct Tachyon {
+    pub light_threshold: Option<bool>,
+    pub plain_highlights: Option<bool>,
+    pub depth_limit_background: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -423,7 +474,11 @@ pub(crate) struct Adaptive {
 #[serde(rename = "Transparency", deny_unknown_fields)]
 pub(crate) struct Transparency {
     pub mode: Option<TransparencyMode>,
+    pub angle: Option<TransparencyAngle>,
     pub max_surfaces: Option<f64>,
+    pub beyond_max: Option<BeyondMax>,
+    pub shadows: Option<TransparentShadows>,
+    pub scale_reflection: Option<bool>,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -432,6 +487,29 @@ pub(crate) enum TransparencyMode {
     Filter,
     AngleModulated,
     PostMultiplied,
+    Additive,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "TransparencyAngle")]
+pub(crate) enum TransparencyAngle {
+    Constant,
+    Raster3D,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "BeyondMax")]
+pub(crate) enum BeyondMax {
+    Opaque,
+    Skip,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "TransparentShadows")]
+pub(crate) enum TransparentShadows {
+    Tinted,
+    Untinted,
+    Off,
 }
 
 #[derive(Deserialize)]

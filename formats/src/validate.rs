@@ -2,7 +2,9 @@
 //! positions and errors; finite numbers, ranges, colours, plugin names; the conversion modules
 //! add their parts to it) and `references` (names used but never defined, after merging).
 
-use crate::desc::{Origin, SceneDesc, Spanned};
+use crate::desc::{
+    parse_memory_size, MemorySize, Origin, SceneDesc, Spanned, MEMORY_SIZE_EXAMPLES,
+};
 use crate::error::{shown, unknown_name, SceneError};
 use crate::spans::{Node, SourceMap};
 
@@ -87,6 +89,24 @@ impl Checker<'_> {
                 format!("`{name}` is {written}; expected a number greater than 0"),
             ))
         }
+    }
+
+    /// A memory size written as a string (`"6 GiB"`, `"50%"`; see `parse_memory_size`).
+    pub fn memory_size(
+        &self,
+        node: &Node,
+        name: &str,
+        text: &str,
+    ) -> Result<MemorySize, SceneError> {
+        parse_memory_size(text).map_err(|why| {
+            self.error(
+                node,
+                format!(
+                    "`{name}` is {}: {why}; expected {MEMORY_SIZE_EXAMPLES}",
+                    self.literal(node)
+                ),
+            )
+        })
     }
 
     /// A whole number in `[min, max]`.

@@ -264,6 +264,14 @@ fn ambient_occlusion_errors() {
     check(found, 3, 34, &["`samples` is 0"]);
 }
 
+#[test]
+fn fog_errors() {
+    let found = scene_error("    fog: (mode: Exp(density: 0.1, start: -1), every_ray: true),");
+    check(found, 3, 42, &["`start` is -1", "0"]);
+    let found = scene_error("    fog: (mode: Exp2(density: 0.1), misses: 1),");
+    check(found, 3, 45, &["expected `true` or `false`"]);
+}
+
 // ---- Materials ----
 
 #[test]
@@ -276,6 +284,8 @@ fn material_coefficients() {
         ("ior: 0", "`ior` is 0"),
         ("ambient: -1", "`ambient` is -1"),
         ("color: (0.5, 0.5, -2)", "-2"),
+        ("outline: 1.5", "`outline` is 1.5"),
+        ("outline_width: -0.5", "`outline_width` is -0.5"),
     ];
     for (field, words) in cases {
         let body = format!("    materials: {{ \"m\": ({field}) }},");
@@ -406,6 +416,32 @@ fn adaptive_settings() {
 }
 
 #[test]
+fn tachyon_shading_settings() {
+    check(
+        render_error("light_scale: -1"),
+        3,
+        27,
+        &["`light_scale` is -1", "0"],
+    );
+    check(
+        render_error("transparency: (mode: AngleModulated, angle: Raster3D)"),
+        3,
+        58,
+        &["`angle`", "AngleModulated", "expected one of them"],
+    );
+    check(
+        render_error("transparency: (mode: Filter, scale_reflection: true)"),
+        3,
+        61,
+        &["`scale_reflection`", "PostMultiplied"],
+    );
+    let (_, _, m) = render_error("transparency: (beyond_max: Hidden)");
+    assert!(m.contains("Skip"), "{m}");
+    let (_, _, m) = render_error("tachyon: (threshold: true)");
+    assert!(m.contains("light_threshold"), "{m}");
+}
+
+#[test]
 fn render_limits() {
     check(
         render_error("samples: 0"),
@@ -524,4 +560,77 @@ fn echoed_names_cannot_drive_the_terminal() {
             "expected one of `\\u{1b}[31m`",
         ],
     );
+}
+
+// ---- Memory sizes (`render: (memory: ..., texture_cache: ...)`) ----
+
+#[test]
+fn memory_sizes_parse_with_binary_units_or_as_percentages() {
+    use luxon_formats::{parse_memory_size, MemorySize};
+    for (text, bytes) in [
+        ("6 GiB", 6u64 << 30),
+        ("512M", 512 << 20),
+        ("1.5G", 3 << 29),
+        ("64 kb", 64 << 10),
+        ("2T", 2 << 40),
+        ("100 B", 100),
+    ] {
+        assert_eq!(
+            parse_memory_size(text),
+            Ok(MemorySize::Bytes(bytes)),
+            "{text}"
+        );
+    }
+    assert_eq!(parse_memory_size("50%"), Ok(MemorySize::Percent(50.0)));
+    // Written back as a scene writes them, they read back the same.
+    for m in [
+        MemorySize::Bytes(6 << 30),
+        MemorySize::Bytes(3 << 29),
+        MemorySize::Bytes(100),
+        MemorySize::Percent(12.5),
+    ] {
+        assert_eq!(parse_memory_size(&m.to_string()), Ok(m), "{m}");
+    }
+    assert_eq!(MemorySize::Bytes(3 << 29).to_string(), "1536 MiB");
+    for (text, why) in [
+        ("1.5 X", "`X` is not a unit"),
+        ("1024", "no unit"),
+        ("G", "does not start with a number"),
+        ("-1G", "does not start with a number"),
+        ("0M", "at least 1 byte"),
+        ("0%", "above 0 and at most 100"),
+        ("150%", "above 0 and at most 100"),
+        ("99999999T", "below 8 EiB"),
+    ] {
+        let e = parse_memory_size(text).unwrap_err();
+        assert!(e.contains(why), "{text}: {e}");
+    }
+}
+
+#[test]
+fn a_memory_size_without_a_unit_is_an_error_at_its_value() {
+    let found = scene_error("    render: (width: 8, memory: \"1.5 X\"),");
+    check(
+        found,
+        3,
+        32,
+        &["`memory` is \"1.5 X\": `X` is not a unit; expected a size such as 512M"],
+    );
+    let found = scene_error("    render: (texture_cache: \"25%\"),");
+    check(
+        found,
+        3,
+        29,
+        &["`texture_cache` is \"25%\"", "not a percentage"],
+    );
+    let desc = load_ron_str(
+        &format!("(\n{CAMERA}\n    render: (memory: \"50%\", texture_cache: \"1 GiB\"),\n)"),
+        Path::new("ok.ron"),
+    )
+    .unwrap();
+    assert_eq!(
+        desc.render.memory,
+        Some(luxon_formats::MemorySize::Percent(50.0))
+    );
+    assert_eq!(desc.render.texture_cache, Some(1 << 30));
 }

@@ -5,9 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use luxon_formats::tachyon::{parse_file, syntax};
+use luxon_formats::tachyon::{parse_file, syntax, Highlights, Options, ShadeLevel, Skylight};
 use luxon_formats::{
-    load, FogMode, InlineGeometry, LightDesc, MaterialDesc, Projection, SceneDesc, TransparencyMode,
+    load, BeyondMax, FogMode, Highlight, HighlightColor, InlineGeometry, LightDesc, MaterialDesc,
+    Origin, Projection, SceneDesc, TransparencyAngle, TransparencyMode, TransparentShadows,
 };
 
 struct TempDir(PathBuf);
@@ -237,12 +238,25 @@ fn lights_are_mirrored_with_attenuation_and_cones() {
         LightDesc::Spot {
             cone_deg,
             falloff_deg,
+            fade,
             ..
-        } => assert_eq!((*cone_deg, *falloff_deg), (90.0, 50.0)),
+        } => {
+            assert_eq!((*cone_deg, *falloff_deg), (90.0, 50.0));
+            assert_eq!(*fade, luxon_formats::SpotFade::Linear);
+        }
         other => panic!("{other:?}"),
     }
-    // The visible light sphere is not drawn yet: said once.
-    assert!(warned(&d, "LIGHT with RAD > 0"));
+    // The RAD 0.5 light is also a sphere in its colour, unlit, unfogged, casting no shadow.
+    let g = only(&d);
+    assert_eq!(g.spheres, vec![[0.0, 0.0, 0.0, 0.5]]);
+    assert!(g.shadowless);
+    let m = material(&d, &g.material.as_ref().unwrap().value);
+    assert_eq!(
+        (m.color, m.ambient, m.diffuse, m.specular),
+        ([1.0; 3], 1.0, 0.0, 0.0)
+    );
+    assert!(!m.fog);
+    assert!(!warned(&d, "RAD"));
 }
 
 #[test]
@@ -260,6 +274,119 @@ fn sky_light_and_ambient_occlusion() {
     assert_eq!((ao.samples, ao.direct), (8, 0.2));
 }
 
+/// Loads scene `body` with command-line `options` (their origin is filled in).
+fn scene_with(name: &str, body: &str, options: impl FnOnce(&mut Options)) -> SceneDesc {
+    let dir = TempDir::new(name);
+    let p = dir.write("s.dat", &format!("{HEAD}{body}\nEND_SCENE\n"));
+    let mut o = Options::new(Origin {
+        file: std::sync::Arc::new(PathBuf::from("<command line>")),
+        line: 1,
+        col: 1,
+    });
+    options(&mut o);
+    luxon_formats::tachyon::load_with(&p, &o).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn intensity(l: &LightDesc) -> f64 {
+    match l {
+        LightDesc::Point { intensity, .. } | LightDesc::Directional { intensity, .. } => *intensity,
+        other => panic!("unexpected light {other:?}"),
+    }
+}
+
+#[test]
+fn command_line_options_override_the_scene() {
+    let body = "CAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 2 RAYDEPTH 8 CENTER 0 0 0 VIEWDIR 0 0 1 \
+                UPDIR 0 1 0 END_CAMERA\n\
+                SHADER_MODE MEDIUM TRANS_VMD END_SHADER_MODE\n\
+                LIGHT CENTER 0 0 0 RAD 0 COLOR 1 1 1\n\
+                SPHERE CENTER 0 0 5 RAD 1 TEXTURE AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0 \
+                OPACITY 0.5 PHONG PLASTIC 0.5 PHONG_SIZE 20 COLOR 1 1 1 TEXFUNC 0";
+    let d = scene_with("cli-none", body, |_| {});
+    assert_eq!((d.render.width, d.render.height), (64, 32));
+    assert_eq!((d.render.samples, d.render.max_depth), (3, 7));
+    assert_eq!(d.render.transparency.mode, TransparencyMode::PostMultiplied);
+    assert!(matches!(
+        d.lights[0].value,
+        LightDesc::Point { shadows: false, .. }
+    ));
+    let d = scene_with("cli-all", body, |o| {
+        o.resolution = Some([20, 10]);
+        o.antialiasing = Some(0);
+        o.raydepth = Some(3);
+        o.shade = Some(ShadeLevel::Full);
+        o.transparency = Some((false, true));
+        o.max_surfaces = Some(1);
+        o.fog_vmd = Some(true);
+        o.highlights = Some(Highlights::Phong);
+    });
+    assert_eq!((d.render.width, d.render.height), (20, 10));
+    assert_eq!((d.render.samples, d.render.max_depth), (1, 2));
+    // -trans_raster3d alone: TRANS_ORIG's additive mode with Raster3D's angle rule.
+    assert_eq!(d.render.transparency.mode, TransparencyMode::Additive);
+    assert_eq!(d.render.transparency.angle, TransparencyAngle::Raster3D);
+    assert_eq!(d.render.transparency.max_surfaces, Some(1));
+    assert_eq!(d.render.transparency.beyond_max, BeyondMax::Skip);
+    assert!(matches!(
+        d.lights[0].value,
+        LightDesc::Point { shadows: true, .. }
+    ));
+    let m = &d.materials[0].1.value;
+    assert_eq!((m.highlight, m.specular), (Highlight::Phong, 0.5));
+    // The window follows the new resolution: 2:1 stays 2:1.
+    let f = d.camera.value.frustum.unwrap();
+    assert!(close((f.right - f.left) / (f.top - f.bottom), 2.0));
+    let d = scene_with("cli-null", body, |o| o.highlights = Some(Highlights::None));
+    assert_eq!(d.materials[0].1.value.specular, 0.0);
+    let d = scene_with("cli-fast", body, |o| {
+        o.highlights = Some(Highlights::BlinnFast)
+    });
+    assert_eq!(d.materials[0].1.value.highlight, Highlight::BlinnFast);
+    assert!(!warned(&d, "-shade_blinn_fast"));
+}
+
+#[test]
+fn light_scale_and_skylight_follow_tachyon() {
+    let light = "LIGHT CENTER 0 0 0 RAD 0 COLOR 1 1 1";
+    let ao = "SHADER_MODE FULL AMBIENT_OCCLUSION AMBIENT_COLOR 0.2 0.2 0.2 RESCALE_DIRECT 0.5 \
+              SAMPLES 8 END_SHADER_MODE";
+    // -rescale_lights: only factors below 1, replacing RESCALE_DIRECT; lights scale when
+    // there is no occlusion.
+    let d = scene_with("scale-up", light, |o| o.light_scale = Some(2.0));
+    assert_eq!(intensity(&d.lights[0].value), 1.0);
+    let d = scene_with("scale-down", light, |o| o.light_scale = Some(0.25));
+    assert_eq!(intensity(&d.lights[0].value), 0.25);
+    let d = scene_with("scale-ao", &format!("{ao}\n{light}"), |o| {
+        o.light_scale = Some(0.8)
+    });
+    let a = d.ambient_occlusion.unwrap();
+    assert_eq!((a.direct, intensity(&d.lights[0].value)), (0.8, 1.0));
+    // MEDIUM traces no occlusion but keeps the scene's RESCALE_DIRECT (measured: 66 -> 33).
+    let d = scene_with("scale-medium", &format!("{ao}\n{light}"), |o| {
+        o.shade = Some(ShadeLevel::Medium)
+    });
+    assert!(d.ambient_occlusion.is_none());
+    assert_eq!(intensity(&d.lights[0].value), 0.5);
+    // -auto_skylight f: occlusion of colour f, lights × (1 − f); -add_skylight keeps the scale.
+    let sky = |rescale| Skylight {
+        level: 0.25,
+        samples: 32,
+        rescale,
+    };
+    let d = scene_with("auto", &format!("{ao}\n{light}"), |o| {
+        o.skylight = Some(sky(true))
+    });
+    let a = d.ambient_occlusion.unwrap();
+    assert_eq!((a.samples, a.color, a.direct), (32, [0.25; 3], 0.75));
+    let d = scene_with("add", &format!("{ao}\n{light}"), |o| {
+        o.skylight = Some(sky(false))
+    });
+    let a = d.ambient_occlusion.unwrap();
+    assert_eq!((a.samples, a.color, a.direct), (32, [0.25; 3], 0.5));
+    let d = scene_with("add-plain", light, |o| o.skylight = Some(sky(false)));
+    assert_eq!(d.ambient_occlusion.unwrap().direct, 1.0);
+}
+
 #[test]
 fn shader_modes_set_transparency_fog_and_levels() {
     let glass = "SPHERE CENTER 0 0 5 RAD 1 TEXTURE AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0 \
@@ -271,18 +398,33 @@ fn shader_modes_set_transparency_fog_and_levels() {
              END_SHADER_MODE\nFOG LINEAR START 0 END 10 DENSITY 1 COLOR 1 1 1\n{glass}"
         ),
     );
-    assert_eq!(d.render.transparency.mode, TransparencyMode::PostMultiplied);
-    assert_eq!(d.render.transparency.max_surfaces, Some(2));
-    assert!(d.fog.as_ref().unwrap().planar);
-    assert!(warned(&d, "TRANS_MAX_SURFACES") && warned(&d, "SHADOW_FILTER_OFF"));
-    assert!(!warned(&d, "FOG leaves the background"));
-    // TRANS_ORIG clears the flags; the default transparency is said to differ.
+    let t = d.render.transparency;
+    assert_eq!(t.mode, TransparencyMode::PostMultiplied);
+    assert!(t.scale_reflection);
+    assert_eq!(t.max_surfaces, Some(2));
+    assert_eq!(t.beyond_max, BeyondMax::Skip);
+    assert_eq!(t.shadows, TransparentShadows::Off);
+    let f = d.fog.as_ref().unwrap();
+    // FOG_VMD: planar for camera rays, the background unfogged.
+    assert!(f.planar && f.every_ray && !f.misses);
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    let r = d.render.tachyon;
+    assert!(r.light_threshold && r.plain_highlights && r.depth_limit_background);
+    // TRANS_ORIG clears the flags: Tachyon's additive transparency, grey shadows.
     let d = scene(
         "orig",
         &format!("SHADER_MODE FULL TRANS_RASTER3D TRANS_ORIG END_SHADER_MODE\n{glass}"),
     );
-    assert_eq!(d.render.transparency.mode, TransparencyMode::Filter);
-    assert!(warned(&d, "TRANS_ORIG"));
+    let t = d.render.transparency;
+    assert_eq!(t.mode, TransparencyMode::Additive);
+    assert_eq!(t.angle, TransparencyAngle::Constant);
+    assert_eq!(t.shadows, TransparentShadows::Untinted);
+    assert!(!t.scale_reflection);
+    let d = scene(
+        "r3d",
+        &format!("SHADER_MODE FULL TRANS_RASTER3D END_SHADER_MODE\n{glass}"),
+    );
+    assert_eq!(d.render.transparency.angle, TransparencyAngle::Raster3D);
     let d = scene(
         "medium",
         &format!(
@@ -328,15 +470,31 @@ fn fog_modes() {
     assert!(!f.planar);
     assert_eq!(
         fog("fe", "EXP").unwrap().mode,
-        FogMode::Exp { density: 0.3 }
+        FogMode::Exp {
+            density: 0.3,
+            start: 0.0
+        }
     );
     assert_eq!(
         fog("f2", "exp2").unwrap().mode,
-        FogMode::Exp2 { density: 0.3 }
+        FogMode::Exp2 {
+            density: 0.3,
+            start: 0.0
+        }
     );
     assert!(fog("fo", "OFF").is_none());
+    // Tachyon's radial fog: every ray over its own segment, misses in the fog colour.
+    assert!(f.every_ray && f.misses);
     let d = scene("fs", "FOG EXP START 1 END 4 DENSITY 0.3 COLOR 0 0 1");
-    assert!(warned(&d, "START"));
+    assert_eq!(
+        d.fog.unwrap().mode,
+        FogMode::Exp {
+            density: 0.3,
+            start: 1.0
+        }
+    );
+    let d = scene("fn", "FOG EXP START -1 END 4 DENSITY 0.3 COLOR 0 0 1");
+    assert!(warned(&d, "START below 0"));
 }
 
 #[test]
@@ -432,8 +590,11 @@ fn optional_surface_parts_are_kept_in_the_tree() {
     let d = load(&p).unwrap();
     // Any PHONG word but METAL is plastic: Luxon's highlight, no note.
     assert_eq!(material(&d, "glass").specular, 0.6);
-    assert!(!warned(&d, "PHONG METAL"));
-    assert!(warned(&d, "TRANSMODE R3D") && warned(&d, "OUTLINE"));
+    let m = material(&d, "glass");
+    assert_eq!(m.highlight_color, HighlightColor::Light);
+    assert_eq!(m.transparency_angle, Some(TransparencyAngle::Raster3D));
+    assert_eq!((m.outline, m.outline_width), (0.5, 0.3));
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
 }
 
 #[test]
@@ -725,7 +886,8 @@ fn vcstri_keeps_its_surface_with_a_white_colour() {
     let m = material(&d, &g.material.as_ref().unwrap().value);
     assert_eq!((m.color, m.ambient, m.specular), ([1.0; 3], 0.2, 0.5));
     assert!(warned(&d, "VCSTRI vertex colours"));
-    assert!(warned(&d, "PHONG METAL"));
+    // METAL: the highlight in the surface's colour.
+    assert_eq!(m.highlight_color, HighlightColor::Surface);
 }
 
 #[test]
@@ -1148,7 +1310,14 @@ fn every_debian_example_loads_except_the_one_tachyon_rejects() {
             .sum::<usize>(),
         2 * 159 * 159
     );
-    assert!(get("tpolytest.dat").inline[0].mesh.indices.len() > 1000);
+    assert!(
+        get("tpolytest.dat")
+            .inline
+            .iter()
+            .map(|g| g.mesh.indices.len())
+            .sum::<usize>()
+            > 1000
+    );
     assert_eq!(get("engine.dat").volumes.len(), 1);
     assert_eq!(get("clipplanes.dat").clip_groups.len(), 1);
     let msti = get("msti.dat");

@@ -126,5 +126,14 @@ pub fn read_volume_of(
         None => format!("volume {i}"),
     };
     let dir = desc.source.parent().unwrap();
-    luxon::plugin::read_volume(reg, entry, &call.params, &call.params_at, dir, &name)
+    let budget = std::sync::Arc::new(luxon::budget::Budget::unlimited());
+    luxon::plugin::read_volume(
+        reg,
+        entry,
+        &call.params,
+        &call.params_at,
+        dir,
+        &name,
+        &budget,
+    )
 }

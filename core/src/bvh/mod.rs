@@ -48,6 +48,12 @@ fn offset_of(link: u64) -> usize {
     (link & OFFSET_MASK) as usize
 }
 
+/// At most the bytes a build holds at once per primitive, for charging the memory budget
+/// before building: its records, the binary tree, the wide nodes and the leaf order (at most
+/// 196 per primitive in the tests, which check this bound), and the copy an owner makes to put
+/// its primitives in leaf order (44 bytes for a triangle and its material).
+pub const BUILD_BYTES_PER_PRIM: u64 = 256;
+
 /// A BVH over primitives `0..n`. After building, primitive `order[i]` is the i-th in leaf order;
 /// owners reorder their arrays by `order` so leaves address contiguous ranges.
 #[derive(Clone, Debug, Default)]
@@ -85,6 +91,11 @@ impl Bvh {
         self.nodes.len()
     }
 
+    /// Bytes of the nodes.
+    pub fn memory_bytes(&self) -> u64 {
+        (self.nodes.capacity() * std::mem::size_of::<Wide>()) as u64
+    }
+
     pub fn bounds(&self) -> Aabb {
         match self.nodes.first() {
             Some(n) => n.bounds(),
@@ -107,6 +118,41 @@ mod tests {
                 .filter(|&l| l != wide::EMPTY)
                 .map(count_of)
                 .filter(|&c| c > 0)
+        }
+    }
+
+    /// The bytes a build holds at once (records, binary tree, wide nodes, collapse's depths and
+    /// the leaf order) stay within `BUILD_BYTES_PER_PRIM` per primitive, for spread-out boxes,
+    /// identical ones, and thin slivers along a line.
+    #[test]
+    fn a_build_holds_at_most_its_estimate_per_primitive() {
+        let line = |n: usize| -> Vec<Aabb> {
+            (0..n)
+                .map(|i| {
+                    let c = Vec3A::new(i as f32 * 0.01, 0.0, 0.0);
+                    Aabb::new(c, c + Vec3A::new(0.001, 1.0, 1.0))
+                })
+                .collect()
+        };
+        let same = |n: usize| vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); n];
+        for n in [1, 2, 7, 100, 5000, 40_000] {
+            for bounds in [boxes(n), same(n), line(n)] {
+                let mut prims: Vec<BuildPrim> =
+                    (0..n).map(|i| BuildPrim::new(bounds[i], i)).collect();
+                let mut binary = Vec::new();
+                build_node(&mut prims, 0, 0, &mut binary);
+                let wide = Bvh::collapse(&binary);
+                let peak = prims.capacity() * std::mem::size_of::<BuildPrim>()
+                    + binary.capacity() * std::mem::size_of::<build::Node>()
+                    + binary.len() * 2
+                    + n * 8
+                    + wide.memory_bytes() as usize;
+                println!("{n}: {} bytes per primitive", peak / n);
+                assert!(
+                    peak as u64 <= n as u64 * BUILD_BYTES_PER_PRIM + 4096,
+                    "{n} primitives: {peak} bytes"
+                );
+            }
         }
     }
 

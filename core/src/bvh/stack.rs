@@ -39,7 +39,9 @@ impl<'a, T: Copy> Stack<'a, T> {
 
     /// Pushes an entry. The traversals keep `len < STACK` here: they push only a node's hit
     /// children, and after taking one of them hold at most `LANES - 1` entries per level above
-    /// the current node; every inner node is less than `MAX_DEPTH` deep (`collapse` keeps the
+    /// the current node; the links they follow go down the tree (an empty lane's inverted box
+    /// is never hit: the loops `Bvh::closest` and `Bvh::first` trace only rays with finite
+    /// coordinates), and every inner node is less than `MAX_DEPTH` deep (`collapse` keeps the
     /// binary tree's depth, and `from_words` refuses deeper cached trees along any path), so at
     /// most `(LANES - 1) * (MAX_DEPTH - 1) + LANES = STACK` entries are ever held.
     #[inline(always)]

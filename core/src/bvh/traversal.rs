@@ -13,9 +13,23 @@ fn first_lane(mask: u32) -> usize {
     mask.trailing_zeros() as usize & (LANES - 1)
 }
 
+/// Whether a ray's coordinates are all finite. Others meet nothing: a NaN (from a zero-length
+/// direction, say) or an infinity makes the box tests enter empty lanes too, whose link is the
+/// root's, so their traversal would never end (and would overrun its stack). Checked in the
+/// loops, after the check for an empty tree, not in `Bvh::intersect` and `Bvh::any`, which are
+/// inlined into every caller (one call per primitive kind).
+#[inline(always)]
+#[allow(clippy::eq_op)] // x - x on purpose (below)
+fn finite(origin: Vec3A, dir: Vec3A) -> bool {
+    // x - x is 0 for finite x and NaN for the others (fewer instructions than glam's
+    // `is_finite`, which masks the sign bits and compares with infinity).
+    ((origin - origin) + (dir - dir)).cmpeq(Vec3A::ZERO).all()
+}
+
 impl Bvh {
     /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
-    /// `t_max` (and records whatever it needs). Returns the final `t_max`.
+    /// `t_max` (and records whatever it needs). Returns the final `t_max`. A ray with a NaN or
+    /// infinite coordinate meets nothing.
     // Only this dispatch is inlined; the loops (`intersect_avx`, `intersect_base`) are not, or
     // their 14 KB stack would sit in every frame of the recursive integrator, and deep
     // reflections (max_depth in the hundreds) would overflow the thread's stack. The primitive
@@ -50,7 +64,7 @@ impl Bvh {
         mut t_max: f32,
         mut test: F,
     ) -> f32 {
-        if self.nodes.is_empty() {
+        if self.nodes.is_empty() || !finite(origin, dir) {
             return t_max;
         }
         let ray = BoxRay::new(origin, dir);
@@ -107,7 +121,8 @@ impl Bvh {
         }
     }
 
-    /// Any-hit traversal: stops as soon as `test(prim)` returns true.
+    /// Any-hit traversal: stops as soon as `test(prim)` returns true. A ray with a NaN or
+    /// infinite coordinate meets nothing.
     #[inline]
     pub fn any<F: FnMut(usize) -> bool>(
         &self,
@@ -138,7 +153,7 @@ impl Bvh {
         t_max: f32,
         mut test: F,
     ) -> bool {
-        if self.nodes.is_empty() {
+        if self.nodes.is_empty() || !finite(origin, dir) {
             return false;
         }
         let ray = BoxRay::new(origin, dir);
@@ -324,6 +339,37 @@ mod tests {
             tested > 500,
             "the rays should meet many boxes, met {tested}"
         );
+    }
+
+    /// NaN or infinite coordinates (a zero-length direction normalised, a point at infinity)
+    /// made the box tests enter every lane, empty ones included, whose link leads back to the
+    /// root: the traversal never ended. Such rays meet nothing.
+    #[test]
+    fn rays_with_nan_or_infinite_coordinates_meet_nothing() {
+        let b = boxes(5000);
+        let (bvh, _) = Bvh::build(&b);
+        let (nan, inf) = (f32::NAN, f32::INFINITY);
+        // Aimed at a box.
+        let o = b[0].centroid() - Vec3A::new(200.0, 0.0, 0.0);
+        for (o, d) in [
+            (Vec3A::splat(nan), Vec3A::X),
+            (o, Vec3A::ZERO / 0.0),
+            (o, Vec3A::new(1.0, nan, 0.0)),
+            (Vec3A::splat(inf), -Vec3A::ONE.normalize()),
+            (Vec3A::new(-inf, o.y, o.z), Vec3A::X),
+        ] {
+            for t_max in [1e3, inf] {
+                let mut tests = 0;
+                let t = bvh.intersect(o, d, t_max, |_, _| {
+                    tests += 1;
+                    None
+                });
+                assert_eq!((t, tests), (t_max, 0), "closest hit, {o} {d}");
+                assert!(!bvh.any(o, d, t_max, |_| true), "any hit, {o} {d}");
+            }
+        }
+        // The same tree meets a finite ray along that line.
+        assert!(bvh.any(o, Vec3A::X, inf, |_| true));
     }
 
     #[test]

@@ -1,16 +1,19 @@
 //! `luxon check`: validate a scene and describe it.
 
+use luxon::budget::Budget;
 use luxon::plugin::Registry;
 use luxon::{Error, Scene};
-use luxon_formats::SceneDesc;
+use luxon_formats::{MemorySize, SceneDesc};
 use std::path::Path;
+use std::sync::Arc;
 
-pub fn run(path: &Path) -> Result<(), Error> {
+pub fn run(path: &Path, memory: Option<MemorySize>) -> Result<(), Error> {
     let desc = luxon_formats::load(path)?;
     super::warn_scene(&desc);
     let registry = Registry::discover(&desc.plugin_path);
     super::warn_skipped(&registry);
-    let scene = Scene::build(&desc, &registry)?;
+    let budget = Arc::new(Budget::for_render(&desc.render, memory, 1));
+    let scene = Scene::build_with(&desc, &registry, budget)?;
     let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
     describe(&desc, &scene, &outputs);
     Ok(())
@@ -72,11 +75,12 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
     for v in &scene.volumes {
         let (lo, hi) = v.min_max();
         println!(
-            "volume     `{}` ({}): {} voxels, values {lo}..{hi}, {:.1} MiB",
+            "volume     `{}` ({}): {} voxels, values {lo}..{hi}, {:.1} MiB ({})",
             v.name,
             v.plugin,
             v.voxel_count(),
-            v.memory_bytes() as f64 / (1024.0 * 1024.0)
+            v.memory_bytes() as f64 / (1024.0 * 1024.0),
+            brick_summary(v)
         );
     }
     for (i, v) in desc.volumes.iter().enumerate() {
@@ -116,6 +120,14 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
         }
     );
     println!("effects    {}", scene.features);
+    // What the image will take is charged when rendering; here it is only counted.
+    let image = u64::from(s.width) * u64::from(s.height) * 16;
+    println!(
+        "memory     budget {}; the scene holds {}; the image will take {}",
+        scene.budget.describe(),
+        scene.budget.in_use(),
+        luxon::budget::bytes(image)
+    );
     for o in outputs {
         println!(
             "output     {} (writer `{}`)",
@@ -202,4 +214,26 @@ fn animation(a: &luxon_formats::AnimationDesc) -> String {
         line.push_str(&format!("; keyed: {}", keyed.join("; ")));
     }
     line
+}
+
+/// "bricks: 1200 u8, 40 constant": the stored bricks by kind (at the precision the reader
+/// gave), the kinds with none left out.
+fn brick_summary(v: &luxon::volume::Volume) -> String {
+    let [u8s, u16s, f32s] = v.dense_counts();
+    let (_, constant) = v.brick_counts();
+    let kinds: Vec<String> = [
+        (u8s, "u8"),
+        (u16s, "u16"),
+        (f32s, "f32"),
+        (constant, "constant"),
+    ]
+    .iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, kind)| format!("{n} {kind}"))
+    .collect();
+    if kinds.is_empty() {
+        "no bricks stored".into()
+    } else {
+        format!("bricks: {}", kinds.join(", "))
+    }
 }

@@ -74,6 +74,17 @@ impl Job {
         }
     }
 
+    /// Processes of the job on this node (1 without MPI): they share its memory.
+    pub fn node_ranks(&self) -> usize {
+        match self {
+            Job::Local => 1,
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => c.node_ranks(),
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+
     pub fn size(&self) -> usize {
         match self {
             Job::Local => 1,

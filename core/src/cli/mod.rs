@@ -1,6 +1,7 @@
 //! The subcommands of `luxon`, one module each.
 
 pub mod check;
+pub mod convert;
 pub mod job;
 pub mod plugins;
 pub mod progress;
@@ -12,6 +13,7 @@ pub mod shading;
 pub mod signals;
 pub mod spd;
 pub mod sweep;
+pub mod tachyon;
 pub mod usage;
 
 use luxon::plugin::Registry;
@@ -30,6 +32,12 @@ pub fn warn_scene(desc: &luxon_formats::SceneDesc) {
     for w in &desc.warnings {
         luxon::error::print_warning(&w.to_string());
     }
+}
+
+/// `--memory SIZE`: "6G", "512M", "1.5 GiB", "50%" (of the machine's memory).
+pub fn parse_memory(s: &str) -> Result<luxon_formats::MemorySize, String> {
+    luxon_formats::parse_memory_size(s)
+        .map_err(|why| format!("expected {} ({why})", luxon_formats::MEMORY_SIZE_EXAMPLES))
 }
 
 /// `--res WIDTHxHEIGHT`.

@@ -3,6 +3,7 @@
 
 use super::job::Job;
 use super::progress::Progress;
+use luxon::budget::Budget;
 use luxon::cache::{self, Lookup};
 use luxon::framebuffer::Chunk;
 use luxon::output::stream::{is_ppm8, AsyncOutput};
@@ -12,7 +13,7 @@ use luxon::render::RenderStats;
 use luxon::schedule::RankStats;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{
-    Decomposition, Origin, OutputDesc, OutputIo, ParallelMode, RenderDesc, SceneDesc,
+    Decomposition, MemorySize, Origin, OutputDesc, OutputIo, ParallelMode, RenderDesc, SceneDesc,
 };
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -42,6 +43,11 @@ pub struct Overrides {
     /// Render threads per process (default: every CPU; with MPI, the rank's share of them).
     #[arg(long)]
     pub threads: Option<u32>,
+    /// Memory budget: a size (512M, 6G, "1.5 GiB") or a share of the machine's memory (50%);
+    /// replaces the scene's `memory`. Default: 75% of the machine's limit, at most 90% of
+    /// what is free, shared by the MPI ranks of a node.
+    #[arg(long, value_name = "SIZE", value_parser = super::parse_memory)]
+    pub memory: Option<MemorySize>,
     /// Print rays cast per kind, intersection tests, timings and the work of every rank and
     /// thread.
     #[arg(long)]
@@ -182,6 +188,7 @@ pub(super) fn plan<'r>(
     job: &Job,
     registry: &Registry,
     scene_dir: &Path,
+    budget: &Arc<Budget>,
 ) -> Result<Plan<'r>, Error> {
     let io = r.parallel.io;
     let mpi_io = io == OutputIo::MpiIo && matches!(job, Job::Mpi(_));
@@ -195,7 +202,7 @@ pub(super) fn plan<'r>(
         .partition(|(_, o)| mpi_io && is_ppm8(o));
     let streams = match (files.take(), io) {
         (Some(set), OutputIo::Async | OutputIo::MpiIo) if !written_by_root.is_empty() => Some(
-            AsyncOutput::new(written_by_root.clone(), set, r.width, r.height)?,
+            AsyncOutput::new(written_by_root.clone(), set, r.width, r.height, budget)?,
         ),
         (set, _) => {
             files = set;
@@ -420,13 +427,15 @@ fn prepare<'r>(
     // Outputs first: an unwritable path or a writer's bad parameter fails before any work.
     let outputs = luxon::output::resolve(&desc.render.outputs, registry)?;
     let scene_dir = desc.source.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let plan = plan(&desc.render, outputs, job, registry, &scene_dir)?;
+    let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
+    let budget = Arc::new(budget);
+    let plan = plan(&desc.render, outputs, job, registry, &scene_dir, &budget)?;
     let had_objects = !desc.objects.is_empty();
     let from_cache = cached.is_some();
     let prebuilt = match cached {
         Some(c) => {
             let cache::Cached { path, geometry, .. } = *c;
-            Scene::build_prebuilt(&desc, geometry, registry)
+            Scene::build_prebuilt(&desc, geometry, registry, budget.clone())
                 .ok()
                 .map(|s| (s, path))
         }
@@ -442,7 +451,7 @@ fn prepare<'r>(
                 // The cache's view of the scene did not fit: read the source itself.
                 desc = load(path, o, None)?;
             }
-            let scene = Scene::build_taking_geometry(&mut desc, registry)?;
+            let scene = Scene::build_taking_geometry(&mut desc, registry, budget)?;
             cache.write = cache.on
                 && (o.cache || scene.primitive_count() >= CACHE_MIN_PRIMITIVES)
                 && cache::cacheable(&scene, had_objects);
@@ -489,8 +498,12 @@ fn render(
     let done = AtomicU64::new(0);
     let sync = s.io == OutputIo::Sync && job.rank() == 0;
     let sync_fb = Mutex::new(Framebuffer::new(0, 0));
+    // Held while rendering: the image's bytes in the memory budget.
+    let mut _image = None;
     if sync {
-        *sync_fb.lock().unwrap_or_else(|e| e.into_inner()) = Framebuffer::new(s.width, s.height);
+        let (fb, charge) = Framebuffer::charged(s.width, s.height, &scene.budget)?;
+        *sync_fb.lock().unwrap_or_else(|e| e.into_inner()) = fb;
+        _image = Some(charge);
     }
     let (tx, rx) = mpsc::channel::<Chunk>();
     let start = Instant::now();
@@ -571,6 +584,11 @@ pub(super) fn print_stats(
         );
     }
     eprintln!("  effects          {}", scene.features);
+    eprintln!(
+        "  memory budget    {}; the scene holds {}",
+        scene.budget.describe(),
+        scene.budget.in_use()
+    );
     let mode = match (job, set.mode) {
         (Job::Local, ParallelMode::Threads) => "threads",
         (Job::Local, _) => "threads (this luxon was built without MPI)",

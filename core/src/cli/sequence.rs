@@ -10,11 +10,13 @@
 
 use super::job::Job;
 use super::render::{plan, print_stats, warn_nan, write_image, Image, Overrides};
+use luxon::budget::Budget;
 use luxon::output::frames::FrameNames;
 use luxon::plugin::Registry;
 use luxon::{Error, Scene};
 use luxon_formats::SceneDesc;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// `--frames A..B` or `--frames K`.
@@ -59,11 +61,13 @@ fn frame_list(o: &Overrides, desc: &SceneDesc) -> Result<Vec<u32>, Error> {
     Ok((first..=last).step_by(step as usize).collect())
 }
 
-/// Loads nothing (the caller did), builds the scene once and names the outputs.
+/// Loads nothing (the caller did), builds the scene once (within the memory budget, which
+/// every frame's keyed objects and image are charged to as well) and names the outputs.
 fn prepare(
     o: &Overrides,
     mut desc: SceneDesc,
     registry: &Registry,
+    job: &Job,
 ) -> Result<(SceneDesc, Scene, Vec<u32>, FrameNames), Error> {
     let frames = frame_list(o, &desc)?;
     let scene_last = desc.animation.as_ref().map_or(0, |a| a.value.last);
@@ -71,7 +75,8 @@ fn prepare(
     let names = FrameNames::new(&desc.render.outputs, last, frames.len() == 1)?;
     // Writers first: an output no writer takes fails before any work.
     luxon::output::resolve(&desc.render.outputs, registry)?;
-    let scene = Scene::build_taking_geometry(&mut desc, registry)?;
+    let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
+    let scene = Scene::build_taking_geometry(&mut desc, registry, Arc::new(budget))?;
     Ok((desc, scene, frames, names))
 }
 
@@ -84,7 +89,7 @@ pub fn run(
     job: Job,
 ) -> Result<(), Error> {
     let t0 = Instant::now();
-    let ready = desc.and_then(|d| prepare(o, d, registry));
+    let ready = desc.and_then(|d| prepare(o, d, registry, &job));
     let (ready, status) = match ready {
         Ok(r) => {
             let threads = job.threads(&r.1);
@@ -168,7 +173,14 @@ fn frame(
 ) -> Result<Option<Image>, Error> {
     let ready = scene.set_frame(k).and_then(|()| {
         let outputs = luxon::output::resolve(&names.outputs_for(k), registry)?;
-        plan(&desc.render, outputs, job, registry, scene_dir)
+        plan(
+            &desc.render,
+            outputs,
+            job,
+            registry,
+            scene_dir,
+            &scene.budget,
+        )
     });
     let (ready, status) = match ready {
         Ok(p) => (Some(p), Ok(job.threads(scene))),

@@ -34,6 +34,9 @@ pub struct Args {
     /// Render threads (default: every CPU).
     #[arg(long)]
     pub threads: Option<u32>,
+    /// Memory budget of every build and render (as for `render`).
+    #[arg(long, value_name = "SIZE", value_parser = super::parse_memory)]
+    pub memory: Option<luxon_formats::MemorySize>,
     /// Directory for the report.
     #[arg(short, long = "output", value_name = "OUTPUT")]
     pub out: PathBuf,
@@ -72,6 +75,9 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
             return Err(Error::Usage(format!("--threads {n}: expected 1..=4096")));
         }
         desc.render.parallel.threads = Some(n);
+    }
+    if let Some(m) = a.memory {
+        desc.render.memory = Some(m);
     }
     // The sweep writes its own files, not the scene's outputs.
     desc.render.outputs.clear();

@@ -3,6 +3,7 @@
 //! Rays cross the boundary in f64 world coordinates (the core works re-centred in f32).
 
 use super::{clip_of, material_of, Clips, Counters, Hit, Kind, Surface};
+use crate::budget::{Budget, Use};
 use crate::bvh::Bvh;
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
@@ -108,6 +109,29 @@ impl Customs {
 
     pub fn len(&self) -> usize {
         self.refs.len()
+    }
+
+    /// Room for `n` more primitives, charged to `budget` (see `Set::reserve`).
+    pub fn reserve(
+        &mut self,
+        n: usize,
+        budget: &Budget,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), String> {
+        budget.grow(&mut self.refs, n, Use::Geometry, what)?;
+        budget.grow(&mut self.material, n, Use::Geometry, what)?;
+        Ok(())
+    }
+
+    /// Bytes of the primitive references and materials (capacities).
+    pub fn bytes(&self) -> u64 {
+        (self.refs.capacity() * std::mem::size_of::<(u32, u64)>() + self.material.capacity() * 4)
+            as u64
+    }
+
+    /// Bytes of the built BVH.
+    pub fn bvh_bytes(&self) -> u64 {
+        self.bvh.memory_bytes()
     }
 
     /// Asks the plugin for every primitive's bounds; an error names the plugin.

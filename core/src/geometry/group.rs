@@ -1,7 +1,8 @@
 //! A group of native sets of its own: the geometry of an animated scene's keyed objects, stored
 //! for one frame at a time and rebuilt from scratch for each (so a frame never depends on the
 //! frames before it). It is tested after the scene's still geometry; hits in it are marked
-//! `Hit::moving`. Custom (plugin-intersected) geometry cannot be moved, so it has none.
+//! `Hit::moving`. Custom (plugin-intersected) geometry cannot be moved, so it has none. The
+//! group holds the charges of its memory to the budget, given back when it is replaced.
 
 use super::cone::Cones;
 use super::disc::Discs;
@@ -9,7 +10,10 @@ use super::plane::Planes;
 use super::sphere::Spheres;
 use super::triangle::Triangles;
 use super::{Clips, Counters, Hit, Kind, Surface};
+use crate::budget::{Budget, BudgetError, Charge, Use};
+use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::ray::Ray;
+use std::sync::Arc;
 
 #[derive(Default)]
 pub struct Group {
@@ -18,6 +22,8 @@ pub struct Group {
     pub planes: Planes,
     pub cones: Cones,
     pub discs: Discs,
+    /// What the group's arrays and BVHs hold of the memory budget.
+    pub charges: Vec<Charge>,
 }
 
 impl Group {
@@ -33,12 +39,27 @@ impl Group {
             + self.discs.len()
     }
 
-    /// Builds every set's BVH.
-    pub fn build(&mut self) {
+    /// Builds every set's BVH, charging the build's working memory while it runs and the BVHs'
+    /// bytes for the group's life.
+    pub fn build(&mut self, budget: &Arc<Budget>) -> Result<(), BudgetError> {
+        let n = self.spheres.len() + self.triangles.len() + self.cones.len() + self.discs.len();
+        let work = budget.charge(Use::Bvh, n as u64 * BUILD_BYTES_PER_PRIM, || {
+            format!("building the BVHs over {n} moving primitives")
+        })?;
         self.spheres.build();
         self.triangles.set.build();
         self.cones.build();
         self.discs.build();
+        drop(work);
+        let bvhs = self.spheres.bvh_bytes()
+            + self.triangles.set.bvh_bytes()
+            + self.cones.bvh_bytes()
+            + self.discs.bvh_bytes();
+        let held = budget.charge(Use::Bvh, bvhs, || {
+            format!("the BVHs over {n} moving primitives")
+        })?;
+        self.charges.push(held);
+        Ok(())
     }
 
     /// The closest hit before `t_max`, if closer than `hit`: kinds in the scene's order.

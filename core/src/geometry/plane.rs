@@ -1,6 +1,7 @@
 //! Infinite planes: unbounded, so they stay outside the BVHs and are tested one by one.
 
 use super::{clip_of, material_of, Clips, Counters, Hit, Kind, Surface};
+use crate::budget::{Budget, Use};
 use crate::math::{gamma, DVec3, Vec3A};
 use crate::ray::Ray;
 
@@ -29,6 +30,21 @@ pub struct Planes {
 }
 
 impl Planes {
+    /// Bytes of the planes (capacity).
+    pub fn bytes(&self) -> u64 {
+        (self.planes.capacity() * std::mem::size_of::<Plane>()) as u64
+    }
+
+    /// Room for `n` more planes, charged to `budget` (see `Set::reserve`).
+    pub fn reserve(
+        &mut self,
+        n: usize,
+        budget: &Budget,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), String> {
+        Ok(budget.grow(&mut self.planes, n, Use::Geometry, what)?)
+    }
+
     /// Validates and stores plane `i` (point, normal) given in world coordinates.
     pub fn push_world(
         &mut self,

@@ -3,6 +3,7 @@
 //! new native primitive is one small file.
 
 use super::{clip_of, material_of, Clips, Counters, Hit, Kind};
+use crate::budget::{Budget, Use};
 use crate::bvh::Bvh;
 use crate::math::Aabb;
 use crate::ray::Ray;
@@ -77,6 +78,29 @@ impl<S: Shape> Set<S> {
             bvh,
             clipped,
         }
+    }
+
+    /// Room for `n` more primitives, charged to `budget` for good (the set keeps them); the
+    /// error names `what` needed it.
+    pub fn reserve(
+        &mut self,
+        n: usize,
+        budget: &Budget,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), String> {
+        budget.grow(&mut self.data, n, Use::Geometry, what)?;
+        budget.grow(&mut self.material, n, Use::Geometry, what)?;
+        Ok(())
+    }
+
+    /// Bytes of the built BVH.
+    pub fn bvh_bytes(&self) -> u64 {
+        self.bvh.memory_bytes()
+    }
+
+    /// Bytes of the primitives and their materials (capacities).
+    pub fn bytes(&self) -> u64 {
+        (self.data.capacity() * std::mem::size_of::<S>() + self.material.capacity() * 4) as u64
     }
 
     pub fn push(&mut self, shape: S, material: u32) {

@@ -4,6 +4,7 @@
 
 use super::set::{Set, Shape};
 use super::{material_of, Hit, Kind, Surface};
+use crate::budget::{Budget, Use};
 use crate::math::{gamma, Aabb, Vec3A};
 use crate::ray::Ray;
 use glam::{DVec3, Vec3};
@@ -199,6 +200,31 @@ impl Triangles {
 
     /// Validates and stores a mesh given in world coordinates; returns how many zero-area
     /// triangles were dropped (they can never be hit and have no normal).
+    /// Bytes of the triangles, their materials and shading attributes (capacities).
+    pub fn bytes(&self) -> u64 {
+        self.set.bytes()
+            + (self.vertex_attrs.capacity() * std::mem::size_of::<VertexAttr>()
+                + self.corners.capacity() * 12) as u64
+    }
+
+    /// Room for a mesh of `triangles` triangles over `vertices` vertices, charged to `budget`
+    /// (see `Set::reserve`); `attrs`: the mesh has normals, colours or uvs.
+    pub fn reserve_mesh(
+        &mut self,
+        triangles: usize,
+        vertices: usize,
+        attrs: bool,
+        budget: &Budget,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), String> {
+        self.set.reserve(triangles, budget, what)?;
+        if attrs {
+            budget.grow(&mut self.vertex_attrs, vertices, Use::Geometry, what)?;
+            budget.grow(&mut self.corners, triangles, Use::Geometry, what)?;
+        }
+        Ok(())
+    }
+
     pub fn push_mesh(
         &mut self,
         m: &MeshInput,

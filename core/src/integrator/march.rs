@@ -117,6 +117,7 @@ fn toward(light: &Light, p: Vec3A) -> Option<(Vec3A, f32, Vec3A)> {
             axis,
             cos_inner,
             cos_outer,
+            fade,
             color,
             attenuation,
             ..
@@ -125,7 +126,7 @@ fn toward(light: &Light, p: Vec3A) -> Option<(Vec3A, f32, Vec3A)> {
             if cos <= *cos_outer {
                 return None;
             }
-            let w = Light::spot_weight(cos, *cos_inner, *cos_outer);
+            let w = Light::spot_weight(cos, *cos_inner, *cos_outer, *fade);
             point(*position, *color * w, attenuation)
         }
         Light::Sphere {

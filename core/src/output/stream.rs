@@ -4,6 +4,7 @@
 //! assembled image at the end. The files are committed together afterwards ([`super::commit`]).
 
 use super::{Output, OutputSet};
+use crate::budget::{Budget, Charge};
 use crate::error::Error;
 use crate::framebuffer::Chunk;
 use crate::framebuffer::Framebuffer;
@@ -12,6 +13,7 @@ use crate::ppm::{ppm_header, srgb8};
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::Arc;
 use std::time::Duration;
 
 /// An output the core writes itself, row by row: the `ppm` writer with 8 bits per channel.
@@ -51,6 +53,8 @@ pub struct AsyncOutput<'r> {
     /// Outputs encoded from the whole image at the end, with their index in the set.
     encoded: Vec<(usize, Output<'r>)>,
     fb: Framebuffer,
+    /// The image's bytes in the memory budget, held while it is assembled.
+    _image: Charge,
     /// Pixels still missing per row.
     missing: Vec<u32>,
 }
@@ -62,7 +66,10 @@ impl<'r> AsyncOutput<'r> {
         mut set: OutputSet,
         width: u32,
         height: u32,
+        budget: &Arc<Budget>,
     ) -> Result<AsyncOutput<'r>, Error> {
+        // The image first: one over the budget fails before any file is touched.
+        let (fb, image) = Framebuffer::charged(width, height, budget)?;
         let mut rows = Vec::new();
         let mut encoded = Vec::new();
         for (i, o) in outputs {
@@ -86,7 +93,8 @@ impl<'r> AsyncOutput<'r> {
             set,
             rows,
             encoded,
-            fb: Framebuffer::new(width, height),
+            fb,
+            _image: image,
             missing: vec![width; height as usize],
         })
     }

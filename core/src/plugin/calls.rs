@@ -2,6 +2,7 @@
 //! and the helpers every kind's sink callbacks share.
 
 use super::registry::{Entry, PluginKind, Registry};
+use crate::budget::Budget;
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
@@ -85,12 +86,31 @@ pub fn call_plugin(
     ))
 }
 
-pub fn call_context<'a>(scene_dir: &'a str, instance: &'a str) -> abi::CallContext {
+/// The bytes a plugin call may allocate for what it produces or keeps
+/// ([`abi::CallContext::memory_budget`]): what is left of `budget` at the call, at least 1;
+/// 0 (unknown) without a budget or a limit.
+pub fn memory_budget_for_plugins(budget: Option<&Budget>) -> u64 {
+    match budget.and_then(Budget::limit) {
+        Some(_) => budget.map_or(0, |b| b.remaining().max(1)),
+        None => 0,
+    }
+}
+
+/// The context of a plugin call: where the scene is, which instance, and the memory it may use
+/// (`budget`: the run's; `None` for calls outside a scene's build, such as writers, which get
+/// 0, "unknown").
+pub fn call_context<'a>(
+    scene_dir: &'a str,
+    instance: &'a str,
+    budget: Option<&Budget>,
+) -> abi::CallContext {
     abi::CallContext {
         scene_dir: abi::Str::new(scene_dir),
         instance: abi::Str::new(instance),
-        texture_cache_bytes: 0,
+        // 0 lets the plugin choose (1 GiB).
+        texture_cache_bytes: budget.map_or(0, Budget::texture_cache),
         threads: rayon::current_num_threads() as u32,
+        memory_budget: memory_budget_for_plugins(budget),
     }
 }
 
@@ -152,4 +172,29 @@ pub fn plugin_label(registry: &Registry, entry: &Entry) -> String {
         .map(|f| f.to_string_lossy().to_string())
         .unwrap_or_default();
     format!("plugin `{}` ({file})", entry.name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Plugins are told what is left of the budget and the texture cache's share; without a
+    /// budget or a limit, 0 ("unknown", "choose").
+    #[test]
+    fn call_contexts_carry_the_budget() {
+        let b = Budget::new(1 << 30, "test".into(), None);
+        b.reserve(crate::budget::Use::Geometry, 1 << 20, String::new)
+            .unwrap();
+        let ctx = call_context(".", "t", Some(&b));
+        assert_eq!(ctx.memory_budget, (1 << 30) - (1 << 20));
+        assert_eq!(ctx.texture_cache_bytes, 256 << 20);
+        let ctx = call_context(".", "t", Some(&Budget::unlimited()));
+        assert_eq!((ctx.memory_budget, ctx.texture_cache_bytes), (0, 1 << 30));
+        let ctx = call_context(".", "t", None);
+        assert_eq!((ctx.memory_budget, ctx.texture_cache_bytes), (0, 0));
+        let full = Budget::new(10, "test".into(), None);
+        full.reserve(crate::budget::Use::Image, 10, String::new)
+            .unwrap();
+        assert_eq!(memory_budget_for_plugins(Some(&full)), 1);
+    }
 }

@@ -3,6 +3,7 @@
 
 use super::calls::{call_context, call_plugin, checked_len, fail, slice, wrong_kind};
 use super::registry::{Entry, PluginKind, Registry, Table};
+use crate::budget::{Budget, Use};
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::{CustomObject, Customs};
 use crate::geometry::disc::Discs;
@@ -33,6 +34,19 @@ pub struct GeometryBuilder<'a> {
     /// When set, the geometry is recorded here as the plugin gives it instead of stored in the
     /// sets (an object that moves is stored anew for every frame, see `scene::frame`).
     pub record: Option<&'a mut Recorded>,
+    /// Charged for what is stored (or recorded), before it is stored.
+    pub budget: &'a Budget,
+    /// The object, for messages: "object 3 (plugin `mesh`, scene.ron:20:9)".
+    pub object: String,
+}
+
+impl GeometryBuilder<'_> {
+    /// "object 3 (plugin `mesh`, scene.ron:20:9): 40000000 triangles", for budget messages.
+    fn describe(&self, n: usize, kind: &str) -> impl Fn() -> String {
+        let object = self.object.clone();
+        let kind = kind.to_string();
+        move || format!("{object}: {n} {kind}")
+    }
 }
 
 /// A plugin's geometry exactly as it gave it (f64 world coordinates), in the order it gave it.
@@ -43,6 +57,23 @@ pub struct Recorded {
     pub cones: Vec<[f64; 8]>,
     pub discs: Vec<[f64; 8]>,
     pub meshes: Vec<RecordedMesh>,
+}
+
+impl Recorded {
+    /// Bytes held (capacities), what recording charged to the budget.
+    pub fn bytes(&self) -> u64 {
+        held(&self.spheres)
+            + held(&self.planes)
+            + held(&self.cones)
+            + held(&self.discs)
+            + held(&self.meshes)
+            + self.meshes.iter().map(RecordedMesh::bytes).sum::<u64>()
+    }
+}
+
+/// Bytes of `v`'s capacity.
+fn held<T>(v: &Vec<T>) -> u64 {
+    (v.capacity() * std::mem::size_of::<T>()) as u64
 }
 
 /// A mesh's arrays as [`MeshInput`] takes them.
@@ -56,6 +87,35 @@ pub struct RecordedMesh {
 }
 
 impl RecordedMesh {
+    /// Copies `m`, charging its arrays to `budget` before they are allocated.
+    fn record(m: &MeshInput, budget: &Budget, what: &dyn Fn() -> String) -> Result<Self, String> {
+        fn copy<T: Copy>(
+            src: &[T],
+            budget: &Budget,
+            what: &dyn Fn() -> String,
+        ) -> Result<Vec<T>, String> {
+            let mut v = Vec::new();
+            budget.grow(&mut v, src.len(), Use::Geometry, what)?;
+            v.extend_from_slice(src);
+            Ok(v)
+        }
+        Ok(RecordedMesh {
+            positions: copy(m.positions, budget, what)?,
+            indices: copy(m.indices, budget, what)?,
+            normals: copy(m.normals, budget, what)?,
+            colors: copy(m.colors, budget, what)?,
+            uvs: copy(m.uvs, budget, what)?,
+        })
+    }
+
+    fn bytes(&self) -> u64 {
+        held(&self.positions)
+            + held(&self.indices)
+            + held(&self.normals)
+            + held(&self.colors)
+            + held(&self.uvs)
+    }
+
     pub fn input(&self) -> MeshInput<'_> {
         MeshInput {
             positions: &self.positions,
@@ -91,7 +151,12 @@ unsafe fn guard(
     }
 }
 
-/// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`.
+/// How a batch makes room for `n` records in its set, within the budget (the message names
+/// what needed it).
+type Reserve = fn(&mut GeometryBuilder, usize, &dyn Fn() -> String) -> Result<(), String>;
+
+/// Stores a batch of `count` records of `N` f64 each through `push(builder, index, record)`,
+/// after `reserve` made room for them.
 ///
 /// # Safety
 /// As for [`guard`]; `data` is null or points to `count * N` values.
@@ -101,11 +166,14 @@ unsafe fn add_batch<const N: usize>(
     count: u64,
     err: *const abi::ErrorSink,
     what: &str,
+    reserve: Reserve,
     push: impl Fn(&mut GeometryBuilder, usize, [f64; N]) -> Result<(), String>,
 ) -> abi::Status {
     let store = |b: &mut GeometryBuilder| {
         // SAFETY: the caller's promise about `data` (the length is checked to fit memory).
         let v = unsafe { slice(data, checked_len(count, N as u64, what)?) };
+        let describe = b.describe(v.len() / N, &format!("{what}s"));
+        reserve(b, v.len() / N, &describe)?;
         for (i, r) in v.chunks_exact(N).enumerate() {
             push(b, i, r.try_into().expect("chunk of N"))?;
         }
@@ -125,12 +193,17 @@ unsafe extern "C" fn add_spheres(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.spheres, n, Use::Geometry, what)?),
+            None => b.spheres.reserve(n, b.budget, what),
+        };
         add_batch(
             ctx,
             data,
             count,
             err,
             "sphere",
+            reserve,
             |b, i, r: [f64; 4]| match b.record.as_deref_mut() {
                 Some(rec) => {
                     rec.spheres.push(r);
@@ -152,12 +225,17 @@ unsafe extern "C" fn add_planes(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.planes, n, Use::Geometry, what)?),
+            None => b.planes.reserve(n, b.budget, what),
+        };
         add_batch(
             ctx,
             data,
             count,
             err,
             "plane",
+            reserve,
             |b, i, r: [f64; 6]| match b.record.as_deref_mut() {
                 Some(rec) => {
                     rec.planes.push(r);
@@ -179,15 +257,25 @@ unsafe extern "C" fn add_cones(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "cone", |b, i, r: [f64; 8]| {
-            match b.record.as_deref_mut() {
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.cones, n, Use::Geometry, what)?),
+            None => b.cones.reserve(n, b.budget, what),
+        };
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "cone",
+            reserve,
+            |b, i, r: [f64; 8]| match b.record.as_deref_mut() {
                 Some(rec) => {
                     rec.cones.push(r);
                     Ok(())
                 }
                 None => b.cones.push_world(i, r, b.world_offset, b.material),
-            }
-        })
+            },
+        )
     }
 }
 
@@ -201,15 +289,25 @@ unsafe extern "C" fn add_discs(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        add_batch(ctx, data, count, err, "disc", |b, i, r: [f64; 8]| {
-            match b.record.as_deref_mut() {
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.discs, n, Use::Geometry, what)?),
+            None => b.discs.reserve(n, b.budget, what),
+        };
+        add_batch(
+            ctx,
+            data,
+            count,
+            err,
+            "disc",
+            reserve,
+            |b, i, r: [f64; 8]| match b.record.as_deref_mut() {
                 Some(rec) => {
                     rec.discs.push(r);
                     Ok(())
                 }
                 None => b.discs.push_world(i, r, b.world_offset, b.material),
-            }
-        })
+            },
+        )
     }
 }
 
@@ -236,16 +334,18 @@ unsafe extern "C" fn add_mesh(
                 uvs: slice(m.uvs, optional(m.uvs.is_null(), 2)),
             }
         };
+        let triangles = input.indices.len() / 3;
+        let describe = b.describe(triangles, "triangles");
         if let Some(rec) = b.record.as_deref_mut() {
-            rec.meshes.push(RecordedMesh {
-                positions: input.positions.to_vec(),
-                indices: input.indices.to_vec(),
-                normals: input.normals.to_vec(),
-                colors: input.colors.to_vec(),
-                uvs: input.uvs.to_vec(),
-            });
+            b.budget
+                .grow(&mut rec.meshes, 1, Use::Geometry, &describe)?;
+            rec.meshes
+                .push(RecordedMesh::record(&input, b.budget, &describe)?);
             return Ok(());
         }
+        let attrs = !(input.normals.is_empty() && input.colors.is_empty() && input.uvs.is_empty());
+        b.triangles
+            .reserve_mesh(triangles, nv, attrs, b.budget, &describe)?;
         b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
         Ok(())
     };
@@ -284,6 +384,9 @@ unsafe extern "C" fn add_custom(
                 g.count
             ));
         }
+        let describe = b.describe(object.count as usize, "custom primitives");
+        b.customs
+            .reserve(object.count as usize, b.budget, &describe)?;
         let o = b.customs.objects.len() as u32;
         for i in 0..object.count {
             b.customs.refs.push((o, i));
@@ -324,7 +427,7 @@ pub fn create_primitive(
         ));
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, instance);
+    let ctx = call_context(&dir, instance, Some(builder.budget));
     call_plugin(registry, entry, params_at, |err| {
         // SAFETY: the calling contract: `params`, `ctx`, `sink` and `err` live across the
         // call; `sink.ctx` is `builder`, which this function borrows mutably and does not touch

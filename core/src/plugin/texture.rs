@@ -2,6 +2,7 @@
 
 use super::calls::{call_context, call_plugin, wrong_kind};
 use super::registry::{Entry, PluginKind, Registry, Table};
+use crate::budget::Budget;
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
@@ -25,32 +26,62 @@ unsafe impl Send for TextureInstance {}
 // SAFETY: see `Send`: `&TextureInstance` only ever calls `eval`.
 unsafe impl Sync for TextureInstance {}
 
+/// Why a texture gave no value: its status ([`abi::STATUS_ERROR`] or [`abi::STATUS_PANIC`]) and
+/// the message the plugin sent with it.
+#[derive(Debug)]
+pub struct EvalFailure {
+    pub status: abi::Status,
+    pub message: Option<String>,
+}
+
+/// The host's `ErrorSink::set` for `eval`.
+///
+/// # Safety
+/// `ctx` is the `Option<String>` of the running [`TextureInstance::eval`]; `message` is
+/// readable for the call.
+unsafe extern "C" fn set_eval_error(ctx: *mut c_void, message: abi::Str, _line: u32, _col: u32) {
+    // SAFETY: the plugin calls this only through the sink of a running `eval`, on its thread
+    // (ABI contract), so `ctx` is that call's slot, which nothing else touches until `eval`
+    // returns; the message is copied before returning.
+    let (slot, message) = unsafe { (&mut *(ctx as *mut Option<String>), message.as_str()) };
+    *slot = Some(message.unwrap_or("(invalid UTF-8)").to_string());
+}
+
 impl TextureInstance {
-    /// Linear RGBA, or the plugin's status when it panicked or failed (see [`Self::failure`]).
+    /// Linear RGBA, or why the plugin could give none (see [`Self::failure`]).
     #[inline]
-    pub fn eval(&self, q: &abi::TexQuery) -> Result<[f32; 4], abi::Status> {
+    pub fn eval(&self, q: &abi::TexQuery) -> Result<[f32; 4], EvalFailure> {
         let mut out = [0.0f32; 4];
-        // SAFETY: `object` is live until `drop`, the query and result live across the call, and
-        // the ABI allows concurrent `eval`s.
-        let s = unsafe { (self.vtable.eval)(self.object, q, &mut out) };
-        if s == abi::STATUS_OK {
+        let mut message: Option<String> = None;
+        let err = abi::ErrorSink {
+            ctx: &mut message as *mut Option<String> as *mut c_void,
+            set: set_eval_error,
+        };
+        // SAFETY: `object` is live until `drop`, the query, result and error sink (with its
+        // slot, untouched until the call returns) live across the call, and the ABI allows
+        // concurrent `eval`s.
+        let status = unsafe { (self.vtable.eval)(self.object, q, &mut out, &err) };
+        if status == abi::STATUS_OK {
             Ok(out)
         } else {
-            Err(s)
+            Err(EvalFailure { status, message })
         }
     }
 
-    /// The error of an `eval` that returned `status`. A failing texture logged its cause
-    /// before (plugin ABI 1 has no error sink for `eval`).
-    pub fn failure(&self, status: abi::Status) -> String {
-        if status == abi::STATUS_PANIC {
-            format!("plugin `{}` panicked evaluating a texture", self.plugin)
+    /// The error of a failed `eval`, on one line: where the texture is in the scene, its name,
+    /// its plugin and the plugin's message.
+    pub fn failure(&self, f: &EvalFailure) -> String {
+        let what = if f.status == abi::STATUS_PANIC {
+            "panicked"
         } else {
-            format!(
-                "{}: texture `{}` (plugin `{}`) failed during the render (its error is above)",
-                self.at, self.name, self.plugin
-            )
-        }
+            "failed"
+        };
+        let message = f.message.as_deref().unwrap_or("no message");
+        let message = message.strip_prefix("panicked: ").unwrap_or(message);
+        format!(
+            "{}: texture `{}` (plugin `{}`) {what} during the render: {message}",
+            self.at, self.name, self.plugin
+        )
     }
 }
 
@@ -62,6 +93,8 @@ impl Drop for TextureInstance {
     }
 }
 
+/// Creates a texture instance; `budget` gives the plugin its memory budget and texture cache
+/// share (the caller charges the cache).
 pub fn create_texture(
     registry: &Registry,
     entry: &Entry,
@@ -69,12 +102,13 @@ pub fn create_texture(
     params_at: &Origin,
     scene_dir: &Path,
     instance: &str,
+    budget: &Budget,
 ) -> Result<TextureInstance, (Origin, String)> {
     let Table::Texture(vt) = entry.table else {
         return Err(wrong_kind(registry, entry, PluginKind::Texture, params_at));
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, instance);
+    let ctx = call_context(&dir, instance, Some(budget));
     let mut out = abi::TextureObject {
         object: std::ptr::null_mut(),
         vtable: std::ptr::null(),

@@ -17,9 +17,16 @@ unsafe extern "C" fn collect_bytes(ctx: *mut c_void, data: *const u8, len: usize
     // thread and one call at a time (ABI contract): `ctx` is that call's `Vec`, which nothing
     // else touches until the plugin returns, and `data` is `len` readable bytes.
     let (v, data) = unsafe { (&mut *(ctx as *mut Vec<u8>), slice(data, len)) };
-    match catch_unwind(AssertUnwindSafe(|| v.extend_from_slice(data))) {
-        Ok(()) => abi::STATUS_OK,
-        Err(_) => abi::STATUS_ERROR,
+    // An encoder's output the system cannot hold is an error, not an abort.
+    let append = || {
+        v.try_reserve(data.len()).is_ok() && {
+            v.extend_from_slice(data);
+            true
+        }
+    };
+    match catch_unwind(AssertUnwindSafe(append)) {
+        Ok(true) => abi::STATUS_OK,
+        _ => abi::STATUS_ERROR,
     }
 }
 
@@ -63,7 +70,7 @@ pub fn encode_image(
         rgba: rgba.as_ptr(),
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, "");
+    let ctx = call_context(&dir, "", None);
     call_plugin(registry, entry, params_at, |err| {
         // SAFETY: the calling contract: `params`, `ctx`, `image` (with its `width * height * 4`
         // values, checked above), `sink` and `err` live across the call; `sink.ctx` is `bytes`,

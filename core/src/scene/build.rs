@@ -6,7 +6,9 @@
 //! here.
 
 use super::frame::{self, Animation, Keyed};
-use super::{Ao, Features, Fog, Light, Material, Scene, Settings};
+use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
+use crate::budget::{Budget, Use};
+use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
 use crate::error::Error;
 use crate::geometry::cone::Cones;
@@ -22,9 +24,13 @@ use crate::plugin::texture::{create_texture, TextureInstance};
 use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
-use luxon_formats::{Highlight, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned};
+use luxon_formats::{
+    HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned, SpotFade,
+    TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
+};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A scene's native geometry with its BVHs built, as a geometry cache gives it back
@@ -43,10 +49,22 @@ pub struct Prebuilt {
 type Inline<'g> = Box<dyn Iterator<Item = Cow<'g, InlineGeometry>> + 'g>;
 
 impl Scene {
-    /// Resolves plugins, instantiates every object and builds the BVHs.
+    /// Resolves plugins, instantiates every object and builds the BVHs, within the scene's
+    /// memory budget (its `render: (memory: ...)`, else the machine's default).
     pub fn build(desc: &SceneDesc, registry: &Registry) -> Result<Scene, Error> {
+        let budget = Budget::for_render(&desc.render, None, 1);
+        Scene::build_with(desc, registry, Arc::new(budget))
+    }
+
+    /// `build` within `budget`.
+    pub fn build_with(
+        desc: &SceneDesc,
+        registry: &Registry,
+        budget: Arc<Budget>,
+    ) -> Result<Scene, Error> {
         let groups = desc.inline.iter().map(Cow::Borrowed);
-        Scene::build_from(desc, Box::new(groups), None, registry)
+        let shadowless = shadowless_groups(desc);
+        Scene::build_from(desc, Box::new(groups), shadowless, None, registry, budget)
     }
 
     /// Builds with the native geometry and BVHs of a geometry cache (`desc` holds the rest of
@@ -55,46 +73,63 @@ impl Scene {
         desc: &SceneDesc,
         geometry: Prebuilt,
         registry: &Registry,
+        budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
-        Scene::build_from(desc, Box::new(std::iter::empty()), Some(geometry), registry)
+        let none = Box::new(std::iter::empty());
+        Scene::build_from(desc, none, Vec::new(), Some(geometry), registry, budget)
     }
 
-    /// Like `build`, but takes the imported geometry (`desc.inline`) out of `desc` and frees
-    /// each group once it is stored, so a large import is not held twice while the BVHs are
-    /// built and the image rendered.
+    /// Like `build_with`, but takes the imported geometry (`desc.inline`) out of `desc` and
+    /// frees each group once it is stored, so a large import is not held twice while the BVHs
+    /// are built and the image rendered.
     pub fn build_taking_geometry(
         desc: &mut SceneDesc,
         registry: &Registry,
+        budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
+        // Which groups cast no shadow is needed before they are taken: their materials get a
+        // shadowless copy in the palette.
+        let shadowless = shadowless_groups(desc);
         let groups = std::mem::take(&mut desc.inline).into_iter().map(Cow::Owned);
-        Scene::build_from(desc, Box::new(groups), None, registry)
+        Scene::build_from(desc, Box::new(groups), shadowless, None, registry, budget)
     }
 
     /// The build, stage after stage (errors are reported in this order too).
     fn build_from(
         desc: &SceneDesc,
         inline: Inline,
+        shadowless: Vec<Option<Spanned<String>>>,
         prebuilt: Option<Prebuilt>,
         registry: &Registry,
+        budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
-        let b = Build::new(desc, registry);
+        let b = Build::new(desc, registry, budget);
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
-        let (materials, material_names) = b.materials(&texture_names)?;
+        let palette = b.materials(&texture_names, &shadowless)?;
         let clips = b.clips()?;
         let render_volumes = b.render_volumes(&volumes)?;
-        let mut stored = Stored::new(b.world_offset, materials.len());
-        b.objects(&material_names, &mut stored)?;
-        b.imported(inline, &material_names, &mut stored)?;
+        let mut stored = Stored::new(b.world_offset, palette.materials.len());
+        b.objects(&palette, &mut stored)?;
+        b.imported(inline, &palette, &mut stored)?;
+        let Palette {
+            materials,
+            names: material_names,
+            shadowless: shadowless_copies,
+        } = palette;
         let native_built = prebuilt.is_some();
         if let Some(p) = prebuilt {
             stored.take_prebuilt(p, b.world_offset)?;
+            let held = stored.geometry_bytes();
+            b.budget.reserve(Use::Geometry, held, || {
+                "the geometry read from the geometry cache".into()
+            })?;
         }
         let plugin_time = t0.elapsed();
 
         let t1 = Instant::now();
-        stored.build_bvhs(!native_built)?;
+        stored.build_bvhs(!native_built, &b.budget)?;
         let bvh_time = t1.elapsed();
 
         let lights = b.lights();
@@ -144,10 +179,11 @@ impl Scene {
             plugin_time,
             moving: Default::default(),
             animation: None,
+            budget: b.budget,
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
-            let animation = Animation::new(desc, &scene.material_names, keyed)?;
+            let animation = Animation::new(desc, &scene.material_names, &shadowless_copies, keyed)?;
             scene.animation = Some(Box::new(animation));
             scene.set_frame(a.value.first)?;
         }
@@ -162,6 +198,33 @@ pub(super) struct Build<'a> {
     registry: &'a Registry,
     scene_dir: PathBuf,
     world_offset: DVec3,
+    budget: Arc<Budget>,
+}
+
+/// The materials of the imported geometry groups that cast no shadow.
+fn shadowless_groups(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
+    let groups = desc.inline.iter().filter(|g| g.shadowless);
+    groups.map(|g| g.material.clone()).collect()
+}
+
+/// The materials (index 0: the default; then the scene's, by name; then copies of those that
+/// objects casting no shadow use), their names, and each one's copy that casts no shadow.
+struct Palette {
+    materials: Vec<Material>,
+    names: Vec<String>,
+    shadowless: Vec<Option<usize>>,
+}
+
+impl Palette {
+    /// The material an object or geometry group names, its copy when it casts no shadow.
+    fn index(&self, name: &Option<Spanned<String>>, shadows: bool) -> Result<usize, Error> {
+        let m = material_index(&self.names, name)?;
+        Ok(if shadows {
+            m
+        } else {
+            self.shadowless[m].unwrap_or(m)
+        })
+    }
 }
 
 /// The scene's geometry while it is being stored, and what storing it tells.
@@ -183,10 +246,11 @@ struct Stored {
 }
 
 impl<'a> Build<'a> {
-    fn new(desc: &'a SceneDesc, registry: &'a Registry) -> Build<'a> {
+    fn new(desc: &'a SceneDesc, registry: &'a Registry, budget: Arc<Budget>) -> Build<'a> {
         Build {
             desc,
             registry,
+            budget,
             scene_dir: desc
                 .source
                 .parent()
@@ -196,10 +260,20 @@ impl<'a> Build<'a> {
         }
     }
 
-    /// Stage: an instance of every texture, through its plugin; and their names.
+    /// Stage: an instance of every texture, through its plugin; and their names. A scene with
+    /// textures reserves the texture cache's share of the budget (what texture plugins may keep
+    /// decoded; they are told its size).
     fn textures(&self) -> Result<(Vec<TextureInstance>, Vec<String>), Error> {
         let mut texture_names = Vec::new();
         let mut textures = Vec::new();
+        if let Some((name, call)) = self.desc.textures.first() {
+            let cache = self.budget.texture_cache();
+            self.budget
+                .reserve(Use::Textures, cache, || {
+                    format!("the texture cache (for texture `{name}` and the others)")
+                })
+                .map_err(|e| Error::at(&call.at, e.0))?;
+        }
         for (name, call) in &self.desc.textures {
             let entry = self
                 .registry
@@ -212,6 +286,7 @@ impl<'a> Build<'a> {
                 &call.value.params_at,
                 &self.scene_dir,
                 name,
+                &self.budget,
             )
             .map_err(|(at, m)| Error::at(&at, m))?;
             texture_names.push(name.clone());
@@ -240,6 +315,7 @@ impl<'a> Build<'a> {
                 &call.params_at,
                 &self.scene_dir,
                 &name,
+                &self.budget,
             )
             .map_err(|(at, m)| Error::at(&at, m))?;
             volumes.push(volume);
@@ -248,10 +324,16 @@ impl<'a> Build<'a> {
     }
 
     /// Stage: the materials (index 0: the default, which the scene may redefine) with their
-    /// textures resolved; and their names.
-    fn materials(&self, texture_names: &[String]) -> Result<(Vec<Material>, Vec<String>), Error> {
+    /// textures resolved, then a copy casting no shadow of each material that objects casting
+    /// none use.
+    fn materials(
+        &self,
+        texture_names: &[String],
+        shadowless_groups: &[Option<Spanned<String>>],
+    ) -> Result<Palette, Error> {
+        let t = &self.desc.render.transparency;
         let mut material_names = vec!["default".to_string()];
-        let mut materials = vec![material(&Default::default(), [None; 3])];
+        let mut materials = vec![material(&Default::default(), [None; 3], t)];
         for (name, m) in &self.desc.materials {
             let find = |t: &Option<Spanned<String>>| -> Result<Option<u32>, Error> {
                 match t {
@@ -268,12 +350,28 @@ impl<'a> Build<'a> {
                 find(&m.value.reflect_texture)?,
                 find(&m.value.transmit_texture)?,
             ];
-            let mat = material(&m.value, tex);
+            let mat = material(&m.value, tex, t);
             if let Some(i) = material_names.iter().position(|n| n == name) {
                 materials[i] = mat;
             } else {
                 material_names.push(name.clone());
                 materials.push(mat);
+            }
+        }
+        let mut shadowless = vec![None; materials.len()];
+        let unshadowed = self
+            .desc
+            .objects
+            .iter()
+            .filter(|o| !o.value.shadows)
+            .map(|o| &o.value.material);
+        for name in unshadowed.chain(shadowless_groups) {
+            let m = material_index(&material_names, name)?;
+            if shadowless[m].is_none() {
+                shadowless[m] = Some(materials.len());
+                let mut copy = materials[m].clone();
+                copy.shadow = Some(Vec3A::ONE);
+                materials.push(copy);
             }
         }
         if materials.len() as u32 > MAX_MATERIALS {
@@ -282,7 +380,11 @@ impl<'a> Build<'a> {
                 materials.len()
             )));
         }
-        Ok((materials, material_names))
+        Ok(Palette {
+            materials,
+            names: material_names,
+            shadowless,
+        })
     }
 
     /// Stage: the clip groups, in render space.
@@ -342,14 +444,14 @@ impl<'a> Build<'a> {
     }
 
     /// Stage: every object, created by its primitive plugin into the native sets.
-    fn objects(&self, material_names: &[String], stored: &mut Stored) -> Result<(), Error> {
+    fn objects(&self, palette: &Palette, stored: &mut Stored) -> Result<(), Error> {
         for (i, obj) in self.desc.objects.iter().enumerate() {
             let call = &obj.value.call;
             let entry = self
                 .registry
                 .get(&call.plugin.value, PluginKind::Primitive)
                 .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
-            let material = material_index(material_names, &obj.value.material)?;
+            let material = palette.index(&obj.value.material, obj.value.shadows)?;
             stored.used[material] = true;
             let clip = self.clip_group(&obj.value.clip)?;
             let keyed = self.desc.animation.as_ref().and_then(|a| {
@@ -369,6 +471,8 @@ impl<'a> Build<'a> {
                 plugin: entry.name.clone(),
                 dropped: 0,
                 record: keyed.map(|_| &mut recorded),
+                budget: &self.budget,
+                object: format!("object {i} (plugin `{}`, {})", entry.name, obj.at),
             };
             create_primitive(
                 self.registry,
@@ -405,16 +509,17 @@ impl<'a> Build<'a> {
     fn imported(
         &self,
         inline: Inline,
-        material_names: &[String],
+        palette: &Palette,
         stored: &mut Stored,
     ) -> Result<(), Error> {
         let world_offset = self.world_offset;
         for (k, g) in inline.enumerate() {
             let at = || g.at.clone().unwrap_or_else(|| self.desc.camera.at.clone());
-            let material = material_index(material_names, &g.material)?;
+            let material = palette.index(&g.material, !g.shadowless)?;
             stored.used[material] = true;
             let m = pack(material as u32, self.clip_group(&g.clip)?);
             let fail = |e: String| Error::at(&at(), format!("imported geometry group {k}: {e}"));
+            stored.reserve_group(&g, &self.budget).map_err(fail)?;
             for (i, s) in g.spheres.iter().enumerate() {
                 stored
                     .spheres
@@ -463,11 +568,21 @@ impl<'a> Build<'a> {
 
     /// Stage: the lights, in render space.
     fn lights(&self) -> Vec<Light> {
-        Build::lights_from(&self.desc.lights, self.world_offset)
+        Build::lights_from(
+            &self.desc.lights,
+            self.world_offset,
+            self.desc.render.light_scale,
+        )
     }
 
-    /// `lights` in render space (also each frame's, in an animated scene).
-    pub(super) fn lights_from(lights: &[Spanned<LightDesc>], world_offset: DVec3) -> Vec<Light> {
+    /// `lights` in render space (also each frame's, in an animated scene); every light's colour
+    /// carries the render's light scale.
+    pub(super) fn lights_from(
+        lights: &[Spanned<LightDesc>],
+        world_offset: DVec3,
+        scale: f64,
+    ) -> Vec<Light> {
+        let rgb = |color: &[f64; 3], intensity: &f64| v3(*color) * (*intensity * scale) as f32;
         let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - world_offset).as_vec3());
         let unit = |d: &[f64; 3]| Vec3A::from(DVec3::from(*d).normalize().as_vec3());
         let att = |a: &luxon_formats::Attenuation| {
@@ -484,7 +599,7 @@ impl<'a> Build<'a> {
                     attenuation,
                 } => Light::Point {
                     position: at(position),
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -495,7 +610,7 @@ impl<'a> Build<'a> {
                     shadows,
                 } => Light::Directional {
                     to_light: -unit(direction),
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                 },
                 LightDesc::Spot {
@@ -503,6 +618,7 @@ impl<'a> Build<'a> {
                     direction,
                     cone_deg,
                     falloff_deg,
+                    fade,
                     color,
                     intensity,
                     shadows,
@@ -512,7 +628,14 @@ impl<'a> Build<'a> {
                     axis: unit(direction),
                     cos_inner: ((cone_deg - falloff_deg) * 0.5).to_radians().cos() as f32,
                     cos_outer: (cone_deg * 0.5).to_radians().cos() as f32,
-                    color: v3(*color) * *intensity as f32,
+                    fade: match fade {
+                        SpotFade::Smooth => Fade::Smooth,
+                        SpotFade::Linear => Fade::Linear {
+                            inner: ((cone_deg - falloff_deg) * 0.5).to_radians() as f32,
+                            outer: (cone_deg * 0.5).to_radians() as f32,
+                        },
+                    },
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -528,7 +651,7 @@ impl<'a> Build<'a> {
                     center: at(center),
                     radius: *radius as f32,
                     samples: *samples,
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -547,7 +670,7 @@ impl<'a> Build<'a> {
                     edge2: v3(*edge2),
                     normal: v3(*edge1).cross(v3(*edge2)).normalize(),
                     samples: *samples,
-                    color: v3(*color) * *intensity as f32,
+                    color: rgb(color, intensity),
                     shadows: *shadows,
                     attenuation: att(attenuation),
                 },
@@ -561,6 +684,8 @@ impl<'a> Build<'a> {
             mode: f.mode,
             color: v3(f.color),
             planar: f.planar,
+            every_ray: f.every_ray,
+            misses: f.misses,
         });
         let ao = self.desc.ambient_occlusion.as_ref().map(|a| Ao {
             samples: a.samples,
@@ -615,6 +740,39 @@ impl Stored {
         }
     }
 
+    /// Room for an imported group's primitives, charged to `budget`.
+    fn reserve_group(&mut self, g: &InlineGeometry, budget: &Budget) -> Result<(), String> {
+        let n = |n: usize, kind: &'static str| move || format!("{n} {kind}");
+        let (s, c, d, p) = (
+            g.spheres.len(),
+            g.cones.len(),
+            g.discs.len(),
+            g.planes.len(),
+        );
+        self.spheres.reserve(s, budget, &n(s, "spheres"))?;
+        self.cones.reserve(c, budget, &n(c, "cones"))?;
+        self.discs.reserve(d, budget, &n(d, "discs"))?;
+        self.planes.reserve(p, budget, &n(p, "planes"))?;
+        let m = &g.mesh;
+        let attrs = !(m.normals.is_empty() && m.uvs.is_empty());
+        let t = m.indices.len();
+        let describe = n(t, "triangles");
+        self.triangles
+            .reserve_mesh(t, m.positions.len(), attrs, budget, &describe)
+    }
+
+    /// Bytes of the stored geometry (its arrays' capacities), the keyed objects' recorded
+    /// geometry included.
+    fn geometry_bytes(&self) -> u64 {
+        self.spheres.bytes()
+            + self.triangles.bytes()
+            + self.planes.bytes()
+            + self.cones.bytes()
+            + self.discs.bytes()
+            + self.customs.bytes()
+            + self.keyed.iter().map(|k| k.geometry.bytes()).sum::<u64>()
+    }
+
     /// Stage (with a geometry cache): its native sets and BVHs replace the (empty) ones here.
     fn take_prebuilt(&mut self, p: Prebuilt, world_offset: DVec3) -> Result<(), Error> {
         if p.used.len() != self.used.len() || p.world_offset != world_offset {
@@ -634,7 +792,36 @@ impl Stored {
 
     /// Stage: the BVHs of every set, in parallel; the native ones only when `native` (a
     /// cache's come built).
-    fn build_bvhs(&mut self, native: bool) -> Result<(), Error> {
+    /// Builds every set's BVH. The build's working memory is charged first (for the sets it
+    /// builds at once) and given back after, keeping the BVHs' own bytes; the geometry's
+    /// charge is brought down to what the sets hold once built (they grew by doubling).
+    fn build_bvhs(&mut self, native: bool, budget: &Budget) -> Result<(), Error> {
+        let n = if native {
+            self.spheres.len() + self.triangles.len() + self.cones.len() + self.discs.len()
+        } else {
+            0
+        } + self.customs.len();
+        let work = n as u64 * BUILD_BYTES_PER_PRIM;
+        budget.reserve(Use::Bvh, work, || {
+            format!("building the BVHs over {n} primitives")
+        })?;
+        let built = self.build_sets(native);
+        budget.release(Use::Bvh, work);
+        built?;
+        let bvhs = self.spheres.bvh_bytes()
+            + self.triangles.set.bvh_bytes()
+            + self.cones.bvh_bytes()
+            + self.discs.bvh_bytes()
+            + self.customs.bvh_bytes();
+        budget.reserve(Use::Bvh, bvhs, || format!("the BVHs over {n} primitives"))?;
+        let (charged, held) = (budget.used(Use::Geometry), self.geometry_bytes());
+        if charged > held {
+            budget.release(Use::Geometry, charged - held);
+        }
+        Ok(())
+    }
+
+    fn build_sets(&mut self, native: bool) -> Result<(), Error> {
         let Stored {
             spheres,
             triangles,
@@ -683,12 +870,20 @@ fn features(
         .map(|(m, _)| m)
         .collect();
     let has_geometry = stored.has_geometry();
+    let transmission = used_mats.iter().any(|m| m.transmit > 0.0);
+    let every_ray = fog.as_ref().is_some_and(|f| f.every_ray);
     Features {
         shadows: has_geometry && lights.iter().any(Light::casts_shadows),
         ambient_occlusion: has_geometry && ao.is_some(),
-        fog: fog.is_some(),
+        fog: fog.is_some() && !every_ray,
+        fog_every_ray: every_ray,
         reflection: used_mats.iter().any(|m| m.reflect > 0.0),
-        transmission: used_mats.iter().any(|m| m.transmit > 0.0),
+        transmission,
+        // Transparent materials and the copies that cast no shadow.
+        shadow_filters: used_mats.iter().any(|m| m.shadow.is_some()),
+        outline: used_mats.iter().any(|m| m.outline > 0.0),
+        tachyon_lights: (r.tachyon.light_threshold || r.tachyon.plain_highlights)
+            && !lights.is_empty(),
         textures: used_mats.iter().any(|m| {
             m.texture
                 .or(m.reflect_texture)
@@ -718,6 +913,8 @@ fn settings(r: &RenderDesc) -> Settings {
         io: r.parallel.io,
         volume_skip: r.volume_skip,
         adaptive: r.adaptive,
+        light_scale: r.light_scale as f32,
+        tachyon: r.tachyon,
     }
 }
 
@@ -725,10 +922,42 @@ fn v3(a: [f64; 3]) -> Vec3A {
     Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
 }
 
-/// `textures`: the material's colour, reflect and transmit textures.
-fn material(m: &luxon_formats::MaterialDesc, textures: [Option<u32>; 3]) -> Material {
+/// What a shadow ray keeps after crossing a surface of transmit coefficient `transmit` and
+/// colour `color` under the render's rule for transparent shadows; `None`: it is blocked.
+pub(super) fn shadow_filter(
+    transmit: f32,
+    color: Vec3A,
+    rule: TransparentShadows,
+) -> Option<Vec3A> {
+    if transmit <= 0.0 {
+        return None;
+    }
+    Some(match rule {
+        TransparentShadows::Tinted => transmit * color,
+        TransparentShadows::Untinted => Vec3A::splat(transmit),
+        TransparentShadows::Off => Vec3A::ONE,
+    })
+}
+
+/// `textures`: the material's colour, reflect and transmit textures; `t`: the render's
+/// transparency rules (the angle rule a material does not override, shadows' filters).
+fn material(
+    m: &luxon_formats::MaterialDesc,
+    textures: [Option<u32>; 3],
+    t: &TransparencyDesc,
+) -> Material {
+    let color = v3(m.color);
+    let transmit = m.transmit as f32;
+    let angle = match m.transparency_angle {
+        Some(TransparencyAngle::Raster3D) => AngleRule::Raster3D,
+        Some(TransparencyAngle::Constant) => AngleRule::Constant,
+        None if t.mode == TransparencyMode::AngleModulated => AngleRule::Slab,
+        None if t.angle == TransparencyAngle::Raster3D => AngleRule::Raster3D,
+        None => AngleRule::Constant,
+    };
+    let shadow = shadow_filter(transmit, color, t.shadows);
     Material {
-        color: v3(m.color),
+        color,
         texture: textures[0],
         reflect_texture: textures[1],
         transmit_texture: textures[2],
@@ -736,9 +965,15 @@ fn material(m: &luxon_formats::MaterialDesc, textures: [Option<u32>; 3]) -> Mate
         diffuse: m.diffuse as f32,
         specular: m.specular as f32,
         shininess: m.shininess as f32,
-        blinn: m.highlight == Highlight::Blinn,
+        highlight: m.highlight,
+        highlight_surface: m.highlight_color == HighlightColor::Surface,
         reflect: m.reflect as f32,
-        transmit: m.transmit as f32,
+        transmit,
         ior: m.ior as f32,
+        angle,
+        shadow,
+        outline: m.outline as f32,
+        outline_power: 32.0 * (1.0 - m.outline_width as f32),
+        fog: m.fog,
     }
 }

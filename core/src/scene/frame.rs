@@ -1,7 +1,8 @@
 //! The frames of an animated scene: [`Scene::set_frame`] puts every keyed value at a frame —
 //! the camera, the lights, material colours, and the keyed objects, whose geometry is placed
 //! anew from what their plugins gave once (recorded at the build, in f64) and stored in the
-//! scene's moving group with BVHs of its own.
+//! scene's moving group with BVHs of its own, charged to the memory budget like the still
+//! geometry (and given back when the next frame's group replaces it).
 //!
 //! **A frame is a function of its number alone.** `set_frame` overwrites every value it
 //! touches and rebuilds the moving group from scratch (never refits what an earlier frame
@@ -13,19 +14,21 @@
 //! scene's first frame (not the frame being rendered, which would move every coordinate), and
 //! each frame's camera is placed relative to it.
 
-use super::build::Build;
+use super::build::{shadow_filter, Build};
 use super::{Light, Scene};
-use crate::camera::Camera;
+use crate::budget::{Budget, Use};
 use crate::error::Error;
 use crate::geometry::group::Group;
+use crate::geometry::triangle::MeshInput;
 use crate::math::{DVec3, Vec3A};
 use crate::motion::keys::value;
 use crate::motion::Placement;
 use crate::plugin::primitive::Recorded;
 use luxon_formats::{
     AnimationDesc, CameraDesc, LightDesc, ObjectTracks, Origin, Projection, SceneDesc, ShutterDesc,
-    Spanned, Track,
+    Spanned, Track, TransparentShadows,
 };
+use std::sync::Arc;
 
 /// A keyed object as the build recorded it.
 pub(super) struct Keyed {
@@ -43,8 +46,13 @@ pub struct Animation {
     desc: AnimationDesc,
     camera: Spanned<CameraDesc>,
     lights: Vec<Spanned<LightDesc>>,
-    /// Keyed material colours: index in `Scene::materials` and the track.
-    materials: Vec<(usize, Track<[f64; 3]>)>,
+    /// The render's light scale, which every frame's lights carry.
+    light_scale: f64,
+    /// How transparent surfaces filter shadows (by their colour, when `Tinted`).
+    shadows: TransparentShadows,
+    /// Keyed material colours: index in `Scene::materials`, that of its copy that casts no
+    /// shadow (if objects use one), and the track.
+    materials: Vec<(usize, Option<usize>, Track<[f64; 3]>)>,
     objects: Vec<Keyed>,
     frame: u32,
 }
@@ -64,12 +72,14 @@ pub(super) fn world_offset(desc: &SceneDesc) -> DVec3 {
 }
 
 impl Animation {
-    /// The animation of `desc`, with the objects the build recorded. A shutter that stays
+    /// The animation of `desc`, with the objects the build recorded; `shadowless`: each
+    /// material's copy that casts no shadow (`Scene::materials` index). A shutter that stays
     /// open is refused (motion blur is not rendered yet), as is a scale that would turn a
     /// sphere, cone or disc into something it cannot store.
     pub(super) fn new(
         desc: &SceneDesc,
         material_names: &[String],
+        shadowless: &[Option<usize>],
         objects: Vec<Keyed>,
     ) -> Result<Animation, Error> {
         let a = desc
@@ -112,13 +122,15 @@ impl Animation {
             .filter_map(|m| {
                 let color = m.color.clone()?;
                 let i = material_names.iter().position(|n| *n == m.material.value)?;
-                Some((i, color))
+                Some((i, shadowless.get(i).copied().flatten(), color))
             })
             .collect();
         Ok(Animation {
             desc: a.value.clone(),
             camera: desc.camera.clone(),
             lights: desc.lights.clone(),
+            light_scale: desc.render.light_scale,
+            shadows: desc.render.transparency.shadows,
             materials,
             objects,
             frame: a.value.first,
@@ -259,33 +271,59 @@ impl Animation {
                 *c = v;
             }
         }
-        Ok(Build::lights_from(&lights, world_offset))
+        Ok(Build::lights_from(&lights, world_offset, self.light_scale))
     }
 
-    /// The keyed objects placed at time `t`, in render space, with their BVHs.
-    fn group_at(&self, t: f64, k: u32, world_offset: DVec3) -> Result<Group, Error> {
+    /// The keyed objects placed at time `t`, in render space, with their BVHs, charged to
+    /// `budget` (the group keeps the charges).
+    fn group_at(
+        &self,
+        t: f64,
+        k: u32,
+        world_offset: DVec3,
+        budget: &Arc<Budget>,
+    ) -> Result<Group, Error> {
         let mut group = Group::default();
-        for o in &self.objects {
+        // The sets charge their arrays as they grow, for good; the group takes that charge
+        // over (nothing else stores geometry while a frame is set), so it is given back with
+        // the group, or at once if placing fails.
+        let before = budget.used(Use::Geometry);
+        let placed = self.objects.iter().try_for_each(|o| {
             let p = Placement::at(&o.tracks, t);
-            place(&o.geometry, &p, world_offset, o.material, &mut group).map_err(|m| {
+            place(
+                &o.geometry,
+                &p,
+                world_offset,
+                o.material,
+                &mut group,
+                budget,
+            )
+            .map_err(|m| {
                 Error::at(
                     &o.at,
                     format!("frame {k}: object `{}`: {m}", o.tracks.name.value),
                 )
-            })?;
-        }
-        group.build();
+            })
+        });
+        let grown = budget.used(Use::Geometry).saturating_sub(before);
+        group.charges.push(budget.guard(Use::Geometry, grown));
+        placed?;
+        group
+            .build(budget)
+            .map_err(|e| Error::Render(format!("frame {k}: the keyed objects: {}", e.0)))?;
         Ok(group)
     }
 }
 
-/// Stores `g` moved by `p` into `group` (through the sets' own checks).
+/// Stores `g` moved by `p` into `group` (through the sets' own checks), charging its arrays
+/// to `budget` before they grow.
 fn place(
     g: &Recorded,
     p: &Placement,
     offset: DVec3,
     material: u32,
     group: &mut Group,
+    budget: &Arc<Budget>,
 ) -> Result<(), String> {
     let m = p.world_from_object.matrix3;
     let det = m.determinant();
@@ -306,6 +344,17 @@ fn place(
     };
     let xyz = |r: &[f64], i: usize| p.point([r[i], r[i + 1], r[i + 2]]);
     let normal = |r: &[f64], i: usize| p.normal([r[i], r[i + 1], r[i + 2]]);
+    let count = |n: usize, kind: &'static str| move || format!("{n} {kind}");
+    let (ns, np, nc, nd) = (
+        g.spheres.len(),
+        g.planes.len(),
+        g.cones.len(),
+        g.discs.len(),
+    );
+    group.spheres.reserve(ns, budget, &count(ns, "spheres"))?;
+    group.planes.reserve(np, budget, &count(np, "planes"))?;
+    group.cones.reserve(nc, budget, &count(nc, "cones"))?;
+    group.discs.reserve(nd, budget, &count(nd, "discs"))?;
     for (i, r) in g.spheres.iter().enumerate() {
         let c = xyz(r, 0);
         group
@@ -329,16 +378,29 @@ fn place(
         group.discs.push_world(i, disc, offset, material)?;
     }
     for mesh in &g.meshes {
-        let mut moved = mesh.clone();
-        for v in moved.positions.chunks_exact_mut(3) {
-            v.copy_from_slice(&xyz(v, 0));
-        }
-        for n in moved.normals.chunks_exact_mut(3) {
-            n.copy_from_slice(&normal(n, 0));
-        }
+        let triangles = mesh.indices.len() / 3;
+        let what = count(triangles, "triangles");
+        let attrs = !(mesh.normals.is_empty() && mesh.colors.is_empty() && mesh.uvs.is_empty());
+        let vertices = mesh.positions.len() / 3;
         group
             .triangles
-            .push_mesh(&moved.input(), offset, material)?;
+            .reserve_mesh(triangles, vertices, attrs, budget, &what)?;
+        // The moved positions and normals, charged while they are stored.
+        let moved = |from: &[f64], f: &dyn Fn(&[f64], usize) -> [f64; 3]| {
+            let (mut to, charge) = budget.alloc_vec(Use::Geometry, from.len(), 0.0, what)?;
+            for (a, b) in to.chunks_exact_mut(3).zip(from.chunks_exact(3)) {
+                a.copy_from_slice(&f(b, 0));
+            }
+            Ok::<_, String>((to, charge))
+        };
+        let (positions, _p) = moved(&mesh.positions, &xyz)?;
+        let (normals, _n) = moved(&mesh.normals, &normal)?;
+        let input = MeshInput {
+            positions: &positions,
+            normals: &normals,
+            ..mesh.input()
+        };
+        group.triangles.push_mesh(&input, offset, material)?;
     }
     Ok(())
 }
@@ -359,23 +421,28 @@ impl Scene {
         let t = f64::from(k);
         let camera = anim.camera_at(t, k)?;
         let lights = anim.lights_at(t, k, self.world_offset)?;
-        let moving = anim.group_at(t, k, self.world_offset)?;
-        let colors: Vec<(usize, Vec3A)> = anim
+        let moving = anim.group_at(t, k, self.world_offset, &self.budget)?;
+        let shadows = anim.shadows;
+        let colors: Vec<(usize, Option<usize>, Vec3A)> = anim
             .materials
             .iter()
-            .map(|(i, track)| {
+            .map(|(i, copy, track)| {
                 let c = value(track, t).map(|x| x.max(0.0));
-                (*i, Vec3A::new(c[0] as f32, c[1] as f32, c[2] as f32))
+                (*i, *copy, Vec3A::new(c[0] as f32, c[1] as f32, c[2] as f32))
             })
             .collect();
-        let origin = Vec3A::from((DVec3::from(camera.position) - self.world_offset).as_vec3());
-        let s = &self.settings;
-        self.camera = Camera::new(&camera, origin, s.width, s.height);
-        (self.primary_width, self.pixel_spread) = self.camera.footprint();
+        self.set_camera(&camera);
         self.lights = lights;
+        // The previous frame's group goes, and its charges with it.
         self.moving = moving;
-        for (i, c) in colors {
-            self.materials[i].color = c;
+        for (i, copy, c) in colors {
+            let m = &mut self.materials[i];
+            m.color = c;
+            // A tinted shadow takes the colour too (the copy casting no shadow keeps its none).
+            m.shadow = shadow_filter(m.transmit, c, shadows);
+            if let Some(j) = copy {
+                self.materials[j].color = c;
+            }
         }
         self.settings.frame = k;
         if let Some(anim) = &mut self.animation {

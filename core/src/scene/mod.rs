@@ -9,6 +9,7 @@ mod frame;
 pub use build::Prebuilt;
 pub use frame::Animation;
 
+use crate::budget::Budget;
 use crate::camera::Camera;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
@@ -25,6 +26,7 @@ use crate::volume::Volume;
 use crate::volume_render::RenderVolume;
 use luxon_formats::OutputDesc;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(Clone, Debug)]
@@ -38,17 +40,40 @@ pub struct Material {
     pub diffuse: f32,
     pub specular: f32,
     pub shininess: f32,
-    pub blinn: bool,
+    pub highlight: luxon_formats::Highlight,
+    /// The highlight takes the surface's colour (metal), not white.
+    pub highlight_surface: bool,
     pub reflect: f32,
     pub transmit: f32,
     pub ior: f32,
+    /// How the transmit coefficient changes with the viewing angle.
+    pub angle: AngleRule,
+    /// What a shadow ray keeps after crossing this surface once; `None`: it is blocked.
+    pub shadow: Option<Vec3A>,
+    /// Silhouette darkening of the diffuse light (0: none) and its exponent 32·(1 − width).
+    pub outline: f32,
+    pub outline_power: f32,
+    /// Whether fog covers the surface.
+    pub fog: bool,
+}
+
+/// How a material's transmit coefficient t changes with the angle θ it is seen at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AngleRule {
+    Constant,
+    /// t^(1/|cos θ|): a slab seen at θ (the `AngleModulated` mode).
+    Slab,
+    /// Tachyon's Raster3D: opacity 1 − t becomes ¼(1 + cos(π·t·cos θ))².
+    Raster3D,
 }
 
 impl Material {
-    /// What a shadow ray keeps after crossing this surface once.
+    /// The outline factor on the diffuse light where the view direction makes cosine `cos`
+    /// with the normal: 1 facing the viewer, darker toward the silhouette.
     #[inline]
-    pub fn shadow_filter(&self) -> Vec3A {
-        self.transmit * self.color
+    pub fn outline_factor(&self, cos: f32) -> f32 {
+        let edge = (1.0 - cos * cos).max(0.0).powf(self.outline_power);
+        (1.0 - self.outline) + self.outline * (1.0 - edge)
     }
 }
 
@@ -67,12 +92,13 @@ pub enum Light {
         shadows: bool,
     },
     /// `axis` points from the light into the scene; full strength where the angle to it has a
-    /// cosine above `cos_inner`, none below `cos_outer`.
+    /// cosine above `cos_inner`, none below `cos_outer`, fading between as `fade` says.
     Spot {
         position: Vec3A,
         axis: Vec3A,
         cos_inner: f32,
         cos_outer: f32,
+        fade: Fade,
         color: Vec3A,
         shadows: bool,
         attenuation: [f32; 3],
@@ -107,19 +133,25 @@ impl Light {
     }
 
     /// A spot light's weight where the direction from it makes cosine `cos` with its axis:
-    /// 1 inside the inner cone, 0 outside the outer one, and a smoothstep across the band
-    /// between them (no visible edge).
+    /// 1 inside the inner cone, 0 outside the outer one, and across the band between them a
+    /// smoothstep in the cosine (no visible edge) or linear in the angle.
     #[inline]
-    pub fn spot_weight(cos: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    pub fn spot_weight(cos: f32, cos_inner: f32, cos_outer: f32, fade: Fade) -> f32 {
         if cos <= cos_outer {
             return 0.0;
         }
-        let x = if cos >= cos_inner {
-            1.0
-        } else {
-            (cos - cos_outer) / (cos_inner - cos_outer)
-        };
-        x * x * (3.0 - 2.0 * x)
+        if cos >= cos_inner {
+            return 1.0;
+        }
+        match fade {
+            Fade::Smooth => {
+                let x = (cos - cos_outer) / (cos_inner - cos_outer);
+                x * x * (3.0 - 2.0 * x)
+            }
+            Fade::Linear { inner, outer } => {
+                ((outer - cos.acos()) / (outer - inner)).clamp(0.0, 1.0)
+            }
+        }
     }
 
     pub fn casts_shadows(&self) -> bool {
@@ -133,24 +165,43 @@ impl Light {
     }
 }
 
-/// Fog over the distance camera rays travel; `planar` measures it along the view direction.
+/// How a spot light fades across its band (angles from the axis in radians).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Fade {
+    Smooth,
+    Linear { inner: f32, outer: f32 },
+}
+
+/// Fog over the distance camera rays travel (`every_ray`: every ray, over its own segment);
+/// `planar` measures camera rays' distance along the view direction.
 #[derive(Clone, Debug)]
 pub struct Fog {
     pub mode: luxon_formats::FogMode,
     pub color: Vec3A,
     pub planar: bool,
+    pub every_ray: bool,
+    /// Rays that hit nothing show the fog colour.
+    pub misses: bool,
 }
 
 impl Fog {
     /// The fraction of the surface's colour left after distance `d`.
     pub fn visibility(&self, d: f32) -> f32 {
         use luxon_formats::FogMode;
+        // Exponential fog starts at `start`: clear before it.
+        let after = |start: f64| {
+            if start > 0.0 {
+                (d - start as f32).max(0.0)
+            } else {
+                d
+            }
+        };
         match self.mode {
             FogMode::Linear { start, end } => {
                 (1.0 - (d - start as f32) / (end - start) as f32).clamp(0.0, 1.0)
             }
-            FogMode::Exp { density } => (-(density as f32) * d).exp(),
-            FogMode::Exp2 { density } => (-(density as f32 * d).powi(2)).exp(),
+            FogMode::Exp { density, start } => (-(density as f32) * after(start)).exp(),
+            FogMode::Exp2 { density, start } => (-(density as f32 * after(start)).powi(2)).exp(),
         }
     }
 }
@@ -171,10 +222,20 @@ pub struct Ao {
 pub struct Features {
     pub shadows: bool,
     pub ambient_occlusion: bool,
+    /// Fog on camera rays' own shading.
     pub fog: bool,
+    /// Fog on every ray's segment and whole colour (Tachyon's).
+    pub fog_every_ray: bool,
     pub reflection: bool,
     /// Any used material lets light through (refraction or plain transparency).
     pub transmission: bool,
+    /// Shadow rays can pass some surface (a transparent one, or one that casts no shadow), so
+    /// they look at what they hit.
+    pub shadow_filters: bool,
+    /// Some used material darkens its silhouette.
+    pub outline: bool,
+    /// Lights follow Tachyon's rules (its threshold, plain highlights).
+    pub tachyon_lights: bool,
     pub textures: bool,
     pub antialiasing: bool,
     /// Some volume is drawn (has `render` settings).
@@ -187,9 +248,10 @@ impl std::fmt::Display for Features {
         for (on, name) in [
             (self.shadows, "shadows"),
             (self.ambient_occlusion, "ambient occlusion"),
-            (self.fog, "fog"),
+            (self.fog || self.fog_every_ray, "fog"),
             (self.reflection, "reflection"),
             (self.transmission, "refraction/transparency"),
+            (self.outline, "outlines"),
             (self.textures, "textures"),
             (self.antialiasing, "antialiasing"),
             (self.volumes, "volumes"),
@@ -226,6 +288,10 @@ pub struct Settings {
     pub volume_skip: bool,
     /// Adaptive supersampling; `None`: `samples` uniform samples per pixel.
     pub adaptive: Option<luxon_formats::AdaptiveDesc>,
+    /// Scale of every light's direct contribution (light colours are multiplied by it).
+    pub light_scale: f32,
+    /// Tachyon's shading rules.
+    pub tachyon: luxon_formats::TachyonDesc,
 }
 
 pub struct Scene {
@@ -274,6 +340,9 @@ pub struct Scene {
     pub moving: Group,
     /// How the scene changes from frame to frame; `None`: a still scene.
     pub animation: Option<Box<Animation>>,
+    /// The memory budget the build charged (geometry, BVHs, volumes, texture cache) and the
+    /// render charges (images).
+    pub budget: Arc<Budget>,
 }
 
 impl Scene {
@@ -318,10 +387,10 @@ impl Scene {
     }
 
     /// What reaches the end of a shadow ray: zero when an opaque surface blocks it, otherwise
-    /// the product of the filters of the transparent surfaces it crosses.
+    /// the product of the filters (`Material::shadow`) of the surfaces it crosses.
     #[inline]
     pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
-        if !self.features.transmission {
+        if !self.features.shadow_filters {
             // Opaque world: the first hit anywhere ends the query.
             let blocked = self.spheres.any(ray, t_max, &self.clips, c, |_, _| true)
                 || self
@@ -340,12 +409,10 @@ impl Scene {
         }
         let mut filter = Vec3A::ONE;
         let mut on_hit = |m: u32, crossings: u32| {
-            let mat = &self.materials[m as usize];
-            if mat.transmit <= 0.0 {
+            let Some(f) = self.materials[m as usize].shadow else {
                 filter = Vec3A::ZERO;
                 return true;
-            }
-            let f = mat.shadow_filter();
+            };
             for _ in 0..crossings {
                 filter *= f;
             }
@@ -365,6 +432,18 @@ impl Scene {
             return Vec3A::ZERO;
         }
         filter
+    }
+
+    /// Moves the camera without rebuilding anything (the next view of a Tachyon camera file,
+    /// or an animated scene's keyed camera, which `set_frame` places here): the
+    /// geometry stays stored relative to `world_offset` (the first camera's position) and the
+    /// new camera is placed in that space. Only the camera's position, direction and window
+    /// change what a render computes; `settings` (resolution, samples) stay as built.
+    pub fn set_camera(&mut self, desc: &luxon_formats::CameraDesc) {
+        let origin = Vec3A::from((DVec3::from(desc.position) - self.world_offset).as_vec3());
+        let s = &self.settings;
+        self.camera = Camera::new(desc, origin, s.width, s.height);
+        (self.primary_width, self.pixel_spread) = self.camera.footprint();
     }
 
     pub fn primitive_count(&self) -> usize {

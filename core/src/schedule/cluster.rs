@@ -36,6 +36,8 @@ pub struct Cluster {
     size: usize,
     /// Ranks on this node that share this rank's CPUs (including it).
     sharing: usize,
+    /// Ranks on this node (they share its memory).
+    node_ranks: usize,
     // Dropped last: finalises MPI.
     _universe: mpi::environment::Universe,
 }
@@ -80,6 +82,7 @@ impl Cluster {
             rank,
             size,
             sharing,
+            node_ranks: all.len().max(1),
             _universe: universe,
         })
     }
@@ -90,6 +93,11 @@ impl Cluster {
 
     pub fn size(&self) -> usize {
         self.size
+    }
+
+    /// Ranks on this node, this one included.
+    pub fn node_ranks(&self) -> usize {
+        self.node_ranks
     }
 
     /// Render threads for this rank: the settings' count, else one in pure MPI mode, else this

@@ -34,6 +34,12 @@
 //! Instead of the environment variable a scene can name the directory (or the `.so` itself),
 //! relative to the scene file: `plugin_path: ["../target/release"]`.
 //!
+//! The library records the plugin ABI it was built for (ABI 2: `luxon-plugin` 0.2); Luxon
+//! skips a library built for another and says so, naming both versions: rebuild it against the
+//! SDK of the Luxon that loads it. A shape that builds big arrays (a tessellated mesh) should
+//! allocate them with `ctx.alloc_vec`, which keeps to the memory budget the host gives the call
+//! and turns a refused allocation into an error instead of an abort.
+//!
 //! ## `torus`
 //! ```text
 //! center: (x, y, z) = (0, 0, 0)  centre of the ring

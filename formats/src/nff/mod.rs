@@ -403,6 +403,7 @@ impl Assembler {
                 material,
                 at: Some(self.origin(b.first)),
                 clip: None,
+                shadowless: false,
                 spheres: b.spheres,
                 cones: b.cones,
                 discs: Vec::new(),

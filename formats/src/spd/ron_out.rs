@@ -11,13 +11,15 @@
 //! written as the NFF writes them (`%g`), so both files describe the same geometry.
 //!
 //! The scene is generated twice: first to collect the view, lights and materials for the
-//! header, then streamed into the objects (at most [`BATCH`] primitives per object).
+//! header, then streamed into the objects (at most [`BATCH`] primitives per object). The arrays
+//! are laid out as every RON scene Luxon writes ([`crate::ron_text`]).
 
 use std::collections::HashMap;
 use std::io::{self, Write};
 
 use super::{push_g, Counts, Fill, Sink, SpdScene, View, V3};
 use crate::nff::{fov_of_angle, material_of_fill};
+use crate::ron_text::items;
 
 /// Most primitives per object.
 pub const BATCH: usize = 1 << 16;
@@ -203,16 +205,10 @@ impl<'a> RonWriter<'a> {
         let spheres = std::mem::take(&mut self.spheres);
         self.buf
             .extend_from_slice(b"        (plugin: \"spheres\", params: (\n            centers: [");
-        for (k, (c, _)) in spheres.iter().enumerate() {
-            self.buf.extend_from_slice(if k.is_multiple_of(4) {
-                b"\n                "
-            } else {
-                b" "
-            });
-            tuple(&mut self.buf, c);
-            self.buf.push(b',');
-            self.spill()?;
-        }
+        items(&mut self.buf, spheres.len(), 4, ITEM, |b, k| {
+            tuple(b, &spheres[k].0)
+        });
+        self.spill()?;
         self.buf
             .extend_from_slice(b"\n            ],\n            ");
         let r0 = spheres[0].1;
@@ -281,32 +277,19 @@ impl<'a> RonWriter<'a> {
         }
         self.buf
             .extend_from_slice(b"\n            ],\n            indices: [");
-        for (k, t) in tris.iter().enumerate() {
-            self.buf.extend_from_slice(if k.is_multiple_of(8) {
-                b"\n                "
-            } else {
-                b" "
-            });
-            let _ = write!(self.buf, "({}, {}, {}),", t[0], t[1], t[2]);
-            self.spill()?;
-        }
+        items(&mut self.buf, tris.len(), 8, ITEM, |b, k| {
+            let t = tris[k];
+            let _ = write!(b, "({}, {}, {})", t[0], t[1], t[2]);
+        });
+        self.spill()?;
         self.buf.extend_from_slice(b"\n            ],\n        ");
         self.material_suffix();
         self.spill()
     }
 
     fn vectors(&mut self, v: &[V3]) -> io::Result<()> {
-        for (k, p) in v.iter().enumerate() {
-            self.buf.extend_from_slice(if k.is_multiple_of(3) {
-                b"\n                "
-            } else {
-                b" "
-            });
-            tuple(&mut self.buf, p);
-            self.buf.push(b',');
-            self.spill()?;
-        }
-        Ok(())
+        items(&mut self.buf, v.len(), 3, ITEM, |b, k| tuple(b, &v[k]));
+        self.spill()
     }
 }
 
@@ -391,14 +374,11 @@ impl Sink for RonWriter<'_> {
 
 /// `(x, y, z)` with `%g` numbers.
 fn tuple(b: &mut Vec<u8>, v: &[f64; 3]) {
-    b.push(b'(');
-    push_g(b, v[0]);
-    b.extend_from_slice(b", ");
-    push_g(b, v[1]);
-    b.extend_from_slice(b", ");
-    push_g(b, v[2]);
-    b.push(b')');
+    crate::ron_text::tuple(b, v, push_g);
 }
+
+/// Array items' indentation inside an object's params.
+const ITEM: &str = "                ";
 
 /// `x` rounded as `%g` writes it.
 fn round_g(x: f64) -> f64 {

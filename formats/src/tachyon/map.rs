@@ -6,13 +6,16 @@ use std::collections::HashSet;
 
 use super::materials::Materials;
 use super::notes::Notes;
+use super::options::{Highlights, Options};
 use super::shapes::{tpoly_vertex, volume_slices, Shapes};
 use super::syntax::*;
 use super::terrain::scape;
 use super::{mirror, Warnings};
 use crate::desc::{
-    AoDesc, Attenuation, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum, LightDesc,
-    Projection as LuxProjection, RenderDesc, SceneDesc, TransparencyDesc, TransparencyMode,
+    AoDesc, Attenuation, BeyondMax, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum,
+    Highlight, LightDesc, MaterialDesc, Projection as LuxProjection, RenderDesc, SceneDesc,
+    SpotFade, TachyonDesc, TransparencyAngle, TransparencyDesc, TransparencyMode,
+    TransparentShadows,
 };
 use crate::error::SceneError;
 use crate::origin::{Origin, Spanned};
@@ -39,15 +42,19 @@ struct Mapper {
     background: V3,
     fog: Option<(Origin, Fog)>,
     ao: Option<AoDesc>,
+    /// Tachyon's direct light scale (RESCALE_DIRECT): it outlives the occlusion that set it.
+    light_scale: f64,
     shading: Shading,
     lights: Vec<Spanned<LightDesc>>,
     materials: Materials,
     shapes: Shapes,
     notes: Notes,
     warnings: Warnings,
+    /// The command line's overrides.
+    options: Options,
 }
 
-pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
+pub(super) fn to_desc(scene: Scene, options: &Options) -> Result<SceneDesc> {
     let reserved: HashSet<String> = scene
         .statements
         .iter()
@@ -61,6 +68,7 @@ pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
         background: [0.0; 3],
         fog: None,
         ao: None,
+        light_scale: 1.0,
         shading: Shading {
             level: ShadeLevel::Full,
             vmd: false,
@@ -74,10 +82,12 @@ pub(super) fn to_desc(scene: Scene) -> Result<SceneDesc> {
         shapes: Shapes::default(),
         notes: Notes::default(),
         warnings: scene.warnings,
+        options: options.clone(),
     };
     for s in &scene.statements {
         m.statement(s)?;
     }
+    m.command_line_shading();
     m.finish(&scene.source, &scene.resolution, &scene.begin)
 }
 
@@ -132,18 +142,12 @@ impl Mapper {
             ),
             Kind::Fog(f) => self.fog = Some((at.clone(), f.clone())),
             Kind::Light(l) => {
-                if l.rad > 0.0 {
-                    self.notes.add(
-                        "LIGHT with RAD > 0",
-                        "lights the scene, but its sphere (drawn by Tachyon in the light's \
-                         colour) is not drawn yet",
-                        at,
-                    );
-                }
+                let color = light_color(l.color, at)?;
+                self.light_sphere(l.center, l.rad, color, at);
                 self.lights.push(Spanned {
                     value: LightDesc::Point {
                         position: mirror(l.center),
-                        color: light_color(l.color, at)?,
+                        color,
                         intensity: 1.0,
                         shadows: true,
                         attenuation: attenuation(&l.attenuation),
@@ -322,6 +326,89 @@ impl Mapper {
         Ok(())
     }
 
+    /// The command line's shading switches, over the scene's SHADER_MODE (Tachyon applies
+    /// them after reading the scene).
+    fn command_line_shading(&mut self) {
+        let (o, s) = (&self.options, &mut self.shading);
+        if let Some(level) = o.shade {
+            s.level = level;
+        }
+        if let Some((vmd, raster3d)) = o.transparency {
+            (s.vmd, s.raster3d) = (vmd, raster3d);
+        }
+        if let Some(n) = o.max_surfaces {
+            s.max_surfaces = Some((n, o.at.clone()));
+        }
+        if let Some(on) = o.shadow_filter {
+            s.shadow_filter_off = (!on).then(|| o.at.clone());
+        }
+        if let Some(vmd) = o.fog_vmd {
+            s.fog_vmd = vmd;
+        }
+    }
+
+    /// Ambient occlusion and the direct light scale: the scene's, then the command line's
+    /// (`-rescale_lights` below 1 replaces the scene's RESCALE_DIRECT; `-auto_skylight f`
+    /// replaces both with f and 1 − f; `-add_skylight f` only the occlusion). The scale is the
+    /// occlusion's `direct` while occlusion is on, else it scales every light.
+    fn lighting(&mut self, shadows: bool) -> Option<AoDesc> {
+        let o = &self.options;
+        let mut scale = self.light_scale;
+        if let Some(s) = o.light_scale.filter(|&s| s < 1.0) {
+            scale = s.max(0.0);
+        }
+        let mut ao = self.ao.take();
+        if let Some(sky) = o.skylight.filter(|s| s.level > 0.0) {
+            let old = ao.as_ref().map_or(1.0, |a| a.intensity);
+            ao = (sky.samples > 0).then_some(AoDesc {
+                samples: sky.samples,
+                max_distance: f64::INFINITY,
+                color: [sky.level; 3],
+                intensity: old,
+                direct: 1.0,
+            });
+            if sky.rescale {
+                scale = (1.0 - sky.level).max(0.0);
+            }
+        }
+        // MEDIUM and below trace no occlusion rays; the scale stays.
+        if !shadows {
+            ao = None;
+        }
+        match &mut ao {
+            Some(a) => a.direct = scale,
+            None if scale != 1.0 => {
+                for l in &mut self.lights {
+                    match &mut l.value {
+                        LightDesc::Point { intensity, .. }
+                        | LightDesc::Directional { intensity, .. }
+                        | LightDesc::Spot { intensity, .. }
+                        | LightDesc::Sphere { intensity, .. }
+                        | LightDesc::Rect { intensity, .. } => *intensity *= scale,
+                    }
+                }
+            }
+            None => {}
+        }
+        ao
+    }
+
+    /// `-shade_phong` and the other highlight switches, on every material.
+    fn highlights(&mut self, materials: &mut [(String, Spanned<MaterialDesc>)]) {
+        let Some(h) = self.options.highlights else {
+            return;
+        };
+        for (_, m) in materials.iter_mut() {
+            let m = &mut m.value;
+            match h {
+                Highlights::Phong => m.highlight = Highlight::Phong,
+                Highlights::Blinn => m.highlight = Highlight::Blinn,
+                Highlights::BlinnFast => m.highlight = Highlight::BlinnFast,
+                Highlights::None => m.specular = 0.0,
+            }
+        }
+    }
+
     fn shader_mode(&mut self, mode: &ShaderMode) {
         let s = &mut self.shading;
         s.level = mode.level.value;
@@ -345,21 +432,26 @@ impl Mapper {
                         max_distance: f64::INFINITY,
                         color: *color,
                         intensity: 1.0,
-                        direct: *rescale_direct,
+                        direct: 1.0,
                     });
+                    self.light_scale = *rescale_direct;
                 }
             }
         }
     }
 
-    fn spotlight(&mut self, l: &Spotlight, at: &Origin) -> Result<()> {
-        if l.rad > 0.0 {
-            self.notes.add(
-                "SPOTLIGHT with RAD > 0",
-                "lights the scene, but its sphere is not drawn yet",
-                at,
-            );
+    /// A light with RAD > 0 is also a sphere in its colour, unlit and unfogged, casting no
+    /// shadow (Tachyon's light object).
+    fn light_sphere(&mut self, center: V3, rad: f64, color: V3, at: &Origin) {
+        if rad > 0.0 {
+            let m = self.materials.light(color, at);
+            self.shapes.light_sphere(&m, center, rad, at);
         }
+    }
+
+    fn spotlight(&mut self, l: &Spotlight, at: &Origin) -> Result<()> {
+        let color = light_color(l.color, at)?;
+        self.light_sphere(l.center, l.rad, color, at);
         let end = l.falloff_end.clamp(0.0, 180.0);
         let start = l.falloff_start.clamp(0.0, end);
         self.lights.push(Spanned {
@@ -368,7 +460,8 @@ impl Mapper {
                 direction: mirror(nonzero(l.direction, "DIRECTION", at)?),
                 cone_deg: 2.0 * end,
                 falloff_deg: 2.0 * (end - start),
-                color: light_color(l.color, at)?,
+                fade: SpotFade::Linear,
+                color,
                 intensity: 1.0,
                 shadows: true,
                 attenuation: attenuation(&l.attenuation),
@@ -416,7 +509,7 @@ impl Mapper {
         res: &Spanned<[u32; 2]>,
         begin: &Origin,
     ) -> Result<SceneDesc> {
-        let [width, height] = res.value;
+        let [width, height] = self.options.resolution.unwrap_or(res.value);
         if u64::from(width) * u64::from(height) > 1 << 28 {
             return Err(SceneError::at(
                 res.at.clone(),
@@ -426,10 +519,9 @@ impl Mapper {
         let (camera, samples, max_depth) = self.camera(width, height, begin)?;
         let level = self.shading.level;
         let mut fog = self.fog()?;
-        let mut ao = self.ao.take();
         let shadows = level == ShadeLevel::Full;
+        let ao = self.lighting(shadows);
         if !shadows {
-            ao = None;
             for l in &mut self.lights {
                 match &mut l.value {
                     LightDesc::Point { shadows, .. }
@@ -460,11 +552,8 @@ impl Mapper {
                 textures.clear();
             }
         }
-        let first_transparent = materials
-            .iter()
-            .find(|(_, m)| m.value.transmit > 0.0)
-            .map(|(_, m)| m.at.clone());
-        let transparency = self.transparency(first_transparent);
+        self.highlights(&mut materials);
+        let transparency = self.transparency();
         let mut warnings = self.warnings;
         warnings.extend(self.notes.into_warnings());
         Ok(SceneDesc {
@@ -486,6 +575,11 @@ impl Mapper {
                 samples,
                 max_depth,
                 transparency,
+                tachyon: TachyonDesc {
+                    light_threshold: true,
+                    plain_highlights: true,
+                    depth_limit_background: true,
+                },
                 ..RenderDesc::default()
             },
             animation: None,
@@ -500,46 +594,31 @@ impl Mapper {
         })
     }
 
-    /// The transparency mode, and notes where it is not Tachyon's (only when some material,
-    /// the first at `first_transparent`, is transparent).
-    fn transparency(&mut self, first_transparent: Option<Origin>) -> TransparencyDesc {
-        let (vmd, raster3d) = (self.shading.vmd, self.shading.raster3d);
-        let mode = if vmd {
-            TransparencyMode::PostMultiplied
-        } else if raster3d {
-            TransparencyMode::AngleModulated
-        } else {
-            TransparencyMode::Filter
-        };
-        let max_surfaces = self.shading.max_surfaces.clone();
-        if let Some(at) = self.shading.shadow_filter_off.clone() {
-            self.notes.add(
-                "SHADOW_FILTER_OFF",
-                "is not rendered yet: transparent surfaces cast filtered shadows",
-                &at,
-            );
-        }
-        if let Some(at) = first_transparent {
-            let what = match (vmd, raster3d) {
-                (true, true) => Some("TRANS_VMD with TRANS_RASTER3D transparency is rendered as TRANS_VMD"),
-                (false, true) => Some("TRANS_RASTER3D transparency is rendered with Luxon's angle-modulated transmittance (a different formula)"),
-                (false, false) => Some("Tachyon's default transparency (TRANS_ORIG: the surface's shading kept, what is behind added untinted) is rendered with Luxon's filter mode (shading scaled by opacity, what is behind tinted by the colour)"),
-                (true, false) => None,
-            };
-            if let Some(what) = what {
-                self.notes.add(what, "", &at);
-            }
-            if let Some((_, at)) = &max_surfaces {
-                self.notes.add(
-                    "TRANS_MAX_SURFACES",
-                    "shows the surface after the limit opaque (Tachyon leaves it out)",
-                    at,
-                );
-            }
-        }
+    /// Tachyon's transparency: TRANS_ORIG adds what is behind to the unscaled shading,
+    /// TRANS_VMD post-multiplies (the mirror reflection too), TRANS_RASTER3D changes opacity
+    /// with the angle; later surfaces past TRANS_MAX_SURFACES are skipped; shadows through
+    /// transparent surfaces are grey, or none with SHADOW_FILTER_OFF.
+    fn transparency(&mut self) -> TransparencyDesc {
+        let s = &self.shading;
         TransparencyDesc {
-            mode,
-            max_surfaces: max_surfaces.map(|(n, _)| n),
+            mode: if s.vmd {
+                TransparencyMode::PostMultiplied
+            } else {
+                TransparencyMode::Additive
+            },
+            angle: if s.raster3d {
+                TransparencyAngle::Raster3D
+            } else {
+                TransparencyAngle::Constant
+            },
+            max_surfaces: s.max_surfaces.as_ref().map(|(n, _)| *n),
+            beyond_max: BeyondMax::Skip,
+            shadows: if s.shadow_filter_off.is_some() {
+                TransparentShadows::Off
+            } else {
+                TransparentShadows::Untinted
+            },
+            scale_reflection: s.vmd,
         }
     }
 
@@ -565,32 +644,35 @@ impl Mapper {
                 }
             }
             FogMode::Exp | FogMode::Exp2 => {
-                if f.start != 0.0 {
+                if f.density <= 0.0 {
+                    // Tachyon's visibility, clamped to 1: no fog.
+                    return Ok(None);
+                }
+                // Tachyon's visibility is 1 before START: a negative START is fog from the eye
+                // on, thicker.
+                let (density, start) = (f.density, f.start.max(0.0));
+                if f.start < 0.0 {
                     self.notes.add(
-                        "FOG EXP/EXP2 with START",
-                        "starts at the eye (Luxon's exponential fog has no start distance)",
+                        "FOG START below 0",
+                        "starts at the eye (Tachyon's fog is already thicker there)",
                         &at,
                     );
                 }
                 if f.mode.value == FogMode::Exp {
-                    LuxFog::Exp { density: f.density }
+                    LuxFog::Exp { density, start }
                 } else {
-                    LuxFog::Exp2 { density: f.density }
+                    LuxFog::Exp2 { density, start }
                 }
             }
         };
-        if !self.shading.fog_vmd {
-            self.notes.add(
-                "FOG",
-                "leaves the background unfogged (Tachyon's radial fog turns it into the fog \
-                 colour)",
-                &at,
-            );
-        }
+        // Tachyon fogs every ray over its own segment; radial fog turns misses into the fog
+        // colour, FOG_VMD (planar for camera rays) leaves the background alone.
         Ok(Some(FogDesc {
             mode,
             color: light_color(f.color, &at)?,
             planar: self.shading.fog_vmd,
+            every_ray: true,
+            misses: !self.shading.fog_vmd,
         }))
     }
 
@@ -603,7 +685,7 @@ impl Mapper {
         height: u32,
         begin: &Origin,
     ) -> Result<(Spanned<CameraDesc>, u32, u32)> {
-        let (at, c) = match self.camera.take() {
+        let (at, mut c) = match self.camera.take() {
             Some(c) => c,
             None => (
                 begin.clone(),
@@ -620,6 +702,12 @@ impl Mapper {
                 },
             ),
         };
+        if let Some(n) = self.options.antialiasing {
+            c.antialiasing = n;
+        }
+        if let Some(n) = self.options.raydepth {
+            c.raydepth = n;
+        }
         if c.zoom <= 0.0 {
             return Err(SceneError::at(
                 at,
@@ -742,6 +830,43 @@ impl Mapper {
         let max_depth = c.raydepth.saturating_sub(1).min(MAX_DEPTH);
         Ok((Spanned { value: camera, at }, c.antialiasing + 1, max_depth))
     }
+}
+
+/// `camera` at Tachyon's CENTER, looking along VIEWDIR with UPDIR up (see `camera_at`).
+pub(super) fn moved_camera(
+    camera: &CameraDesc,
+    viewdir: V3,
+    updir: V3,
+    center: V3,
+) -> std::result::Result<CameraDesc, String> {
+    let finite = |v: V3| v.iter().all(|x| x.is_finite());
+    if !(finite(viewdir) && finite(updir) && finite(center)) {
+        return Err("a number is not finite; expected finite numbers".into());
+    }
+    if viewdir == [0.0; 3] {
+        return Err("VIEWDIR is (0, 0, 0); expected a direction".into());
+    }
+    if updir == [0.0; 3] {
+        return Err("UPDIR is (0, 0, 0); expected a direction".into());
+    }
+    let [v, u] = [viewdir, updir];
+    let cross = [
+        v[1] * u[2] - v[2] * u[1],
+        v[2] * u[0] - v[0] * u[2],
+        v[0] * u[1] - v[1] * u[0],
+    ];
+    if cross == [0.0; 3] {
+        return Err(
+            "UPDIR is parallel to VIEWDIR; expected an up direction across the view".into(),
+        );
+    }
+    let (p, v) = (mirror(center), mirror(viewdir));
+    Ok(CameraDesc {
+        position: p,
+        look_at: [p[0] + v[0], p[1] + v[1], p[2] + v[2]],
+        up: mirror(updir),
+        ..camera.clone()
+    })
 }
 
 /// A strip's triangles: (s[t], s[t+1], s[t+2]) for even t, (s[t+1], s[t], s[t+2]) for odd t,

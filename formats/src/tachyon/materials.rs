@@ -10,7 +10,7 @@ use super::syntax::{
     Frame, ImageKind, PhongKind, SolidKind, Surface, TexBody, TexFunc, TexRef, V3,
 };
 use super::{mirror, Warnings};
-use crate::desc::{Highlight, MaterialDesc, PluginCall};
+use crate::desc::{Highlight, HighlightColor, MaterialDesc, PluginCall, TransparencyAngle};
 use crate::error::SceneError;
 use crate::origin::{Origin, Spanned};
 
@@ -170,6 +170,22 @@ impl Materials {
             specular: 0.0,
             reflect: 0.0,
             transmit: 0.0,
+            ..MaterialDesc::default()
+        };
+        self.shared_material(m, None, at)
+    }
+
+    /// A light's visible sphere: its colour, unlit (ambient 1, nothing else) and unfogged, as
+    /// Tachyon draws it.
+    pub fn light(&mut self, color: V3, at: &Origin) -> String {
+        let m = MaterialDesc {
+            color,
+            ambient: 1.0,
+            diffuse: 0.0,
+            specular: 0.0,
+            reflect: 0.0,
+            transmit: 0.0,
+            fog: false,
             ..MaterialDesc::default()
         };
         self.shared_material(m, None, at)
@@ -478,31 +494,14 @@ fn check_surface(s: &Surface, at: &Origin) -> Result<()> {
     Ok(())
 }
 
-/// Notes for the parts of a surface Luxon does not render yet.
+/// Notes for the parts of a surface Luxon renders otherwise: OUTLINE values outside what the
+/// formula is meant for are clamped to [0, 1].
 fn note_surface(s: &Surface, notes: &mut Notes) {
-    if let Some(p) = &s.phong {
-        if p.value.kind == PhongKind::Metal && p.value.phong > 0.0 {
-            notes.add(
-                "PHONG METAL",
-                "highlights take the light's colour (Tachyon tints them with the surface colour)",
-                &p.at,
-            );
-        }
-    }
-    if let Some(t) = &s.transmode {
-        if t.value.eq_ignore_ascii_case("R3D") {
-            notes.add(
-                "TRANSMODE R3D",
-                "(per-texture Raster3D transparency) is not rendered yet",
-                &t.at,
-            );
-        }
-    }
     if let Some(o) = &s.outline {
-        if o.value[0] > 0.0 {
+        if o.value.iter().any(|v| !(0.0..=1.0).contains(v)) {
             notes.add(
-                "OUTLINE",
-                "(silhouette darkening) is not rendered yet",
+                "OUTLINE or OUTLINE_WIDTH outside 0..1",
+                "is clamped into 0..1",
                 &o.at,
             );
         }
@@ -510,13 +509,26 @@ fn note_surface(s: &Surface, notes: &mut Notes) {
 }
 
 /// Tachyon's shading coefficients as a Luxon material: ambient and diffuse as they are,
-/// SPECULAR the mirror reflectance, PHONG the (Blinn) highlight, OPACITY o a transmission of
-/// 1 - o without refraction.
+/// SPECULAR the mirror reflectance, PHONG the (Blinn) highlight in the light's colour
+/// (PLASTIC) or the surface's (METAL), OPACITY o a transmission of 1 - o without refraction,
+/// TRANSMODE R3D the Raster3D angle rule, OUTLINE the outline.
 fn material_of(s: &Surface, color: V3) -> MaterialDesc {
-    let (specular, shininess) = match &s.phong {
-        Some(p) => (p.value.phong, p.value.size.max(1e-9)),
-        None => (0.0, 100.0),
+    let (specular, shininess, metal) = match &s.phong {
+        Some(p) => (
+            p.value.phong,
+            p.value.size.max(1e-9),
+            p.value.kind == PhongKind::Metal,
+        ),
+        None => (0.0, 100.0, false),
     };
+    let r3d = s
+        .transmode
+        .as_ref()
+        .is_some_and(|t| t.value.eq_ignore_ascii_case("R3D"));
+    let [outline, outline_width] = s
+        .outline
+        .as_ref()
+        .map_or([0.0; 2], |o| o.value.map(|v| v.clamp(0.0, 1.0)));
     MaterialDesc {
         color,
         texture: None,
@@ -527,9 +539,18 @@ fn material_of(s: &Surface, color: V3) -> MaterialDesc {
         specular,
         shininess,
         highlight: Highlight::Blinn,
+        highlight_color: if metal {
+            HighlightColor::Surface
+        } else {
+            HighlightColor::Light
+        },
         reflect: s.specular,
         transmit: (1.0 - s.opacity).clamp(0.0, 1.0),
         ior: 1.0,
+        transparency_angle: r3d.then_some(TransparencyAngle::Raster3D),
+        outline,
+        outline_width,
+        fog: true,
     }
 }
 

@@ -73,27 +73,54 @@
 //! NFF importer does), because Tachyon's arithmetic (ambient + diffuse sums, products of
 //! light and surface colours, mirror and transmission mixes) is on these values: converting
 //! would change every mix, and only an output written without sRGB encoding can show
-//! Tachyon's tones. Until Luxon has that output option, midtones come out brighter than
-//! Tachyon's (Luxon encodes its output as sRGB); where both are 0 or 1 they agree.
+//! Tachyon's tones: `luxon tachyon` writes its images so (the writers' `encoding: display`:
+//! values as they are, clamped and truncated as Tachyon writes them). `luxon render` writes
+//! sRGB unless an output asks for `encoding: display`, so there midtones come out brighter
+//! than Tachyon's; where both are 0 or 1 they agree.
 //!
 //! ## Lights, shading settings, fog
 //!
 //! | Tachyon | Luxon |
 //! |---|---|
-//! | `LIGHT CENTER RAD COLOR` | `Point` light of that colour, intensity 1, with shadows |
-//! | `ATTENUATION CONSTANT c LINEAR l QUADRATIC q` | `attenuation: (c, l, q)`, the same 1/(c + l·d + q·d²); Luxon also attenuates highlights (Tachyon does not) |
+//! | `LIGHT CENTER RAD COLOR` | `Point` light of that colour, intensity 1, with shadows; with RAD > 0 also a sphere of that radius in the light's colour, unlit (`ambient: 1`, `diffuse: 0`), unfogged (`fog: false`) and casting no shadow (`InlineGeometry::shadowless`), as Tachyon draws it |
+//! | `ATTENUATION CONSTANT c LINEAR l QUADRATIC q` | `attenuation: (c, l, q)`, the same 1/(c + l·d + q·d²) (on diffuse light only: see `plain_highlights` below) |
 //! | `DIRECTIONAL_LIGHT DIRECTION d COLOR c` | `Directional` travelling along d |
-//! | `SPOTLIGHT ... FALLOFF_START s FALLOFF_END e` | `Spot` with `angle: 2e`, `falloff: 2(e − s)`: full inside s, none beyond e; Tachyon fades linearly in the angle, Luxon smoothly in its cosine |
+//! | `SPOTLIGHT ... FALLOFF_START s FALLOFF_END e` | `Spot` with `angle: 2e`, `falloff: 2(e − s)`, `fade: Linear`: full inside s, none beyond e, linear in the angle between (Tachyon's ramp); RAD > 0 draws a sphere as LIGHT does |
 //! | `SKY_LIGHT NUMSAMPLES n COLOR c` | `ambient_occlusion`: n samples, unlimited distance, colour c, direct 1 |
-//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r` |
+//! | `SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR c RESCALE_DIRECT r SAMPLES n` | the same with `direct: r`; r scales direct light even where occlusion is off (MEDIUM shading, measured), there as every light's `intensity` |
 //! | `SHADER_MODE FULL` / `MEDIUM` | everything / no shadows and no occlusion |
 //! | `SHADER_MODE LOW` / `LOWEST` | every surface shows its texture colour unlit (no fog) / white on black |
-//! | `TRANS_VMD`, `TRANS_RASTER3D`, `TRANS_ORIG` | `transparency` `PostMultiplied`, `AngleModulated`, `Filter` (see "Not yet") |
-//! | `TRANS_MAX_SURFACES n` | `max_surfaces: n` (see "Not yet") |
+//! | (default), `TRANS_ORIG` | `transparency: (mode: Additive)`: the surface shaded as if opaque plus (1 − o)·behind, untinted |
+//! | `TRANS_VMD` | `mode: PostMultiplied, scale_reflection: true`: o·(shading and mirror reflection) + (1 − o)·behind |
+//! | `TRANS_RASTER3D` (with either), texture `TRANSMODE R3D` | `angle: Raster3D` (render) / `transparency_angle: Raster3D` (material): opacity o seen along D becomes ¼(1 + cos(π(1 − o)(N·D)))² |
+//! | `TRANS_MAX_SURFACES n` | `max_surfaces: n, beyond_max: Skip`: later transparent surfaces are not drawn at all |
+//! | shadows through transparent surfaces, `SHADOW_FILTER_OFF` | `shadows: Untinted` (× (1 − o) per crossing, grey) / `shadows: Off` (none) |
 //! | `FOG LINEAR START s END e` | `Linear { start, end }` |
-//! | `FOG EXP` / `EXP2 DENSITY d` | `Exp` / `Exp2 { density }` (from the eye: START is not used) |
-//! | `FOG_VMD` | `planar: true` (depth along the view direction) |
+//! | `FOG EXP` / `EXP2 START s DENSITY d` | `Exp` / `Exp2 { density, start }` (a negative START is taken as 0, with a warning) |
+//! | fog (any mode) | `every_ray: true` (every ray fogged over its own segment, reflections and transmissions included, as Tachyon shades), `misses: true` (rays that miss show the fog colour) |
+//! | `FOG_VMD` | `planar: true` (camera rays' depth along the view direction), `misses: false` (the background stays) |
 //! | `BACKGROUND c` | `background` |
+//!
+//! Three rules of Tachyon's shading are render settings the importer turns on
+//! (`render.tachyon`): a light counts only where its term N·L × attenuation × spot fade ×
+//! rescale exceeds 1/510 (`light_threshold`, with mirror and transmission coefficients of
+//! 1/510 or less ignored); highlights take the light's whole colour, without attenuation, spot
+//! fade or transparent-shadow filtering, and METAL's the surface colour in its place
+//! (`plain_highlights`); a ray past the depth limit adds the background unscaled
+//! (`depth_limit_background`).
+//!
+//! ## Command-line options
+//!
+//! [`load_with`] takes [`Options`], Tachyon's command-line overrides (`luxon tachyon` fills
+//! them). They replace the scene's settings after the whole file is read, as Tachyon applies
+//! them, and then map like the statements they stand for (`-mediumshade` as `SHADER_MODE
+//! MEDIUM`, `-trans_vmd` as `TRANS_VMD`, `-aasamples n` as `ANTIALIASING n`, `-res` as
+//! `RESOLUTION`), with the same warnings, placed at the command line. Tachyon keeps one direct
+//! light scale: RESCALE_DIRECT sets it, `-rescale_lights f` replaces it when f < 1 (Tachyon
+//! ignores larger factors), `-auto_skylight f` sets it to 1 − f and turns on occlusion of
+//! colour f (`-add_skylight f`: occlusion only), with `-skylight_samples` rays (128 by
+//! default). `-shade_phong` gives every material Phong highlights, `-shade_nullphong` none;
+//! `-shade_blinn_fast` Tachyon's fast Blinn (`highlight: BlinnFast`).
 //!
 //! ## Textures and materials
 //!
@@ -101,7 +128,11 @@
 //! TEXFUNC ...` becomes a material: `color: c`, `ambient: a` (Tachyon's ambient term has no
 //! light colour: nor has Luxon's), `diffuse: d`, `reflect: s` (Tachyon's SPECULAR is the mirror
 //! reflectance, without Fresnel in both), `specular: p`, `shininess: n`, `highlight: Blinn`
-//! (Tachyon's default), `transmit: 1 − o` without refraction (`ior: 1`). `TEXDEF name` gives
+//! (Tachyon's default), `highlight_color: Light` for PLASTIC (and any other word) or `Surface`
+//! for METAL, `transmit: 1 − o` without refraction (`ior: 1`), `TRANSMODE R3D` as
+//! `transparency_angle: Raster3D`, `OUTLINE o OUTLINE_WIDTH w` as `outline: o, outline_width: w`
+//! (the diffuse light, lights and occlusion, times (1 − o) + o·(1 − (1 − (N·D)²)^(32(1 − w))),
+//! Tachyon's formula; values outside 0..1 are clamped with a warning). `TEXDEF name` gives
 //! the material that name; `TEXALIAS` another name for it; inline bodies become `tachyon-N`,
 //! shared by every body that maps to the same material.
 //!
@@ -134,28 +165,23 @@
 //! ## Not yet
 //!
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
-//! renders them: the visible sphere of a LIGHT or SPOTLIGHT with RAD > 0; PHONG METAL's
-//! surface-coloured highlight (Luxon's is the light's colour); Tachyon's transparency
-//! formulas (TRANS_ORIG keeps the surface's shading and adds what is behind untinted, Luxon's
-//! filter mode scales and tints; RASTER3D's angle rule differs; TRANS_MAX_SURFACES leaves
-//! later surfaces out, Luxon shows one opaque; per-texture TRANSMODE R3D; SHADOW_FILTER_OFF);
-//! BACKGROUND_GRADIENT; OUTLINE; the FISHEYE projection (Tachyon's is a latitude/longitude
-//! window, rendered as Luxon's circular fisheye of the same height); fog on the background and
-//! EXP/EXP2 fog's START; vertex colours (VCSTRI, VERTEXARRAY COLORS); TEXFUNC 3 (marble), 4
+//! renders them: BACKGROUND_GRADIENT; the FISHEYE projection (Tachyon's is a latitude/longitude
+//! window, rendered as Luxon's circular fisheye of the same height); vertex colours (VCSTRI,
+//! VERTEXARRAY COLORS); TEXFUNC 3 (marble), 4
 //! (wood), 6 (cylindrical checker) and 10 (IMAGEDEF volume textures), and image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
-//! Tachyon's two-pass volume compositing; the output without sRGB encoding. Also different in
+//! Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
-//! windows blur more sideways in Tachyon), spot falloff shape, highlights attenuated, the 1/510 light threshold, image
-//! texel centres (Tachyon puts u = 0 and 1 on the first and last texel centres), MIP level
-//! choice, the unscaled background added when the ray depth runs out, and the noise of
-//! antialiasing, depth of field and occlusion.
+//! windows blur more sideways in Tachyon), image texel centres (Tachyon puts u = 0 and 1 on
+//! the first and last texel centres), MIP level choice, and the noise of antialiasing, depth of
+//! field and occlusion.
 
 mod files;
 mod lex;
 mod map;
 mod materials;
 mod notes;
+mod options;
 mod parse;
 mod ron;
 mod shapes;
@@ -166,7 +192,10 @@ use std::path::Path;
 
 use crate::desc::SceneDesc;
 use crate::error::SceneError;
-use crate::origin::Spanned;
+use crate::origin::{Origin, Spanned};
+
+pub use options::{Highlights, Options, Skylight};
+pub use syntax::ShadeLevel;
 
 /// Problems that did not stop the import, each where it was found.
 type Warnings = Vec<Spanned<String>>;
@@ -190,5 +219,27 @@ pub fn parse_file(path: &Path) -> Result<syntax::Scene, SceneError> {
 
 /// Loads a Tachyon scene file as a Luxon scene (no outputs: the command line gives them).
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
-    map::to_desc(parse::parse_file(path)?)
+    let at = Origin {
+        file: std::sync::Arc::new(path.to_path_buf()),
+        line: 1,
+        col: 1,
+    };
+    load_with(path, &Options::new(at))
+}
+
+/// The camera of `scene` moved to a frame of a Tachyon camera file (`-camfile`): VIEWDIR,
+/// UPDIR and CENTER as Tachyon writes them, mapped as a CAMERA's are (mirrored); zoom,
+/// window, projection and lens stay. The error says which vector is unusable.
+pub fn camera_at(
+    camera: &crate::desc::CameraDesc,
+    viewdir: [f64; 3],
+    updir: [f64; 3],
+    center: [f64; 3],
+) -> Result<crate::desc::CameraDesc, String> {
+    map::moved_camera(camera, viewdir, updir, center)
+}
+
+/// [`load`] with Tachyon's command-line overrides (`luxon tachyon`).
+pub fn load_with(path: &Path, options: &Options) -> Result<SceneDesc, SceneError> {
+    map::to_desc(parse::parse_file(path)?, options)
 }

@@ -43,8 +43,8 @@ fn has_area(v: &[V3; 3]) -> bool {
 #[derive(Default)]
 pub(super) struct Shapes {
     pub groups: Vec<InlineGeometry>,
-    /// (material, clip group, smooth) → index into `groups`.
-    index: HashMap<(String, Option<usize>, bool), usize>,
+    /// (material, clip group, smooth, shadowless) → index into `groups`.
+    index: HashMap<(String, Option<usize>, bool, bool), usize>,
     pub objects: Vec<Spanned<ObjectDesc>>,
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
     pub clip_groups: Vec<(String, Spanned<Vec<ClipPlaneDesc>>)>,
@@ -57,7 +57,18 @@ impl Shapes {
     /// vertex normals) and everything else are kept apart, since a mesh has normals for all
     /// of its vertices or none.
     fn group(&mut self, material: &str, smooth: bool, at: &Origin) -> &mut InlineGeometry {
-        let key = (material.to_string(), self.clip, smooth);
+        self.group_of(material, smooth, false, at)
+    }
+
+    /// The inline group for `material`, casting shadows or not (`shadowless`).
+    fn group_of(
+        &mut self,
+        material: &str,
+        smooth: bool,
+        shadowless: bool,
+        at: &Origin,
+    ) -> &mut InlineGeometry {
+        let key = (material.to_string(), self.clip, smooth, shadowless);
         let i = match self.index.get(&key) {
             Some(&i) => i,
             None => {
@@ -70,6 +81,7 @@ impl Shapes {
                     }),
                     at: Some(at.clone()),
                     clip,
+                    shadowless,
                     ..InlineGeometry::default()
                 });
                 self.index.insert(key, i);
@@ -129,6 +141,15 @@ impl Shapes {
                 .spheres
                 .push([c[0], c[1], c[2], rad.abs()]);
         }
+    }
+
+    /// A light's visible sphere (RAD > 0): it casts no shadow, so neither its own light nor
+    /// any other is blocked by it (`material`: the light's colour, unlit and unfogged).
+    pub fn light_sphere(&mut self, material: &str, center: V3, rad: f64, at: &Origin) {
+        let c = mirror(center);
+        self.group_of(material, false, true, at)
+            .spheres
+            .push([c[0], c[1], c[2], rad]);
     }
 
     /// An open cylinder from `base` to `apex`.
@@ -255,6 +276,7 @@ impl Shapes {
                     at: at.clone(),
                 }),
                 clip,
+                shadows: true,
             },
             at: at.clone(),
         });

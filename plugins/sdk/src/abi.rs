@@ -41,8 +41,10 @@
 
 use std::ffi::c_void;
 
-/// Bumped on every incompatible change to this file.
-pub const ABI_VERSION: u32 = 1;
+/// Bumped on every incompatible change to this file. Version 2 added
+/// [`CallContext::memory_budget`], [`VolumeSink::add_dense_typed`] and the error sink of
+/// [`TextureInstanceVTable::eval`].
+pub const ABI_VERSION: u32 = 2;
 /// First eight bytes of every [`PluginHeader`].
 pub const MAGIC: [u8; 8] = *b"LUXONPLG";
 /// The one symbol a plugin library exports (NUL-terminated for `dlsym`).
@@ -115,7 +117,7 @@ pub struct HostTable {
 pub struct PluginHeader {
     pub magic: [u8; 8],
     pub abi_version: u32,
-    /// Version of the `luxon-plugin` crate the plugin was built with, e.g. "0.1.0".
+    /// Version of the `luxon-plugin` crate the plugin was built with, e.g. "0.2.0".
     pub sdk_version: Str,
     /// Only read when `magic` and `abi_version` match (the fields above this one never move).
     pub declaration: *const Declaration,
@@ -164,6 +166,11 @@ pub struct CallContext {
     pub texture_cache_bytes: u64,
     /// Threads that will call the instance concurrently.
     pub threads: u32,
+    /// Bytes this call may allocate for what it produces or keeps (a mesh, decoded texels, a
+    /// buffer of voxels): an allocation beyond it should be refused with an error naming what
+    /// needed it. 0 means unknown (no budget is given: allocate what the data needs). The
+    /// host counts what it receives against its own budget anyway.
+    pub memory_budget: u64,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -347,11 +354,14 @@ pub struct TexQuery {
 #[repr(C)]
 pub struct TextureInstanceVTable {
     /// Writes linear RGBA into `out`; returns [`STATUS_PANIC`] when the plugin panicked and
-    /// [`STATUS_ERROR`] when it could give no value (it logged why through the host table).
+    /// [`STATUS_ERROR`] when it could give no value (an image that turns out not to decode),
+    /// in both cases with the reason sent to `err` (which may be null). The host then stops
+    /// the render with that message.
     pub eval: unsafe extern "C" fn(
         object: *const c_void,
         query: *const TexQuery,
         out: *mut [f32; 4],
+        err: *const ErrorSink,
     ) -> Status,
     pub destroy: unsafe extern "C" fn(object: *mut c_void),
 }
@@ -384,6 +394,12 @@ pub struct VolumeDesc {
     pub grid_name: Str,
 }
 
+/// Voxel formats of [`VolumeSink::add_dense_typed`].
+pub const VOXEL_U8: u32 = 1;
+/// Native-endian `u16`.
+pub const VOXEL_U16: u32 = 2;
+pub const VOXEL_F32: u32 = 3;
+
 #[repr(C)]
 pub struct VolumeSink {
     pub ctx: *mut c_void,
@@ -399,6 +415,23 @@ pub struct VolumeSink {
         origin: *const [i64; 3],
         dims: *const [u64; 3],
         values: *const f32,
+        err: *const ErrorSink,
+    ) -> Status,
+    /// A dense block as [`add_dense`](Self::add_dense), of voxels in `format` ([`VOXEL_U8`],
+    /// [`VOXEL_U16`] or [`VOXEL_F32`]): `data` holds `len` bytes, exactly
+    /// `dims[0]*dims[1]*dims[2]` voxels of that format (`u16` and `f32` in the machine's byte
+    /// order, `data` aligned for the type). Voxel value = `raw as f32 / divisor`, computed in
+    /// f32 (`divisor` finite and > 0; 1 for the raw values). Integer formats let the host store
+    /// the data at its own precision (a u8 volume costs a byte per voxel), so a volume must
+    /// use one divisor per format.
+    pub add_dense_typed: unsafe extern "C" fn(
+        ctx: *mut c_void,
+        origin: *const [i64; 3],
+        dims: *const [u64; 3],
+        format: u32,
+        data: *const u8,
+        len: usize,
+        divisor: f32,
         err: *const ErrorSink,
     ) -> Status,
     /// A constant box of `dims` voxels starting at `origin`.

@@ -34,7 +34,7 @@
 //! plugin; they never unwind across `extern "C"`.
 //!
 //! The rest of this page is the repository's `plugins/README.md`: the shipped plugins and how
-//! to write one. Its Rust example is compiled as a doctest here.
+//! to write one. Its Rust examples are compiled as doctests here.
 #![doc = include_str!("../../README.md")]
 
 pub mod abi;
@@ -114,16 +114,21 @@ pub struct Context {
     pub texture_cache_bytes: u64,
     /// Threads that will call the instance concurrently.
     pub threads: u32,
+    /// Bytes this call may allocate for what it produces or keeps (0: unknown, no limit
+    /// given). Allocate big arrays with [`Context::alloc_vec`], which checks it.
+    pub memory_budget: u64,
 }
 
 impl Default for Context {
-    /// A context outside any scene (tests, tools): relative paths resolve against ".".
+    /// A context outside any scene (tests, tools): relative paths resolve against ".", and
+    /// no memory budget is given.
     fn default() -> Context {
         Context {
             scene_dir: PathBuf::from("."),
             instance: String::new(),
             texture_cache_bytes: 0,
             threads: 1,
+            memory_budget: 0,
         }
     }
 }
@@ -132,6 +137,28 @@ impl Context {
     /// `path` relative to the scene file's directory (absolute paths are kept).
     pub fn resolve(&self, path: impl AsRef<Path>) -> PathBuf {
         self.scene_dir.join(path)
+    }
+
+    /// `n` copies of `value`, allocated within [`memory_budget`](Self::memory_budget) and
+    /// without aborting when the system refuses: either is an error naming `what` (say "a
+    /// slab of 8 slices of 1024x1024 u8 voxels") and the size it needs.
+    pub fn alloc_vec<T: Clone>(&self, n: usize, value: T, what: &str) -> Result<Vec<T>, Error> {
+        let bytes = (n as u64).saturating_mul(std::mem::size_of::<T>() as u64);
+        let size = files::bytes(bytes);
+        if self.memory_budget != 0 && bytes > self.memory_budget {
+            return Err(Error::new(format!(
+                "{what} needs {size}, more than the memory budget left for this plugin ({})",
+                files::bytes(self.memory_budget)
+            )));
+        }
+        let mut v = Vec::new();
+        v.try_reserve_exact(n).map_err(|_| {
+            Error::new(format!(
+                "{what} needs {size}, which the system cannot allocate"
+            ))
+        })?;
+        v.resize(n, value);
+        Ok(v)
     }
 }
 
@@ -495,23 +522,16 @@ unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
 pub trait Texture: Describe + Send + Sync + Sized + 'static {
     type Params: serde::de::DeserializeOwned;
     fn create(params: Self::Params, ctx: &Context) -> Result<Self, Error>;
-    /// Linear RGBA at the query point. When no value can be given (an image that turns out not
-    /// to decode), call [`texture_failed`] and return anything.
+    /// Linear RGBA at the query point.
     fn eval(&self, query: &abi::TexQuery) -> [f32; 4];
-}
-
-thread_local! {
-    /// Set by [`texture_failed`] during the `eval` call running on this thread.
-    static EVAL_FAILED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Marks the texture evaluation running on this thread as failed: the host stops the render
-/// with an error naming the texture, and the run fails (its outputs are left untouched). Log
-/// the cause first, once, with [`host_log`] at level 0: plugin ABI 1 carries no message back
-/// from `eval`, only its status ([`abi::STATUS_ERROR`]). Works from any depth of nested
-/// textures.
-pub fn texture_failed() {
-    EVAL_FAILED.with(|f| f.set(true));
+    /// What the host calls: [`eval`](Self::eval)'s value, or an error when no value can be
+    /// given (an image that turns out not to decode). The host then stops the render with the
+    /// error's message, naming the texture and its place in the scene, and the run fails (its
+    /// outputs are left untouched). Override it only for textures that can fail; `eval` may
+    /// then return a stand-in colour for callers that do not care.
+    fn try_eval(&self, query: &abi::TexQuery) -> Result<[f32; 4], Error> {
+        Ok(self.eval(query))
+    }
 }
 
 fn texture_instance_vtable<T: Texture>() -> &'static abi::TextureInstanceVTable {
@@ -530,23 +550,31 @@ fn texture_instance_vtable<T: Texture>() -> &'static abi::TextureInstanceVTable 
 // after every other call (ABI contract); `T: Sync`, so concurrent `eval`s are fine.
 
 /// # Safety
-/// `object` is a live `T` from `shim::texture_create`; `query` is readable, `out` writable.
+/// `object` is a live `T` from `shim::texture_create`; `query` is readable, `out` writable;
+/// `err` is null or the host's error sink for this call.
 unsafe extern "C" fn texture_eval<T: Texture>(
     object: *const c_void,
     query: *const abi::TexQuery,
     out: *mut [f32; 4],
+    err: *const abi::ErrorSink,
 ) -> abi::Status {
-    // SAFETY: see the comment above these functions; the host's query is valid for the call.
-    let (tex, q) = unsafe { (&*(object as *const T), &*query) };
-    EVAL_FAILED.with(|f| f.set(false));
-    match catch_unwind(AssertUnwindSafe(|| tex.eval(q))) {
-        Ok(_) if EVAL_FAILED.with(|f| f.replace(false)) => abi::STATUS_ERROR,
-        Ok(c) => {
+    // SAFETY: see the comment above these functions; the host's query and error sink (or
+    // null) are valid for the call.
+    let (tex, q, err) = unsafe { (&*(object as *const T), &*query, err.as_ref()) };
+    match catch_unwind(AssertUnwindSafe(|| tex.try_eval(q))) {
+        Ok(Ok(c)) => {
             // SAFETY: the host passes a writable `[f32; 4]` for the call (ABI contract).
             unsafe { *out = c };
             abi::STATUS_OK
         }
-        Err(_) => abi::STATUS_PANIC,
+        Ok(Err(e)) => {
+            shim::report(err, &e);
+            abi::STATUS_ERROR
+        }
+        Err(p) => {
+            shim::report(err, &Error::new(shim::panic_message(p)));
+            abi::STATUS_PANIC
+        }
     }
 }
 
@@ -580,6 +608,17 @@ pub struct GridInfo {
     pub name: String,
 }
 
+/// An error unless a block of `dims` voxels comes with `len` values.
+fn check_count(dims: [u64; 3], len: usize) -> Result<(), Error> {
+    let n = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
+    if n != Some(len as u64) {
+        return Err(Error::new(format!(
+            "dense block of {dims:?} voxels given {len} values"
+        )));
+    }
+    Ok(())
+}
+
 /// The host's volume builder, seen from a reader.
 pub struct VolumeOut<'a> {
     sink: &'a abi::VolumeSink,
@@ -602,17 +641,72 @@ impl VolumeOut<'_> {
 
     /// A dense block, x fastest; `values.len()` must be `dims[0] * dims[1] * dims[2]`.
     pub fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error> {
-        let n = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
-        if n != Some(values.len() as u64) {
-            return Err(Error::new(format!(
-                "dense block of {dims:?} voxels given {} values",
-                values.len()
-            )));
-        }
+        check_count(dims, values.len())?;
         let sink = self.sink;
         // SAFETY: `sink` is the host's table for the running `read` and `ctx` its own; `values`
         // holds the `dims[0] * dims[1] * dims[2]` values the call reads (checked above).
         call_sink(|err| unsafe { (sink.add_dense)(sink.ctx, &origin, &dims, values.as_ptr(), err) })
+    }
+
+    /// A dense block of bytes, x fastest: voxel value `byte as f32 / divisor` (1 for the raw
+    /// values, 255 to map them to [0, 1]). The host keeps it at a byte per voxel where it can,
+    /// so a u8 file costs about its own size; a volume uses one divisor for all its u8 blocks.
+    pub fn dense_u8(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u8],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        check_count(dims, values.len())?;
+        self.dense_typed(
+            origin,
+            dims,
+            abi::VOXEL_U8,
+            values.as_ptr(),
+            values.len(),
+            divisor,
+        )
+    }
+
+    /// A dense block of `u16` (in the machine's byte order: swap a file's first), as
+    /// [`dense_u8`](Self::dense_u8): value `v as f32 / divisor`, one divisor per volume.
+    pub fn dense_u16(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u16],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        check_count(dims, values.len())?;
+        let data = values.as_ptr() as *const u8;
+        self.dense_typed(
+            origin,
+            dims,
+            abi::VOXEL_U16,
+            data,
+            values.len() * 2,
+            divisor,
+        )
+    }
+
+    /// `len` bytes at `data`: the voxels of a block checked by `check_count`, in `format`.
+    fn dense_typed(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        format: u32,
+        data: *const u8,
+        len: usize,
+        divisor: f32,
+    ) -> Result<(), Error> {
+        let sink = self.sink;
+        // SAFETY: `sink` is the host's table for the running `read` and `ctx` its own; `data`
+        // borrows the caller's slice of `len` bytes (aligned for its element type), which holds
+        // the block's voxels in `format` (its count checked by the callers).
+        call_sink(|err| unsafe {
+            (sink.add_dense_typed)(sink.ctx, &origin, &dims, format, data, len, divisor, err)
+        })
     }
 
     pub fn tile(&mut self, origin: [i64; 3], dims: [u64; 3], value: f32) -> Result<(), Error> {
@@ -681,7 +775,7 @@ pub mod shim {
     use super::*;
     use std::marker::PhantomData;
 
-    fn report(err: Option<&abi::ErrorSink>, e: &Error) {
+    pub(crate) fn report(err: Option<&abi::ErrorSink>, e: &Error) {
         if let Some(sink) = err {
             // SAFETY: `sink` is the host's error sink for the running call and `ctx` its own
             // (ABI contract); the message is borrowed across the call.
@@ -689,7 +783,7 @@ pub mod shim {
         }
     }
 
-    fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    pub(crate) fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
         if let Some(s) = p.downcast_ref::<&str>() {
             format!("panicked: {s}")
         } else if let Some(s) = p.downcast_ref::<String>() {
@@ -709,6 +803,7 @@ pub mod shim {
                     instance: c.instance.as_str().unwrap_or("").to_string(),
                     texture_cache_bytes: c.texture_cache_bytes,
                     threads: c.threads,
+                    memory_budget: c.memory_budget,
                 }
             },
             None => Context::default(),
@@ -1057,7 +1152,7 @@ macro_rules! export {
 mod tests {
     use super::*;
 
-    /// Fails when the query's `time` is negative.
+    /// Fails when the query's `time` is negative, panics when it is NaN.
     struct Picky;
 
     impl Describe for Picky {
@@ -1071,16 +1166,20 @@ mod tests {
         fn create(_: (), _: &Context) -> Result<Self, Error> {
             Ok(Picky)
         }
-        fn eval(&self, q: &abi::TexQuery) -> [f32; 4] {
-            if q.time < 0.0 {
-                texture_failed();
-            }
+        fn eval(&self, _: &abi::TexQuery) -> [f32; 4] {
             [0.5; 4]
+        }
+        fn try_eval(&self, q: &abi::TexQuery) -> Result<[f32; 4], Error> {
+            assert!(!q.time.is_nan(), "a NaN time");
+            if q.time < 0.0 {
+                return Err(Error::new(format!("no value at time {}", q.time)));
+            }
+            Ok(self.eval(q))
         }
     }
 
     #[test]
-    fn a_failed_texture_evaluation_returns_an_error_status_once() {
+    fn a_failed_texture_evaluation_returns_its_message() {
         let vt = texture_instance_vtable::<Picky>();
         let object = Box::into_raw(Box::new(Picky)) as *mut c_void;
         let mut out = [0.0f32; 4];
@@ -1088,16 +1187,123 @@ mod tests {
             time,
             ..Default::default()
         };
-        // SAFETY: `object` is a live `Picky` made above for this table; queries and `out` live
-        // across each call; `destroy` is the last use of `object`.
+        let mut slot = SinkError(None);
+        let err = abi::ErrorSink {
+            ctx: &mut slot as *mut SinkError as *mut c_void,
+            set: sink_error_set,
+        };
+        // SAFETY: `object` is a live `Picky` made above for this table; queries, `out` and the
+        // error sink (whose slot is only read between calls) live across each call; `destroy`
+        // is the last use of `object`.
         unsafe {
-            assert_eq!((vt.eval)(object, &q(-1.0), &mut out), abi::STATUS_ERROR);
+            assert_eq!(
+                (vt.eval)(object, &q(-1.0), &mut out, &err),
+                abi::STATUS_ERROR
+            );
             assert_eq!(out, [0.0; 4], "a failed evaluation writes no value");
-            // The mark belongs to one evaluation only.
-            assert_eq!((vt.eval)(object, &q(1.0), &mut out), abi::STATUS_OK);
+            assert_eq!(slot.0.take().unwrap().message, "no value at time -1");
+            assert_eq!((vt.eval)(object, &q(1.0), &mut out, &err), abi::STATUS_OK);
             assert_eq!(out, [0.5; 4]);
+            assert!(slot.0.is_none());
+            assert_eq!(
+                (vt.eval)(object, &q(f32::NAN), &mut out, &err),
+                abi::STATUS_PANIC
+            );
+            assert_eq!(slot.0.take().unwrap().message, "panicked: a NaN time");
+            // Without an error sink the status still says what happened.
+            assert_eq!(
+                (vt.eval)(object, &q(-1.0), &mut out, std::ptr::null()),
+                abi::STATUS_ERROR
+            );
             (vt.destroy)(object);
         }
+    }
+
+    /// Keeps a table of 300 `u32` (1200 bytes).
+    struct Hungry(#[allow(dead_code)] Vec<u32>);
+
+    impl Describe for Hungry {
+        const NAME: &'static str = "hungry";
+        const DESCRIPTION: &'static str = "";
+        const PARAMS: &'static str = "";
+    }
+
+    impl Texture for Hungry {
+        type Params = ();
+        fn create(_: (), ctx: &Context) -> Result<Self, Error> {
+            Ok(Hungry(ctx.alloc_vec(300, 0u32, "the table")?))
+        }
+        fn eval(&self, _: &abi::TexQuery) -> [f32; 4] {
+            [0.0; 4]
+        }
+    }
+
+    #[test]
+    fn the_call_contexts_memory_budget_reaches_the_plugin() {
+        let create = |budget: u64| {
+            let ctx = abi::CallContext {
+                scene_dir: abi::Str::new("."),
+                instance: abi::Str::new("t"),
+                texture_cache_bytes: 0,
+                threads: 1,
+                memory_budget: budget,
+            };
+            let mut out = abi::TextureObject {
+                object: std::ptr::null_mut(),
+                vtable: std::ptr::null(),
+            };
+            let mut slot = SinkError(None);
+            let err = abi::ErrorSink {
+                ctx: &mut slot as *mut SinkError as *mut c_void,
+                set: sink_error_set,
+            };
+            // SAFETY: the calling contract: params, context, `out` and the error sink live
+            // across the call; the object made is destroyed through its own table once.
+            let status = unsafe {
+                let s = shim::texture_create::<Hungry>(abi::Str::EMPTY, &ctx, &mut out, &err);
+                if let Some(vt) = out.vtable.as_ref() {
+                    (vt.destroy)(out.object);
+                }
+                s
+            };
+            (status, slot.0.map(|e| e.message))
+        };
+        assert_eq!(create(0), (abi::STATUS_OK, None));
+        assert_eq!(create(1200), (abi::STATUS_OK, None));
+        assert_eq!(
+            create(1000),
+            (
+                abi::STATUS_ERROR,
+                Some(
+                    "the table needs 1.2 KiB, more than the memory budget left for this plugin \
+                     (1000 bytes)"
+                        .to_string()
+                )
+            )
+        );
+    }
+
+    #[test]
+    fn alloc_vec_keeps_to_the_budget_and_never_aborts() {
+        let ctx = Context {
+            memory_budget: 1000,
+            ..Context::default()
+        };
+        assert_eq!(ctx.alloc_vec(250, 7u32, "four").unwrap(), vec![7u32; 250]);
+        let e = ctx.alloc_vec(251, 0u32, "a row of 251 voxels").unwrap_err();
+        assert_eq!(
+            e.message,
+            "a row of 251 voxels needs 1004 bytes, more than the memory budget left for this \
+             plugin (1000 bytes)"
+        );
+        // No budget: only what the system refuses is an error (here: more than it can address).
+        let e = Context::default()
+            .alloc_vec(1usize << 60, 0u8, "everything")
+            .unwrap_err();
+        assert_eq!(
+            e.message,
+            "everything needs 1048576 TiB, which the system cannot allocate"
+        );
     }
 
     #[derive(serde::Deserialize, Debug, PartialEq)]

@@ -11,8 +11,9 @@
 //!
 //! **Misses.** A missing level (never loaded, or evicted) is filled under the image's own load
 //! mutex, so two threads never decode the same file at once while other images keep being
-//! read: the file is decoded, its whole MIP pyramid built, and every level not already resident
-//! is installed — the wanted ones marked as just used, the others as never used, so they are
+//! read: the file is decoded, its MIP pyramid built from the plan's first level on (`decode.rs`:
+//! an image larger than the decode cap is used at a smaller size), and every level not already
+//! resident is installed — the wanted ones marked as just used, the others as never used, so they are
 //! the first to go. The missing thread samples through `Arc`s it holds itself, so it makes
 //! progress even if its levels are evicted again at once.
 //!
@@ -29,10 +30,11 @@
 //!
 //! **Thrashing.** When an image has to be decoded a second time (its data was evicted and is
 //! needed again), the cache logs once, with the budget and the size of all registered texture
-//! data. A decode failure logs once per image; lookups then fail (the render stops with an error).
+//! data. A decode failure is kept with the image: every lookup then fails with its message
+//! (the texture's `try_eval` hands it to the host, which stops the render with it).
 
-use crate::decode::{decode, Header};
-use crate::mipmap::{build_pyramid, level_sizes, Level};
+use crate::decode::{decode, size, Header, Plan};
+use crate::mipmap::{level_sizes, Level};
 use std::path::{Path, PathBuf};
 use std::ptr;
 use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering::*};
@@ -92,12 +94,16 @@ pub struct CachedImage {
     modified: Option<SystemTime>,
     srgb: bool,
     header: Header,
+    /// From which MIP level of the file on the image is decoded: its level 0 is that one.
+    plan: Plan,
+    /// Size of the image as used (the plan's first level).
+    size: (usize, usize),
     slots: Box<[Slot]>,
     readers: [Stripe; STRIPES],
     /// Held while decoding and installing this image.
     loading: Mutex<()>,
-    /// The decode failed; lookups fail without trying again.
-    failed: AtomicBool,
+    /// Why the decode failed; lookups fail with it without trying again.
+    failed: OnceLock<String>,
     /// How many times the file was decoded.
     decodes: AtomicU64,
 }
@@ -112,12 +118,13 @@ impl Drop for ReadGuard<'_> {
 }
 
 impl CachedImage {
+    /// Width of the image as used (smaller than the file's when its plan skips levels).
     pub fn width(&self) -> usize {
-        self.header.width
+        self.size.0
     }
 
     pub fn height(&self) -> usize {
-        self.header.height
+        self.size.1
     }
 
     pub fn levels(&self) -> usize {
@@ -218,17 +225,6 @@ pub fn global() -> Arc<Cache> {
         .clone()
 }
 
-/// A byte count for people.
-fn size(bytes: u64) -> String {
-    let b = bytes as f64;
-    match bytes {
-        0..1024 => format!("{bytes} bytes"),
-        1024..1_048_576 => format!("{:.1} KiB", b / 1024.0),
-        1_048_576..1_073_741_824 => format!("{:.1} MiB", b / 1_048_576.0),
-        _ => format!("{:.1} GiB", b / 1_073_741_824.0),
-    }
-}
-
 impl Cache {
     pub fn new(budget: u64, log: Log) -> Cache {
         Cache {
@@ -271,18 +267,34 @@ impl Cache {
         }
     }
 
-    /// The shared entry for an image file whose header was read at create time. Nothing is
-    /// decoded until the first lookup.
-    pub fn register(&self, path: &Path, header: Header, srgb: bool) -> Arc<CachedImage> {
+    /// The shared entry for an image file whose header was read and plan made at create time.
+    /// Nothing is decoded until the first lookup. A new entry for an image used below its full
+    /// size logs the plan's warning.
+    pub fn register(
+        &self,
+        path: &Path,
+        header: Header,
+        srgb: bool,
+        plan: Plan,
+    ) -> Arc<CachedImage> {
+        let given = path;
         let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
         let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
         let mut st = self.lock();
         if let Some(img) = st.images.iter().find(|i| {
-            i.path == path && i.srgb == srgb && i.header == header && i.modified == modified
+            i.path == path
+                && i.srgb == srgb
+                && i.header == header
+                && i.modified == modified
+                && i.plan.first_level == plan.first_level
         }) {
             return img.clone();
         }
-        let slots = level_sizes(header.width, header.height)
+        if let Some(warning) = plan.warning(&given.display().to_string(), &header) {
+            (self.log)(1, &warning);
+        }
+        let size = plan.size(&header);
+        let slots = level_sizes(size.0, size.1)
             .into_iter()
             .map(|(w, h)| Slot {
                 data: AtomicPtr::new(ptr::null_mut()),
@@ -295,10 +307,12 @@ impl Cache {
             modified,
             srgb,
             header,
+            plan,
+            size,
             slots,
             readers: Default::default(),
             loading: Mutex::new(()),
-            failed: AtomicBool::new(false),
+            failed: OnceLock::new(),
             decodes: AtomicU64::new(0),
         });
         st.images.push(img.clone());
@@ -325,14 +339,14 @@ impl Cache {
     }
 
     /// Runs `f` on levels `a` and `b` of `img` (equal indices allowed), loading them first when
-    /// they are not resident. `None` when the image cannot be decoded.
+    /// they are not resident. The error says why the image cannot be decoded.
     pub fn with_levels<R>(
         &self,
         img: &CachedImage,
         a: usize,
         b: usize,
         f: impl FnOnce(&Level, &Level) -> R,
-    ) -> Option<R> {
+    ) -> Result<R, String> {
         {
             let _reading = img.enter();
             let pa = img.slots[a].data.load(SeqCst);
@@ -342,18 +356,23 @@ impl Cache {
                 self.touch(&img.slots[b]);
                 // SAFETY: non-null pointers from `Arc::into_raw`; an evictor that swaps them out
                 // waits for our reader counter to drop before freeing them.
-                return Some(f(unsafe { &*pa }, unsafe { &*pb }));
+                return Ok(f(unsafe { &*pa }, unsafe { &*pb }));
             }
         }
         // Miss: no reader counter held from here on (the loader may wait for readers).
-        if img.failed.load(Acquire) {
-            return None;
+        if let Some(e) = img.failed.get() {
+            return Err(e.clone());
         }
         let (la, lb) = self.load(img, a, b)?;
-        Some(f(&la, &lb))
+        Ok(f(&la, &lb))
     }
 
-    fn load(&self, img: &CachedImage, a: usize, b: usize) -> Option<(Arc<Level>, Arc<Level>)> {
+    fn load(
+        &self,
+        img: &CachedImage,
+        a: usize,
+        b: usize,
+    ) -> Result<(Arc<Level>, Arc<Level>), String> {
         let _loading = img.loading.lock().unwrap_or_else(PoisonError::into_inner);
         {
             // Another thread may have loaded them while we waited.
@@ -361,26 +380,30 @@ impl Cache {
             if let (Some(la), Some(lb)) = (img.slots[a].get(&st), img.slots[b].get(&st)) {
                 self.touch(&img.slots[a]);
                 self.touch(&img.slots[b]);
-                return Some((la, lb));
+                return Ok((la, lb));
             }
         }
-        if img.failed.load(Acquire) {
-            return None;
+        if let Some(e) = img.failed.get() {
+            return Err(e.clone());
         }
-        let base = match decode(&img.path, &img.header, img.srgb) {
-            Ok(level) => level,
+        let decoded = decode(&img.path, &img.header, img.srgb, &img.plan).and_then(|levels| {
+            if levels.len() == img.slots.len() {
+                Ok(levels)
+            } else {
+                Err(format!(
+                    "{} MIP levels decoded, {} expected",
+                    levels.len(),
+                    img.slots.len()
+                ))
+            }
+        });
+        let levels = match decoded {
+            Ok(levels) => levels,
             Err(e) => {
-                if !img.failed.swap(true, AcqRel) {
-                    (self.log)(
-                        0,
-                        &format!("cannot decode image `{}`: {e}", img.path.display()),
-                    );
-                }
-                return None;
+                let e = format!("cannot decode image `{}`: {e}", img.path.display());
+                return Err(img.failed.get_or_init(|| e).clone());
             }
         };
-        let levels = build_pyramid(base);
-        debug_assert_eq!(levels.len(), img.slots.len());
         self.decodes.fetch_add(1, Relaxed);
         let again = img.decodes.fetch_add(1, Relaxed) > 0;
 
@@ -420,15 +443,21 @@ impl Cache {
                 &format!(
                     "the texture cache is thrashing: the scene's image textures need {} \
                      (with their MIP levels) but the cache budget is {}; images are evicted \
-                     and decoded again (`{}` just now), which is slow. Raise the texture cache \
-                     budget in the render settings.",
+                     and decoded again (`{}` just now), which is slow. Raise the budget with \
+                     the render setting `texture_cache` (e.g. `render: (texture_cache: \"2 GiB\")`).",
                     size(data),
                     size(self.budget()),
                     img.path.display()
                 ),
             );
         }
-        Some((out_a?, out_b?))
+        match (out_a, out_b) {
+            (Some(la), Some(lb)) => Ok((la, lb)),
+            _ => Err(format!(
+                "MIP level {a} or {b} of `{}` is missing after decoding",
+                img.path.display()
+            )),
+        }
     }
 
     /// Evicts least recently used levels until the resident bytes fit the budget, sparing
@@ -470,6 +499,12 @@ mod tests {
     use crate::decode::probe;
     use crate::testutil::{write_png, TempDir};
 
+    /// Every level: the decode cap is not what these tests are about.
+    const FULL: Plan = Plan {
+        first_level: 0,
+        cap: u64::MAX,
+    };
+
     /// Messages a test cache logged: (level, text).
     type Seen = Arc<Mutex<Vec<(u32, String)>>>;
 
@@ -489,7 +524,7 @@ mod tests {
         p
     }
 
-    fn level0(cache: &Cache, img: &CachedImage) -> Option<f32> {
+    fn level0(cache: &Cache, img: &CachedImage) -> Result<f32, String> {
         cache.with_levels(img, 0, 0, |l, _| l.texels[0][0])
     }
 
@@ -500,21 +535,21 @@ mod tests {
         let (log, _) = recorder();
         let cache = Cache::new(0, log);
         let h = probe(&p).unwrap();
-        let img = cache.register(&p, h, true);
-        let same = cache.register(&dir.path("./a.png"), h, true);
+        let img = cache.register(&p, h, true, FULL);
+        let same = cache.register(&dir.path("./a.png"), h, true, FULL);
         assert!(Arc::ptr_eq(&img, &same), "one entry per file");
-        let linear = cache.register(&p, h, false);
+        let linear = cache.register(&p, h, false, FULL);
         assert!(!Arc::ptr_eq(&img, &linear), "srgb is part of the key");
         // Nothing decoded at registration.
         assert_eq!(cache.stats().decodes, 0);
         assert!(!img.is_resident(0));
-        assert_eq!(level0(&cache, &img), Some(1.0));
+        assert_eq!(level0(&cache, &img), Ok(1.0));
         assert_eq!(cache.stats().decodes, 1);
         // The whole pyramid (8, 4, 2, 1) is resident: 85 texels of 16 bytes.
         assert_eq!(img.levels(), 4);
         assert!((0..4).all(|i| img.is_resident(i)));
         assert_eq!(cache.stats().resident, 85 * 16);
-        assert_eq!(level0(&cache, &img), Some(1.0));
+        assert_eq!(level0(&cache, &img), Ok(1.0));
         assert_eq!(cache.stats().decodes, 1, "a hit decodes nothing");
         cache.release(&same);
         drop(same);
@@ -536,7 +571,7 @@ mod tests {
             .map(|&v| {
                 let want = crate::decode::srgb_to_linear(v as f32 / 255.0);
                 let p = flat(&dir, &format!("g{v}.png"), v);
-                (cache.register(&p, probe(&p).unwrap(), true), want)
+                (cache.register(&p, probe(&p).unwrap(), true, FULL), want)
             })
             .collect();
         for round in 0..4 {
@@ -571,8 +606,8 @@ mod tests {
         let p = flat(&dir, "big.png", 255);
         let (log, _) = recorder();
         let cache = Cache::new(100, log);
-        let img = cache.register(&p, probe(&p).unwrap(), true);
-        assert_eq!(level0(&cache, &img), Some(1.0));
+        let img = cache.register(&p, probe(&p).unwrap(), true, FULL);
+        assert_eq!(level0(&cache, &img), Ok(1.0));
         // Only the level in use stays (it alone exceeds the budget).
         assert!(img.is_resident(0));
         assert!(!img.is_resident(1) && !img.is_resident(3));
@@ -593,13 +628,13 @@ mod tests {
         let cache = Cache::new(2 * 1024 + 300, log);
         let mk = |n: &str, v| {
             let p = flat(&dir, n, v);
-            cache.register(&p, probe(&p).unwrap(), true)
+            cache.register(&p, probe(&p).unwrap(), true, FULL)
         };
         let (a, b, c) = (mk("a.png", 10), mk("b.png", 20), mk("c.png", 30));
-        level0(&cache, &a);
-        level0(&cache, &b);
-        level0(&cache, &a); // a is now more recent than b
-        level0(&cache, &c); // evicts b's level 0, not a's
+        level0(&cache, &a).unwrap();
+        level0(&cache, &b).unwrap();
+        level0(&cache, &a).unwrap(); // a is now more recent than b
+        level0(&cache, &c).unwrap(); // evicts b's level 0, not a's
         assert!(a.is_resident(0) && c.is_resident(0), "{:?}", cache.stats());
         assert!(!b.is_resident(0));
         assert_eq!(cache.stats().decodes, 3);
@@ -607,7 +642,7 @@ mod tests {
     }
 
     #[test]
-    fn decode_failure_is_reported_once() {
+    fn a_decode_failure_is_kept_and_every_lookup_fails_with_it() {
         let dir = TempDir::new("cache-broken");
         let p = flat(&dir, "broken.png", 128);
         let h = probe(&p).unwrap();
@@ -616,18 +651,20 @@ mod tests {
         std::fs::write(&p, &bytes[..40]).unwrap();
         let (log, seen) = recorder();
         let cache = Cache::new(0, log);
-        let img = cache.register(&p, h, true);
-        for _ in 0..3 {
-            assert_eq!(level0(&cache, &img), None);
-        }
-        let seen = seen.lock().unwrap();
-        assert_eq!(seen.len(), 1, "{seen:?}");
-        assert_eq!(seen[0].0, 0);
+        let img = cache.register(&p, h, true, FULL);
+        let e = level0(&cache, &img).unwrap_err();
         assert!(
-            seen[0].1.contains("cannot decode image") && seen[0].1.contains("broken.png"),
-            "{}",
-            seen[0].1
+            e.starts_with("cannot decode image `") && e.contains("broken.png`: "),
+            "{e}"
         );
+        // The file is not decoded again: even a good file there now fails the same way.
+        flat(&dir, "broken.png", 128);
+        for _ in 0..3 {
+            assert_eq!(level0(&cache, &img), Err(e.clone()));
+        }
+        assert_eq!(cache.stats().decodes, 0);
+        // The message travels with the lookups; nothing is logged.
+        assert!(seen.lock().unwrap().is_empty());
     }
 
     #[test]
@@ -640,7 +677,7 @@ mod tests {
                 let v = 40 + 50 * k;
                 let p = flat(&dir, &format!("t{k}.png"), v);
                 (
-                    cache.register(&p, probe(&p).unwrap(), false),
+                    cache.register(&p, probe(&p).unwrap(), false, FULL),
                     v as f32 / 255.0,
                 )
             })

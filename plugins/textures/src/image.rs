@@ -1,7 +1,7 @@
 //! The `image` entry: an image file mapped onto surfaces, filtered, through the shared cache.
 
 use crate::cache::{self, Cache, CachedImage};
-use crate::decode::probe;
+use crate::decode::{plan, probe};
 use crate::mapping::{Kind, Mapping};
 use crate::mipmap::{bilinear, level_pair, mip_level, nearest, trilinear, Wrap};
 use crate::params::{up, yes, Factors};
@@ -73,6 +73,28 @@ wrap: repeat|clamp|mirror = repeat  outside the image: tile, extend the edges, o
 filter: nearest|bilinear|mip = mip  mip: trilinear, level chosen from the ray's footprint";
 }
 
+/// The most memory one image may use while it is decoded (see `decode.rs`): its MIP levels
+/// from the first one kept, plus what the decoder holds. An image whose full pyramid does not
+/// fit is used from the first level that does (with a warning); a format decoded whole whose
+/// buffer alone does not fit is refused.
+///
+/// It is the texture cache budget (`texture_cache_bytes`), or when that is 0 the cache's
+/// default of 1 GiB ([`cache::DEFAULT_BUDGET`]): levels that do not fit the cache cannot stay
+/// resident anyway (they would be evicted after each decode and decoded again), and 1 GiB holds
+/// the full pyramid of a 7000×7000 image, more than a 4K or 8K render resolves. When the host
+/// gives a memory budget (`memory_budget`, 0 when unknown), the cap is at most what is left of
+/// it, so a decode never takes memory the rest of the scene was promised.
+pub fn decode_cap(ctx: &Context) -> u64 {
+    let cache = match ctx.texture_cache_bytes {
+        0 => cache::DEFAULT_BUDGET,
+        bytes => bytes,
+    };
+    match ctx.memory_budget {
+        0 => cache,
+        left => cache.min(left),
+    }
+}
+
 impl ImageTexture {
     /// `create` with an explicit cache (the plugin uses `cache::global`).
     pub fn create_in(p: ImageParams, ctx: &Context, cache: Arc<Cache>) -> Result<Self, Error> {
@@ -99,7 +121,8 @@ impl ImageTexture {
         }
         let path = ctx.resolve(&p.file);
         let header = probe(&path)?;
-        let image = cache.register(&path, header, p.srgb);
+        let plan = plan(&path.display().to_string(), &header, decode_cap(ctx))?;
+        let image = cache.register(&path, header, p.srgb, plan);
         Ok(ImageTexture {
             cache,
             image,
@@ -125,7 +148,12 @@ impl Texture for ImageTexture {
         Self::create_in(p, ctx, cache)
     }
 
+    /// Magenta where the image cannot be decoded (the host calls `try_eval`, which fails).
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        self.try_eval(q).unwrap_or(MAGENTA)
+    }
+
+    fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
         let l = self.mapping.lookup(q);
         let (wrap, img) = (self.wrap, &*self.image);
         let got = match self.filter {
@@ -144,11 +172,7 @@ impl Texture for ImageTexture {
                     .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
             }
         };
-        got.unwrap_or_else(|| {
-            // The cache logged why, once; the host stops the render.
-            luxon_plugin::texture_failed();
-            MAGENTA
-        })
+        got.map_err(Error::new)
     }
 }
 
@@ -406,7 +430,7 @@ mod tests {
     }
 
     #[test]
-    fn decode_failure_on_first_use_is_magenta() {
+    fn decode_failure_on_first_use_fails_the_lookup_with_its_reason() {
         let dir = TempDir::new("img-corrupt");
         fixture(&dir);
         let seen = Arc::new(Mutex::new(Vec::<String>::new()));
@@ -424,9 +448,116 @@ mod tests {
             0, 0, 0, 10, b'I', b'D', b'A', b'T', 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0,
         ]);
         std::fs::write(dir.path("ramp.png"), bad).unwrap();
+        let q = |u: f32| TexQuery {
+            uv: [u, 0.5],
+            ..Default::default()
+        };
+        let e = t.try_eval(&q(0.5)).unwrap_err().message;
+        let path = dir.path("ramp.png");
+        assert!(
+            e.starts_with(&format!("cannot decode image `{}`: ", path.display())),
+            "{e}"
+        );
+        assert_eq!(t.try_eval(&q(0.1)).unwrap_err().message, e);
+        // `eval` gives a stand-in; nothing is logged (the message goes to the host).
         assert_eq!(at_uv(&t, [0.5, 0.5], 0.0), MAGENTA);
-        assert_eq!(at_uv(&t, [0.1, 0.5], 0.0), MAGENTA);
-        assert_eq!(seen.lock().unwrap().len(), 1, "{:?}", seen.lock().unwrap());
+        assert!(
+            seen.lock().unwrap().is_empty(),
+            "{:?}",
+            seen.lock().unwrap()
+        );
+    }
+
+    #[test]
+    fn an_image_over_the_decode_cap_is_used_smaller_with_one_warning() {
+        let dir = TempDir::new("img-cap");
+        // 64×64 columns of greys; its levels from 16×16 on need 5,456 bytes.
+        write_png(&dir.path("wide.png"), 64, 64, |x, _| {
+            let v = (x * 4) as u8;
+            [v, v, v, 255]
+        });
+        let seen = Arc::new(Mutex::new(Vec::<(u32, String)>::new()));
+        let s = seen.clone();
+        let cache = Arc::new(Cache::new(
+            0,
+            Box::new(move |l, m| s.lock().unwrap().push((l, m.into()))),
+        ));
+        let mut ctx = ctx_in(dir.dir());
+        ctx.texture_cache_bytes = 5_456 + 128 * 64;
+        assert_eq!(decode_cap(&ctx), 5_456 + 128 * 64);
+        let mk = |params: &str| {
+            let p: ImageParams = luxon_plugin::parse_params(params).unwrap();
+            ImageTexture::create_in(p, &ctx, cache.clone()).unwrap()
+        };
+        let near = mk(r#"(file: "wide.png", filter: nearest)"#);
+        let _again = mk(r#"(file: "wide.png", filter: bilinear)"#);
+        assert_eq!((near.image.width(), near.image.height()), (16, 16));
+        assert_eq!(near.image.levels(), 5);
+        let seen = seen.lock().unwrap().clone();
+        assert_eq!(seen.len(), 1, "one warning per image: {seen:?}");
+        assert_eq!(seen[0].0, 1);
+        assert!(
+            seen[0]
+                .1
+                .contains("wide.png` (64x64) is decoded at 16x16 to stay within")
+                && seen[0].1.contains("texture memory cap of 13.3 KiB"),
+            "{}",
+            seen[0].1
+        );
+        // Texel 5 of 16 averages columns 20..24 of the full image.
+        let want = (20..24).map(|x| lin(x * 4)).sum::<f32>() / 4.0;
+        let got = at_uv(&near, [5.5 / 16.0, 0.5], 0.0);
+        assert!(close(got, grey(want), 1e-6), "{got:?} vs {want}");
+        // Under the default cap (1 GiB) the same file is used whole, without a warning.
+        let full: ImageTexture = make_in(r#"(file: "wide.png")"#, &ctx_in(dir.dir())).unwrap();
+        assert_eq!(full.image.width(), 64);
+        assert_eq!(decode_cap(&ctx_in(dir.dir())), 1 << 30);
+    }
+
+    /// The host's memory budget bounds the cap too: what is left of it, when less than the
+    /// texture cache.
+    #[test]
+    fn the_decode_cap_keeps_to_the_memory_budget() {
+        let dir = TempDir::new("img-budget");
+        let mut ctx = ctx_in(dir.dir());
+        ctx.memory_budget = 1 << 20;
+        assert_eq!(decode_cap(&ctx), 1 << 20);
+        ctx.texture_cache_bytes = 4096;
+        assert_eq!(decode_cap(&ctx), 4096);
+        ctx.memory_budget = 0;
+        ctx.texture_cache_bytes = 0;
+        assert_eq!(decode_cap(&ctx), 1 << 30);
+        // An image over the budget's cap is used smaller, as over the cache's.
+        write_png(&dir.path("wide.png"), 64, 64, |x, _| {
+            let v = (x * 4) as u8;
+            [v, v, v, 255]
+        });
+        let cache = Arc::new(Cache::new(0, quiet()));
+        ctx.memory_budget = 5_456 + 128 * 64;
+        let p: ImageParams = luxon_plugin::parse_params(r#"(file: "wide.png")"#).unwrap();
+        let t = ImageTexture::create_in(p, &ctx, cache).unwrap();
+        assert_eq!((t.image.width(), t.image.height()), (16, 16));
+    }
+
+    #[test]
+    fn a_whole_decode_over_the_cap_is_refused_at_create() {
+        let dir = TempDir::new("img-refuse");
+        image::RgbImage::from_pixel(300, 200, image::Rgb([9, 99, 199]))
+            .save(dir.path("photo.jpg"))
+            .unwrap();
+        let mut ctx = ctx_in(dir.dir());
+        ctx.texture_cache_bytes = 100_000;
+        let e = make_in::<ImageTexture>(r#"(file: "photo.jpg")"#, &ctx)
+            .err()
+            .unwrap()
+            .message;
+        assert!(
+            e.contains(
+                "photo.jpg` (300x200 JPEG) needs 175.8 KiB to decode, more than the \
+                        texture memory cap of 97.7 KiB"
+            ),
+            "{e}"
+        );
     }
 
     #[test]

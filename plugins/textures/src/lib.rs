@@ -160,12 +160,21 @@
 //!
 //! **Loading and the cache.** `create` checks that the file exists and reads its header
 //! (errors name the resolved path); the texels are decoded on the first lookup. Every image of
-//! the library lives in one LRU cache bounded by the render settings' texture cache budget
-//! (`texture_cache_bytes`; 0: 1 GiB), counted per MIP level; lookups that hit take no lock.
+//! the library lives in one LRU cache bounded by the call context's texture cache budget
+//! (`texture_cache_bytes`: the render setting `texture_cache`, by default 1 GiB or a quarter of
+//! the memory budget when that is less; 0, from a host that gives none: 1 GiB), counted per MIP
+//! level; lookups that hit take no lock.
 //! Least recently used levels are evicted when the budget is exceeded and decoded again when
 //! needed, so scenes with more texture data than the budget still render; a warning says once
 //! when that happens (the cache is thrashing), with the budget and the data size. An image
-//! that cannot be decoded logs one error and makes the render fail. See `cache.rs`.
+//! that cannot be decoded makes its lookups fail (`try_eval`) with the decoder's reason, which
+//! the host reports as the render's one error, naming the texture. See `cache.rs`.
+//!
+//! **Large images.** Each image is decoded within a cap: the texture cache budget, at most what
+//! is left of the host's memory budget (`memory_budget`). An image whose MIP pyramid does not
+//! fit is used from the first level that does, with a warning (a PNG is streamed, so only those
+//! levels are ever held); a format decoded whole whose buffer does not fit is refused at
+//! create. See `decode.rs`.
 //!
 //! ## Scene
 //!
@@ -195,13 +204,16 @@
 // Levels shared through atomic pointers.
 #[allow(unsafe_code)]
 mod cache;
-mod decode;
+// Public for the `image_texture` fuzz target (tests/fuzz): probe, plan and decode from bytes.
+pub mod decode;
 mod image;
 mod mapping;
 mod mipmap;
 mod noise;
 mod params;
 mod procedural;
+mod reduce;
+mod texels;
 mod transform;
 mod tree;
 

@@ -53,32 +53,57 @@ pub fn level_sizes(width: usize, height: usize) -> Vec<(usize, usize)> {
     sizes
 }
 
-/// Reduces a line of `n` samples (read through `get`) to `max(1, n/2)` area averages.
-fn reduce_line(n: usize, get: impl Fn(usize) -> [f32; 4], mut put: impl FnMut(usize, [f32; 4])) {
-    let m = (n / 2).max(1);
+/// Output sample `x` of a line of `n` samples (read through `get`) reduced to `max(1, n/2)`
+/// area averages: the weighted sum of the one to three samples it covers. The one definition of
+/// the filter: [`downsample`] and the streaming reducers (`reduce.rs`) both call it, so they
+/// agree bit for bit.
+#[inline]
+pub fn reduce_sample(n: usize, x: usize, get: impl Fn(usize) -> [f32; 4]) -> [f32; 4] {
+    if n == 1 {
+        return get(0);
+    }
     let add = |acc: &mut [f32; 4], w: f32, v: [f32; 4]| {
         for c in 0..4 {
             acc[c] += w * v[c];
         }
     };
-    for x in 0..m {
-        let mut acc = [0.0f32; 4];
-        if n == 1 {
-            acc = get(0);
-        } else if n.is_multiple_of(2) {
-            add(&mut acc, 0.5, get(2 * x));
-            add(&mut acc, 0.5, get(2 * x + 1));
-        } else {
-            let nf = n as f32;
-            add(&mut acc, (m - x) as f32 / nf, get(2 * x));
-            add(&mut acc, m as f32 / nf, get(2 * x + 1));
-            add(&mut acc, (x + 1) as f32 / nf, get(2 * x + 2));
-        }
-        put(x, acc);
+    let mut acc = [0.0f32; 4];
+    if n.is_multiple_of(2) {
+        add(&mut acc, 0.5, get(2 * x));
+        add(&mut acc, 0.5, get(2 * x + 1));
+    } else {
+        let (m, nf) = (n / 2, n as f32);
+        add(&mut acc, (m - x) as f32 / nf, get(2 * x));
+        add(&mut acc, m as f32 / nf, get(2 * x + 1));
+        add(&mut acc, (x + 1) as f32 / nf, get(2 * x + 2));
+    }
+    acc
+}
+
+/// The last input sample output sample `x` of a line of `n` reads (see [`reduce_sample`]).
+pub fn last_tap(n: usize, x: usize) -> usize {
+    match n {
+        1 => 0,
+        _ if n.is_multiple_of(2) => 2 * x + 1,
+        _ => 2 * x + 2,
     }
 }
 
-/// The next coarser level (separable: rows first, then columns).
+/// Reduces a line of `n` samples (read through `get`) to `max(1, n/2)` area averages.
+pub fn reduce_line(
+    n: usize,
+    get: impl Fn(usize) -> [f32; 4],
+    mut put: impl FnMut(usize, [f32; 4]),
+) {
+    for x in 0..(n / 2).max(1) {
+        put(x, reduce_sample(n, x, &get));
+    }
+}
+
+/// The next coarser level (separable: rows first, then columns). The reference definition of
+/// the MIP filter: images are reduced row by row as they are decoded (`reduce.rs`), which is
+/// tested to give these texels bit for bit.
+#[cfg(test)]
 pub fn downsample(src: &Level) -> Level {
     let (w, h) = (src.width, src.height);
     let (mw, mh) = ((w / 2).max(1), (h / 2).max(1));
@@ -94,6 +119,7 @@ pub fn downsample(src: &Level) -> Level {
 }
 
 /// Every level, finest (the image itself) first.
+#[cfg(test)]
 pub fn build_pyramid(base: Level) -> Vec<Level> {
     let mut levels = vec![base];
     loop {
@@ -104,6 +130,14 @@ pub fn build_pyramid(base: Level) -> Vec<Level> {
         let next = downsample(last);
         levels.push(next);
     }
+}
+
+/// Bytes of the float RGBA texels of levels of these sizes.
+pub fn pyramid_bytes(sizes: &[(usize, usize)]) -> u64 {
+    sizes
+        .iter()
+        .map(|&(w, h)| w as u64 * h as u64 * std::mem::size_of::<[f32; 4]>() as u64)
+        .sum()
 }
 
 /// What a lookup outside [0, 1) does.

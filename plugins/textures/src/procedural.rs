@@ -2,6 +2,7 @@
 //! noise. Every one is placed by a [`Transform`] (`scale`, `rotate`, `translate`) applied to the
 //! lookup point; colours are linear RGB with alpha 1.
 
+use crate::image::MAGENTA;
 use crate::noise::{Fractal, Perlin};
 use crate::params::{color, direction, non_negative, octaves, one, positive, up, white, Factors};
 use crate::transform::Transform;
@@ -154,6 +155,11 @@ impl Texture for Checker {
     }
 
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        self.try_eval(q).unwrap_or(MAGENTA)
+    }
+
+    /// Fails when the input of the cell fails (a nested image that does not decode).
+    fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
         let l = self.place.apply(q.p);
         let sum = l.iter().fold(0i64, |acc, &u| acc.wrapping_add(cell(u)));
         if sum & 1 == 0 {

@@ -7,7 +7,7 @@
 //! Nested textures are evaluated at the same shading point as their parent, each with its own
 //! `scale`/`rotate`/`translate` (a parent's placement does not move its inputs).
 
-use crate::image::{ImageParams, ImageTexture};
+use crate::image::{ImageParams, ImageTexture, MAGENTA};
 use crate::params::explain;
 use crate::procedural::{
     Checker, CheckerParams, Constant, ConstantParams, Gradient, GradientParams, Marble,
@@ -19,14 +19,15 @@ use serde::de::value::{MapAccessDeserializer, MapDeserializer};
 use serde::de::{Deserializer, Error as _, MapAccess, Visitor};
 use serde::Deserialize;
 
-/// Anything that can be evaluated at a shading point (every texture of this plugin).
+/// Anything that can be evaluated at a shading point (every texture of this plugin); an
+/// image that does not decode fails, and so does every tree holding it.
 pub trait Eval: Send + Sync {
-    fn eval_at(&self, q: &TexQuery) -> [f32; 4];
+    fn eval_at(&self, q: &TexQuery) -> Result<[f32; 4], Error>;
 }
 
 impl<T: Texture> Eval for T {
-    fn eval_at(&self, q: &TexQuery) -> [f32; 4] {
-        self.eval(q)
+    fn eval_at(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
+        self.try_eval(q)
     }
 }
 
@@ -159,9 +160,9 @@ pub enum Input {
 }
 
 impl Input {
-    pub fn eval(&self, q: &TexQuery) -> [f32; 4] {
+    pub fn eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
         match self {
-            Input::Color(c) => *c,
+            Input::Color(c) => Ok(*c),
             Input::Texture(t) => t.eval_at(q),
         }
     }
@@ -223,16 +224,20 @@ impl Texture for Blend {
     }
 
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
-        let a = self.a.eval(q);
-        let b = self.b.eval(q);
+        self.try_eval(q).unwrap_or(MAGENTA)
+    }
+
+    fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
+        let a = self.a.eval(q)?;
+        let b = self.b.eval(q)?;
         let m = self
             .mix
-            .eval(q)
+            .eval(q)?
             .map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) });
         // Alpha is mixed by the mean of the colour weights.
         let ma = (m[0] + m[1] + m[2]) / 3.0;
         let w = [m[0], m[1], m[2], ma];
-        std::array::from_fn(|i| a[i] + (b[i] - a[i]) * w[i])
+        Ok(std::array::from_fn(|i| a[i] + (b[i] - a[i]) * w[i]))
     }
 }
 
@@ -320,6 +325,35 @@ mod tests {
             "{}",
             e.message
         );
+    }
+    /// A nested image that turns out not to decode fails its tree's lookups with its reason,
+    /// in the cells that use it, at any depth.
+    #[test]
+    fn a_broken_nested_image_fails_the_tree_with_its_reason() {
+        let dir = TempDir::new("tree-broken-image");
+        write_png(&dir.path("red.png"), 16, 16, |x, y| {
+            [(x * 16) as u8, y as u8, 0, 255]
+        });
+        let t: Blend = make_in(
+            r#"(a: Checker(even: Image(file: "red.png", mapping: planar), odd: 1), b: 0, mix: 0)"#,
+            &ctx_in(dir.dir()),
+        )
+        .unwrap();
+        // Header intact, data gone.
+        let bytes = std::fs::read(dir.path("red.png")).unwrap();
+        std::fs::write(dir.path("red.png"), &bytes[..40]).unwrap();
+        let q = |p| TexQuery {
+            p,
+            ..Default::default()
+        };
+        let e = t.try_eval(&q([0.5, 0.5, 0.5])).unwrap_err().message;
+        assert!(
+            e.starts_with("cannot decode image `") && e.contains("red.png"),
+            "{e}"
+        );
+        // An odd cell does not touch the image.
+        assert_eq!(t.try_eval(&q([1.5, 0.5, 0.5])).unwrap(), WHITE);
+        assert_eq!(t.eval(&q([0.5, 0.5, 0.5])), MAGENTA);
     }
 
     #[test]

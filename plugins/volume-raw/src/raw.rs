@@ -182,39 +182,42 @@ impl Layout {
         Ok((layout, size))
     }
 
-    /// Converts `raw` (whole voxels of this format) into `out` (normalising by division, so that
-    /// `v / 255` is exactly what a reader of the file computes).
-    fn convert(&self, raw: &[u8], out: &mut Vec<f32>) {
+    /// The divisor of integer voxels: the format's largest value when normalising (so that
+    /// `v / 255` is exactly what a reader of the file computes), else 1.
+    fn divisor(&self) -> f32 {
+        match (self.format, self.normalize) {
+            (Format::U8, true) => 255.0,
+            (Format::U16, true) => 65535.0,
+            _ => 1.0,
+        }
+    }
+
+    /// Converts `raw` (whole u16 voxels in the file's byte order) into native words.
+    fn words(&self, raw: &[u8], out: &mut Vec<u16>) {
         out.clear();
         let big = self.endian == Endian::Big;
-        match self.format {
-            Format::U8 => {
-                let scale = if self.normalize { 255.0 } else { 1.0 };
-                out.extend(raw.iter().map(|&b| f32::from(b) / scale));
+        out.extend(raw.chunks_exact(2).map(|c| {
+            let b = [c[0], c[1]];
+            if big {
+                u16::from_be_bytes(b)
+            } else {
+                u16::from_le_bytes(b)
             }
-            Format::U16 => {
-                let scale = if self.normalize { 65535.0 } else { 1.0 };
-                out.extend(raw.chunks_exact(2).map(|c| {
-                    let b = [c[0], c[1]];
-                    let v = if big {
-                        u16::from_be_bytes(b)
-                    } else {
-                        u16::from_le_bytes(b)
-                    };
-                    f32::from(v) / scale
-                }));
+        }));
+    }
+
+    /// Converts `raw` (whole f32 voxels in the file's byte order) into `out`.
+    fn floats(&self, raw: &[u8], out: &mut Vec<f32>) {
+        out.clear();
+        let big = self.endian == Endian::Big;
+        out.extend(raw.chunks_exact(4).map(|c| {
+            let b = [c[0], c[1], c[2], c[3]];
+            if big {
+                f32::from_be_bytes(b)
+            } else {
+                f32::from_le_bytes(b)
             }
-            Format::F32 => {
-                out.extend(raw.chunks_exact(4).map(|c| {
-                    let b = [c[0], c[1], c[2], c[3]];
-                    if big {
-                        f32::from_be_bytes(b)
-                    } else {
-                        f32::from_le_bytes(b)
-                    }
-                }));
-            }
-        }
+        }));
     }
 }
 
@@ -259,6 +262,31 @@ pub trait Blocks {
     fn begin(&mut self, info: &GridInfo) -> Result<(), Error>;
     /// A dense block, x fastest.
     fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error>;
+
+    /// A dense block of bytes, voxel value `byte as f32 / divisor` (by default converted and
+    /// given to [`dense`](Self::dense); the host keeps the bytes).
+    fn dense_u8(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u8],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
+        self.dense(origin, dims, &values)
+    }
+
+    /// A dense block of `u16` (native byte order), voxel value `v as f32 / divisor`.
+    fn dense_u16(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u16],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        let values: Vec<f32> = values.iter().map(|&v| f32::from(v) / divisor).collect();
+        self.dense(origin, dims, &values)
+    }
 }
 
 impl Blocks for VolumeOut<'_> {
@@ -268,6 +296,26 @@ impl Blocks for VolumeOut<'_> {
 
     fn dense(&mut self, origin: [i64; 3], dims: [u64; 3], values: &[f32]) -> Result<(), Error> {
         VolumeOut::dense(self, origin, dims, values)
+    }
+
+    fn dense_u8(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u8],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        VolumeOut::dense_u8(self, origin, dims, values, divisor)
+    }
+
+    fn dense_u16(
+        &mut self,
+        origin: [i64; 3],
+        dims: [u64; 3],
+        values: &[u16],
+        divisor: f32,
+    ) -> Result<(), Error> {
+        VolumeOut::dense_u16(self, origin, dims, values, divisor)
     }
 }
 
@@ -498,7 +546,7 @@ impl VolumeReader for Raw {
             checked.size(&path, meta.len())?;
         }
         let mut input = Input::new(file, gzip, &path, &checked);
-        checked.decode(name, &mut input, out, Sizes::DEFAULT)
+        checked.decode(name, &mut input, out, Sizes::within(ctx.memory_budget))
     }
 }
 
@@ -517,6 +565,16 @@ impl Sizes {
         slab_bytes: 64 << 20,
         block_voxels: BLOCK_VOXELS,
     };
+
+    /// The default sizes, with slabs of at most a quarter of the memory budget the host gave
+    /// (0: none given): a tighter budget reads rows or parts of rows instead.
+    fn within(memory_budget: u64) -> Sizes {
+        let mut s = Sizes::DEFAULT;
+        if memory_budget > 0 {
+            s.slab_bytes = s.slab_bytes.min(memory_budget / 4);
+        }
+        s
+    }
 }
 
 /// A buffer of `n` bytes, or an error naming what needed it (never an abort).
@@ -554,11 +612,23 @@ fn stream(
     let bpv = layout.format.bytes();
     input.skip(layout.header)?;
     let path = input.path;
-    let mut values: Vec<f32> = Vec::new();
+    let (mut floats, mut words) = (Vec::new(), Vec::new());
+    let divisor = layout.divisor();
+    // Integer voxels go to the host as they are (it stores them at their precision).
     let mut send = |raw: &[u8], origin: [u64; 3], dims: [u64; 3]| -> Result<(), Error> {
-        layout.convert(raw, &mut values);
-        check_finite(&values, origin, dims, layout, path)?;
-        out.dense(origin.map(|c| c as i64), dims, &values)
+        let at = origin.map(|c| c as i64);
+        match layout.format {
+            Format::U8 => out.dense_u8(at, dims, raw, divisor),
+            Format::U16 => {
+                layout.words(raw, &mut words);
+                out.dense_u16(at, dims, &words, divisor)
+            }
+            Format::F32 => {
+                layout.floats(raw, &mut floats);
+                check_finite(&floats, origin, dims, layout, path)?;
+                out.dense(at, dims, &floats)
+            }
+        }
     };
     let slab_bytes = nx.saturating_mul(ny).saturating_mul(SLAB * bpv);
     if slab_bytes <= max_slab {
@@ -625,9 +695,6 @@ fn check_finite(
     layout: &Layout,
     path: &Path,
 ) -> Result<(), Error> {
-    if layout.format != Format::F32 {
-        return Ok(());
-    }
     let Some(i) = values.iter().position(|v| !v.is_finite()) else {
         return Ok(());
     };
@@ -671,6 +738,8 @@ mod tests {
         /// Times each voxel was given.
         given: Vec<u32>,
         blocks: Vec<([i64; 3], [u64; 3])>,
+        /// Format and divisor of each typed block.
+        divisors: Vec<(u32, f32)>,
     }
 
     // The sink below stands in for the host's. The reader calls it during `read`, on the test's
@@ -700,6 +769,26 @@ mod tests {
         abi::STATUS_OK
     }
 
+    impl Got {
+        /// Stores a block's values (x fastest) in the dense copy.
+        fn put(&mut self, o: [i64; 3], d: [u64; 3], value: impl Fn(usize) -> f32) {
+            self.blocks.push((o, d));
+            let [sx, sy, _] = self.index_max.map(|m| (m + 1) as usize);
+            let mut i = 0;
+            for z in 0..d[2] as usize {
+                for y in 0..d[1] as usize {
+                    for x in 0..d[0] as usize {
+                        let at =
+                            ((o[2] as usize + z) * sy + o[1] as usize + y) * sx + o[0] as usize + x;
+                        self.values[at] = value(i);
+                        self.given[at] += 1;
+                        i += 1;
+                    }
+                }
+            }
+        }
+    }
+
     /// # Safety
     /// See the comment above `begin`; `values` holds `dims[0] * dims[1] * dims[2]` values.
     unsafe extern "C" fn add_dense(
@@ -711,22 +800,45 @@ mod tests {
     ) -> abi::Status {
         // SAFETY: see the comment above `begin`.
         let (g, o, d) = unsafe { (&mut *(ctx as *mut Got), *origin, *dims) };
-        g.blocks.push((o, d));
         let n = (d[0] * d[1] * d[2]) as usize;
         // SAFETY: the reader's promise: `n` values, borrowed for the call.
         let v = unsafe { std::slice::from_raw_parts(values, n) };
-        let [sx, sy, _] = g.index_max.map(|m| (m + 1) as usize);
-        let mut i = 0;
-        for z in 0..d[2] as usize {
-            for y in 0..d[1] as usize {
-                for x in 0..d[0] as usize {
-                    let at =
-                        ((o[2] as usize + z) * sy + o[1] as usize + y) * sx + o[0] as usize + x;
-                    g.values[at] = v[i];
-                    g.given[at] += 1;
-                    i += 1;
-                }
+        g.put(o, d, |i| v[i]);
+        abi::STATUS_OK
+    }
+
+    /// # Safety
+    /// See the comment above `begin`; `data` holds `len` bytes: `dims[0] * dims[1] * dims[2]`
+    /// voxels of `format`, aligned for it.
+    #[allow(clippy::too_many_arguments)]
+    unsafe extern "C" fn add_dense_typed(
+        ctx: *mut c_void,
+        origin: *const [i64; 3],
+        dims: *const [u64; 3],
+        format: u32,
+        data: *const u8,
+        len: usize,
+        divisor: f32,
+        _err: *const abi::ErrorSink,
+    ) -> abi::Status {
+        // SAFETY: see the comment above `begin`.
+        let (g, o, d) = unsafe { (&mut *(ctx as *mut Got), *origin, *dims) };
+        let n = (d[0] * d[1] * d[2]) as usize;
+        g.divisors.push((format, divisor));
+        match format {
+            abi::VOXEL_U8 => {
+                assert_eq!(len, n);
+                // SAFETY: the reader's promise: `n` bytes, borrowed for the call.
+                let v = unsafe { std::slice::from_raw_parts(data, n) };
+                g.put(o, d, |i| f32::from(v[i]) / divisor);
             }
+            abi::VOXEL_U16 => {
+                assert_eq!(len, 2 * n);
+                // SAFETY: the reader's promise: `n` aligned u16, borrowed for the call.
+                let v = unsafe { std::slice::from_raw_parts(data as *const u16, n) };
+                g.put(o, d, |i| f32::from(v[i]) / divisor);
+            }
+            other => panic!("the raw reader sends f32 through `add_dense`, not format {other}"),
         }
         abi::STATUS_OK
     }
@@ -759,6 +871,7 @@ mod tests {
             ctx: &mut got as *mut Got as *mut c_void,
             begin,
             add_dense,
+            add_dense_typed,
             add_tile,
         };
         let mut message: Option<String> = None;
@@ -823,6 +936,8 @@ mod tests {
         assert_eq!(got.name, "small.raw");
         let want: Vec<f32> = bytes.iter().map(|&b| b as f32 / 255.0).collect();
         assert_eq!(got.values, want);
+        // The bytes go to the host as they are, with the divisor that normalises them.
+        assert_eq!(got.divisors, [(abi::VOXEL_U8, 255.0)]);
 
         // A negative step runs the axis backwards from `origin`.
         let got = read(&format!(
@@ -839,6 +954,7 @@ mod tests {
         ))
         .unwrap();
         assert_eq!(got.values[11], 220.0);
+        assert_eq!(got.divisors, [(abi::VOXEL_U8, 1.0)]);
         assert_eq!(
             got.world_from_index,
             [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.]
@@ -857,11 +973,13 @@ mod tests {
         .unwrap();
         let want: Vec<f32> = words.iter().map(|&w| w as f32).collect();
         assert_eq!(got.values, want);
+        assert_eq!(got.divisors, [(abi::VOXEL_U16, 1.0)]);
         let got = read(&format!(
             r#"(file: "{file}", dims: (4, 3, 2), format: "u16", endian: "big")"#
         ))
         .unwrap();
         assert_eq!(got.values[23], 23.0 * 2731.0 / 65535.0);
+        assert_eq!(got.divisors, [(abi::VOXEL_U16, 65535.0)]);
         // Read as little-endian, the same bytes mean something else.
         let got = read(&format!(
             r#"(file: "{file}", dims: (4, 3, 2), format: "u16")"#
@@ -1242,6 +1360,14 @@ mod tests {
             "{}",
             e.message
         );
+    }
+
+    #[test]
+    fn slabs_keep_to_a_quarter_of_the_memory_budget() {
+        assert_eq!(Sizes::within(0).slab_bytes, 64 << 20);
+        assert_eq!(Sizes::within(1 << 40).slab_bytes, 64 << 20);
+        assert_eq!(Sizes::within(100 << 20).slab_bytes, 25 << 20);
+        assert_eq!(Sizes::within(1).slab_bytes, 0);
     }
 
     #[test]

@@ -1,7 +1,30 @@
-//! What every integer format shares: the image checks, sRGB encoding and quantisation of the
-//! samples, and the error of a failed encoder.
+//! What every integer format shares: the image checks, the encoding and quantisation of the
+//! samples (`encoding`), and the error of a failed encoder.
 
 use luxon_plugin::{invalid, linear_to_srgb, Error, Image};
+use serde::Deserialize;
+
+/// How colour values become integer samples (parameter `encoding`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum Encoding {
+    /// Linear values through the sRGB curve, rounded to the nearest step.
+    #[default]
+    Srgb,
+    /// The values are display values already (a Tachyon scene's colours are): written as they
+    /// are, clamped to [0, 1] and truncated as Tachyon writes its images, floor(255·c) (and
+    /// floor(65535·c) at 16 bits), so that `luxon tachyon` writes Tachyon's tones.
+    Display,
+}
+
+/// The `PARAMS` line of `encoding`, shared by every integer writer (a literal, for `concat!`).
+macro_rules! encoding_param {
+    () => {
+        "encoding: srgb|display = srgb  srgb: linear colours through the sRGB curve; display: \
+         values written as they are, clamped and truncated (as Tachyon writes; luxon tachyon)"
+    };
+}
+pub(crate) use encoding_param;
 
 /// Checks the image is non-empty and its buffer matches its size; returns the pixel count.
 pub(crate) fn check_image(image: &Image) -> Result<usize, Error> {
@@ -41,12 +64,27 @@ pub(crate) fn quantize16(x: f32) -> u16 {
     (x * 65535.0).round() as u16
 }
 
-/// sRGB-encoded samples, RGB or RGBA, one `T` per channel.
-fn encode_samples<T>(image: &Image, alpha: bool, quantize: impl Fn(f32) -> T) -> Vec<T> {
+/// A display value's step: truncated, as Tachyon quantises (NaN is 0, as for sRGB).
+fn truncate(x: f32, max: f32) -> f32 {
+    (linear_unit(x) * max).floor().min(max)
+}
+
+/// Encoded samples, RGB or RGBA, one `T` per channel; alpha is stored linearly and rounded.
+fn encode_samples<T>(
+    image: &Image,
+    alpha: bool,
+    encoding: Encoding,
+    quantize: impl Fn(f32) -> T,
+    max: f32,
+    from_step: impl Fn(f32) -> T,
+) -> Vec<T> {
     let channels = if alpha { 4 } else { 3 };
     let mut out = Vec::with_capacity(image.rgba.len() / 4 * channels);
     for px in image.rgba.chunks_exact(4) {
-        out.extend(px[..3].iter().map(|&c| quantize(linear_to_srgb(c))));
+        match encoding {
+            Encoding::Srgb => out.extend(px[..3].iter().map(|&c| quantize(linear_to_srgb(c)))),
+            Encoding::Display => out.extend(px[..3].iter().map(|&c| from_step(truncate(c, max)))),
+        }
         if alpha {
             out.push(quantize(linear_unit(px[3])));
         }
@@ -54,12 +92,12 @@ fn encode_samples<T>(image: &Image, alpha: bool, quantize: impl Fn(f32) -> T) ->
     out
 }
 
-pub(crate) fn srgb8(image: &Image, alpha: bool) -> Vec<u8> {
-    encode_samples(image, alpha, quantize8)
+pub(crate) fn samples8(image: &Image, alpha: bool, encoding: Encoding) -> Vec<u8> {
+    encode_samples(image, alpha, encoding, quantize8, 255.0, |s| s as u8)
 }
 
-pub(crate) fn srgb16(image: &Image, alpha: bool) -> Vec<u16> {
-    encode_samples(image, alpha, quantize16)
+pub(crate) fn samples16(image: &Image, alpha: bool, encoding: Encoding) -> Vec<u16> {
+    encode_samples(image, alpha, encoding, quantize16, 65535.0, |s| s as u16)
 }
 
 pub(crate) fn check_bits(bits: i64) -> Result<u8, Error> {
@@ -94,5 +132,28 @@ mod tests {
         assert_eq!(quantize8(linear_to_srgb(-3.0)), 0);
         assert_eq!(quantize16(linear_to_srgb(0.5)), 48192);
         assert_eq!(quantize16(linear_to_srgb(1.0)), 65535);
+    }
+
+    #[test]
+    fn display_values_are_truncated_as_tachyon_writes() {
+        let rgba = [0.5, 0.999, 1.0, 1.0, 2.0, -1.0, f32::NAN, 0.5];
+        let image = Image {
+            width: 2,
+            height: 1,
+            rgba: &rgba,
+        };
+        assert_eq!(
+            samples8(&image, false, Encoding::Display),
+            [127, 254, 255, 255, 0, 0]
+        );
+        assert_eq!(
+            samples8(&image, true, Encoding::Display),
+            [127, 254, 255, 255, 255, 0, 0, 128]
+        );
+        assert_eq!(
+            samples16(&image, false, Encoding::Display),
+            [32767, 65469, 65535, 65535, 0, 0]
+        );
+        assert_eq!(samples8(&image, false, Encoding::Srgb)[0], 188);
     }
 }

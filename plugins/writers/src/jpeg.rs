@@ -1,8 +1,9 @@
-//! `jpeg`: JPEG, sRGB-encoded, 8 bits per channel (alpha is dropped).
+//! `jpeg`: JPEG, sRGB-encoded (or display values, `encoding: display`), 8 bits per channel
+//! (alpha is dropped).
 
 use std::io::Write;
 
-use crate::encode::{check_image, encode_error, srgb8};
+use crate::encode::{check_image, encode_error, encoding_param, samples8, Encoding};
 use image::codecs::jpeg::JpegEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 use luxon_plugin::{invalid, Context, Describe, Error, Image, Writer};
@@ -15,6 +16,8 @@ pub struct Jpeg;
 pub struct JpegParams {
     #[serde(default = "default_quality")]
     quality: i64,
+    #[serde(default)]
+    encoding: Encoding,
 }
 
 fn default_quality() -> i64 {
@@ -23,8 +26,12 @@ fn default_quality() -> i64 {
 
 impl Describe for Jpeg {
     const NAME: &'static str = "jpeg";
-    const DESCRIPTION: &'static str = "JPEG, sRGB-encoded, 8 bits per channel (alpha is dropped).";
-    const PARAMS: &'static str = "quality: int = 90  encoder quality, 1 (smallest) to 100 (best)";
+    const DESCRIPTION: &'static str =
+        "JPEG, sRGB-encoded or display values, 8 bits per channel (alpha is dropped).";
+    const PARAMS: &'static str = concat!(
+        "quality: int = 90  encoder quality, 1 (smallest) to 100 (best)\n",
+        encoding_param!()
+    );
 }
 
 impl Writer for Jpeg {
@@ -47,7 +54,7 @@ impl Writer for Jpeg {
         let mut bytes = Vec::new();
         JpegEncoder::new_with_quality(&mut bytes, params.quality as u8)
             .write_image(
-                &srgb8(image, false),
+                &samples8(image, false, params.encoding),
                 image.width,
                 image.height,
                 ExtendedColorType::Rgb8,

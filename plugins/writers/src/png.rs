@@ -1,8 +1,12 @@
-//! `png`: PNG, sRGB-encoded, 8 or 16 bits per channel, RGB or RGBA.
+//! `png`: PNG, sRGB-encoded (or display values, `encoding: display`), 8 or 16 bits per channel,
+//! RGB or RGBA.
 
 use std::io::Write;
 
-use crate::encode::{check_bits, check_image, default_bits, encode_error, srgb16, srgb8};
+use crate::encode::{
+    check_bits, check_image, default_bits, encode_error, encoding_param, samples16, samples8,
+    Encoding,
+};
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 use luxon_plugin::{Context, Describe, Error, Image, Writer};
@@ -17,14 +21,19 @@ pub struct PngParams {
     bits: i64,
     #[serde(default)]
     alpha: bool,
+    #[serde(default)]
+    encoding: Encoding,
 }
 
 impl Describe for Png {
     const NAME: &'static str = "png";
-    const DESCRIPTION: &'static str = "PNG, sRGB-encoded, 8 or 16 bits per channel, RGB or RGBA.";
-    const PARAMS: &'static str = "\
-bits: int = 8  bits per channel: 8 or 16
-alpha: bool = false  write an alpha channel (RGBA instead of RGB)";
+    const DESCRIPTION: &'static str =
+        "PNG, sRGB-encoded or display values, 8 or 16 bits per channel, RGB or RGBA.";
+    const PARAMS: &'static str = concat!(
+        "bits: int = 8  bits per channel: 8 or 16\n",
+        "alpha: bool = false  write an alpha channel (RGBA instead of RGB)\n",
+        encoding_param!()
+    );
 }
 
 impl Writer for Png {
@@ -48,7 +57,7 @@ impl Writer for Png {
             } else {
                 ExtendedColorType::Rgb8
             };
-            encoder.write_image(&srgb8(image, alpha), w, h, color)
+            encoder.write_image(&samples8(image, alpha, params.encoding), w, h, color)
         } else {
             let color = if alpha {
                 ExtendedColorType::Rgba16
@@ -56,7 +65,7 @@ impl Writer for Png {
                 ExtendedColorType::Rgb16
             };
             // PngEncoder takes native-endian 16-bit samples and swaps them itself.
-            let samples: Vec<u8> = srgb16(image, alpha)
+            let samples: Vec<u8> = samples16(image, alpha, params.encoding)
                 .iter()
                 .flat_map(|s| s.to_ne_bytes())
                 .collect();

@@ -1,8 +1,11 @@
-//! `ppm`: binary PPM (P6), sRGB-encoded, 8 or 16 bits per channel, RGB; written directly.
+//! `ppm`: binary PPM (P6), sRGB-encoded (or display values, `encoding: display`), 8 or 16 bits
+//! per channel, RGB; written directly.
 
 use std::io::Write;
 
-use crate::encode::{check_bits, check_image, default_bits, srgb16, srgb8};
+use crate::encode::{
+    check_bits, check_image, default_bits, encoding_param, samples16, samples8, Encoding,
+};
 use luxon_plugin::{Context, Describe, Error, Image, Writer};
 use serde::Deserialize;
 
@@ -13,14 +16,18 @@ pub struct Ppm;
 pub struct PpmParams {
     #[serde(default = "default_bits")]
     bits: i64,
+    #[serde(default)]
+    encoding: Encoding,
 }
 
 impl Describe for Ppm {
     const NAME: &'static str = "ppm";
     const DESCRIPTION: &'static str =
-        "Binary PPM (P6), sRGB-encoded, 8 or 16 bits per channel, RGB.";
-    const PARAMS: &'static str =
-        "bits: int = 8  8 (maxval 255) or 16 (maxval 65535, big-endian samples)";
+        "Binary PPM (P6), sRGB-encoded or display values, 8 or 16 bits per channel, RGB.";
+    const PARAMS: &'static str = concat!(
+        "bits: int = 8  8 (maxval 255) or 16 (maxval 65535, big-endian samples)\n",
+        encoding_param!()
+    );
 }
 
 impl Writer for Ppm {
@@ -39,9 +46,13 @@ impl Writer for Ppm {
         let maxval = if bits == 8 { 255 } else { 65535 };
         let mut bytes = format!("P6\n{} {}\n{maxval}\n", image.width, image.height).into_bytes();
         if bits == 8 {
-            bytes.extend(srgb8(image, false));
+            bytes.extend(samples8(image, false, params.encoding));
         } else {
-            bytes.extend(srgb16(image, false).iter().flat_map(|s| s.to_be_bytes()));
+            bytes.extend(
+                samples16(image, false, params.encoding)
+                    .iter()
+                    .flat_map(|s| s.to_be_bytes()),
+            );
         }
         out.write_all(&bytes)?;
         Ok(())

@@ -1,8 +1,10 @@
-//! `tga`: Truevision TGA, sRGB-encoded, 8 bits per channel, RGB or RGBA.
+//! `tga`: Truevision TGA, sRGB-encoded (or display values, `encoding: display`), 8 bits per
+//! channel, RGB or RGBA, run-length encoded unless `rle: false` (uncompressed, as Tachyon writes
+//! its Targa files, for tools that read only those).
 
 use std::io::Write;
 
-use crate::encode::{check_image, encode_error, srgb8};
+use crate::encode::{check_image, encode_error, encoding_param, samples8, Encoding};
 use image::codecs::tga::TgaEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 use luxon_plugin::{Context, Describe, Error, Image, Writer};
@@ -15,14 +17,25 @@ pub struct Tga;
 pub struct TgaParams {
     #[serde(default)]
     alpha: bool,
+    #[serde(default = "yes")]
+    rle: bool,
+    #[serde(default)]
+    encoding: Encoding,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Describe for Tga {
     const NAME: &'static str = "tga";
     const DESCRIPTION: &'static str =
-        "Truevision TGA, sRGB-encoded, 8 bits per channel, RGB or RGBA.";
-    const PARAMS: &'static str =
-        "alpha: bool = false  write an alpha channel (RGBA instead of RGB)";
+        "Truevision TGA, sRGB-encoded or display values, 8 bits per channel, RGB or RGBA, run-length encoded or not.";
+    const PARAMS: &'static str = concat!(
+        "alpha: bool = false  write an alpha channel (RGBA instead of RGB)\n",
+        "rle: bool = true  run-length encode the pixels (false: uncompressed)\n",
+        encoding_param!()
+    );
 }
 
 impl Writer for Tga {
@@ -42,9 +55,13 @@ impl Writer for Tga {
             ExtendedColorType::Rgb8
         };
         let mut bytes = Vec::new();
-        TgaEncoder::new(&mut bytes)
+        let encoder = match params.rle {
+            true => TgaEncoder::new(&mut bytes),
+            false => TgaEncoder::new(&mut bytes).disable_rle(),
+        };
+        encoder
             .write_image(
-                &srgb8(image, params.alpha),
+                &samples8(image, params.alpha, params.encoding),
                 image.width,
                 image.height,
                 color,
@@ -81,5 +98,17 @@ mod tests {
         };
         assert_eq!(img.get_pixel(0, 0).0, [0, 188, srgb8_of(0.25), 0]);
         assert_eq!(img.get_pixel(5, 2).0[3], 170);
+    }
+
+    #[test]
+    fn uncompressed_tga_holds_the_same_pixels() {
+        let rgba = gradient();
+        let rle = encode::<Tga>("()", &rgba).unwrap();
+        let raw = encode::<Tga>("(rle: false)", &rgba).unwrap();
+        // Image type 10 (run-length RGB) and 2 (uncompressed RGB), as Tachyon writes.
+        assert_eq!((rle[2], raw[2]), (10, 2));
+        assert_eq!(raw.len(), 18 + (W * H * 3) as usize);
+        let pixels = |b: &[u8]| decode(b, image::ImageFormat::Tga).to_rgb8().into_raw();
+        assert_eq!(pixels(&rle), pixels(&raw));
     }
 }

@@ -1,5 +1,7 @@
-//! Test plugin: a handshake with the right magic but an ABI version no host supports. The host
-//! must stop after reading `abi_version` and never touch `declaration` (null here).
+//! Test plugin: the handshake of a plugin built for plugin ABI 1 with luxon-plugin 0.1.0 (the
+//! version before the current one), which the host must refuse. The header's leading fields
+//! keep their layout in every ABI version, so this is what such a library really declares; the
+//! host must stop after reading `abi_version` and never touch `declaration` (null here).
 
 use luxon_plugin::abi::{DeclareFn, HostTable, PluginHeader, Str, MAGIC};
 
@@ -11,8 +13,8 @@ unsafe impl Sync for Header {}
 
 static HEADER: Header = Header(PluginHeader {
     magic: MAGIC,
-    abi_version: 9999,
-    sdk_version: Str::new(luxon_plugin::SDK_VERSION),
+    abi_version: 1,
+    sdk_version: Str::new("0.1.0"),
     declaration: std::ptr::null(),
 });
 

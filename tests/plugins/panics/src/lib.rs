@@ -1,10 +1,12 @@
-//! Test plugin: entry points that panic, so the host can check that each panic becomes an error
-//! naming the plugin instead of unwinding into it or aborting.
+//! Test plugin: entry points that panic or fail, so the host can check that each becomes an
+//! error naming the plugin instead of unwinding into it, aborting or going unnoticed.
 //!
 //! - `panic_create` (primitive): panics in `create`.
 //! - `panic_intersect` (primitive): custom geometry filling the box [-1, 1]³ whose `intersect`
 //!   and `occluded` panic (`bounds` works, so the host gets as far as tracing rays).
 //! - `panic_texture` (texture): created fine, panics in `eval`.
+//! - `fail_texture` (texture): created fine, `try_eval` fails with a message where the hit
+//!   point has `x < 0` (plugin ABI 2's error sink for `eval`); elsewhere it is grey.
 
 #![forbid(unsafe_code)]
 
@@ -86,10 +88,34 @@ impl Texture for PanicTexture {
     }
 }
 
+pub struct FailTexture;
+
+impl Describe for FailTexture {
+    const NAME: &'static str = "fail_texture";
+    const DESCRIPTION: &'static str = "Test plugin: a texture with no value where x < 0.";
+    const PARAMS: &'static str = "";
+}
+
+impl Texture for FailTexture {
+    type Params = NoParams;
+    fn create(_: NoParams, _: &Context) -> Result<Self, Error> {
+        Ok(FailTexture)
+    }
+    fn eval(&self, _: &TexQuery) -> [f32; 4] {
+        [0.5, 0.5, 0.5, 1.0]
+    }
+    fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
+        if q.p[0] < 0.0 {
+            return Err(Error::new("deliberate failure: no value where x < 0"));
+        }
+        Ok(self.eval(q))
+    }
+}
+
 luxon_plugin::export!(
     library: "luxon-test-panics",
     primitives: [PanicCreate, PanicIntersect],
-    textures: [PanicTexture],
+    textures: [PanicTexture, FailTexture],
 );
 
 #[cfg(test)]

@@ -1,0 +1,228 @@
+//! A decoded row of samples, at the source's precision, turned into linear RGBA texels.
+//!
+//! Integer sources (8 and 16 bits) are sRGB-encoded unless `srgb` is false; their alpha is
+//! linear. Float sources are linear already. Grey becomes grey RGB; a missing alpha is 1.
+
+/// How one sample is stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sample {
+    U8,
+    /// Big-endian, as PNG rows are.
+    U16Be,
+    /// Native-endian, as the `image` crate's buffers are.
+    U16Ne,
+    F32Ne,
+}
+
+impl Sample {
+    fn bytes(self) -> usize {
+        match self {
+            Sample::U8 => 1,
+            Sample::U16Be | Sample::U16Ne => 2,
+            Sample::F32Ne => 4,
+        }
+    }
+}
+
+/// The layout of a row: the sample type and the channels per texel (1 grey, 2 grey and
+/// alpha, 3 RGB, 4 RGBA).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RowFormat {
+    pub sample: Sample,
+    pub channels: usize,
+}
+
+impl RowFormat {
+    /// The format of the `image` crate's decoded buffer, if one Luxon reads.
+    pub fn of_image(c: image::ColorType) -> Option<RowFormat> {
+        use image::ColorType::*;
+        let (sample, channels) = match c {
+            L8 => (Sample::U8, 1),
+            La8 => (Sample::U8, 2),
+            Rgb8 => (Sample::U8, 3),
+            Rgba8 => (Sample::U8, 4),
+            L16 => (Sample::U16Ne, 1),
+            La16 => (Sample::U16Ne, 2),
+            Rgb16 => (Sample::U16Ne, 3),
+            Rgba16 => (Sample::U16Ne, 4),
+            Rgb32F => (Sample::F32Ne, 3),
+            Rgba32F => (Sample::F32Ne, 4),
+            _ => return None,
+        };
+        Some(RowFormat { sample, channels })
+    }
+
+    /// The format of the `png` crate's rows (after `EXPAND`: no palette, no fewer than 8 bits).
+    pub fn of_png(c: png::ColorType, depth: png::BitDepth) -> Option<RowFormat> {
+        let sample = match depth {
+            png::BitDepth::Eight => Sample::U8,
+            png::BitDepth::Sixteen => Sample::U16Be,
+            _ => return None,
+        };
+        let channels = match c {
+            png::ColorType::Grayscale => 1,
+            png::ColorType::GrayscaleAlpha => 2,
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            png::ColorType::Indexed => return None,
+        };
+        Some(RowFormat { sample, channels })
+    }
+
+    pub fn bytes_per_texel(self) -> usize {
+        self.sample.bytes() * self.channels
+    }
+}
+
+/// The sRGB transfer function, decoded to linear.
+pub fn srgb_to_linear(x: f32) -> f32 {
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Converts rows of one format.
+pub struct Converter {
+    format: RowFormat,
+    srgb: bool,
+    /// Colour of each 8-bit value.
+    table: [f32; 256],
+}
+
+impl Converter {
+    pub fn new(format: RowFormat, srgb: bool) -> Converter {
+        let table = std::array::from_fn(|i| {
+            let x = i as f32 / 255.0;
+            if srgb {
+                srgb_to_linear(x)
+            } else {
+                x
+            }
+        });
+        Converter {
+            format,
+            srgb,
+            table,
+        }
+    }
+
+    /// One texel's colour channel and alpha, from its raw sample.
+    fn colour(&self, raw: &[u8]) -> f32 {
+        match self.format.sample {
+            Sample::U8 => self.table[raw[0] as usize],
+            Sample::U16Be | Sample::U16Ne => {
+                let x = self.u16(raw) as f32 / 65535.0;
+                if self.srgb {
+                    srgb_to_linear(x)
+                } else {
+                    x
+                }
+            }
+            Sample::F32Ne => f32::from_ne_bytes([raw[0], raw[1], raw[2], raw[3]]),
+        }
+    }
+
+    fn alpha(&self, raw: &[u8]) -> f32 {
+        match self.format.sample {
+            Sample::U8 => raw[0] as f32 / 255.0,
+            Sample::U16Be | Sample::U16Ne => self.u16(raw) as f32 / 65535.0,
+            Sample::F32Ne => f32::from_ne_bytes([raw[0], raw[1], raw[2], raw[3]]),
+        }
+    }
+
+    fn u16(&self, raw: &[u8]) -> u16 {
+        let b = [raw[0], raw[1]];
+        match self.format.sample {
+            Sample::U16Be => u16::from_be_bytes(b),
+            _ => u16::from_ne_bytes(b),
+        }
+    }
+
+    /// Converts `row` (at least `out.len()` texels of samples) into `out`.
+    pub fn row(&self, row: &[u8], out: &mut [[f32; 4]]) {
+        let s = self.format.sample.bytes();
+        let texel = self.format.bytes_per_texel();
+        for (raw, o) in row.chunks_exact(texel).zip(out.iter_mut()) {
+            let ch = |i: usize| &raw[i * s..(i + 1) * s];
+            *o = match self.format.channels {
+                1 => {
+                    let l = self.colour(ch(0));
+                    [l, l, l, 1.0]
+                }
+                2 => {
+                    let l = self.colour(ch(0));
+                    [l, l, l, self.alpha(ch(1))]
+                }
+                3 => [
+                    self.colour(ch(0)),
+                    self.colour(ch(1)),
+                    self.colour(ch(2)),
+                    1.0,
+                ],
+                _ => [
+                    self.colour(ch(0)),
+                    self.colour(ch(1)),
+                    self.colour(ch(2)),
+                    self.alpha(ch(3)),
+                ],
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_of_every_layout() {
+        let c = Converter::new(
+            RowFormat {
+                sample: Sample::U8,
+                channels: 2,
+            },
+            true,
+        );
+        let mut out = [[0.0; 4]; 2];
+        c.row(&[255, 51, 0, 255], &mut out);
+        assert_eq!(out, [[1.0, 1.0, 1.0, 0.2], [0.0, 0.0, 0.0, 1.0]]);
+        let be = Converter::new(
+            RowFormat {
+                sample: Sample::U16Be,
+                channels: 3,
+            },
+            false,
+        );
+        let mut one = [[0.0; 4]; 1];
+        be.row(&[0xff, 0xff, 0x80, 0x00, 0, 0], &mut one);
+        assert_eq!(one[0], [1.0, 32768.0 / 65535.0, 0.0, 1.0]);
+        let ne = Converter::new(
+            RowFormat {
+                sample: Sample::U16Ne,
+                channels: 4,
+            },
+            true,
+        );
+        let raw: Vec<u8> = [65535u16, 0, 65535, 13107]
+            .iter()
+            .flat_map(|v| v.to_ne_bytes())
+            .collect();
+        ne.row(&raw, &mut one);
+        assert_eq!(one[0], [1.0, 0.0, 1.0, 0.2]);
+        let f = Converter::new(
+            RowFormat {
+                sample: Sample::F32Ne,
+                channels: 3,
+            },
+            true,
+        );
+        let raw: Vec<u8> = [2.5f32, -1.0, 0.25]
+            .iter()
+            .flat_map(|v| v.to_ne_bytes())
+            .collect();
+        f.row(&raw, &mut one);
+        assert_eq!(one[0], [2.5, -1.0, 0.25, 1.0], "floats are linear");
+    }
+}
