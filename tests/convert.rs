@@ -6,15 +6,15 @@
 //! RON scene with an OBJ mesh and outputs complete the formats. Through the command line, a
 //! Tachyon example (or a scene of its own) and an NFF scene converted with `luxon convert` and
 //! rendered with `luxon render` give the source's pixels, and the warnings say what is not
-//! carried over.
+//! carried over. An animated scene keeps its keys.
 
 mod common;
 
 use common::*;
 use luxon::Scene;
 use luxon_formats::{
-    inline_as_objects, load_ron_str, to_ron, CameraDesc, MaterialDesc, ObjectDesc, OutputDesc,
-    Projection, SceneDesc, Spanned,
+    inline_as_objects, load_ron_str, to_ron, CameraDesc, Interpolate, MaterialDesc, ObjectDesc,
+    OutputDesc, Projection, SceneDesc, Spanned, Track,
 };
 use std::path::{Path, PathBuf};
 
@@ -85,6 +85,66 @@ fn material(m: &MaterialDesc) -> (MaterialDesc, [Option<String>; 3]) {
         plain.shininess = MaterialDesc::default().shininess;
     }
     (plain, names)
+}
+
+/// A track's keys (frame, value) and interpolation, without their positions.
+type Keys<T> = Option<(Vec<(f64, T)>, Interpolate)>;
+
+fn keys<T: Clone>(t: &Option<Track<T>>) -> Keys<T> {
+    let t = t.as_ref()?;
+    let keys = t.keys.iter().map(|k| (k.frame, k.value.clone())).collect();
+    Some((keys, t.interpolation))
+}
+
+/// The animation without positions: frames, shutter, and every track by what it keys (light
+/// and object indices, names).
+fn animation(d: &SceneDesc) -> Option<String> {
+    let a = &d.animation.as_ref()?.value;
+    let c = &a.camera;
+    let camera = (
+        keys(&c.position),
+        keys(&c.look_at),
+        keys(&c.up),
+        keys(&c.fov),
+        keys(&c.focal_distance),
+    );
+    let lights: Vec<_> = a
+        .lights
+        .iter()
+        .map(|l| {
+            let tracks = (
+                keys(&l.position),
+                keys(&l.direction),
+                keys(&l.intensity),
+                keys(&l.color),
+            );
+            (l.light, &l.name.value, tracks)
+        })
+        .collect();
+    let materials: Vec<_> = a
+        .materials
+        .iter()
+        .map(|m| (&m.material.value, keys(&m.color)))
+        .collect();
+    let objects: Vec<_> = a
+        .objects
+        .iter()
+        .map(|o| {
+            let tracks = (keys(&o.translate), keys(&o.rotate), keys(&o.scale));
+            (o.object, &o.name.value, tracks)
+        })
+        .collect();
+    let shutter = a.shutter.as_ref().map(|s| s.value);
+    Some(format!(
+        "{:?}",
+        (
+            (a.first, a.last, a.fps, shutter),
+            camera,
+            lights,
+            materials,
+            objects
+        )
+    ))
 }
 
 /// Asserts that `back` (read from the RON text) describes what `source` does.
@@ -165,6 +225,7 @@ fn assert_same(source: &SceneDesc, back: &SceneDesc, what: &str) {
         objects(&values(&back.objects)),
         "{what}: objects"
     );
+    assert_eq!(animation(source), animation(back), "{what}: animation");
     let mut a = source.render.clone();
     let mut b = back.render.clone();
     assert_eq!(outputs(&a.outputs), outputs(&b.outputs), "{what}: outputs");
@@ -373,6 +434,40 @@ fn nff_and_ron_scenes_convert_too() {
     assert!(round_trip(&budgeted, &dir) > 40);
 }
 
+/// An animated scene keeps its `animation:` block and the names of what it keys: the same
+/// tracks read back, and a later frame renders the same image.
+#[test]
+fn animated_scenes_convert_with_their_keys() {
+    let dir = temp_dir("convert-animation");
+    let path = root().join("scenes/carousel.ron");
+    assert!(round_trip(&path, &dir) > 40);
+    let source = luxon_formats::load(&path).unwrap();
+    let text = to_ron(&source, &dir).unwrap();
+    for name in [
+        "name: \"lamp\"",
+        "name: \"ball\"",
+        "animation: (",
+        "CatmullRom",
+    ] {
+        assert!(text.contains(name), "{name} missing:\n{text}");
+    }
+    // An animated scene takes no `frame` or `time`: neither is written.
+    assert!(!text.contains("frame: 0,"), "{text}");
+    let back = load_ron_str(&text, &dir.join("carousel.ron")).unwrap();
+    let frame = |desc: &SceneDesc| {
+        let mut desc = desc.clone();
+        desc.render.width = 32;
+        desc.render.height = 24;
+        desc.render.parallel.threads = Some(2);
+        let mut scene = Scene::build(&desc, &registry(&desc)).unwrap_or_else(|e| panic!("{e}"));
+        scene.set_frame(17).unwrap();
+        let (fb, _) = luxon::render::render(&scene, &|_, _| {}).unwrap();
+        fb.rgba.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    };
+    assert!(frame(&source) == frame(&back), "frame 17 differs");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 /// Distinct colours of an image, and the share of its pixels that are black.
 fn content(img: &image::RgbImage) -> (usize, f64) {
     let colours: std::collections::HashSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
@@ -421,32 +516,30 @@ fn converted_scenes_render_the_same_images_on_the_command_line() {
             p
         }
     };
-    let (_, _, img) = convert_and_render(&tachyon, &dir, "96x72");
+    let (text, err, img) = convert_and_render(&tachyon, &dir, "96x72");
     let (colours, black) = content(&img);
     assert!(
         colours > 200 && black < 0.5,
         "{colours} colours, {black} black"
     );
-    // What the RON scene cannot hold: on stderr and at the top of the file. A missing image
-    // map is rendered white (as Tachyon does), which the RON scene cannot say.
-    let missing = dir.join("missing-map.dat");
-    let body = TACHYON[0].replace(
-        "END_SCENE",
-        "SPHERE CENTER 3 0 0 RAD 0.5 TEXTURE AMBIENT 0.1 DIFFUSE 0.8 SPECULAR 0 OPACITY 1 \
-         COLOR 1 1 1 TEXFUNC 7 no-such-map.ppm CENTER 3 0 0 ROTATE 0 0 0 SCALE 1 1 1\nEND_SCENE",
-    );
-    assert_ne!(body, TACHYON[0]);
-    std::fs::write(&missing, body).unwrap();
-    let (text, err, _) = convert_and_render(&missing, &dir, "32x24");
-    let warning = "image map `no-such-map.ppm`";
-    assert!(err.contains(warning), "{err}");
+    // What the RON scene cannot hold: on stderr and at the top of the file. Both scenes
+    // above convert whole since Tachyon's light spheres and transparency are rendered; an
+    // alias defined twice (Tachyon keeps the first) still warns.
+    assert!(!err.contains("warning"), "{err}");
+    assert!(!text.contains("Not carried over"));
+    let warned = dir.join("warned.dat");
+    let twice = "TEXALIAS crimson red\n";
+    std::fs::write(&warned, TACHYON[0].replacen(twice, &twice.repeat(2), 1)).unwrap();
+    let (text, err, _) = convert_and_render(&warned, &dir, "96x72");
+    let light = "TEXDEF/TEXALIAS of a name already defined (`crimson` here";
+    assert!(err.contains(light), "{err}");
     assert!(
         err.contains("is not carried over (listed at the top of the file)"),
         "{err}"
     );
     let header: Vec<&str> = text.lines().take_while(|l| l.starts_with("//")).collect();
     assert!(header[1].starts_with("// Not carried over"), "{header:?}");
-    assert!(header.iter().any(|l| l.contains(warning)), "{header:?}");
+    assert!(header.iter().any(|l| l.contains(light)), "{header:?}");
 
     let nff = dir.join("s.nff");
     std::fs::write(&nff, NFF).unwrap();

@@ -8,14 +8,34 @@ use common::*;
 
 const WIDTH: u32 = 192;
 
+/// The scene's render size scaled to `WIDTH` pixels across.
+fn small(d: &mut luxon_formats::SceneDesc) {
+    let aspect = d.render.height as f64 / d.render.width as f64;
+    d.render.width = WIDTH;
+    d.render.height = (WIDTH as f64 * aspect).round() as u32;
+}
+
 fn check(name: &str) {
     let path = root().join("scenes").join(format!("{name}.ron"));
-    let fb = render_with(&path, |d| {
-        let aspect = d.render.height as f64 / d.render.width as f64;
-        d.render.width = WIDTH;
-        d.render.height = (WIDTH as f64 * aspect).round() as u32;
-    });
-    let got = to_srgb8(&fb);
+    let fb = render_with(&path, small);
+    compare(name, &fb);
+}
+
+/// Frame `k` of an animated scene, against `golden/{name}-f{k}.png`.
+fn check_frame(name: &str, k: u32) {
+    let path = root().join("scenes").join(format!("{name}.ron"));
+    let mut desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    small(&mut desc);
+    let reg = registry(&desc);
+    let mut scene = luxon::Scene::build(&desc, &reg).unwrap_or_else(|e| panic!("{e}"));
+    scene.set_frame(k).unwrap_or_else(|e| panic!("{e}"));
+    let (fb, _) = luxon::render::render(&scene, &|_, _| {}).unwrap_or_else(|e| panic!("{e}"));
+    compare(&format!("{name}-f{k}"), &fb);
+}
+
+/// `fb` against `golden/{name}.png` (or blessed into it).
+fn compare(name: &str, fb: &luxon::Framebuffer) {
+    let got = to_srgb8(fb);
     let golden = root().join("tests/golden").join(format!("{name}.png"));
     if std::env::var_os("LUXON_BLESS").is_some() {
         image::save_buffer(&golden, &got, fb.width, fb.height, image::ColorType::Rgb8).unwrap();
@@ -47,6 +67,12 @@ fn check(name: &str) {
         mean < 0.5 && max < 64,
         "{name}: mean diff {mean:.3}, max {max} (see LUXON_BLESS in this file)"
     );
+}
+
+#[test]
+fn animation_carousel_frames() {
+    check_frame("carousel", 0);
+    check_frame("carousel", 17);
 }
 
 #[test]

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 /// layers before its own. Keep in step with the table in core/src/lib.rs.
 const CORE: &[(&str, &[&str])] = &[
     ("math", &["math", "sampler", "error"]),
+    ("motion", &["motion"]),
     ("memory", &["budget"]),
     ("ray", &["ray"]),
     ("image", &["framebuffer", "ppm", "metrics", "files"]),
@@ -35,7 +36,7 @@ const CORE: &[(&str, &[&str])] = &[
 /// The layers of formats/src, bottom to top. Keep in step with the table in formats/src/lib.rs.
 const FORMATS: &[(&str, &[&str])] = &[
     ("origin", &["origin"]),
-    ("leaves", &["error", "geometry", "spans", "raw"]),
+    ("leaves", &["error", "geometry", "spans", "raw", "pattern"]),
     ("description", &["desc"]),
     ("text", &["ron_text"]),
     ("input", &["input"]),
@@ -43,7 +44,7 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("checks", &["validate", "ron_error"]),
     (
         "conversion",
-        &["convert", "camera", "effects", "volume_render"],
+        &["convert", "camera", "effects", "volume_render", "animation"],
     ),
     ("importers", &["nff", "obj", "tachyon"]),
     ("includes", &["includes"]),

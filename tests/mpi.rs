@@ -244,4 +244,69 @@ mod with_mpi {
             );
         }
     }
+
+    /// An animated scene's frames under 2 and 3 ranks equal one process's, file for file;
+    /// a frame that fails (its camera degenerates) is skipped by every rank, the others
+    /// written, and the job ends with status 1.
+    #[test]
+    fn animation_frames_match_one_process() {
+        let dir = temp_dir("mpi-frames");
+        let s = root().join("scenes/carousel.ron").display().to_string();
+        let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
+            let mut v: Vec<_> = std::fs::read_dir(d)
+                .unwrap()
+                .map(|e| {
+                    let e = e.unwrap();
+                    let name = e.file_name().to_string_lossy().to_string();
+                    (name, std::fs::read(e.path()).unwrap())
+                })
+                .collect();
+            v.sort();
+            v
+        };
+        let frames = ["--frames", "0..47", "--step", "23", "--res", "48x36"];
+        let one = dir.join("one");
+        let pattern = one.join("f%02d.ppm").display().to_string();
+        let mut args = vec!["render", &s, "--threads", "1", "-o", &pattern];
+        args.extend(frames);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let want = files(&one);
+        assert_eq!(want.len(), 3);
+        for (ranks, extra) in [(2, &["--parallel", "mpi"][..]), (3, &[][..])] {
+            let out = dir.join(format!("np{ranks}"));
+            let pattern = out.join("f%02d.ppm").display().to_string();
+            let mut args = vec!["render", &s, "-o", &pattern];
+            args.extend(frames);
+            args.extend(extra);
+            let (o, _) = mpirun(ranks, &args, &[]);
+            assert!(o.status.success(), "-np {ranks}: {}", stderr(&o));
+            assert!(files(&out) == want, "-np {ranks}: the frames differ");
+        }
+        // At frame 1 the camera's `up` passes through zero length.
+        let studio = root().join("scenes/include/studio.ron");
+        let text = std::fs::read_to_string(&s)
+            .unwrap()
+            .replace(
+                "\"include/studio.ron\"",
+                &format!("{:?}", studio.display().to_string()),
+            )
+            .replace(
+                "        camera: (\n",
+                "        camera: (\n            up: (keys: [(0, (0, 1, 0)), (2, (0, -1, 0))]),\n",
+            );
+        let broken = dir.join("broken.ron");
+        std::fs::write(&broken, text).unwrap();
+        let out = dir.join("broken");
+        let pattern = out.join("f%d.ppm").display().to_string();
+        let b = broken.display().to_string();
+        let args = [
+            "render", &b, "--frames", "0..2", "--res", "24x18", "-o", &pattern,
+        ];
+        let (o, _) = mpirun(2, &args, &[]);
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("frames failed (1)"), "{}", stderr(&o));
+        let names: Vec<String> = files(&out).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(names, ["f0.ppm", "f2.ppm"]);
+    }
 }

@@ -229,6 +229,16 @@ impl Budget {
         })
     }
 
+    /// A guard over `n` bytes already [`reserve`](Self::reserve)d for `kind` (by
+    /// [`grow`](Self::grow), say), which gives them back when it drops.
+    pub fn guard(self: &Arc<Self>, kind: Use, n: u64) -> Charge {
+        Charge {
+            budget: self.clone(),
+            kind,
+            bytes: n,
+        }
+    }
+
     /// The error for an allocation of `n` bytes the system refused.
     pub fn refused(&self, n: u64, what: &str) -> BudgetError {
         let budget = match self.limit() {

@@ -40,6 +40,7 @@
 //! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks; PPM bytes; image error measures; files written whole |
 //! | ray | [`ray`] | rays and robust ray spawning |
 //! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
+//! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |
 //! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
 
 // Unsafe code only in the modules that allow it by name below (each block says why it is sound).
@@ -63,6 +64,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod math;
 pub mod metrics;
+pub mod motion;
 pub mod output;
 // Every call across the plugin ABI.
 #[allow(unsafe_code)]

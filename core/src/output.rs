@@ -10,6 +10,7 @@ use luxon_formats::OutputDesc;
 use std::path::{Path, PathBuf};
 
 pub mod commit;
+pub mod frames;
 pub mod stream;
 
 pub use commit::OutputSet;

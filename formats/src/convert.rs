@@ -28,6 +28,12 @@ pub(crate) struct Part {
     pub render: Option<RenderDesc>,
     pub outputs: Vec<OutputDesc>,
     pub plugin_path: Vec<PathBuf>,
+    pub animation: Option<Spanned<AnimationDesc>>,
+    /// The named lights and objects (index within this part's list).
+    pub light_names: Vec<(usize, Spanned<String>)>,
+    pub object_names: Vec<(usize, Spanned<String>)>,
+    /// Where this part's `render` gives `frame` or `time` (which an animation decides).
+    pub render_clock: Option<Origin>,
 }
 
 /// A mesh file named by a scene: the path resolved against that scene file, at the `file`
@@ -72,6 +78,16 @@ impl Checker<'_> {
         if let Some(ao) = scene.ambient_occlusion {
             part.ambient_occlusion = Some(self.ao(ao, field("ambient_occlusion"))?);
         }
+        part.light_names = self.item_names(
+            field("lights"),
+            scene.lights.iter().map(raw::Light::name),
+            "light",
+        )?;
+        part.object_names = self.item_names(
+            field("objects"),
+            scene.objects.iter().map(|o| o.name.as_deref()),
+            "object",
+        )?;
         for (i, light) in scene.lights.into_iter().enumerate() {
             let node = field("lights").item(i).unwrap_or(root);
             part.lights.push(self.light(light, node)?);
@@ -158,7 +174,16 @@ impl Checker<'_> {
                 material,
             });
         }
+        if let Some(a) = scene.animation {
+            let at = field("animation");
+            part.animation = Some(self.spanned(self.animation(a, at)?, at));
+        }
         if let Some(render) = scene.render {
+            part.render_clock = ["frame", "time"]
+                .into_iter()
+                .zip([render.frame.is_some(), render.time.is_some()])
+                .find(|(_, given)| *given)
+                .map(|(name, _)| self.origin(field("render").field(name).unwrap_or(root)));
             let (render, outputs) = self.render(render, field("render"), &dir)?;
             part.render = Some(render);
             part.outputs = outputs;

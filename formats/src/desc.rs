@@ -48,6 +48,8 @@ pub struct SceneDesc {
     /// Problems that did not stop the load (an OBJ's missing material library, an NFF sphere
     /// with a negative radius...), in the order found. The CLI prints them.
     pub warnings: Vec<Warning>,
+    /// The `animation:` block (RON scenes only); `None`: a still scene.
+    pub animation: Option<Spanned<AnimationDesc>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -784,4 +786,146 @@ pub enum OutputIo {
     /// Every MPI rank writes its own pixels of 8-bit PPM outputs (`MPI_File_write_at_all`);
     /// other outputs, and runs without MPI, as `Async`.
     MpiIo,
+}
+
+/// A scene's time: which frames it has and how keyed values change from frame to frame. Time is
+/// counted in frames (keys may sit at fractional frames); `fps` only converts to seconds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnimationDesc {
+    /// The first and last frame, inclusive (`first <= last`).
+    pub first: u32,
+    pub last: u32,
+    /// Frames per second (> 0).
+    pub fps: f64,
+    /// The shutter, in frames; `None`: none given (no motion blur).
+    pub shutter: Option<Spanned<ShutterDesc>>,
+    pub camera: CameraTracks,
+    /// Keyed lights, at most one entry per light.
+    pub lights: Vec<LightTracks>,
+    /// Keyed materials, at most one entry per material.
+    pub materials: Vec<MaterialTracks>,
+    /// Keyed objects (by their `name`), at most one entry per object.
+    pub objects: Vec<ObjectTracks>,
+}
+
+/// How long the shutter stays open (in frames, from 0 to 2) and where that interval sits
+/// around the frame's time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShutterDesc {
+    pub length: f64,
+    pub at: ShutterAt,
+}
+
+impl ShutterDesc {
+    /// (open, close) relative to the frame's time, in frames.
+    pub fn interval(&self) -> (f64, f64) {
+        let l = self.length;
+        match self.at {
+            ShutterAt::Start => (0.0, l),
+            ShutterAt::Centre => (-0.5 * l, 0.5 * l),
+            ShutterAt::End => (-l, 0.0),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShutterAt {
+    Start,
+    Centre,
+    End,
+}
+
+/// How a track moves between its keys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Interpolate {
+    /// Straight from key to key (rotations: slerp along the shorter arc).
+    #[default]
+    Linear,
+    /// The smooth curve through every key (non-uniform Catmull-Rom in the key times).
+    CatmullRom,
+}
+
+/// A value at a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Key<T> {
+    pub frame: f64,
+    pub value: T,
+    /// Where the key is written.
+    pub at: Origin,
+}
+
+/// Keys in strictly increasing frame order (at least one). Before the first key and after the
+/// last the value holds; one key is a constant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Track<T> {
+    pub keys: Vec<Key<T>>,
+    pub interpolation: Interpolate,
+    /// Where the track is written.
+    pub at: Origin,
+}
+
+/// A rotation by `degrees` about `axis` (unit length), counter-clockwise looking down the axis
+/// (right-handed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RotationDesc {
+    pub axis: [f64; 3],
+    pub degrees: f64,
+}
+
+/// The camera's keyed values; each replaces the camera's own value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CameraTracks {
+    pub position: Option<Track<[f64; 3]>>,
+    pub look_at: Option<Track<[f64; 3]>>,
+    pub up: Option<Track<[f64; 3]>>,
+    /// Vertical field of view in degrees (a perspective camera given by `fov`).
+    pub fov: Option<Track<f64>>,
+    /// The sharp distance of the camera's `depth_of_field`.
+    pub focal_distance: Option<Track<f64>>,
+}
+
+impl CameraTracks {
+    pub fn is_empty(&self) -> bool {
+        self.position.is_none()
+            && self.look_at.is_none()
+            && self.up.is_none()
+            && self.fov.is_none()
+            && self.focal_distance.is_none()
+    }
+}
+
+/// A light's keyed values. `position` is a point or spot light's position, a sphere light's
+/// centre or a rectangle light's corner; `direction` a directional or spot light's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightTracks {
+    /// Index in `SceneDesc::lights`.
+    pub light: usize,
+    /// The light's `name`, where the animation names it.
+    pub name: Spanned<String>,
+    pub position: Option<Track<[f64; 3]>>,
+    pub direction: Option<Track<[f64; 3]>>,
+    pub intensity: Option<Track<f64>>,
+    pub color: Option<Track<[f64; 3]>>,
+}
+
+/// A material's keyed colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialTracks {
+    /// The material's name, where the animation names it.
+    pub material: Spanned<String>,
+    pub color: Option<Track<[f64; 3]>>,
+}
+
+/// A named object's keyed transform: `world_from_object = translate · rotate · scale` (scaled
+/// first, then rotated, then moved), applied to the coordinates its plugin gives. A missing
+/// track is the identity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectTracks {
+    /// Index in `SceneDesc::objects`.
+    pub object: usize,
+    /// The object's `name`, where the animation names it.
+    pub name: Spanned<String>,
+    pub translate: Option<Track<[f64; 3]>>,
+    pub rotate: Option<Track<RotationDesc>>,
+    pub scale: Option<Track<[f64; 3]>>,
 }

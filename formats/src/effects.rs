@@ -21,6 +21,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => LightDesc::Point {
                 position,
                 color: f.colour(color)?,
@@ -33,6 +34,7 @@ impl Checker<'_> {
                 color,
                 intensity,
                 shadows,
+                ..
             } => LightDesc::Directional {
                 direction: f.direction("direction", direction)?,
                 color: f.colour(color)?,
@@ -49,6 +51,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => {
                 let cone =
                     self.range(f.field("angle"), "angle", angle, f64::MIN_POSITIVE, 179.0)?;
@@ -79,6 +82,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => LightDesc::Sphere {
                 center,
                 radius: self.positive(f.field("radius"), "radius", radius)?,
@@ -97,6 +101,7 @@ impl Checker<'_> {
                 intensity,
                 shadows,
                 attenuation,
+                ..
             } => {
                 let (edge1, edge2) = f.rectangle(edge1, edge2)?;
                 LightDesc::Rect {

@@ -7,7 +7,7 @@
 //!   Lists (lights, objects, volumes, meshes, plugin paths) are concatenated; named maps
 //!   (textures, materials, clip groups) let a later definition replace an earlier one of the
 //!   same name in its place; single settings (camera, background, fog, ambient occlusion,
-//!   render) are taken from the last file that gives them. Outputs belong to the file that
+//!   render, animation) are taken from the last file that gives them. Outputs belong to the file that
 //!   renders: an including file that names any replaces those of its includes.
 //! - **Each file is merged once per load** (like `#pragma once`), where it is first reached.
 //!   Includes have no parameters or transforms, so a second copy would only double lights
@@ -25,6 +25,7 @@ use std::path::{Path, PathBuf};
 use luxon_plugin::files::bytes;
 use ron::extensions::Extensions;
 
+use crate::animation::ItemNames;
 use crate::convert::Part;
 use crate::desc::Origin;
 use crate::error::{SceneError, Warning};
@@ -254,7 +255,16 @@ impl Accumulator {
         }
         if later.render.is_some() {
             part.render = later.render;
+            part.render_clock = later.render_clock;
         }
+        if later.animation.is_some() {
+            part.animation = later.animation;
+        }
+        // Names follow their lights and objects to their places in the merged lists.
+        let (lights, objects) = (part.lights.len(), part.objects.len());
+        let shift = |names: ItemNames, by: usize| names.into_iter().map(move |(i, n)| (i + by, n));
+        part.light_names.extend(shift(later.light_names, lights));
+        part.object_names.extend(shift(later.object_names, objects));
         part.lights.extend(later.lights);
         part.objects.extend(later.objects);
         part.volumes.extend(later.volumes);

@@ -11,13 +11,13 @@
 //! | layer       | modules                                          |
 //! |-------------|--------------------------------------------------|
 //! | origin      | `origin`                                         |
-//! | leaves      | `error`, `geometry`, `spans`, `raw`              |
+//! | leaves      | `error`, `geometry`, `spans`, `raw`, `pattern`   |
 //! | description | `desc`                                           |
 //! | text        | `ron_text`                                       |
 //! | input       | `input`                                          |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
-//! | conversion  | `convert`, `camera`, `effects`, `volume_render`  |
+//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation` |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
 //! | includes    | `includes`                                       |
 //! | formats     | `ron_scene`, `spd`                               |
@@ -25,6 +25,7 @@
 
 #![forbid(unsafe_code)]
 
+mod animation;
 mod camera;
 mod convert;
 pub mod desc;
@@ -37,6 +38,7 @@ mod load;
 pub mod nff;
 pub mod obj;
 mod origin;
+mod pattern;
 mod raw;
 mod ron_error;
 mod ron_scene;
@@ -54,5 +56,6 @@ pub use geometry::{InlineGeometry, InlineMesh};
 pub use includes::MAX_DEPTH as MAX_INCLUDE_DEPTH;
 pub use input::{DiskSource, LoadOptions, MemorySource, Source};
 pub use load::{load, load_with};
+pub use pattern::FramePattern;
 pub use ron_scene::{load_ron_str, load_ron_with};
 pub use ron_text::{inline_as_objects, to_ron};

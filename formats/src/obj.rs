@@ -678,6 +678,7 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
             height,
             ..RenderDesc::default()
         },
+        animation: None,
         plugin_path: Vec::new(),
         warnings: import.warnings,
     })

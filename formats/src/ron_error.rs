@@ -42,6 +42,23 @@ fn ron_message(code: &ron::Error) -> String {
     };
     use ron::Error as E;
     match code {
+        // The keyed structs of `animation:` list exactly what can be animated.
+        E::NoSuchStructField {
+            expected,
+            found,
+            outer: Some(outer),
+        } if keyed(outer).is_some() => {
+            let whose = keyed(outer).unwrap_or_default();
+            let mut message = format!("{whose} `{}` cannot be animated", printable(found));
+            if let Some(close) = suggest(found, expected.iter().copied()) {
+                message.push_str(&format!("; did you mean `{close}`?"));
+            } else {
+                message.push(';');
+            }
+            let list: Vec<String> = expected.iter().map(|e| format!("`{e}`")).collect();
+            message.push_str(&format!(" expected one of {}", list.join(", ")));
+            message
+        }
         E::NoSuchStructField {
             expected,
             found,
@@ -105,5 +122,16 @@ fn lower_first(s: &str) -> String {
     match chars.next() {
         Some(c) => c.to_lowercase().chain(chars).collect(),
         None => String::new(),
+    }
+}
+
+/// Whose properties a keyed struct of `animation:` holds, for "… cannot be animated".
+fn keyed(outer: &str) -> Option<&'static str> {
+    match outer {
+        "CameraKeys" => Some("the camera's"),
+        "LightKeys" => Some("a light's"),
+        "MaterialKeys" => Some("a material's"),
+        "ObjectKeys" => Some("an object's"),
+        _ => None,
     }
 }

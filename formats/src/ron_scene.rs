@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use crate::animation::resolve_animation;
 use crate::convert::MeshRef;
 use crate::desc::SceneDesc;
 use crate::error::{quoted_list, unknown_name, SceneError};
@@ -53,6 +54,13 @@ fn load_root(
     let mut render = part.render.unwrap_or_default();
     render.outputs = part.outputs;
     let meshes = std::mem::take(&mut part.meshes);
+    if let (Some(_), Some(at)) = (&part.animation, &part.render_clock) {
+        return Err(SceneError::at(
+            at.clone(),
+            "`frame` and `time` cannot be set in a scene with `animation:`; its frames are \
+             chosen by `animation: (frames: ...)` or `--frames`",
+        ));
+    }
     let mut scene = SceneDesc {
         source: path.to_path_buf(),
         camera,
@@ -69,8 +77,10 @@ fn load_root(
         render,
         plugin_path: part.plugin_path,
         warnings: merged.warnings,
+        animation: part.animation,
     };
     references(&scene)?;
+    resolve_animation(&mut scene, &part.light_names, &part.object_names)?;
     add_meshes(&mut scene, meshes)?;
     Ok(scene)
 }

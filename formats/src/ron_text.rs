@@ -14,6 +14,10 @@
 //! keeps it. Plugin parameters are copied as written (the importers write the image maps and
 //! volume files they found as absolute paths).
 //!
+//! An animated scene keeps its `animation:` block, every track with its keys and interpolation;
+//! the lights and objects it keys are written with their `name:` (the description holds no
+//! other names: a name nothing keys changes nothing and is not written).
+//!
 //! The array layout (a few items per line) is shared with the SPD scenes' RON output
 //! (`spd::ron_out`), which writes its numbers as `%g`.
 
@@ -239,7 +243,18 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
         render,
         plugin_path,
         warnings,
+        animation,
     } = desc;
+    let anim = animation.as_ref().map(|a| &a.value);
+    // The names the animation uses, by index in `lights` / `objects`.
+    let light_name = |i: usize| {
+        let keyed = anim.and_then(|a| a.lights.iter().find(|l| l.light == i));
+        keyed.map(|l| l.name.value.as_str())
+    };
+    let object_name = |i: usize| {
+        let keyed = anim.and_then(|a| a.objects.iter().find(|o| o.object == i));
+        keyed.map(|o| o.name.value.as_str())
+    };
     let mut w = Vec::new();
     let _ = writeln!(
         w,
@@ -267,8 +282,8 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     let _ = writeln!(w, "    background: {},", v3(background));
     if !lights.is_empty() {
         w.extend_from_slice(b"    lights: [\n");
-        for l in lights {
-            let _ = writeln!(w, "        {},", light(&l.value));
+        for (i, l) in lights.iter().enumerate() {
+            let _ = writeln!(w, "        {},", light(&l.value, light_name(i)));
         }
         w.extend_from_slice(b"    ],\n");
     }
@@ -357,14 +372,14 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     let all: Vec<Spanned<ObjectDesc>> = objects.iter().cloned().chain(imported).collect();
     if !all.is_empty() {
         w.extend_from_slice(b"    objects: [\n");
-        for o in &all {
+        for (i, o) in all.iter().enumerate() {
             let o = &o.value;
-            let _ = write!(
-                w,
-                "        (plugin: {}, params: {}",
-                string(&o.call.plugin.value),
-                o.call.params
-            );
+            let _ = write!(w, "        (plugin: {}", string(&o.call.plugin.value));
+            // Only the scene's own objects can be named (imported ones come after them).
+            if let Some(name) = object_name(i).filter(|_| i < objects.len()) {
+                let _ = write!(w, ", name: {}", string(name));
+            }
+            let _ = write!(w, ", params: {}", o.call.params);
             if let Some(m) = &o.material {
                 let _ = write!(w, ", material: {}", string(&m.value));
             }
@@ -378,7 +393,11 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
         }
         w.extend_from_slice(b"    ],\n");
     }
-    write_render(&mut w, render, base);
+    if let Some(a) = anim {
+        write_animation(&mut w, a);
+    }
+    // An animated scene's frames set the frame and time: it takes neither.
+    write_render(&mut w, render, base, anim.is_none());
     w.extend_from_slice(b")\n");
     String::from_utf8(w).map_err(|e| e.to_string())
 }
@@ -465,7 +484,20 @@ fn attenuation(a: &Attenuation) -> String {
     v3(&[a.constant, a.linear, a.quadratic])
 }
 
-fn light(l: &LightDesc) -> String {
+/// The light's RON text, with `name` when it has one.
+fn light(l: &LightDesc, name: Option<&str>) -> String {
+    let text = light_fields(l);
+    match name {
+        // "Point(" + "name: ..., " + the fields.
+        Some(n) => match text.split_once('(') {
+            Some((kind, rest)) => format!("{kind}(name: {}, {rest}", string(n)),
+            None => text,
+        },
+        None => text,
+    }
+}
+
+fn light_fields(l: &LightDesc) -> String {
     match l {
         LightDesc::Point {
             position,
@@ -710,7 +742,148 @@ fn volume(v: &VolumeDescEntry) -> String {
     s + ")"
 }
 
-fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path) {
+/// `animation: (...)`: the frames, the shutter and every track.
+fn write_animation(w: &mut Vec<u8>, a: &AnimationDesc) {
+    let AnimationDesc {
+        first,
+        last,
+        fps,
+        shutter,
+        camera,
+        lights,
+        materials,
+        objects,
+    } = a;
+    let _ = writeln!(w, "    animation: (");
+    let _ = writeln!(
+        w,
+        "        frames: ({first}, {last}),\n        fps: {},",
+        num(*fps)
+    );
+    if let Some(s) = shutter {
+        let at = match s.value.at {
+            ShutterAt::Start => "Start",
+            ShutterAt::Centre => "Centre",
+            ShutterAt::End => "End",
+        };
+        let length = num(s.value.length);
+        let _ = writeln!(w, "        shutter: (length: {length}, at: {at}),");
+    }
+    let point = |v: &[f64; 3]| v3(v);
+    let scalar = |x: &f64| num(*x);
+    let rotation =
+        |r: &RotationDesc| format!("(axis: {}, degrees: {})", v3(&r.axis), num(r.degrees));
+    let CameraTracks {
+        position,
+        look_at,
+        up,
+        fov,
+        focal_distance,
+    } = camera;
+    let fields = [
+        track("position", position, point, CAMERA),
+        track("look_at", look_at, point, CAMERA),
+        track("up", up, point, CAMERA),
+        track("fov", fov, scalar, CAMERA),
+        track("focal_distance", focal_distance, scalar, CAMERA),
+    ];
+    write_tracks(w, "camera", &fields);
+    let mut entries = Vec::new();
+    for l in lights {
+        let fields = [
+            track("position", &l.position, point, KEYED),
+            track("direction", &l.direction, point, KEYED),
+            track("intensity", &l.intensity, scalar, KEYED),
+            track("color", &l.color, point, KEYED),
+        ];
+        entries.push((&l.name.value, fields.into_iter().flatten().collect()));
+    }
+    write_keyed(w, "lights", entries);
+    let mut entries = Vec::new();
+    for m in materials {
+        let fields = [track("color", &m.color, point, KEYED)];
+        entries.push((&m.material.value, fields.into_iter().flatten().collect()));
+    }
+    write_keyed(w, "materials", entries);
+    let mut entries = Vec::new();
+    for o in objects {
+        let fields = [
+            track("translate", &o.translate, point, KEYED),
+            track("rotate", &o.rotate, rotation, KEYED),
+            track("scale", &o.scale, point, KEYED),
+        ];
+        entries.push((&o.name.value, fields.into_iter().flatten().collect()));
+    }
+    write_keyed(w, "objects", entries);
+    w.extend_from_slice(b"    ),\n");
+}
+
+/// Indentation of the tracks of `camera: (...)` and of `lights: { "name": (...) }`'s entries.
+const CAMERA: &str = "            ";
+const KEYED: &str = "                ";
+
+/// `name: (keys: [(frame, value), ...], interpolation: ...)`, or `None` without the track;
+/// more than three keys go three to a line below the field's line (indented by `indent`).
+fn track<T>(
+    name: &str,
+    t: &Option<Track<T>>,
+    value: impl Fn(&T) -> String,
+    indent: &str,
+) -> Option<String> {
+    let t = t.as_ref()?;
+    let key = |k: &Key<T>| format!("({}, {})", num(k.frame), value(&k.value));
+    let keys = if t.keys.len() <= 3 {
+        let keys: Vec<String> = t.keys.iter().map(key).collect();
+        keys.join(", ")
+    } else {
+        let mut out = Vec::new();
+        let inner = format!("{indent}    ");
+        items(&mut out, t.keys.len(), 3, &inner, |o, i| {
+            o.extend_from_slice(key(&t.keys[i]).as_bytes())
+        });
+        let _ = write!(out, "\n{indent}");
+        String::from_utf8(out).unwrap_or_default()
+    };
+    let interpolation = match t.interpolation {
+        Interpolate::Linear => "Linear",
+        Interpolate::CatmullRom => "CatmullRom",
+    };
+    Some(format!(
+        "{name}: (keys: [{keys}], interpolation: {interpolation})"
+    ))
+}
+
+/// `camera: (...)` of the tracks given, nothing when none is.
+fn write_tracks(w: &mut Vec<u8>, name: &str, fields: &[Option<String>]) {
+    let fields: Vec<&str> = fields.iter().flatten().map(String::as_str).collect();
+    if !fields.is_empty() {
+        let _ = writeln!(
+            w,
+            "        {name}: (\n            {},\n        ),",
+            fields.join(",\n            ")
+        );
+    }
+}
+
+/// `lights: { "name": (tracks...), ... }`, nothing when empty.
+fn write_keyed(w: &mut Vec<u8>, map: &str, entries: Vec<(&String, Vec<String>)>) {
+    if entries.is_empty() {
+        return;
+    }
+    let _ = writeln!(w, "        {map}: {{");
+    for (name, fields) in entries {
+        let _ = writeln!(
+            w,
+            "            {}: (\n                {},\n            ),",
+            string(name),
+            fields.join(",\n                ")
+        );
+    }
+    w.extend_from_slice(b"        },\n");
+}
+
+/// `clock`: whether to write `frame` and `time` (an animated scene takes neither).
+fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
     let RenderDesc {
         width,
         height,
@@ -737,7 +910,9 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path) {
         "        samples: {samples},\n        max_depth: {max_depth},\n        min_weight: {},",
         num(*min_weight)
     );
-    let _ = writeln!(w, "        frame: {frame},\n        time: {},", num(*time));
+    if clock {
+        let _ = writeln!(w, "        frame: {frame},\n        time: {},", num(*time));
+    }
     if !outputs.is_empty() {
         w.extend_from_slice(b"        outputs: [\n");
         for o in outputs {

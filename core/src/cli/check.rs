@@ -54,6 +54,18 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
         scene.discs.len(),
         scene.customs.len()
     );
+    if let Some(a) = &scene.animation {
+        let m = &scene.moving;
+        println!(
+            "keyed      {} spheres, {} triangles, {} planes, {} cones, {} discs (at frame {})",
+            m.spheres.len(),
+            m.triangles.len(),
+            m.planes.planes.len(),
+            m.cones.len(),
+            m.discs.len(),
+            a.frame()
+        );
+    }
     if scene.degenerate_triangles > 0 {
         println!(
             "           ({} zero-area triangles dropped)",
@@ -94,6 +106,9 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
             }
         );
     }
+    if let Some(a) = &scene.animation {
+        println!("animation  {}", animation(a.desc()));
+    }
     println!("lights     {}", scene.lights.len());
     println!("materials  {}", scene.material_names.join(", "));
     println!(
@@ -120,6 +135,85 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
             o.writer.name
         );
     }
+}
+
+/// One line about an animation: its frames, its shutter and what is keyed.
+fn animation(a: &luxon_formats::AnimationDesc) -> String {
+    use luxon_formats::{Interpolate, Track};
+    fn track<T>(name: &str, t: &Option<Track<T>>) -> Option<String> {
+        let t = t.as_ref()?;
+        let how = match t.interpolation {
+            Interpolate::Linear => "Linear",
+            Interpolate::CatmullRom => "CatmullRom",
+        };
+        let n = t.keys.len();
+        let s = if n == 1 { "" } else { "s" };
+        Some(format!("{name} ({how}, {n} key{s})"))
+    }
+    let frames = a.last - a.first + 1;
+    let mut line = format!(
+        "frames {}..{} at {} fps ({} frames, {:.2} s)",
+        a.first,
+        a.last,
+        a.fps,
+        frames,
+        f64::from(frames) / a.fps
+    );
+    if let Some(s) = &a.shutter {
+        line.push_str(&format!(
+            ", shutter {} frame {:?}",
+            s.value.length, s.value.at
+        ));
+    }
+    let c = &a.camera;
+    let camera: Vec<String> = [
+        track("position", &c.position),
+        track("look_at", &c.look_at),
+        track("up", &c.up),
+        track("fov", &c.fov),
+        track("focal_distance", &c.focal_distance),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let mut keyed = Vec::new();
+    if !camera.is_empty() {
+        keyed.push(format!("camera {}", camera.join(", ")));
+    }
+    for l in &a.lights {
+        let p: Vec<String> = [
+            track("position", &l.position),
+            track("direction", &l.direction),
+            track("intensity", &l.intensity),
+            track("color", &l.color),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        keyed.push(format!("light `{}` {}", l.name.value, p.join(", ")));
+    }
+    for m in &a.materials {
+        if let Some(c) = track("color", &m.color) {
+            keyed.push(format!("material `{}` {c}", m.material.value));
+        }
+    }
+    for o in &a.objects {
+        let p: Vec<String> = [
+            track("translate", &o.translate),
+            track("rotate", &o.rotate),
+            track("scale", &o.scale),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        keyed.push(format!("object `{}` {}", o.name.value, p.join(", ")));
+    }
+    if keyed.is_empty() {
+        line.push_str("; nothing keyed");
+    } else {
+        line.push_str(&format!("; keyed: {}", keyed.join("; ")));
+    }
+    line
 }
 
 /// "bricks: 1200 u8, 40 constant": the stored bricks by kind (at the precision the reader

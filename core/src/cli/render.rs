@@ -73,6 +73,13 @@ pub struct Overrides {
     pub io: Option<String>,
     #[command(flatten)]
     pub shading: super::shading::ShadingArgs,
+    /// Frames of an animated scene to render, A to B inclusive (or one frame K); default:
+    /// the scene's `animation: (frames: ...)`.
+    #[arg(long, value_name = "A..B|K", value_parser = super::sequence::parse_frames)]
+    pub frames: Option<(u32, u32)>,
+    /// Render every Nth frame from the first (with an animated scene).
+    #[arg(long, value_name = "N")]
+    pub step: Option<u32>,
 }
 
 fn parse_adaptive(s: &str) -> Result<AdaptiveArg, String> {
@@ -91,7 +98,7 @@ pub fn cli_origin(what: &str) -> Origin {
 const CACHE_MIN_PRIMITIVES: usize = 100_000;
 
 /// Loads the scene; `skeleton`: the non-geometry lines of an NFF file from its geometry cache.
-fn load(path: &Path, o: &Overrides, skeleton: Option<&str>) -> Result<SceneDesc, Error> {
+pub(super) fn load(path: &Path, o: &Overrides, skeleton: Option<&str>) -> Result<SceneDesc, Error> {
     let mut desc = match skeleton {
         Some(text) => luxon_formats::nff::parse_str(text, path)?.desc,
         None => luxon_formats::load(path)?,
@@ -166,7 +173,7 @@ fn load(path: &Path, o: &Overrides, skeleton: Option<&str>) -> Result<SceneDesc,
 
 /// How rank 0 writes: outputs split between its writer (async or after the render) and MPI-IO,
 /// each with its index in the output set.
-struct Plan<'r> {
+pub(super) struct Plan<'r> {
     written_by_root: Vec<(usize, Output<'r>)>,
     concurrent: Vec<(usize, Output<'r>)>,
     /// Rank 0: every output's temporary file, created before anything is built or rendered (so
@@ -175,7 +182,7 @@ struct Plan<'r> {
     streams: Option<AsyncOutput<'r>>,
 }
 
-fn plan<'r>(
+pub(super) fn plan<'r>(
     r: &RenderDesc,
     outputs: Vec<Output<'r>>,
     job: &Job,
@@ -230,6 +237,10 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         }
     }
     let load_time = t0.elapsed();
+    let animated = desc.as_ref().is_ok_and(|d| d.animation.is_some());
+    if animated || o.frames.is_some() || o.step.is_some() {
+        return super::sequence::run(o, desc, &registry, job);
+    }
     let ready = desc.and_then(|desc| prepare(path, o, desc, cached, &registry, &job, &mut cache));
     let (ready, status) = match ready {
         Ok(r) => {
@@ -246,46 +257,15 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let Some((desc, scene, plan)) = ready else {
         return Err(Error::Render("not ready to render".into()));
     };
-    let s = &scene.settings;
     let scene_dir = desc.source.parent().unwrap_or(Path::new("."));
-    let Plan {
-        written_by_root,
-        concurrent,
-        files,
-        streams,
-    } = plan;
-    let gather = !written_by_root.is_empty();
-    let keep = !concurrent.is_empty();
-    let shares = Shares {
-        threads: &threads,
-        gather,
-        keep,
-    };
-    let r = render(&scene, &job, &shares, streams, &registry, scene_dir)?;
-
-    let t_write = Instant::now();
-    // Rank 0's output files: kept here, or back from the stream writer.
-    let files = files.or(r.files);
-    for (i, _) in &concurrent {
-        if let Some(f) = &files {
-            f.unlock(*i);
-        }
-        let tmp = files.as_ref().map(|f| f.temp_path(*i));
-        job.write_concurrent(tmp, s.width, s.height, &r.kept)?;
-    }
-    if job.rank() != 0 {
+    let Some(image) = write_image(&scene, plan, &job, &threads, &registry, scene_dir)? else {
         return Ok(());
-    }
-    let mut files = files.ok_or_else(|| Error::Render("the output files are missing".into()))?;
-    if let Some(fb) = r.sync_fb {
-        for (i, o) in &written_by_root {
-            files.encode(*i, o, &fb, &registry, scene_dir)?;
-        }
-    }
-    // The commit point: every output complete, all renamed together.
-    let written = files.commit()?;
-    let write_time = r.tail + t_write.elapsed();
-    let stats = RenderStats::of(r.ranks, r.render_time);
+    };
+    let Image {
+        written,
+        stats,
+        write_time,
+    } = image;
     let total = t0.elapsed();
     // After the image: writing the cache delays no picture.
     let cache_written = cache.write_after(path, &scene);
@@ -299,13 +279,81 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     if let Some(p) = cache_written {
         eprintln!("luxon: wrote geometry cache {}", p.display());
     }
+    warn_nan(&stats);
+    Ok(())
+}
+
+/// What rank 0 has after writing an image.
+pub(super) struct Image {
+    pub written: Vec<PathBuf>,
+    pub stats: RenderStats,
+    pub write_time: Duration,
+}
+
+/// Warns when pixels came out NaN or infinite.
+pub(super) fn warn_nan(stats: &RenderStats) {
     if stats.counters.nan_pixels > 0 {
         luxon::error::print_warning(&format!(
             "{} pixel(s) came out NaN or infinite and were set to black",
             stats.counters.nan_pixels
         ));
     }
-    Ok(())
+}
+
+/// Renders `scene` on every rank and writes its outputs as `plan` says, all or none; rank 0
+/// gets what it wrote, the other ranks `None`.
+pub(super) fn write_image(
+    scene: &Scene,
+    plan: Plan,
+    job: &Job,
+    threads: &[usize],
+    registry: &Registry,
+    scene_dir: &Path,
+) -> Result<Option<Image>, Error> {
+    let s = &scene.settings;
+    let Plan {
+        written_by_root,
+        concurrent,
+        files,
+        streams,
+    } = plan;
+    let gather = !written_by_root.is_empty();
+    let keep = !concurrent.is_empty();
+    let shares = Shares {
+        threads,
+        gather,
+        keep,
+    };
+    let r = render(scene, job, &shares, streams, registry, scene_dir)?;
+
+    let t_write = Instant::now();
+    // Rank 0's output files: kept here, or back from the stream writer.
+    let files = files.or(r.files);
+    for (i, _) in &concurrent {
+        if let Some(f) = &files {
+            f.unlock(*i);
+        }
+        let tmp = files.as_ref().map(|f| f.temp_path(*i));
+        job.write_concurrent(tmp, s.width, s.height, &r.kept)?;
+    }
+    if job.rank() != 0 {
+        return Ok(None);
+    }
+    let mut files = files.ok_or_else(|| Error::Render("the output files are missing".into()))?;
+    if let Some(fb) = r.sync_fb {
+        for (i, o) in &written_by_root {
+            files.encode(*i, o, &fb, registry, scene_dir)?;
+        }
+    }
+    // The commit point: every output complete, all renamed together.
+    let written = files.commit()?;
+    let write_time = r.tail + t_write.elapsed();
+    let stats = RenderStats::of(r.ranks, r.render_time);
+    Ok(Some(Image {
+        written,
+        stats,
+        write_time,
+    }))
 }
 
 /// The geometry cache of an NFF scene during one render: whether it is used, what became of it
@@ -500,7 +548,7 @@ fn render(
     })
 }
 
-fn print_stats(
+pub(super) fn print_stats(
     scene: &Scene,
     job: &Job,
     s: &RenderStats,

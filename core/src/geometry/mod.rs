@@ -6,6 +6,7 @@ pub mod cone;
 #[allow(unsafe_code)]
 pub mod custom;
 pub mod disc;
+pub mod group;
 pub mod plane;
 pub mod set;
 pub mod sphere;
@@ -70,6 +71,8 @@ impl Clips {
 pub struct Hit {
     pub t: f32,
     pub kind: Kind,
+    /// On a keyed object (in the scene's moving group) rather than in the still geometry.
+    pub moving: bool,
     /// The primitive within its kind (64-bit: molecular scenes reach billions of atoms).
     pub index: u64,
     pub b1: f32,
@@ -83,6 +86,7 @@ impl Hit {
         Hit {
             t,
             kind,
+            moving: false,
             index: index as u64,
             b1: 0.0,
             b2: 0.0,

@@ -3,7 +3,7 @@
 
 use super::calls::{call_context, call_plugin, checked_len, fail, slice, wrong_kind};
 use super::registry::{Entry, PluginKind, Registry, Table};
-use crate::budget::Budget;
+use crate::budget::{Budget, Use};
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::{CustomObject, Customs};
 use crate::geometry::disc::Discs;
@@ -31,7 +31,10 @@ pub struct GeometryBuilder<'a> {
     pub plugin: String,
     /// Degenerate triangles dropped.
     pub dropped: u64,
-    /// Charged for what is stored, before it is stored.
+    /// When set, the geometry is recorded here as the plugin gives it instead of stored in the
+    /// sets (an object that moves is stored anew for every frame, see `scene::frame`).
+    pub record: Option<&'a mut Recorded>,
+    /// Charged for what is stored (or recorded), before it is stored.
     pub budget: &'a Budget,
     /// The object, for messages: "object 3 (plugin `mesh`, scene.ron:20:9)".
     pub object: String,
@@ -43,6 +46,84 @@ impl GeometryBuilder<'_> {
         let object = self.object.clone();
         let kind = kind.to_string();
         move || format!("{object}: {n} {kind}")
+    }
+}
+
+/// A plugin's geometry exactly as it gave it (f64 world coordinates), in the order it gave it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Recorded {
+    pub spheres: Vec<[f64; 4]>,
+    pub planes: Vec<[f64; 6]>,
+    pub cones: Vec<[f64; 8]>,
+    pub discs: Vec<[f64; 8]>,
+    pub meshes: Vec<RecordedMesh>,
+}
+
+impl Recorded {
+    /// Bytes held (capacities), what recording charged to the budget.
+    pub fn bytes(&self) -> u64 {
+        held(&self.spheres)
+            + held(&self.planes)
+            + held(&self.cones)
+            + held(&self.discs)
+            + held(&self.meshes)
+            + self.meshes.iter().map(RecordedMesh::bytes).sum::<u64>()
+    }
+}
+
+/// Bytes of `v`'s capacity.
+fn held<T>(v: &Vec<T>) -> u64 {
+    (v.capacity() * std::mem::size_of::<T>()) as u64
+}
+
+/// A mesh's arrays as [`MeshInput`] takes them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RecordedMesh {
+    pub positions: Vec<f64>,
+    pub indices: Vec<u64>,
+    pub normals: Vec<f64>,
+    pub colors: Vec<f32>,
+    pub uvs: Vec<f32>,
+}
+
+impl RecordedMesh {
+    /// Copies `m`, charging its arrays to `budget` before they are allocated.
+    fn record(m: &MeshInput, budget: &Budget, what: &dyn Fn() -> String) -> Result<Self, String> {
+        fn copy<T: Copy>(
+            src: &[T],
+            budget: &Budget,
+            what: &dyn Fn() -> String,
+        ) -> Result<Vec<T>, String> {
+            let mut v = Vec::new();
+            budget.grow(&mut v, src.len(), Use::Geometry, what)?;
+            v.extend_from_slice(src);
+            Ok(v)
+        }
+        Ok(RecordedMesh {
+            positions: copy(m.positions, budget, what)?,
+            indices: copy(m.indices, budget, what)?,
+            normals: copy(m.normals, budget, what)?,
+            colors: copy(m.colors, budget, what)?,
+            uvs: copy(m.uvs, budget, what)?,
+        })
+    }
+
+    fn bytes(&self) -> u64 {
+        held(&self.positions)
+            + held(&self.indices)
+            + held(&self.normals)
+            + held(&self.colors)
+            + held(&self.uvs)
+    }
+
+    pub fn input(&self) -> MeshInput<'_> {
+        MeshInput {
+            positions: &self.positions,
+            indices: &self.indices,
+            normals: &self.normals,
+            colors: &self.colors,
+            uvs: &self.uvs,
+        }
     }
 }
 
@@ -112,7 +193,10 @@ unsafe extern "C" fn add_spheres(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        let reserve: Reserve = |b, n, what| b.spheres.reserve(n, b.budget, what);
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.spheres, n, Use::Geometry, what)?),
+            None => b.spheres.reserve(n, b.budget, what),
+        };
         add_batch(
             ctx,
             data,
@@ -120,7 +204,13 @@ unsafe extern "C" fn add_spheres(
             err,
             "sphere",
             reserve,
-            |b, i, r: [f64; 4]| b.spheres.push_world(i, r, b.world_offset, b.material),
+            |b, i, r: [f64; 4]| match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.spheres.push(r);
+                    Ok(())
+                }
+                None => b.spheres.push_world(i, r, b.world_offset, b.material),
+            },
         )
     }
 }
@@ -135,7 +225,10 @@ unsafe extern "C" fn add_planes(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        let reserve: Reserve = |b, n, what| b.planes.reserve(n, b.budget, what);
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.planes, n, Use::Geometry, what)?),
+            None => b.planes.reserve(n, b.budget, what),
+        };
         add_batch(
             ctx,
             data,
@@ -143,7 +236,13 @@ unsafe extern "C" fn add_planes(
             err,
             "plane",
             reserve,
-            |b, i, r: [f64; 6]| b.planes.push_world(i, r, b.world_offset, b.material),
+            |b, i, r: [f64; 6]| match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.planes.push(r);
+                    Ok(())
+                }
+                None => b.planes.push_world(i, r, b.world_offset, b.material),
+            },
         )
     }
 }
@@ -158,7 +257,10 @@ unsafe extern "C" fn add_cones(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        let reserve: Reserve = |b, n, what| b.cones.reserve(n, b.budget, what);
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.cones, n, Use::Geometry, what)?),
+            None => b.cones.reserve(n, b.budget, what),
+        };
         add_batch(
             ctx,
             data,
@@ -166,7 +268,13 @@ unsafe extern "C" fn add_cones(
             err,
             "cone",
             reserve,
-            |b, i, r: [f64; 8]| b.cones.push_world(i, r, b.world_offset, b.material),
+            |b, i, r: [f64; 8]| match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.cones.push(r);
+                    Ok(())
+                }
+                None => b.cones.push_world(i, r, b.world_offset, b.material),
+            },
         )
     }
 }
@@ -181,7 +289,10 @@ unsafe extern "C" fn add_discs(
 ) -> abi::Status {
     // SAFETY: the caller keeps the ABI contract (see the comment above `guard`).
     unsafe {
-        let reserve: Reserve = |b, n, what| b.discs.reserve(n, b.budget, what);
+        let reserve: Reserve = |b, n, what| match b.record.as_deref_mut() {
+            Some(rec) => Ok(b.budget.grow(&mut rec.discs, n, Use::Geometry, what)?),
+            None => b.discs.reserve(n, b.budget, what),
+        };
         add_batch(
             ctx,
             data,
@@ -189,7 +300,13 @@ unsafe extern "C" fn add_discs(
             err,
             "disc",
             reserve,
-            |b, i, r: [f64; 8]| b.discs.push_world(i, r, b.world_offset, b.material),
+            |b, i, r: [f64; 8]| match b.record.as_deref_mut() {
+                Some(rec) => {
+                    rec.discs.push(r);
+                    Ok(())
+                }
+                None => b.discs.push_world(i, r, b.world_offset, b.material),
+            },
         )
     }
 }
@@ -217,9 +334,16 @@ unsafe extern "C" fn add_mesh(
                 uvs: slice(m.uvs, optional(m.uvs.is_null(), 2)),
             }
         };
-        let attrs = !(input.normals.is_empty() && input.colors.is_empty() && input.uvs.is_empty());
         let triangles = input.indices.len() / 3;
         let describe = b.describe(triangles, "triangles");
+        if let Some(rec) = b.record.as_deref_mut() {
+            b.budget
+                .grow(&mut rec.meshes, 1, Use::Geometry, &describe)?;
+            rec.meshes
+                .push(RecordedMesh::record(&input, b.budget, &describe)?);
+            return Ok(());
+        }
+        let attrs = !(input.normals.is_empty() && input.colors.is_empty() && input.uvs.is_empty());
         b.triangles
             .reserve_mesh(triangles, nv, attrs, b.budget, &describe)?;
         b.dropped += b.triangles.push_mesh(&input, b.world_offset, b.material)?;
@@ -247,6 +371,13 @@ unsafe extern "C" fn add_custom(
         // Own it first so it is destroyed even if we reject it.
         // SAFETY: the plugin hands over `object`, which `vtable` serves (ABI contract).
         let object = unsafe { CustomObject::new(g.object, vtable, b.plugin.clone(), g.count) };
+        if b.record.is_some() {
+            return Err(
+                "custom geometry (drawn by its plugin) cannot be moved by animation keys; \
+                 Luxon moves spheres, planes, cones, discs and meshes"
+                    .into(),
+            );
+        }
         if g.count > u32::MAX as u64 {
             return Err(format!(
                 "custom geometry with {} primitives is too large",

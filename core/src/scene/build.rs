@@ -1,8 +1,11 @@
 //! Building a [`Scene`] from its description, in the stages [`Scene::build_from`] runs in order:
 //! textures, volumes, materials, clip groups, render volumes, objects (plugins, then imported
 //! geometry, then a cache's prebuilt geometry), BVHs, lights, and the effects the scene calls
-//! for. A new kind of scene content gets a stage of its own here.
+//! for; an animated scene then goes to its first frame (keyed objects are recorded by the
+//! objects stage, not stored, see `frame`). A new kind of scene content gets a stage of its own
+//! here.
 
+use super::frame::{self, Animation, Keyed};
 use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
@@ -16,7 +19,7 @@ use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::{MeshInput, Triangles};
 use crate::geometry::{pack, Clips, MAX_CLIP_GROUPS, MAX_MATERIALS};
 use crate::math::{DVec3, Vec3A};
-use crate::plugin::primitive::{create_primitive, GeometryBuilder};
+use crate::plugin::primitive::{create_primitive, GeometryBuilder, Recorded};
 use crate::plugin::texture::{create_texture, TextureInstance};
 use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
@@ -113,7 +116,7 @@ impl Scene {
         let Palette {
             materials,
             names: material_names,
-            ..
+            shadowless: shadowless_copies,
         } = palette;
         let native_built = prebuilt.is_some();
         if let Some(p) = prebuilt {
@@ -142,7 +145,8 @@ impl Scene {
         );
         let r = &desc.render;
         let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
-        Ok(Scene {
+        let keyed = std::mem::take(&mut stored.keyed);
+        let mut scene = Scene {
             source: desc.source.clone(),
             camera: camera.clone(),
             primary_width: camera.footprint().0,
@@ -173,14 +177,23 @@ impl Scene {
             degenerate_triangles: stored.dropped,
             bvh_time,
             plugin_time,
+            moving: Default::default(),
+            animation: None,
             budget: b.budget,
-        })
+        };
+        if let Some(a) = &desc.animation {
+            // An animated scene starts at its first frame.
+            let animation = Animation::new(desc, &scene.material_names, &shadowless_copies, keyed)?;
+            scene.animation = Some(Box::new(animation));
+            scene.set_frame(a.value.first)?;
+        }
+        Ok(scene)
     }
 }
 
 /// What every stage reads: the description, the plugins, where relative paths start, and the
 /// world position of render space's origin (the camera).
-struct Build<'a> {
+pub(super) struct Build<'a> {
     desc: &'a SceneDesc,
     registry: &'a Registry,
     scene_dir: PathBuf,
@@ -228,6 +241,8 @@ struct Stored {
     object_counts: Vec<(String, usize)>,
     /// Degenerate triangles dropped.
     dropped: u64,
+    /// The keyed objects' geometry, recorded to be placed at each frame.
+    keyed: Vec<Keyed>,
 }
 
 impl<'a> Build<'a> {
@@ -241,7 +256,7 @@ impl<'a> Build<'a> {
                 .parent()
                 .map(Path::to_path_buf)
                 .unwrap_or_default(),
-            world_offset: DVec3::from(desc.camera.value.position),
+            world_offset: frame::world_offset(desc),
         }
     }
 
@@ -439,6 +454,11 @@ impl<'a> Build<'a> {
             let material = palette.index(&obj.value.material, obj.value.shadows)?;
             stored.used[material] = true;
             let clip = self.clip_group(&obj.value.clip)?;
+            let keyed = self.desc.animation.as_ref().and_then(|a| {
+                let objects = &a.value.objects;
+                objects.iter().find(|o| o.object == i)
+            });
+            let mut recorded = Recorded::default();
             let mut b = GeometryBuilder {
                 spheres: &mut stored.spheres,
                 triangles: &mut stored.triangles,
@@ -450,6 +470,7 @@ impl<'a> Build<'a> {
                 world_offset: self.world_offset,
                 plugin: entry.name.clone(),
                 dropped: 0,
+                record: keyed.map(|_| &mut recorded),
                 budget: &self.budget,
                 object: format!("object {i} (plugin `{}`, {})", entry.name, obj.at),
             };
@@ -464,6 +485,14 @@ impl<'a> Build<'a> {
             )
             .map_err(|(at, m)| Error::at(&at, m))?;
             stored.dropped += b.dropped;
+            if let Some(tracks) = keyed {
+                stored.keyed.push(Keyed {
+                    tracks: tracks.clone(),
+                    geometry: recorded,
+                    material: pack(material as u32, clip),
+                    at: obj.at.clone(),
+                });
+            }
             match stored
                 .object_counts
                 .iter_mut()
@@ -539,16 +568,27 @@ impl<'a> Build<'a> {
 
     /// Stage: the lights, in render space.
     fn lights(&self) -> Vec<Light> {
-        // Every light's colour carries the render's light scale.
-        let scale = self.desc.render.light_scale;
+        Build::lights_from(
+            &self.desc.lights,
+            self.world_offset,
+            self.desc.render.light_scale,
+        )
+    }
+
+    /// `lights` in render space (also each frame's, in an animated scene); every light's colour
+    /// carries the render's light scale.
+    pub(super) fn lights_from(
+        lights: &[Spanned<LightDesc>],
+        world_offset: DVec3,
+        scale: f64,
+    ) -> Vec<Light> {
         let rgb = |color: &[f64; 3], intensity: &f64| v3(*color) * (*intensity * scale) as f32;
-        let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - self.world_offset).as_vec3());
+        let at = |p: &[f64; 3]| Vec3A::from((DVec3::from(*p) - world_offset).as_vec3());
         let unit = |d: &[f64; 3]| Vec3A::from(DVec3::from(*d).normalize().as_vec3());
         let att = |a: &luxon_formats::Attenuation| {
             [a.constant as f32, a.linear as f32, a.quadratic as f32]
         };
-        self.desc
-            .lights
+        lights
             .iter()
             .map(|l| match &l.value {
                 LightDesc::Point {
@@ -696,6 +736,7 @@ impl Stored {
             used: vec![false; materials],
             object_counts: Vec::new(),
             dropped: 0,
+            keyed: Vec::new(),
         }
     }
 
@@ -720,7 +761,8 @@ impl Stored {
             .reserve_mesh(t, m.positions.len(), attrs, budget, &describe)
     }
 
-    /// Bytes of the stored geometry (its arrays' capacities).
+    /// Bytes of the stored geometry (its arrays' capacities), the keyed objects' recorded
+    /// geometry included.
     fn geometry_bytes(&self) -> u64 {
         self.spheres.bytes()
             + self.triangles.bytes()
@@ -728,6 +770,7 @@ impl Stored {
             + self.cones.bytes()
             + self.discs.bytes()
             + self.customs.bytes()
+            + self.keyed.iter().map(|k| k.geometry.bytes()).sum::<u64>()
     }
 
     /// Stage (with a geometry cache): its native sets and BVHs replace the (empty) ones here.
@@ -805,7 +848,8 @@ impl Stored {
         !(self.spheres.is_empty()
             && self.triangles.is_empty()
             && self.planes.planes.is_empty()
-            && self.customs.is_empty())
+            && self.customs.is_empty()
+            && self.keyed.iter().all(|k| k.geometry == Recorded::default()))
     }
 }
 
@@ -878,6 +922,23 @@ fn v3(a: [f64; 3]) -> Vec3A {
     Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
 }
 
+/// What a shadow ray keeps after crossing a surface of transmit coefficient `transmit` and
+/// colour `color` under the render's rule for transparent shadows; `None`: it is blocked.
+pub(super) fn shadow_filter(
+    transmit: f32,
+    color: Vec3A,
+    rule: TransparentShadows,
+) -> Option<Vec3A> {
+    if transmit <= 0.0 {
+        return None;
+    }
+    Some(match rule {
+        TransparentShadows::Tinted => transmit * color,
+        TransparentShadows::Untinted => Vec3A::splat(transmit),
+        TransparentShadows::Off => Vec3A::ONE,
+    })
+}
+
 /// `textures`: the material's colour, reflect and transmit textures; `t`: the render's
 /// transparency rules (the angle rule a material does not override, shadows' filters).
 fn material(
@@ -894,15 +955,7 @@ fn material(
         None if t.angle == TransparencyAngle::Raster3D => AngleRule::Raster3D,
         None => AngleRule::Constant,
     };
-    let shadow = if transmit <= 0.0 {
-        None
-    } else {
-        Some(match t.shadows {
-            TransparentShadows::Tinted => transmit * color,
-            TransparentShadows::Untinted => Vec3A::splat(transmit),
-            TransparentShadows::Off => Vec3A::ONE,
-        })
-    };
+    let shadow = shadow_filter(transmit, color, t.shadows);
     Material {
         color,
         texture: textures[0],

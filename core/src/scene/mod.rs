@@ -1,16 +1,20 @@
 //! `Scene`: a `SceneDesc` with plugins resolved and called, geometry stored natively and
 //! re-centred, BVHs built, and the set of effects the scene calls for; and the queries the
-//! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`.
+//! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`;
+//! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`.
 
 mod build;
+mod frame;
 
 pub use build::Prebuilt;
+pub use frame::Animation;
 
 use crate::budget::Budget;
 use crate::camera::Camera;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
+use crate::geometry::group::Group;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
@@ -332,6 +336,10 @@ pub struct Scene {
     /// Instantiating the objects through their plugins and storing all geometry natively
     /// (after reading the scene, before the BVH build).
     pub plugin_time: Duration,
+    /// Keyed objects placed at the current frame (empty in a still scene).
+    pub moving: Group,
+    /// How the scene changes from frame to frame; `None`: a still scene.
+    pub animation: Option<Box<Animation>>,
     /// The memory budget the build charged (geometry, BVHs, volumes, texture cache) and the
     /// render charges (images).
     pub budget: Arc<Budget>,
@@ -357,10 +365,17 @@ impl Scene {
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         self.customs
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        if !self.moving.is_empty() {
+            self.moving
+                .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        }
         hit
     }
 
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        if hit.moving {
+            return self.moving.surface(hit, ray, self.features.textures);
+        }
         match hit.kind {
             Kind::Sphere => self.spheres.surface(hit, ray),
             Kind::Triangle => self.triangles.surface(hit, self.features.textures),
@@ -385,7 +400,11 @@ impl Scene {
                 || self.planes.any(ray, t_max, &self.clips, c, |_, _| true)
                 || self.cones.any(ray, t_max, &self.clips, c, |_, _| true)
                 || self.discs.any(ray, t_max, &self.clips, c, |_, _| true)
-                || self.customs.any(ray, t_max, &self.clips, c, |_, _| true);
+                || self.customs.any(ray, t_max, &self.clips, c, |_, _| true)
+                || (!self.moving.is_empty()
+                    && self
+                        .moving
+                        .any(ray, t_max, &self.clips, c, &mut |_, _| true));
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
         let mut filter = Vec3A::ONE;
@@ -408,13 +427,15 @@ impl Scene {
             || self.cones.any(ray, t_max, &self.clips, c, &mut on_hit)
             || self.discs.any(ray, t_max, &self.clips, c, &mut on_hit)
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
+            || (!self.moving.is_empty() && self.moving.any(ray, t_max, &self.clips, c, &mut on_hit))
         {
             return Vec3A::ZERO;
         }
         filter
     }
 
-    /// Moves the camera without rebuilding anything (the next frame of a camera path): the
+    /// Moves the camera without rebuilding anything (the next view of a Tachyon camera file,
+    /// or an animated scene's keyed camera, which `set_frame` places here): the
     /// geometry stays stored relative to `world_offset` (the first camera's position) and the
     /// new camera is placed in that space. Only the camera's position, direction and window
     /// change what a render computes; `settings` (resolution, samples) stay as built.

@@ -523,6 +523,7 @@ impl Assembler {
                 outputs: Vec::new(),
                 ..RenderDesc::default()
             },
+            animation: None,
             plugin_path: Vec::new(),
             warnings: self
                 .warnings

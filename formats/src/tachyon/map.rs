@@ -582,6 +582,7 @@ impl Mapper {
                 },
                 ..RenderDesc::default()
             },
+            animation: None,
             plugin_path: Vec::new(),
             warnings: warnings
                 .into_iter()

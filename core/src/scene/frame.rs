@@ -1,0 +1,453 @@
+//! The frames of an animated scene: [`Scene::set_frame`] puts every keyed value at a frame —
+//! the camera, the lights, material colours, and the keyed objects, whose geometry is placed
+//! anew from what their plugins gave once (recorded at the build, in f64) and stored in the
+//! scene's moving group with BVHs of its own, charged to the memory budget like the still
+//! geometry (and given back when the next frame's group replaces it).
+//!
+//! **A frame is a function of its number alone.** `set_frame` overwrites every value it
+//! touches and rebuilds the moving group from scratch (never refits what an earlier frame
+//! left), so frame k renders the same bits whether it comes first, after other frames, or in
+//! another process. Everything else (still geometry, volumes, textures, the world offset) is
+//! built once and never changes with the frame.
+//!
+//! Render space stays where the build put it: `world_offset` is the camera's position at the
+//! scene's first frame (not the frame being rendered, which would move every coordinate), and
+//! each frame's camera is placed relative to it.
+
+use super::build::{shadow_filter, Build};
+use super::{Light, Scene};
+use crate::budget::{Budget, Use};
+use crate::error::Error;
+use crate::geometry::group::Group;
+use crate::geometry::triangle::MeshInput;
+use crate::math::{DVec3, Vec3A};
+use crate::motion::keys::value;
+use crate::motion::Placement;
+use crate::plugin::primitive::Recorded;
+use luxon_formats::{
+    AnimationDesc, CameraDesc, LightDesc, ObjectTracks, Origin, Projection, SceneDesc, ShutterDesc,
+    Spanned, Track, TransparentShadows,
+};
+use std::sync::Arc;
+
+/// A keyed object as the build recorded it.
+pub(super) struct Keyed {
+    pub tracks: ObjectTracks,
+    pub geometry: Recorded,
+    /// Material and clip group, packed.
+    pub material: u32,
+    /// Where the object is written.
+    pub at: Origin,
+}
+
+/// What an animated scene needs to go to any frame: the tracks, and the unanimated camera,
+/// lights and keyed objects they change.
+pub struct Animation {
+    desc: AnimationDesc,
+    camera: Spanned<CameraDesc>,
+    lights: Vec<Spanned<LightDesc>>,
+    /// The render's light scale, which every frame's lights carry.
+    light_scale: f64,
+    /// How transparent surfaces filter shadows (by their colour, when `Tinted`).
+    shadows: TransparentShadows,
+    /// Keyed material colours: index in `Scene::materials`, that of its copy that casts no
+    /// shadow (if objects use one), and the track.
+    materials: Vec<(usize, Option<usize>, Track<[f64; 3]>)>,
+    objects: Vec<Keyed>,
+    frame: u32,
+}
+
+/// Where render space's origin sits in an animated scene: the camera's position at the first
+/// frame (a property of the scene, so every frame and every subset of frames agrees).
+pub(super) fn world_offset(desc: &SceneDesc) -> DVec3 {
+    let camera = &desc.camera.value;
+    let keyed = desc.animation.as_ref().and_then(|a| {
+        let a = &a.value;
+        a.camera
+            .position
+            .as_ref()
+            .map(|p| value(p, f64::from(a.first)))
+    });
+    DVec3::from(keyed.unwrap_or(camera.position))
+}
+
+impl Animation {
+    /// The animation of `desc`, with the objects the build recorded; `shadowless`: each
+    /// material's copy that casts no shadow (`Scene::materials` index). A shutter that stays
+    /// open is refused (motion blur is not rendered yet), as is a scale that would turn a
+    /// sphere, cone or disc into something it cannot store.
+    pub(super) fn new(
+        desc: &SceneDesc,
+        material_names: &[String],
+        shadowless: &[Option<usize>],
+        objects: Vec<Keyed>,
+    ) -> Result<Animation, Error> {
+        let a = desc
+            .animation
+            .as_ref()
+            .ok_or_else(|| Error::Render("the scene has no animation".into()))?;
+        if let Some(s) = a.value.shutter.as_ref().filter(|s| s.value.length > 0.0) {
+            return Err(Error::at(
+                &s.at,
+                "this build reads the shutter but does not render motion blur yet; expected \
+                 `shutter: (length: 0)` or no `shutter` (frames are rendered at their own \
+                 time)",
+            ));
+        }
+        for o in &objects {
+            let g = &o.geometry;
+            let round = !(g.spheres.is_empty() && g.cones.is_empty() && g.discs.is_empty());
+            let Some(scale) = o.tracks.scale.as_ref().filter(|_| round) else {
+                continue;
+            };
+            for k in &scale.keys {
+                let s = k.value.map(f64::abs);
+                if s[0] != s[1] || s[1] != s[2] {
+                    return Err(Error::at(
+                        &k.at,
+                        format!(
+                            "object `{}` holds spheres, cones or discs, which keep their shape \
+                             only under a uniform scale, but this key scales by ({}, {}, {}); \
+                             expected the same size on every axis",
+                            o.tracks.name.value, k.value[0], k.value[1], k.value[2]
+                        ),
+                    ));
+                }
+            }
+        }
+        let materials = a
+            .value
+            .materials
+            .iter()
+            .filter_map(|m| {
+                let color = m.color.clone()?;
+                let i = material_names.iter().position(|n| *n == m.material.value)?;
+                Some((i, shadowless.get(i).copied().flatten(), color))
+            })
+            .collect();
+        Ok(Animation {
+            desc: a.value.clone(),
+            camera: desc.camera.clone(),
+            lights: desc.lights.clone(),
+            light_scale: desc.render.light_scale,
+            shadows: desc.render.transparency.shadows,
+            materials,
+            objects,
+            frame: a.value.first,
+        })
+    }
+
+    /// The first and last frame of the scene's range (inclusive).
+    pub fn frames(&self) -> (u32, u32) {
+        (self.desc.first, self.desc.last)
+    }
+
+    pub fn fps(&self) -> f64 {
+        self.desc.fps
+    }
+
+    pub fn shutter(&self) -> Option<ShutterDesc> {
+        self.desc.shutter.as_ref().map(|s| s.value)
+    }
+
+    /// The frame the scene is at.
+    pub fn frame(&self) -> u32 {
+        self.frame
+    }
+
+    pub fn desc(&self) -> &AnimationDesc {
+        &self.desc
+    }
+
+    /// The camera at time `t` (frames), checked: a keyed view can degenerate at some frames.
+    fn camera_at(&self, t: f64, k: u32) -> Result<CameraDesc, Error> {
+        let tracks = &self.desc.camera;
+        let mut c = self.camera.value.clone();
+        let at = |track: &Option<Track<[f64; 3]>>| track.as_ref().map(|tr| value(tr, t));
+        if let Some(p) = at(&tracks.position) {
+            c.position = p;
+        }
+        if let Some(p) = at(&tracks.look_at) {
+            c.look_at = p;
+        }
+        if let Some(u) = at(&tracks.up) {
+            c.up = u;
+        }
+        if let (Some(fov), Projection::Perspective { fov_deg }) = (&tracks.fov, &mut c.projection) {
+            // Catmull-Rom may overshoot the keys' range.
+            *fov_deg = value(fov, t).clamp(0.01, 179.99);
+        }
+        if let (Some(f), Some(dof)) = (&tracks.focal_distance, &mut c.depth_of_field) {
+            dof.focal_distance = value(f, t).max(1e-9);
+        }
+        let view = DVec3::from(c.look_at) - DVec3::from(c.position);
+        let up = DVec3::from(c.up);
+        let fail = |m: String| Err(Error::at(&self.camera.at, format!("frame {k}: {m}")));
+        if view.length() == 0.0 {
+            return fail(format!(
+                "the camera's `look_at` equals its `position` {:?} at this frame; expected \
+                 keys that keep them apart",
+                c.position
+            ));
+        }
+        if view.cross(up).length() <= 1e-9 * view.length() * up.length() {
+            return fail(format!(
+                "the camera's `up` {:?} is parallel to its view direction at this frame; \
+                 expected an `up` at an angle to it",
+                c.up
+            ));
+        }
+        Ok(c)
+    }
+
+    /// The lights at time `t`, in render space.
+    fn lights_at(&self, t: f64, k: u32, world_offset: DVec3) -> Result<Vec<Light>, Error> {
+        let mut lights = self.lights.clone();
+        for keys in &self.desc.lights {
+            let Some(light) = lights.get_mut(keys.light) else {
+                continue;
+            };
+            let at = |track: &Option<Track<[f64; 3]>>| track.as_ref().map(|tr| value(tr, t));
+            let position = at(&keys.position);
+            let direction = at(&keys.direction);
+            if let Some(d) = direction {
+                if DVec3::from(d).length() == 0.0 {
+                    return Err(Error::at(
+                        &keys.name.at,
+                        format!(
+                            "frame {k}: light `{}`'s `direction` passes through zero length \
+                             at this frame; expected keys that keep it a direction",
+                            keys.name.value
+                        ),
+                    ));
+                }
+            }
+            let intensity = keys.intensity.as_ref().map(|tr| value(tr, t).max(0.0));
+            let color = at(&keys.color).map(|c| c.map(|x| x.max(0.0)));
+            let (p, d, i, c) = match &mut light.value {
+                LightDesc::Point {
+                    position,
+                    intensity,
+                    color,
+                    ..
+                }
+                | LightDesc::Sphere {
+                    center: position,
+                    intensity,
+                    color,
+                    ..
+                }
+                | LightDesc::Rect {
+                    corner: position,
+                    intensity,
+                    color,
+                    ..
+                } => (Some(position), None, intensity, color),
+                LightDesc::Directional {
+                    direction,
+                    intensity,
+                    color,
+                    ..
+                } => (None, Some(direction), intensity, color),
+                LightDesc::Spot {
+                    position,
+                    direction,
+                    intensity,
+                    color,
+                    ..
+                } => (Some(position), Some(direction), intensity, color),
+            };
+            // The loader made sure a keyed property exists on its light.
+            if let (Some(slot), Some(v)) = (p, position) {
+                *slot = v;
+            }
+            if let (Some(slot), Some(v)) = (d, direction) {
+                *slot = v;
+            }
+            if let Some(v) = intensity {
+                *i = v;
+            }
+            if let Some(v) = color {
+                *c = v;
+            }
+        }
+        Ok(Build::lights_from(&lights, world_offset, self.light_scale))
+    }
+
+    /// The keyed objects placed at time `t`, in render space, with their BVHs, charged to
+    /// `budget` (the group keeps the charges).
+    fn group_at(
+        &self,
+        t: f64,
+        k: u32,
+        world_offset: DVec3,
+        budget: &Arc<Budget>,
+    ) -> Result<Group, Error> {
+        let mut group = Group::default();
+        // The sets charge their arrays as they grow, for good; the group takes that charge
+        // over (nothing else stores geometry while a frame is set), so it is given back with
+        // the group, or at once if placing fails.
+        let before = budget.used(Use::Geometry);
+        let placed = self.objects.iter().try_for_each(|o| {
+            let p = Placement::at(&o.tracks, t);
+            place(
+                &o.geometry,
+                &p,
+                world_offset,
+                o.material,
+                &mut group,
+                budget,
+            )
+            .map_err(|m| {
+                Error::at(
+                    &o.at,
+                    format!("frame {k}: object `{}`: {m}", o.tracks.name.value),
+                )
+            })
+        });
+        let grown = budget.used(Use::Geometry).saturating_sub(before);
+        group.charges.push(budget.guard(Use::Geometry, grown));
+        placed?;
+        group
+            .build(budget)
+            .map_err(|e| Error::Render(format!("frame {k}: the keyed objects: {}", e.0)))?;
+        Ok(group)
+    }
+}
+
+/// Stores `g` moved by `p` into `group` (through the sets' own checks), charging its arrays
+/// to `budget` before they grow.
+fn place(
+    g: &Recorded,
+    p: &Placement,
+    offset: DVec3,
+    material: u32,
+    group: &mut Group,
+    budget: &Arc<Budget>,
+) -> Result<(), String> {
+    let m = p.world_from_object.matrix3;
+    let det = m.determinant();
+    if !(det.is_finite() && det != 0.0) {
+        return Err("its transform is singular at this frame (a scale of 0?)".into());
+    }
+    let round = !(g.spheres.is_empty() && g.cones.is_empty() && g.discs.is_empty());
+    let s = match (p.uniform_scale(), round) {
+        (Some(s), _) => s,
+        (None, false) => 1.0,
+        (None, true) => {
+            let s = m.x_axis.length();
+            return Err(format!(
+                "its scale is not the same on every axis at this frame (x is {s}), and it holds \
+                 spheres, cones or discs, which keep their shape only under a uniform scale"
+            ));
+        }
+    };
+    let xyz = |r: &[f64], i: usize| p.point([r[i], r[i + 1], r[i + 2]]);
+    let normal = |r: &[f64], i: usize| p.normal([r[i], r[i + 1], r[i + 2]]);
+    let count = |n: usize, kind: &'static str| move || format!("{n} {kind}");
+    let (ns, np, nc, nd) = (
+        g.spheres.len(),
+        g.planes.len(),
+        g.cones.len(),
+        g.discs.len(),
+    );
+    group.spheres.reserve(ns, budget, &count(ns, "spheres"))?;
+    group.planes.reserve(np, budget, &count(np, "planes"))?;
+    group.cones.reserve(nc, budget, &count(nc, "cones"))?;
+    group.discs.reserve(nd, budget, &count(nd, "discs"))?;
+    for (i, r) in g.spheres.iter().enumerate() {
+        let c = xyz(r, 0);
+        group
+            .spheres
+            .push_world(i, [c[0], c[1], c[2], r[3] * s], offset, material)?;
+    }
+    for (i, r) in g.planes.iter().enumerate() {
+        let (q, n) = (xyz(r, 0), normal(r, 3));
+        group
+            .planes
+            .push_world(i, [q[0], q[1], q[2], n[0], n[1], n[2]], offset, material)?;
+    }
+    for (i, r) in g.cones.iter().enumerate() {
+        let (b, a) = (xyz(r, 0), xyz(r, 4));
+        let cone = [b[0], b[1], b[2], r[3] * s, a[0], a[1], a[2], r[7] * s];
+        group.cones.push_world(i, cone, offset, material)?;
+    }
+    for (i, r) in g.discs.iter().enumerate() {
+        let (c, n) = (xyz(r, 0), normal(r, 3));
+        let disc = [c[0], c[1], c[2], n[0], n[1], n[2], r[6] * s, r[7] * s];
+        group.discs.push_world(i, disc, offset, material)?;
+    }
+    for mesh in &g.meshes {
+        let triangles = mesh.indices.len() / 3;
+        let what = count(triangles, "triangles");
+        let attrs = !(mesh.normals.is_empty() && mesh.colors.is_empty() && mesh.uvs.is_empty());
+        let vertices = mesh.positions.len() / 3;
+        group
+            .triangles
+            .reserve_mesh(triangles, vertices, attrs, budget, &what)?;
+        // The moved positions and normals, charged while they are stored.
+        let moved = |from: &[f64], f: &dyn Fn(&[f64], usize) -> [f64; 3]| {
+            let (mut to, charge) = budget.alloc_vec(Use::Geometry, from.len(), 0.0, what)?;
+            for (a, b) in to.chunks_exact_mut(3).zip(from.chunks_exact(3)) {
+                a.copy_from_slice(&f(b, 0));
+            }
+            Ok::<_, String>((to, charge))
+        };
+        let (positions, _p) = moved(&mesh.positions, &xyz)?;
+        let (normals, _n) = moved(&mesh.normals, &normal)?;
+        let input = MeshInput {
+            positions: &positions,
+            normals: &normals,
+            ..mesh.input()
+        };
+        group.triangles.push_mesh(&input, offset, material)?;
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Puts every keyed value at frame `k`: the camera, lights, material colours and keyed
+    /// objects (placed anew, with fresh BVHs), and the sampler's frame number. A function of
+    /// `k` alone (see the module documentation). Frames outside the scene's range hold the
+    /// values of its ends. On an error (a camera or object that degenerates at this frame) the
+    /// scene is left as it was.
+    pub fn set_frame(&mut self, k: u32) -> Result<(), Error> {
+        let Some(anim) = &self.animation else {
+            return Err(Error::Render(format!(
+                "frame {k}: {} has no `animation:`",
+                self.source.display()
+            )));
+        };
+        let t = f64::from(k);
+        let camera = anim.camera_at(t, k)?;
+        let lights = anim.lights_at(t, k, self.world_offset)?;
+        let moving = anim.group_at(t, k, self.world_offset, &self.budget)?;
+        let shadows = anim.shadows;
+        let colors: Vec<(usize, Option<usize>, Vec3A)> = anim
+            .materials
+            .iter()
+            .map(|(i, copy, track)| {
+                let c = value(track, t).map(|x| x.max(0.0));
+                (*i, *copy, Vec3A::new(c[0] as f32, c[1] as f32, c[2] as f32))
+            })
+            .collect();
+        self.set_camera(&camera);
+        self.lights = lights;
+        // The previous frame's group goes, and its charges with it.
+        self.moving = moving;
+        for (i, copy, c) in colors {
+            let m = &mut self.materials[i];
+            m.color = c;
+            // A tinted shadow takes the colour too (the copy casting no shadow keeps its none).
+            m.shadow = shadow_filter(m.transmit, c, shadows);
+            if let Some(j) = copy {
+                self.materials[j].color = c;
+            }
+        }
+        self.settings.frame = k;
+        if let Some(anim) = &mut self.animation {
+            anim.frame = k;
+        }
+        Ok(())
+    }
+}
