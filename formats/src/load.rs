@@ -17,10 +17,10 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
 /// [`load`] within the limits of `options`.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneError> {
     if nff::is_nff_path(path) {
-        return nff::load(path);
+        return nff::load_with(path, options);
     }
     if obj::is_obj_path(path) {
-        return obj::load(path);
+        return obj::load_with(path, options);
     }
     if tachyon::is_tachyon_path(path) {
         return tachyon::load(path);
