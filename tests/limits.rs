@@ -388,3 +388,124 @@ fn a_png_header_that_lies_fails_the_render_without_allocating() {
     assert!(!dir.join("t.png").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An NFF file of 2 million spheres (32 MB of text, 61 MiB of imported geometry) with a
+/// `resolution` of 32×32.
+fn many_spheres_nff(path: &std::path::Path) {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    f.write_all(
+        b"v\nfrom 0 0 -400\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 32 32\n\
+          l 0 0 -500\nf 1 0 0 1 0 0 0 0\n",
+    )
+    .unwrap();
+    for i in 0..2_000_000i64 {
+        let (x, y, z) = (i % 126 - 63, (i / 126) % 126 - 63, i / 15876);
+        writeln!(f, "s {x} {y} {z} 0.4").unwrap();
+    }
+    f.flush().unwrap();
+}
+
+/// The geometry an importer reads is charged to the memory budget: an NFF file holding more
+/// than the budget is an error naming the file and the budget, found while it is read (the
+/// run ends in well under a second); one whose import fits but whose scene does not is an error
+/// naming it too; with enough memory it renders. Nothing aborts under the address-space limit.
+#[test]
+fn an_nff_file_over_the_budget_is_an_error_naming_it() {
+    let dir = temp_dir("limits-big-nff");
+    many_spheres_nff(&dir.join("big.nff"));
+    let render = |memory: &str, limit: u64| {
+        let args = [
+            "render",
+            "big.nff",
+            "-o",
+            "b.png",
+            "--threads",
+            "2",
+            "--no-cache",
+            "--memory",
+            memory,
+        ];
+        run_limited(&args, &dir, limit, 120)
+    };
+    let out = render("32M", 512 << 20);
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(
+        e.starts_with("luxon: error: cannot import `big.nff`: its ")
+            && e.contains(" spheres, 0 cones and 0 triangles up to line ")
+            && e.ends_with(
+                "more than the 32 MiB left for imported geometry; the memory budget is 32 MiB \
+                 (from --memory); raise it with --memory\n"
+            ),
+        "{e}"
+    );
+    // The import fits in 64 MiB, the imported spheres and their scene arrays together do not.
+    let out = render("64M", 512 << 20);
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(
+        e.starts_with("luxon: error: big.nff:")
+            && e.contains("the memory budget of 64 MiB (from --memory)")
+            && e.contains("in use: imported geometry 61.0 MiB"),
+        "{e}"
+    );
+    assert!(!dir.join("b.png").exists());
+    let out = render("1G", 3 << 29);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(dir.join("b.png").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An OBJ file's geometry is estimated from its statements before it is read into meshes:
+/// over the budget it is an error naming the file; within it the mesh renders.
+#[test]
+fn an_obj_file_over_the_budget_is_an_error_naming_it() {
+    let dir = temp_dir("limits-big-obj");
+    let n = 300;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("grid.obj")).unwrap());
+    for j in 0..n {
+        for i in 0..n {
+            writeln!(f, "v {i} {j} 0").unwrap();
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i + 1;
+            writeln!(f, "f {a} {} {} {}", a + 1, a + n + 1, a + n).unwrap();
+        }
+    }
+    drop(f);
+    let render = |memory: &str| {
+        let args = [
+            "render",
+            "grid.obj",
+            "-o",
+            "g.png",
+            "--res",
+            "32x32",
+            "--threads",
+            "2",
+            "--memory",
+            memory,
+        ];
+        run_limited(&args, &dir, 1 << 30, 120)
+    };
+    let out = render("16M");
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.starts_with(
+            "luxon: error: cannot import `grid.obj`: its 90000 vertices and 178802 triangles need "
+        ) && e.ends_with(
+            "more than the 16 MiB left for imported geometry; the memory budget is 16 MiB (from \
+             --memory); raise it with --memory\n"
+        ),
+        "{e}"
+    );
+    let out = render("256M");
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(dir.join("g.png").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}

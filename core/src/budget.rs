@@ -15,7 +15,7 @@
 //! cannot fail unless the machine is out of memory anyway.
 
 use crate::error::Error;
-use luxon_formats::{MemorySize, RenderDesc};
+use luxon_formats::{LoadOptions, MemorySize, RenderDesc};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::Arc;
@@ -23,6 +23,8 @@ use std::sync::Arc;
 /// What the charged bytes hold (for the message that lists what is in use).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Use {
+    /// Geometry an importer read (NFF, OBJ), held until the scene's own arrays hold it.
+    Import,
     Geometry,
     Bvh,
     Volumes,
@@ -32,7 +34,8 @@ pub enum Use {
 }
 
 impl Use {
-    const ALL: [Use; 6] = [
+    const ALL: [Use; 7] = [
+        Use::Import,
         Use::Geometry,
         Use::Bvh,
         Use::Volumes,
@@ -43,6 +46,7 @@ impl Use {
 
     fn name(self) -> &'static str {
         match self {
+            Use::Import => "imported geometry",
             Use::Geometry => "geometry",
             Use::Bvh => "BVH",
             Use::Volumes => "volumes",
@@ -70,6 +74,10 @@ impl From<BudgetError> for String {
     }
 }
 
+/// Bytes of memory parsing takes per byte of RON scene text (measured: a 654 MB scene peaks at
+/// 7.9 GB), rounded up.
+const PARSE_BYTES_PER_TEXT_BYTE: u64 = 16;
+
 /// The texture cache when the scene does not set one: 1 GiB, at most a quarter of the budget.
 const DEFAULT_TEXTURE_CACHE: u64 = 1 << 30;
 
@@ -87,7 +95,7 @@ pub struct Budget {
     source: String,
     texture_cache: u64,
     total: AtomicU64,
-    used: [AtomicU64; 6],
+    used: [AtomicU64; 7],
 }
 
 impl Budget {
@@ -139,6 +147,33 @@ impl Budget {
             ),
         };
         Budget::new(limit.max(1), source, render.texture_cache)
+    }
+
+    /// The budget a scene is loaded within: `--memory`, else the machine's default (the
+    /// scene's own setting is read only with it), shared as [`for_render`](Self::for_render)
+    /// shares it.
+    pub fn for_load(cli: Option<MemorySize>, node_ranks: usize) -> Budget {
+        Budget::for_render(&RenderDesc::default(), cli, node_ranks)
+    }
+
+    /// The limits of loading a scene within what is left of the budget: its RON text (a
+    /// sixteenth of it, at most the default 1 GiB) and what the importers may hold.
+    pub fn load_options(&self) -> LoadOptions {
+        let default = LoadOptions::default();
+        if self.limit().is_none() {
+            return default;
+        }
+        let left = self.remaining();
+        LoadOptions {
+            max_scene_bytes: default
+                .max_scene_bytes
+                .min(left / PARSE_BYTES_PER_TEXT_BYTE),
+            max_geometry: left,
+            limit: format!(
+                "the memory budget is {}; raise it with --memory",
+                self.describe()
+            ),
+        }
     }
 
     /// The limit, `None` when there is none.

@@ -49,6 +49,22 @@ impl InlineGeometry {
             && self.mesh.indices.is_empty()
     }
 
+    /// Bytes its arrays hold (their capacities): what an import of it takes.
+    pub fn bytes(&self) -> u64 {
+        fn held<T>(v: &Vec<T>) -> u64 {
+            (v.capacity() * std::mem::size_of::<T>()) as u64
+        }
+        let m = &self.mesh;
+        held(&self.spheres)
+            + held(&self.cones)
+            + held(&self.discs)
+            + held(&self.planes)
+            + held(&m.positions)
+            + held(&m.normals)
+            + held(&m.indices)
+            + held(&m.uvs)
+    }
+
     pub fn primitive_count(&self) -> usize {
         self.spheres.len()
             + self.cones.len()

@@ -12,7 +12,8 @@ pub use luxon_plugin::files::FileError;
 use crate::error::SceneError;
 use crate::origin::Origin;
 
-/// Limits of one load.
+/// Limits of one load. Formats knows no memory budget: the caller (the core, from its budget)
+/// sets these limits and says in `limit` what set them, for the messages.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Bytes of RON scene text one load may read: the main file and all its includes
@@ -20,14 +21,40 @@ pub struct LoadOptions {
     /// peaks at 7.9 GB), so this bounds the memory of a load whatever the files claim to be.
     /// Default: 1 GiB, above the largest scene Luxon generates (`luxon spd teapot --size 200`
     /// writes 654 MB of RON). NFF and OBJ files are streamed and have no such cap: their
-    /// memory is that of the geometry they hold.
+    /// memory is that of the geometry they hold (`max_geometry`).
     pub max_scene_bytes: u64,
+    /// Bytes of geometry the importers may hold: what NFF files and OBJ files (whole scenes
+    /// or a RON scene's `meshes:`) are read into, counted as they are read (NFF) or estimated
+    /// before they are (OBJ, from its statements). Default: no limit.
+    pub max_geometry: u64,
+    /// What sets these limits, ending the message of an import over `max_geometry` ("the
+    /// memory budget is 64 MiB (from --memory); raise it with --memory").
+    pub limit: String,
 }
 
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
             max_scene_bytes: 1 << 30,
+            max_geometry: u64::MAX,
+            limit: "the load has no memory limit".into(),
+        }
+    }
+}
+
+impl LoadOptions {
+    /// The error for importing `path` when `what` (e.g. "its 2000000 spheres up to line
+    /// 2000010") needs `needs` bytes, more than `max_geometry`.
+    pub(crate) fn over_geometry(&self, path: &Path, what: &str, needs: u64) -> SceneError {
+        SceneError::File {
+            path: path.to_path_buf(),
+            message: format!(
+                "cannot import `{}`: {what} need {}, more than the {} left for imported geometry; {}",
+                path.display(),
+                luxon_plugin::files::bytes(needs),
+                luxon_plugin::files::bytes(self.max_geometry),
+                self.limit
+            ),
         }
     }
 }

@@ -17,13 +17,19 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
 /// [`load`] within the limits of `options`.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneError> {
     if nff::is_nff_path(path) {
-        return nff::load(path);
+        return nff::load_with(path, options);
     }
     if obj::is_obj_path(path) {
-        return obj::load(path);
+        return obj::load_with(path, options);
     }
     if tachyon::is_tachyon_path(path) {
-        return tachyon::load(path);
+        let mut o = tachyon::Options::new(crate::origin::Origin {
+            file: std::sync::Arc::new(path.to_path_buf()),
+            line: 1,
+            col: 1,
+        });
+        o.max_text = options.max_scene_bytes;
+        return tachyon::load_with(path, &o);
     }
     let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !extension.eq_ignore_ascii_case("ron") {

@@ -37,7 +37,7 @@ use crate::desc::{
 };
 use crate::error::{shown, SceneError, Warning};
 use crate::geometry::{InlineGeometry, InlineMesh};
-use crate::input::{file_error, FileError, MTL_MAX_BYTES, OBJ_MAX_LINE};
+use crate::input::{file_error, FileError, LoadOptions, MTL_MAX_BYTES, OBJ_MAX_LINE};
 
 /// What an OBJ file held.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -61,9 +61,21 @@ pub fn is_obj_path(path: &Path) -> bool {
 /// reported there (naming the OBJ file and line in the message) and the geometry and
 /// materials carry it as their origin. Without it, the OBJ file itself is the origin.
 pub fn load_obj(path: &Path, at: Option<Origin>) -> Result<ObjImport, SceneError> {
+    load_obj_with(path, at, &LoadOptions::default())
+}
+
+/// [`load_obj`] within the limits of `options`: a file whose geometry would take more than
+/// `max_geometry` (estimated from its statements before it is read into meshes) is an error
+/// naming it.
+pub fn load_obj_with(
+    path: &Path,
+    at: Option<Origin>,
+    options: &LoadOptions,
+) -> Result<ObjImport, SceneError> {
     let file = ObjFile {
         path,
         at: at.as_ref(),
+        options,
     };
     let Parsed {
         models,
@@ -94,6 +106,7 @@ struct Parsed {
 struct ObjFile<'a> {
     path: &'a Path,
     at: Option<&'a Origin>,
+    options: &'a LoadOptions,
 }
 
 impl ObjFile<'_> {
@@ -169,6 +182,14 @@ impl ObjFile<'_> {
     /// The file through tobj, after our own pass over it (`prescan`).
     fn parse(&self) -> Result<Parsed, SceneError> {
         let scan = self.prescan()?;
+        let needs = scan.import_bytes();
+        if needs > self.options.max_geometry {
+            let what = format!(
+                "its {} vertices and {} triangles",
+                scan.positions, scan.triangles
+            );
+            return Err(self.options.over_geometry(self.path, &what, needs));
+        }
         let mut reader = WithoutLines::new(self.open()?);
         let warnings = RefCell::new(scan.warnings);
         let dir = self.path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -261,9 +282,9 @@ impl ObjFile<'_> {
                 Some("vt") => vt += 1,
                 Some("vn") => vn += 1,
                 Some("f") => {
-                    if let Some(detail) = bad_face(words, [v, vt, vn]) {
-                        return Err(self.fail(line, detail));
-                    }
+                    let corners = bad_face(words, [v, vt, vn]).map_err(|e| self.fail(line, e))?;
+                    out.corners += corners;
+                    out.triangles += corners - 2;
                 }
                 Some(k @ ("l" | "p")) => {
                     let slot = &mut ignored[usize::from(k == "p")];
@@ -291,6 +312,7 @@ impl ObjFile<'_> {
                 ));
             }
         }
+        [out.positions, out.uvs, out.normals] = [v, vt, vn].map(|n| n as u64);
         Ok(out)
     }
 }
@@ -364,11 +386,34 @@ struct Prescan {
     /// `mtllib` names and their lines.
     mtllibs: Vec<(String, u32)>,
     warnings: Vec<Warning>,
+    /// `v`, `vt` and `vn` statements.
+    positions: u64,
+    uvs: u64,
+    normals: u64,
+    /// Corners of the faces, and the triangles they become.
+    corners: u64,
+    triangles: u64,
+}
+
+impl Prescan {
+    /// Bytes the import takes at its peak, estimated from the statements (tobj gives no way
+    /// to bound its allocations, so this is checked before it runs): tobj's tables of what the
+    /// file defines (f64) and of its faces' corners; the meshes it builds (a vertex per
+    /// distinct corner: usually about one per position, which is what is counted), with the
+    /// index map that builds them; and the inline geometry they become.
+    fn import_bytes(&self) -> u64 {
+        let (v, t) = (self.positions, self.triangles);
+        let tables = 24 * v + 16 * self.uvs + 24 * self.normals + 24 * self.corners;
+        let meshes = v * (24 + 24 + 16 + 48) + 12 * t;
+        let inline = v * (24 + 24 + 16) + 24 * t;
+        tables.saturating_add(meshes).saturating_add(inline)
+    }
 }
 
 /// What is wrong with a face (the words after `f`), given the counts of vertices, texture
 /// coordinates and normals defined so far.
-fn bad_face<'a>(words: impl Iterator<Item = &'a str>, counts: [i64; 3]) -> Option<String> {
+/// `Ok`: its number of corners.
+fn bad_face<'a>(words: impl Iterator<Item = &'a str>, counts: [i64; 3]) -> Result<u64, String> {
     let mut corners = 0;
     for word in words {
         corners += 1;
@@ -380,14 +425,17 @@ fn bad_face<'a>(words: impl Iterator<Item = &'a str>, counts: [i64; 3]) -> Optio
             let what = ["vertex", "texture coordinate", "normal"][k];
             let resolved = if index < 0 { count + index + 1 } else { index };
             if resolved < 1 || resolved > count {
-                return Some(format!(
+                return Err(format!(
                     "face {what} index {index} is out of bounds; expected 1 to {count} (or -1 \
                      to -{count}: relative to the last one) with {count} defined so far"
                 ));
             }
         }
     }
-    (corners < 3).then(|| format!("a face needs at least 3 vertices, found {corners}"))
+    if corners < 3 {
+        return Err(format!("a face needs at least 3 vertices, found {corners}"));
+    }
+    Ok(corners)
 }
 
 /// An MTL file's materials, or why it cannot be used.
@@ -603,7 +651,12 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// that fits its bounding box, one point light near the camera, 512x512. Warnings go to the
 /// scene's `warnings`.
 pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
-    let import = load_obj(path, None)?;
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] within the limits of `options`.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneError> {
+    let import = load_obj_with(path, None, options)?;
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for g in &import.geometry {

@@ -7,9 +7,10 @@ use crate::animation::resolve_animation;
 use crate::convert::MeshRef;
 use crate::desc::SceneDesc;
 use crate::error::{quoted_list, unknown_name, SceneError};
+use crate::geometry::InlineGeometry;
 use crate::includes::{resolve, upsert, Names};
 use crate::input::{file_error, DiskSource, LoadOptions, Source};
-use crate::obj::{is_obj_path, load_obj};
+use crate::obj::{is_obj_path, load_obj_with};
 use crate::spans::SourceMap;
 use crate::validate::references;
 
@@ -81,13 +82,18 @@ fn load_root(
     };
     references(&scene)?;
     resolve_animation(&mut scene, &part.light_names, &part.object_names)?;
-    add_meshes(&mut scene, meshes)?;
+    add_meshes(&mut scene, meshes, options)?;
     Ok(scene)
 }
 
 /// Reads the `meshes:` files into `inline` geometry (and their materials, unless the entry
-/// names one), in file order, and their warnings into the scene's.
-fn add_meshes(scene: &mut SceneDesc, meshes: Vec<MeshRef>) -> Result<(), SceneError> {
+/// names one), in file order, and their warnings into the scene's. All of them together within
+/// `options.max_geometry`.
+fn add_meshes(
+    scene: &mut SceneDesc,
+    meshes: Vec<MeshRef>,
+    options: &LoadOptions,
+) -> Result<(), SceneError> {
     let mut names: Names = scene
         .materials
         .iter()
@@ -113,7 +119,12 @@ fn add_meshes(scene: &mut SceneDesc, meshes: Vec<MeshRef>) -> Result<(), SceneEr
                 ),
             ));
         }
-        let import = load_obj(&mesh.file.value, Some(mesh.file.at.clone()))?;
+        let held: u64 = scene.inline.iter().map(InlineGeometry::bytes).sum();
+        let left = LoadOptions {
+            max_geometry: options.max_geometry.saturating_sub(held),
+            ..options.clone()
+        };
+        let import = load_obj_with(&mesh.file.value, Some(mesh.file.at.clone()), &left)?;
         scene.warnings.extend(import.warnings);
         match mesh.material {
             Some(material) => {

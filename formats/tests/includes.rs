@@ -492,6 +492,7 @@ fn scene_text_is_capped_per_load() {
     source.insert("big.ron", format!("({})", " ".repeat(200)));
     let options = LoadOptions {
         max_scene_bytes: 250,
+        ..LoadOptions::default()
     };
     let e = load_ron_with(&mut source, Path::new("main.ron"), &options).unwrap_err();
     let at = e.origin().unwrap();
@@ -507,6 +508,7 @@ fn scene_text_is_capped_per_load() {
     // The main file alone.
     let options = LoadOptions {
         max_scene_bytes: 50,
+        ..LoadOptions::default()
     };
     let e = load_ron_with(&mut source, Path::new("main.ron"), &options).unwrap_err();
     assert!(e.origin().is_none());

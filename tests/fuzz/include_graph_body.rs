@@ -18,6 +18,7 @@ pub fn run(data: &[u8]) -> Result<SceneDesc, SceneError> {
     // A small cap keeps the fuzzer's memory bounded.
     let options = LoadOptions {
         max_scene_bytes: 1 << 20,
+        ..LoadOptions::default()
     };
     let result = load_ron_with(&mut source, Path::new("f0.ron"), &options);
     for i in 0..files.len() {

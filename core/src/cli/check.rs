@@ -1,19 +1,25 @@
 //! `luxon check`: validate a scene and describe it.
 
-use luxon::budget::Budget;
+use luxon::budget::{Budget, Use};
 use luxon::plugin::Registry;
 use luxon::{Error, Scene};
-use luxon_formats::{MemorySize, SceneDesc};
+use luxon_formats::{InlineGeometry, MemorySize, SceneDesc};
 use std::path::Path;
 use std::sync::Arc;
 
 pub fn run(path: &Path, memory: Option<MemorySize>) -> Result<(), Error> {
-    let desc = luxon_formats::load(path)?;
+    let desc = luxon_formats::load_with(path, &Budget::for_load(memory, 1).load_options())?;
     super::warn_scene(&desc);
     let registry = Registry::discover(&desc.plugin_path);
     super::warn_skipped(&registry);
     let budget = Arc::new(Budget::for_render(&desc.render, memory, 1));
-    let scene = Scene::build_with(&desc, &registry, budget)?;
+    // The imported geometry stays in `desc` while the scene is built from it.
+    let held = desc.inline.iter().map(InlineGeometry::bytes).sum();
+    let imported = budget.charge(Use::Import, held, || {
+        format!("the geometry imported from `{}`", desc.source.display())
+    })?;
+    let scene = Scene::build_with(&desc, &registry, budget.clone())?;
+    drop(imported);
     let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
     describe(&desc, &scene, &outputs);
     Ok(())

@@ -12,7 +12,8 @@ use std::path::Path;
 
 /// The RON text of the scene at `scene`, to be read from `output`.
 pub fn convert(scene: &Path, output: &Path) -> Result<String, Error> {
-    let desc = luxon_formats::load(scene)?;
+    let options = luxon::budget::Budget::for_load(None, 1).load_options();
+    let desc = luxon_formats::load_with(scene, &options)?;
     let base = output.parent().filter(|p| !p.as_os_str().is_empty());
     let text = to_ron(&desc, base.unwrap_or(Path::new("."))).map_err(Error::Render)?;
     // What is written must read back.

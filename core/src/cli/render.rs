@@ -3,7 +3,7 @@
 
 use super::job::Job;
 use super::progress::Progress;
-use luxon::budget::Budget;
+use luxon::budget::{Budget, Use};
 use luxon::cache::{self, Lookup};
 use luxon::framebuffer::Chunk;
 use luxon::output::stream::{is_ppm8, AsyncOutput};
@@ -13,7 +13,8 @@ use luxon::render::RenderStats;
 use luxon::schedule::RankStats;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{
-    Decomposition, MemorySize, Origin, OutputDesc, OutputIo, ParallelMode, RenderDesc, SceneDesc,
+    Decomposition, InlineGeometry, MemorySize, Origin, OutputDesc, OutputIo, ParallelMode,
+    RenderDesc, SceneDesc,
 };
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -97,11 +98,21 @@ pub fn cli_origin(what: &str) -> Origin {
 /// Scenes with fewer primitives load in well under a second without a cache.
 const CACHE_MIN_PRIMITIVES: usize = 100_000;
 
-/// Loads the scene; `skeleton`: the non-geometry lines of an NFF file from its geometry cache.
-pub(super) fn load(path: &Path, o: &Overrides, skeleton: Option<&str>) -> Result<SceneDesc, Error> {
+/// Loads the scene within the memory budget of `--memory` (or the machine's), shared by
+/// `node_ranks` processes; `skeleton`: the non-geometry lines of an NFF file from its geometry
+/// cache.
+pub(super) fn load(
+    path: &Path,
+    o: &Overrides,
+    node_ranks: usize,
+    skeleton: Option<&str>,
+) -> Result<SceneDesc, Error> {
     let mut desc = match skeleton {
         Some(text) => luxon_formats::nff::parse_str(text, path)?.desc,
-        None => luxon_formats::load(path)?,
+        None => {
+            let options = Budget::for_load(o.memory, node_ranks).load_options();
+            luxon_formats::load_with(path, &options)?
+        }
     };
     o.shading.apply(&mut desc)?;
     let r = &mut desc.render;
@@ -223,7 +234,8 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let job = Job::from_launcher()?;
     let mut cache = CacheUse::new(path, o);
     let cached = cache.open(path);
-    let desc = load(path, o, cached.as_ref().map(|c| c.skeleton.as_str()));
+    let skeleton = cached.as_ref().map(|c| c.skeleton.as_str());
+    let desc = load(path, o, job.node_ranks(), skeleton);
     let job = match &desc {
         Ok(d) => job.for_mode(d.render.parallel.mode)?,
         Err(_) => job,
@@ -449,9 +461,15 @@ fn prepare<'r>(
         None => {
             if from_cache {
                 // The cache's view of the scene did not fit: read the source itself.
-                desc = load(path, o, None)?;
+                desc = load(path, o, job.node_ranks(), None)?;
             }
-            let scene = Scene::build_taking_geometry(&mut desc, registry, budget)?;
+            // Held until the build has taken the imported geometry into the scene's arrays.
+            let held = desc.inline.iter().map(InlineGeometry::bytes).sum();
+            let imported = budget.charge(Use::Import, held, || {
+                format!("the geometry imported from `{}`", desc.source.display())
+            })?;
+            let scene = Scene::build_taking_geometry(&mut desc, registry, budget.clone())?;
+            drop(imported);
             cache.write = cache.on
                 && (o.cache || scene.primitive_count() >= CACHE_MIN_PRIMITIVES)
                 && cache::cacheable(&scene, had_objects);

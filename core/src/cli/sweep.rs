@@ -58,7 +58,8 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
             )));
         }
     }
-    let mut desc = luxon_formats::load(path)?;
+    let options = luxon::budget::Budget::for_load(a.memory, 1).load_options();
+    let mut desc = luxon_formats::load_with(path, &options)?;
     super::warn_scene(&desc);
     if let Some((w, h)) = a.res {
         desc.render.width = w;

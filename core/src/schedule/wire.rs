@@ -58,7 +58,8 @@ pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
         });
     }
     let pixels: usize = spans.iter().map(|s| s.count as usize).sum();
-    let mut rgba = Vec::with_capacity(pixels * 4);
+    // The spans' counts are only a claim: reserve no more than the message holds.
+    let mut rgba = Vec::with_capacity(pixels.saturating_mul(4).min(r.0.len() / 4));
     for _ in 0..pixels * 4 {
         rgba.push(f32::from_bits(r.u32()?));
     }
@@ -125,6 +126,21 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A message whose spans claim billions of pixels it does not hold is refused without
+    /// reserving memory for them.
+    #[test]
+    fn a_chunk_claiming_more_pixels_than_it_holds_is_refused() {
+        let mut b = Vec::new();
+        put32(&mut b, 2);
+        for _ in 0..2 {
+            for v in [0, 0, 1, u32::MAX] {
+                put32(&mut b, v);
+            }
+        }
+        put32(&mut b, 0);
+        assert!(decode_chunk(&b).is_none());
+    }
 
     #[test]
     fn chunks_and_stats_round_trip() {

@@ -81,7 +81,7 @@ use crate::desc::{
 };
 use crate::error::{SceneError, Warning};
 use crate::geometry::{InlineGeometry, InlineMesh};
-use crate::input::{file_error, FileError, NFF_MAX_LINE};
+use crate::input::{file_error, FileError, LoadOptions, NFF_MAX_LINE};
 use parse::{ChunkError, ChunkOut, Directive, Fill, NoteKind, View};
 
 /// What an NFF file held.
@@ -139,12 +139,23 @@ pub fn load(path: &Path) -> Result<SceneDesc, SceneError> {
     import(path).map(|i| i.desc)
 }
 
+/// [`load`] within the limits of `options` (its geometry within `max_geometry`).
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneError> {
+    import_with(path, options).map(|i| i.desc)
+}
+
 /// Loads an NFF file (plain or gzip) and counts what it held.
 pub fn import(path: &Path) -> Result<Imported, SceneError> {
+    import_with(path, &LoadOptions::default())
+}
+
+/// [`import`] within the limits of `options`: the geometry is counted as it is read, and an
+/// error names the file as soon as it holds more than `max_geometry`.
+pub fn import_with(path: &Path, options: &LoadOptions) -> Result<Imported, SceneError> {
     let reader = open(path)?;
     match reader {
-        Opened::Plain(r) => import_reader(r, path),
-        Opened::Gzip(r) => import_reader(r, path),
+        Opened::Plain(r) => import_limited(r, path, stream::BLOCK, options),
+        Opened::Gzip(r) => import_limited(r, path, stream::BLOCK, options),
     }
 }
 
@@ -238,7 +249,16 @@ pub fn import_reader_blocks(
     path: &Path,
     block: usize,
 ) -> Result<Imported, SceneError> {
-    let mut a = Assembler::new(path);
+    import_limited(reader, path, block, &LoadOptions::default())
+}
+
+fn import_limited(
+    reader: impl Read + Send,
+    path: &Path,
+    block: usize,
+    options: &LoadOptions,
+) -> Result<Imported, SceneError> {
+    let mut a = Assembler::new(path, options);
     stream::parse_stream(
         TextReader::new(reader, NFF_MAX_LINE),
         block.max(1),
@@ -251,7 +271,8 @@ pub fn import_reader_blocks(
 /// Parses NFF text held in memory; `path` names it in messages.
 pub fn parse_str(text: &str, path: &Path) -> Result<Imported, SceneError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut a = Assembler::new(path);
+    let options = LoadOptions::default();
+    let mut a = Assembler::new(path, &options);
     let block = stream::Block {
         text: text.as_bytes().to_vec(),
         next: None,
@@ -308,8 +329,11 @@ pub fn fov_of_angle(angle: f64, height: u32) -> f64 {
 type Rgb = [f64; 3];
 
 /// Puts parsed chunks together in file order.
-struct Assembler {
+struct Assembler<'o> {
     file: Arc<PathBuf>,
+    options: &'o LoadOptions,
+    /// Bytes of geometry held (the arrays' capacities), within `options.max_geometry`.
+    held: u64,
     /// Lines before the next chunk.
     line_base: u64,
     materials: Vec<(String, Spanned<MaterialDesc>)>,
@@ -327,10 +351,12 @@ struct Assembler {
     warning_of_kind: HashMap<NoteKind, usize>,
 }
 
-impl Assembler {
-    fn new(path: &Path) -> Assembler {
+impl<'o> Assembler<'o> {
+    fn new(path: &Path, options: &'o LoadOptions) -> Assembler<'o> {
         Assembler {
             file: Arc::new(path.to_path_buf()),
+            options,
+            held: 0,
             line_base: 0,
             materials: Vec::new(),
             material_ids: HashMap::new(),
@@ -356,7 +382,7 @@ impl Assembler {
     fn block(&mut self, results: Vec<Result<ChunkOut, ChunkError>>) -> Result<(), SceneError> {
         for r in results {
             match r {
-                Ok(chunk) => self.chunk(chunk),
+                Ok(chunk) => self.chunk(chunk)?,
                 Err(e) => {
                     return Err(SceneError::At {
                         at: self.origin(e.at),
@@ -368,7 +394,8 @@ impl Assembler {
         Ok(())
     }
 
-    fn chunk(&mut self, c: ChunkOut) {
+    fn chunk(&mut self, c: ChunkOut) -> Result<(), SceneError> {
+        self.hold(&c)?;
         let ids: Vec<usize> = c
             .fills
             .iter()
@@ -436,6 +463,34 @@ impl Assembler {
         self.stats += c.stats;
         self.stats.lines += c.lines as u64;
         self.line_base += c.lines as u64;
+        Ok(())
+    }
+
+    /// Counts a chunk's geometry (its arrays' capacities) against `max_geometry`.
+    fn hold(&mut self, c: &ChunkOut) -> Result<(), SceneError> {
+        fn held<T>(v: &Vec<T>) -> u64 {
+            (v.capacity() * std::mem::size_of::<T>()) as u64
+        }
+        for b in &c.buckets {
+            self.held += held(&b.spheres)
+                + held(&b.cones)
+                + held(&b.positions)
+                + held(&b.normals)
+                + held(&b.indices);
+        }
+        if self.held <= self.options.max_geometry {
+            return Ok(());
+        }
+        let mut s = self.stats;
+        s += c.stats;
+        let what = format!(
+            "its {} spheres, {} cones and {} triangles up to line {}",
+            s.spheres,
+            s.cones,
+            s.triangles,
+            self.line_base + c.lines as u64
+        );
+        Err(self.options.over_geometry(&self.file, &what, self.held))
     }
 
     fn material(&mut self, f: Fill, at: parse::Loc) -> usize {

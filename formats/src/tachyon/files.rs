@@ -7,20 +7,15 @@
 
 use std::path::{Path, PathBuf};
 
-/// The largest Tachyon file read (scene, INCLUDE or `.tpoly`): VMD writes big scenes, but a
-/// gigabyte of text is far beyond any; the cap stops a sparse file or a device name from being
-/// read without end.
-const MAX_FILE_BYTES: u64 = 1 << 30;
-
-/// Reads a text file whole: regular files only (checked by type before opening, as every
+/// Reads a text file of at most `max` bytes whole: regular files only (checked by type before opening, as every
 /// reader of Luxon does; see `luxon_plugin::files`), a leading UTF-8 byte-order mark skipped.
 /// Bytes that are not UTF-8 become U+FFFD (names and paths in Tachyon files are ASCII; this
 /// only keeps a stray Latin-1 comment from stopping the load).
 ///
 /// Every file the importer reads goes through here (the scene, INCLUDEs, `.tpoly` files).
-pub(super) fn read_text(path: &Path) -> std::io::Result<String> {
+pub(super) fn read_text(path: &Path, max: u64) -> std::io::Result<String> {
     use luxon_plugin::files::{read_capped, FileError};
-    let bytes = read_capped(path, MAX_FILE_BYTES).map_err(|e| match e {
+    let bytes = read_capped(path, max).map_err(|e| match e {
         FileError::Io(e) => e,
         FileError::Missing => std::io::ErrorKind::NotFound.into(),
         other => std::io::Error::new(std::io::ErrorKind::InvalidData, other),

@@ -214,7 +214,7 @@ pub fn is_tachyon_path(path: &Path) -> bool {
 
 /// Reads a Tachyon scene file (and its INCLUDEs, `.tpoly` files) into its syntax tree.
 pub fn parse_file(path: &Path) -> Result<syntax::Scene, SceneError> {
-    parse::parse_file(path)
+    parse::parse_file(path, options::MAX_TEXT)
 }
 
 /// Loads a Tachyon scene file as a Luxon scene (no outputs: the command line gives them).
@@ -241,5 +241,5 @@ pub fn camera_at(
 
 /// [`load`] with Tachyon's command-line overrides (`luxon tachyon`).
 pub fn load_with(path: &Path, options: &Options) -> Result<SceneDesc, SceneError> {
-    map::to_desc(parse::parse_file(path)?, options)
+    map::to_desc(parse::parse_file(path, options.max_text)?, options)
 }

@@ -6,6 +6,9 @@
 use super::syntax::ShadeLevel;
 use crate::origin::Origin;
 
+/// The default of [`Options::max_text`].
+pub(super) const MAX_TEXT: u64 = 1 << 30;
+
 /// Tachyon's highlight formulas (`-shade_*`): a global choice in Tachyon.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Highlights {
@@ -57,6 +60,11 @@ pub struct Options {
     pub light_scale: Option<f64>,
     /// `-auto_skylight` / `-add_skylight` (the first wins when both are given, as in Tachyon).
     pub skylight: Option<Skylight>,
+    /// Bytes of text the scene's files may hold together (the scene, its INCLUDEs and
+    /// `.tpoly` files): the syntax tree and the scene grow with it. Default: 1 GiB (VMD writes
+    /// big scenes, but a gigabyte of text is far beyond any); the core sets it from the memory
+    /// budget. It also stops a sparse file or a device from being read without end.
+    pub max_text: u64,
     /// Where the options come from, for the warnings about them.
     pub at: Origin,
 }
@@ -76,6 +84,7 @@ impl Options {
             highlights: None,
             light_scale: None,
             skylight: None,
+            max_text: MAX_TEXT,
             at,
         }
     }

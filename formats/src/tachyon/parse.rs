@@ -64,9 +64,10 @@ const NOT_IN_099: &[&str] = &[
     "MGFFILE",
 ];
 
-/// Reads the scene file at `path` and everything it includes.
-pub(super) fn parse_file(path: &Path) -> Result<Scene> {
-    let text = files::read_text(path).map_err(|source| SceneError::Io {
+/// Reads the scene file at `path` and everything it includes, `max_text` bytes of text at most
+/// (the scene, its INCLUDEs and `.tpoly` files together).
+pub(super) fn parse_file(path: &Path, max_text: u64) -> Result<Scene> {
+    let text = files::read_text(path, max_text).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -74,6 +75,7 @@ pub(super) fn parse_file(path: &Path) -> Result<Scene> {
         statements: Vec::new(),
         warnings: Vec::new(),
         chain: vec![canonical(path)],
+        text_left: max_text.saturating_sub(text.len() as u64),
     };
     let file = Arc::new(path.to_path_buf());
     let mut p = Parser {
@@ -95,12 +97,14 @@ pub(super) fn parse_file(path: &Path) -> Result<Scene> {
 }
 
 /// Reads the triangles of a `.tpoly` file: records of `3` and three vertices (9 numbers),
-/// until a count other than 3 or the end of the file (Tachyon's rule).
-pub(super) fn read_tpoly(path: &Path) -> Result<Vec<[V3; 3]>> {
-    let text = files::read_text(path).map_err(|source| SceneError::Io {
+/// until a count other than 3 or the end of the file (Tachyon's rule). At most `text_left`
+/// bytes, which its size is taken from.
+pub(super) fn read_tpoly(path: &Path, text_left: &mut u64) -> Result<Vec<[V3; 3]>> {
+    let text = files::read_text(path, *text_left).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    *text_left = text_left.saturating_sub(text.len() as u64);
     let mut lex = Lexer::new(&text, Arc::new(path.to_path_buf()));
     let mut triangles = Vec::new();
     while let Some(w) = lex.next_word() {
@@ -201,6 +205,8 @@ struct Context {
     warnings: Vec<Spanned<String>>,
     /// The files being read, outermost first (canonical paths): INCLUDE cycles.
     chain: Vec<PathBuf>,
+    /// Bytes of text the files not yet read may hold.
+    text_left: u64,
 }
 
 /// One file's reader.
@@ -1265,7 +1271,7 @@ impl<'a> Parser<'a, '_> {
         let tex = self.texref()?;
         let path = files::find(&file.value, &self.dir)
             .map_err(|why| SceneError::at(file.at.clone(), format!("TPOLYFILE: {why}")))?;
-        let triangles = read_tpoly(&path).map_err(|e| match e {
+        let triangles = read_tpoly(&path, &mut self.cx.text_left).map_err(|e| match e {
             SceneError::Io { path, source } => SceneError::at(
                 file.at.clone(),
                 format!("TPOLYFILE: cannot read {}: {source}", path.display()),
@@ -1311,12 +1317,13 @@ impl<'a> Parser<'a, '_> {
                 format!("INCLUDEs nest deeper than {MAX_INCLUDE_DEPTH} files"),
             ));
         }
-        let text = files::read_text(&path).map_err(|e| {
+        let text = files::read_text(&path, self.cx.text_left).map_err(|e| {
             SceneError::at(
                 written.at.clone(),
                 format!("INCLUDE: cannot read {}: {e}", path.display()),
             )
         })?;
+        self.cx.text_left = self.cx.text_left.saturating_sub(text.len() as u64);
         self.push(
             at,
             Kind::Include {

@@ -145,7 +145,10 @@ fn seconds(d: Duration) -> f64 {
 /// Loads, builds and renders one scene file (every frame of the camera file, if any).
 fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
     let t0 = Instant::now();
-    let mut desc = luxon_formats::tachyon::load_with(path, &plan.scene)?;
+    // The scene's text within the machine's default budget (Tachyon's options set none).
+    let mut options = plan.scene.clone();
+    options.max_text = Budget::for_load(None, 1).load_options().max_scene_bytes;
+    let mut desc = luxon_formats::tachyon::load_with(path, &options)?;
     super::warn_scene(&desc);
     if plan.threads.is_some() {
         desc.render.parallel.threads = plan.threads;
