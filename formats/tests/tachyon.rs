@@ -683,6 +683,9 @@ fn texture_functions() {
         format!("8 missing.ppm {frame}"),
         "11".to_string(),
         format!("9 img.ppm {frame} UAXIS 1 0 0 VAXIS 1 1 0"),
+        format!("4 {frame}"),
+        format!("6 {frame}"),
+        "4 CENTER 0 0 0 ROTATE 0 0 0 SCALE 1 0 1".to_string(),
     ];
     let mut text = HEAD.to_string();
     for (i, f) in funcs.iter().enumerate() {
@@ -715,9 +718,8 @@ fn texture_functions() {
     let (plugin, p1) = params(1).unwrap();
     assert_eq!(plugin, "noise");
     assert!(p1.contains("from: (0.16000000000000003, 0.16000000000000003, 0.16000000000000003), to: (0.2, 0.2, 0.2)"), "{p1}");
-    // Marble is not rendered yet: the colour, with a warning.
-    assert!(params(2).is_none());
-    assert!(warned(&d, "TEXFUNC 3 (marble)"));
+    // Marble: Tachyon's, which takes no parameters.
+    assert_eq!(params(2).unwrap(), ("tachyon_marble".into(), "()".into()));
     // Cylindrical: u·2 + 0.25; v·(-4) + 0.5 flipped for a PPM: 1 - (…) = v·4 + 0.5.
     let (plugin, p3) = params(3).unwrap();
     assert_eq!(plugin, "image");
@@ -748,6 +750,26 @@ fn texture_functions() {
     assert_eq!(d.materials[6].1.value.color, [0.7000000000000001; 3]);
     // Skewed planar axes cannot be placed yet.
     assert!(warned(&d, "not perpendicular"));
+    // Wood and the cylindrical checker: Tachyon's, the centre mirrored (and wood's SCALE.z, so
+    // that the texture sees Tachyon's coordinates).
+    assert_eq!(
+        params(8).unwrap(),
+        (
+            "tachyon_wood".into(),
+            "(center: (1.0, 2.0, -3.0), scale: (2.0, -4.0, -1.0))".into()
+        )
+    );
+    assert_eq!(
+        params(9).unwrap(),
+        (
+            "tachyon_cylinder_checker".into(),
+            "(center: (1.0, 2.0, -3.0))".into()
+        )
+    );
+    // Wood with a SCALE of 0 divides by zero in Tachyon: the colour, with a warning.
+    assert!(params(10).is_none());
+    assert!(warned(&d, "SCALE of 0"));
+    assert!(!warned(&d, "not rendered yet"));
 }
 
 #[test]

@@ -307,15 +307,20 @@ impl Materials {
                 SolidKind::Grit => (c, Some(grit(c))),
                 // Tachyon clamps its noise, which is almost always above 1: plain COLOR.
                 SolidKind::Gnoise => (c, None),
-                SolidKind::Marble | SolidKind::Wood | SolidKind::CylChecker => {
-                    let name = match kind {
-                        SolidKind::Marble => "TEXFUNC 3 (marble)",
-                        SolidKind::Wood => "TEXFUNC 4 (wood)",
-                        _ => "TEXFUNC 6 (cylindrical checker)",
-                    };
-                    notes.add(name, "is not rendered yet; its COLOR is shown instead", at);
-                    (c, None)
-                }
+                // Tachyon's marble ignores every parameter and COLOR.
+                SolidKind::Marble => (c, Some(("tachyon_marble".into(), "()".into()))),
+                SolidKind::Wood => match wood(frame) {
+                    Some(t) => (c, Some(t)),
+                    None => {
+                        notes.add(
+                            "TEXFUNC 4 (wood) with a SCALE of 0",
+                            "divides by zero in Tachyon; its COLOR is shown instead",
+                            at,
+                        );
+                        (c, None)
+                    }
+                },
+                SolidKind::CylChecker => (c, Some(cylinder_checker(frame))),
             },
             TexFunc::Image {
                 kind,
@@ -568,6 +573,33 @@ fn checker(frame: &Frame) -> (String, String) {
             float(1.0 / 3.0),
             vec3(corner)
         ),
+    )
+}
+
+/// TEXFUNC 4: Tachyon's rings about the y axis through CENTER, the point divided by SCALE
+/// (ROTATE and COLOR ignored). The world is mirrored in z, so CENTER is mirrored and SCALE.z
+/// negated: the texture then sees Tachyon's coordinates. `None` for a SCALE with a 0.
+fn wood(frame: &Frame) -> Option<(String, String)> {
+    let [sx, sy, sz] = frame.scale;
+    if frame.scale.contains(&0.0) {
+        return None;
+    }
+    Some((
+        "tachyon_wood".into(),
+        format!(
+            "(center: {}, scale: {})",
+            vec3(mirror(frame.center)),
+            vec3([sx, sy, -sz])
+        ),
+    ))
+}
+
+/// TEXFUNC 6: Tachyon's sectors about the z axis through CENTER (symmetric in z, so the
+/// mirrored CENTER is all the mirror needs); ROTATE, SCALE and COLOR ignored, as in Tachyon.
+fn cylinder_checker(frame: &Frame) -> (String, String) {
+    (
+        "tachyon_cylinder_checker".into(),
+        format!("(center: {})", vec3(mirror(frame.center))),
     )
 }
 

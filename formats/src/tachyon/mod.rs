@@ -141,7 +141,10 @@
 //! | 0 (and any number without a meaning) | the colour |
 //! | 1 checker | the `checker` texture, exactly Tachyon's: cells ⅓ wide with boundaries ⅙ from CENTER, odd cells (1, 0.2, 0), even (0, 0.2, 1); COLOR, ROTATE, SCALE ignored as in Tachyon |
 //! | 2 grit | the `noise` texture from 0.8·COLOR to COLOR, fine-grained (Tachyon draws a new random factor at every lookup) |
+//! | 3 marble | the `tachyon_marble` texture: Tachyon's formula and its value noise (the same lattice from the same random sequence, integer interpolation), so the same veins; CENTER, ROTATE, SCALE and COLOR are ignored, as in Tachyon. Measured: within a few codes of Tachyon's pixels, which read the hit point in single precision, except on the pattern's jumps |
+//! | 4 wood | the `tachyon_wood` texture: Tachyon's rings about the y axis through CENTER, the point divided by SCALE per axis, (0.8, 1, 0.2) and black; CENTER mirrored and SCALE.z negated, so the texture sees Tachyon's coordinates (the rings' wave is not symmetric in z); ROTATE and COLOR ignored, as in Tachyon; a SCALE with a 0 (Tachyon divides by it) shows COLOR, with a warning |
 //! | 5 gradient noise | the colour (Tachyon's noise value is clamped to 1 almost everywhere) |
+//! | 6 cylindrical checker | the `tachyon_cylinder_checker` texture: 18 sectors about the z axis through CENTER (the angle from +x toward +y) by bands 0.1 high along it, counted from CENTER by \|height\|, odd cells (1, 0.2, 0), even (0, 0.2, 1); CENTER mirrored; ROTATE, SCALE and COLOR ignored, as in Tachyon |
 //! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: bilinear` (Tachyon's MIP blur grows with the distance travelled, not with the pixel's footprint: plain bilinear lookups look closer to it than Luxon's footprint MIP) |
 //!
 //! ## Geometry
@@ -167,8 +170,7 @@
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
 //! renders them: BACKGROUND_GRADIENT; the FISHEYE projection (Tachyon's is a latitude/longitude
 //! window, rendered as Luxon's circular fisheye of the same height); vertex colours (VCSTRI,
-//! VERTEXARRAY COLORS); TEXFUNC 3 (marble), 4
-//! (wood), 6 (cylindrical checker) and 10 (IMAGEDEF volume textures), and image maps whose
+//! VERTEXARRAY COLORS); TEXFUNC 10 (IMAGEDEF volume textures), and image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
 //! Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider

@@ -14,6 +14,9 @@
 //! | `wood`     | growth rings around an axis, wobbled by noise |
 //! | `noise`    | Perlin's improved gradient noise, fractal ("grit") |
 //! | `image`    | an image file (PNG, JPEG, TGA, PPM, EXR), mapped, tiled, MIP-mapped, cached |
+//! | `tachyon_marble` | Tachyon's TEXFUNC 3 (marble), as Tachyon computes it |
+//! | `tachyon_wood` | Tachyon's TEXFUNC 4 (wood) |
+//! | `tachyon_cylinder_checker` | Tachyon's TEXFUNC 6 (cylindrical checker) |
 //!
 //! ## Placement of solid textures
 //!
@@ -127,6 +130,34 @@
 //! divided by the total amplitude, so every octave count keeps the range. One octave of noise is
 //! exactly 0 (weight 0.5) at whole pattern coordinates.
 //!
+//! `tachyon_marble`, `tachyon_wood`, `tachyon_cylinder_checker`
+//!
+//! Tachyon's procedural textures, for scenes imported from Tachyon (`.dat`): the formulas of
+//! Tachyon 0.99b6, measured against `tachyon-nox` pixel by pixel (`tachyon.rs`). They take
+//! Tachyon's own parameters instead of the shared placement (Tachyon ignores ROTATE). Colours
+//! are Tachyon's display values, as the importer keeps every Tachyon colour.
+//!
+//! | texture | name     | type        | default | meaning |
+//! |---------|----------|-------------|---------|---------|
+//! | `tachyon_marble` | — | | | no parameters: Tachyon's marble ignores CENTER, ROTATE, SCALE and COLOR |
+//! | `tachyon_wood` | `center` | `(x, y, z)` | `(0, 0, 0)` | the rings' axis runs through it along y |
+//! | | `scale` | f64 or `(x, y, z)`, not 0 | `1.0` | the point is `(p - center) / scale` per axis (a negative factor mirrors) |
+//! | | `light` | `(r, g, b)` | `(0.8, 1, 0.2)` | the rings |
+//! | | `dark` | `(r, g, b)` | `(0, 0, 0)` | between them |
+//! | `tachyon_cylinder_checker` | `center` | `(x, y, z)` | `(0, 0, 0)` | the axis runs through it along z |
+//! | | `even` | `(r, g, b)` | `(0, 0.2, 1)` | cells whose sector and band sum to an even number |
+//! | | `odd` | `(r, g, b)` | `(1, 0.2, 0)` | the others |
+//!
+//! - Marble: with Tachyon's value noise `n(p)` (a 28³ lattice of integers 0..12000 filled from
+//!   the sequence s ← 1099087573·s mod 2³², s₀ = 1234567, interpolated from |x|, |y|, |z| in
+//!   integer steps; the point in single precision, as Tachyon reads it), `d = x + 0.0006·n`,
+//!   `d ← d·(trunc(d) mod 25)`, `i = clamp(0.1·|d − 10 − trunc(d)|, 0, 1)`, colour
+//!   `((1 + sin 6.28i)/2, (1 + sin 16.28i)/2, (1 + cos 30.28i)/2)`: bands across x.
+//! - Wood: with `q = (p − center)/scale`, `r = hypot(q.x, q.z) + 3·sin(20·atan(q.x/q.z) +
+//!   q.y/150)`; `light` where `trunc(r + 0.5) mod 60 < 40` (C's remainder), else `dark`.
+//! - Cylindrical checker: with `q = p − center`, `u` = the angle of `(q.x, q.y)` from +x toward
+//!   +y in turns, cell `floor(18·u) + floor(10·|q.z|)`.
+//!
 //! `image`
 //!
 //! | name      | type | default    | meaning |
@@ -192,6 +223,9 @@
 //!     )),
 //!     "earth": (plugin: "image", params: (file: "earth.jpg", mapping: spherical, center: (0, 1, 0))),
 //!     "label": (plugin: "image", params: (file: "label.exr", wrap: clamp, filter: bilinear)),
+//!     "veined": (plugin: "tachyon_marble", params: ()),
+//!     "rings": (plugin: "tachyon_wood", params: (center: (0, 2, -6), scale: (0.001, 0.001, -0.001))),
+//!     "stripes": (plugin: "tachyon_cylinder_checker", params: (center: (-2.5, -0.5, -5))),
 //! },
 //! materials: {
 //!     "floor": (texture: "tiles", diffuse: 0.8),
@@ -213,6 +247,7 @@ mod noise;
 mod params;
 mod procedural;
 mod reduce;
+mod tachyon;
 mod texels;
 mod transform;
 mod tree;
@@ -222,11 +257,24 @@ mod testutil;
 
 pub use crate::image::ImageTexture;
 pub use procedural::{Checker, Constant, Gradient, Marble, Noise, Wood};
+pub use tachyon::{TachyonCylinderChecker, TachyonMarble, TachyonWood};
 pub use tree::Blend;
 
 luxon_plugin::export!(
     library: "luxon-textures",
-    textures: [Constant, Checker, Blend, Gradient, Marble, Wood, Noise, ImageTexture]
+    textures: [
+        Constant,
+        Checker,
+        Blend,
+        Gradient,
+        Marble,
+        Wood,
+        Noise,
+        ImageTexture,
+        TachyonMarble,
+        TachyonWood,
+        TachyonCylinderChecker
+    ]
 );
 
 #[cfg(test)]

@@ -943,6 +943,9 @@ mod tests {
             Noise::PARAMS,
             crate::tree::Blend::PARAMS,
             crate::image::ImageTexture::PARAMS,
+            crate::tachyon::TachyonMarble::PARAMS,
+            crate::tachyon::TachyonWood::PARAMS,
+            crate::tachyon::TachyonCylinderChecker::PARAMS,
         ] {
             for line in params.lines() {
                 assert!(line.contains(": ") && line.contains(" = "), "{line}");

@@ -1,0 +1,592 @@
+//! Tachyon's procedural textures (TEXFUNC 3 marble, 4 wood, 6 cylindrical checker), computed
+//! as Tachyon 0.99b6 computes them, so that scenes imported from Tachyon look as Tachyon draws
+//! them. The formulas were measured against `tachyon-nox` pixel by pixel
+//! (`/work/notes/tachyon-mapping.md` §5.9); the tests hold values read from its images.
+//!
+//! They take Tachyon's own parameters (`center`, `scale`), not the shared placement: Tachyon
+//! ignores ROTATE, and marble ignores every parameter. Points are in the scene's world; the
+//! Tachyon importer mirrors Tachyon's left-handed world by negating z, and passes `center` and
+//! `scale` so that each pattern sees Tachyon's coordinates (marble and the cylindrical
+//! checker are symmetric in z; wood's `scale.z` is negated).
+
+use crate::params::{color, Factors};
+use luxon_plugin::abi::TexQuery;
+use luxon_plugin::{finite, Context, Describe, Error, Texture};
+use serde::Deserialize;
+use std::f64::consts::{FRAC_PI_2, TAU};
+use std::sync::OnceLock;
+
+/// Cells per axis of Tachyon's noise lattice.
+const N: usize = 28;
+
+/// Tachyon's noise lattice, flattened x-major (`(x·28 + y)·28 + z`), followed by zeros: its
+/// lookups read one cell past the last index of an axis (index 28), which in the flat table
+/// is the next row, or past the end of the table (where Tachyon finds zeros: measured).
+fn lattice() -> &'static [i32] {
+    static TABLE: OnceLock<Vec<i32>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let at = |x: usize, y: usize, z: usize| (x * N + y) * N + z;
+        // The last flat index a lookup reaches is at(28, 28, 28).
+        let mut t = vec![0i32; at(N, N, N) + 1];
+        // Filled in x, y, z order from the generator s ← 1099087573·s mod 2³², s₀ = 1234567.
+        let mut s: u32 = 1_234_567;
+        for x in 0..N {
+            for y in 0..N {
+                for z in 0..N {
+                    s = s.wrapping_mul(1_099_087_573);
+                    t[at(x, y, z)] = (f64::from(s) * 2.328_306_436_5e-10 * 12000.0) as i32;
+                }
+            }
+        }
+        // Index 27 repeats index 0 on every axis.
+        let last = N - 1;
+        for x in 0..N {
+            for y in 0..N {
+                for z in 0..N {
+                    let k = |i: usize| if i == last { 0 } else { i };
+                    t[at(x, y, z)] = t[at(k(x), k(y), k(z))];
+                }
+            }
+        }
+        t
+    })
+}
+
+/// Tachyon's value noise at `p`: 0..12000, interpolated trilinearly in integer steps (each
+/// lerp `a + trunc((b - a)·f)`, x first, then y, then z), from |x|, |y|, |z|.
+fn noise(p: [f64; 3]) -> i64 {
+    let t = lattice();
+    let p = p.map(f64::abs);
+    // `as` saturates far away (and maps NaN to 0): no panic, some lattice cell.
+    let i = p.map(|v| (v as i64).rem_euclid(N as i64) as usize);
+    let f = p.map(f64::fract);
+    let g = |dx: usize, dy: usize, dz: usize| {
+        i64::from(t[((i[0] + dx) * N + i[1] + dy) * N + i[2] + dz])
+    };
+    let lerp = |a: i64, b: i64, f: f64| a + ((b - a) as f64 * f) as i64;
+    let x00 = lerp(g(0, 0, 0), g(1, 0, 0), f[0]);
+    let x01 = lerp(g(0, 0, 1), g(1, 0, 1), f[0]);
+    let x10 = lerp(g(0, 1, 0), g(1, 1, 0), f[0]);
+    let x11 = lerp(g(0, 1, 1), g(1, 1, 1), f[0]);
+    let y0 = lerp(x00, x10, f[1]);
+    let y1 = lerp(x01, x11, f[1]);
+    lerp(y0, y1, f[2])
+}
+
+/// C's `(int) v`: toward zero, saturating.
+fn trunc(v: f64) -> i64 {
+    v as i64
+}
+
+// ------------------------------------------------------------------------------------------------
+// marble (TEXFUNC 3)
+// ------------------------------------------------------------------------------------------------
+
+/// Tachyon's marble: bands across x, bent by its value noise, in fixed colours.
+pub struct TachyonMarble;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoParams {}
+
+impl Describe for TachyonMarble {
+    const NAME: &'static str = "tachyon_marble";
+    const DESCRIPTION: &'static str =
+        "Tachyon's TEXFUNC 3 (marble), as Tachyon 0.99b6 computes it; no parameters (Tachyon ignores CENTER, ROTATE, SCALE and COLOR).";
+    const PARAMS: &'static str = "";
+}
+
+impl Texture for TachyonMarble {
+    type Params = NoParams;
+
+    fn create(_p: NoParams, _ctx: &Context) -> Result<Self, Error> {
+        Ok(TachyonMarble)
+    }
+
+    // Tachyon's factor 6.28 is not quite 2π; the pattern needs its value.
+    #[allow(clippy::approx_constant)]
+    fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        // Tachyon reads the hit point in single precision (measured: it matches more pixels).
+        let p = q.p.map(|v| v as f32 as f64);
+        let mut d = p[0] + 0.0006 * noise(p) as f64;
+        d *= (trunc(d) % 25) as f64;
+        let i = (0.1 * (d - 10.0 - 20.0 * (trunc(d) as f64 * 0.05)).abs()).clamp(0.0, 1.0);
+        let c = [
+            0.5 * (1.0 + (i * 6.28).sin()),
+            0.5 * (1.0 + (i * 16.28).sin()),
+            0.5 * (1.0 + (i * 30.28).cos()),
+        ];
+        [c[0] as f32, c[1] as f32, c[2] as f32, 1.0]
+    }
+}
+
+// ------------------------------------------------------------------------------------------------
+// wood (TEXFUNC 4)
+// ------------------------------------------------------------------------------------------------
+
+/// Tachyon's wood: rings around the y axis through `center`, waved by the angle.
+pub struct TachyonWood {
+    center: [f64; 3],
+    scale: [f64; 3],
+    light: [f32; 4],
+    dark: [f32; 4],
+}
+
+fn wood_light() -> [f64; 3] {
+    [0.8, 1.0, 0.2]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WoodParams {
+    #[serde(default)]
+    center: [f64; 3],
+    #[serde(default)]
+    scale: Factors<3>,
+    #[serde(default = "wood_light")]
+    light: [f64; 3],
+    #[serde(default)]
+    dark: [f64; 3],
+}
+
+impl Describe for TachyonWood {
+    const NAME: &'static str = "tachyon_wood";
+    const DESCRIPTION: &'static str =
+        "Tachyon's TEXFUNC 4 (wood): rings around the y axis through `center`, as Tachyon 0.99b6 computes them.";
+    const PARAMS: &'static str = concat!(
+        "center: (x, y, z) = (0, 0, 0)  Tachyon's CENTER: the rings' axis runs through it along y\n",
+        "scale: f64 or (x, y, z) = 1.0  Tachyon's SCALE: the point is (p - center) / scale per axis (not 0; negative mirrors)\n",
+        "light: (r, g, b) = (0.8, 1, 0.2)  the rings' colour (Tachyon's)\n",
+        "dark: (r, g, b) = (0, 0, 0)  between the rings (Tachyon's)"
+    );
+}
+
+impl Texture for TachyonWood {
+    type Params = WoodParams;
+
+    fn create(p: WoodParams, _ctx: &Context) -> Result<Self, Error> {
+        Ok(TachyonWood {
+            center: finite("center", p.center)?,
+            scale: p.scale.nonzero("scale")?,
+            light: color("light", p.light)?,
+            dark: color("dark", p.dark)?,
+        })
+    }
+
+    fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        let [x, y, z]: [f64; 3] =
+            std::array::from_fn(|k| (q.p[k] - self.center[k]) / self.scale[k]);
+        let angle = if z == 0.0 { FRAC_PI_2 } else { (x / z).atan() };
+        let r = x.hypot(z) + 3.0 * (20.0 * angle + y / 150.0).sin();
+        // C's `(int)(r + 0.5) % 60`: truncated, so rings near the axis (r < -0.5) count as
+        // negative, below 40, light.
+        if trunc(r + 0.5) % 60 < 40 {
+            self.light
+        } else {
+            self.dark
+        }
+    }
+}
+
+// ------------------------------------------------------------------------------------------------
+// cylindrical checker (TEXFUNC 6)
+// ------------------------------------------------------------------------------------------------
+
+/// Tachyon's cylindrical checker: 18 sectors around the z axis through `center`, bands a tenth
+/// high along it.
+pub struct TachyonCylinderChecker {
+    center: [f64; 3],
+    even: [f32; 4],
+    odd: [f32; 4],
+}
+
+fn checker_even() -> [f64; 3] {
+    [0.0, 0.2, 1.0]
+}
+
+fn checker_odd() -> [f64; 3] {
+    [1.0, 0.2, 0.0]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderCheckerParams {
+    #[serde(default)]
+    center: [f64; 3],
+    #[serde(default = "checker_even")]
+    even: [f64; 3],
+    #[serde(default = "checker_odd")]
+    odd: [f64; 3],
+}
+
+impl Describe for TachyonCylinderChecker {
+    const NAME: &'static str = "tachyon_cylinder_checker";
+    const DESCRIPTION: &'static str =
+        "Tachyon's TEXFUNC 6 (cylindrical checker): 18 sectors around the z axis through `center` by bands 0.1 high, as Tachyon 0.99b6 computes them.";
+    const PARAMS: &'static str = concat!(
+        "center: (x, y, z) = (0, 0, 0)  Tachyon's CENTER: the axis runs through it along z\n",
+        "even: (r, g, b) = (0, 0.2, 1)  cells whose sector and band numbers sum to an even number (Tachyon's colour)\n",
+        "odd: (r, g, b) = (1, 0.2, 0)  the other cells (Tachyon's colour)"
+    );
+}
+
+impl Texture for TachyonCylinderChecker {
+    type Params = CylinderCheckerParams;
+
+    fn create(p: CylinderCheckerParams, _ctx: &Context) -> Result<Self, Error> {
+        Ok(TachyonCylinderChecker {
+            center: finite("center", p.center)?,
+            even: color("even", p.even)?,
+            odd: color("odd", p.odd)?,
+        })
+    }
+
+    fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        let [x, y, z]: [f64; 3] = std::array::from_fn(|k| q.p[k] - self.center[k]);
+        // u: the angle about z from +x toward +y, in turns; v: the height along z.
+        let r = x.hypot(y);
+        let mut u = if r > 0.0 {
+            (x / r).clamp(-1.0, 1.0).acos() / TAU
+        } else {
+            0.0
+        };
+        if y < 0.0 {
+            u = 1.0 - u;
+        }
+        let k = (u.abs() * 18.0).floor() as i64 + (z.abs() * 10.0).floor() as i64;
+        if k % 2 == 0 {
+            self.even
+        } else {
+            self.odd
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{at, make};
+
+    /// Tachyon's 8-bit value of a colour: floor(255·c).
+    fn code(c: [f32; 4]) -> [i32; 3] {
+        [0, 1, 2].map(|k| (255.0 * f64::from(c[k])) as i32)
+    }
+
+    /// Pixels of `tachyon-nox` images of a plane with TEXFUNC 3 (orthographic view, ambient 1):
+    /// the hit point and the pixel. The second group lies where lookups reach lattice index 28
+    /// (x, y and z near 27.5).
+    const MARBLE: [([f64; 3], [i32; 3]); 16] = [
+        ([12.133333333333333, 10.266666666666666, 2.6], [69, 204, 4]),
+        ([6.300000000000001, 4.433333333333333, 2.6], [94, 141, 33]),
+        ([12.966666666666669, 11.1, 2.6], [89, 154, 18]),
+        ([11.3, 8.6, 2.6], [110, 97, 103]),
+        ([10.466666666666669, 10.266666666666666, 2.6], [68, 205, 5]),
+        ([6.300000000000001, 5.266666666666667, 2.6], [75, 188, 0]),
+        ([9.633333333333333, 6.1, 2.6], [94, 139, 36]),
+        ([12.133333333333333, 6.1, 2.6], [64, 216, 15]),
+        (
+            [26.416666666666668, 28.666666666666668, 27.6],
+            [58, 227, 33],
+        ),
+        (
+            [28.083333333333332, 26.166666666666668, 27.6],
+            [97, 131, 45],
+        ),
+        ([29.333333333333332, 29.5, 27.6], [109, 101, 96]),
+        (
+            [25.583333333333332, 27.833333333333332, 27.6],
+            [98, 129, 49],
+        ),
+        (
+            [29.333333333333332, 29.083333333333332, 27.6],
+            [102, 119, 65],
+        ),
+        ([27.25, 26.583333333333332, 27.6], [122, 68, 160]),
+        ([28.083333333333332, 27.0, 27.6], [77, 185, 0]),
+        ([26.0, 26.583333333333332, 27.6], [102, 118, 67]),
+    ];
+
+    #[test]
+    fn marble_matches_tachyon() {
+        let t: TachyonMarble = make("()").unwrap();
+        for (p, want) in MARBLE {
+            let got = code(at(&t, p));
+            assert!(
+                (0..3).all(|k| (got[k] - want[k]).abs() <= 1),
+                "{p:?}: {got:?}, Tachyon {want:?}"
+            );
+            // Symmetric in z (Tachyon's noise takes |z|): the importer's mirror changes nothing.
+            assert_eq!(at(&t, p), at(&t, [p[0], p[1], -p[2]]));
+        }
+        assert!(make::<TachyonMarble>("(scale: 2)").is_err());
+    }
+
+    #[test]
+    fn noise_lattice_is_tachyons() {
+        let t = lattice();
+        // Index 27 repeats index 0; beyond the table, zeros.
+        let at = |x: usize, y: usize, z: usize| t[(x * N + y) * N + z];
+        assert_eq!(at(27, 5, 9), at(0, 5, 9));
+        assert_eq!(at(3, 27, 27), at(3, 0, 0));
+        assert_eq!(t[N * N * N], 0);
+        assert!(t[..N * N * N].iter().all(|v| (0..12000).contains(v)));
+        // Whole points give lattice values; far and odd points do not panic.
+        assert_eq!(noise([1.0, 2.0, 3.0]), i64::from(at(1, 2, 3)));
+        assert_eq!(noise([-1.0, 2.0, -3.0]), i64::from(at(1, 2, 3)));
+        let _ = noise([1e300, f64::NAN, -f64::INFINITY]);
+    }
+
+    /// `tachyon-nox` images (24×24) of a plane y = 0.4 seen from above with TEXFUNC 4: `#` the
+    /// rings' colour (0.8, 1, 0.2), `.` black. Pixel (row r, column i) is the point
+    /// (x0 + (i + 1)·step, 0.4, z0 − r·step).
+    struct Image {
+        center: [f64; 3],
+        scale: [f64; 3],
+        x0: f64,
+        z0: f64,
+        step: f64,
+        rows: [&'static str; 24],
+    }
+
+    const WOOD: [Image; 4] = [
+        // Near the axis r < -0.5 happens: C's remainder keeps it below 40 (light), all light.
+        Image {
+            center: [0.2, 0.0, -0.3],
+            scale: [1.0; 3],
+            x0: -3.8,
+            z0: 3.7,
+            step: 1.0 / 3.0,
+            rows: ["########################"; 24],
+        },
+        Image {
+            center: [0.2, 0.0, -0.3],
+            scale: [1.0; 3],
+            x0: -30.0,
+            z0: 40.0,
+            step: 5.0,
+            rows: [
+                "....#..#.......#########",
+                "..######.#.....#########",
+                "##########.....#########",
+                "############.....#######",
+                "############.....#######",
+                "#############....#######",
+                "#############....#######",
+                "##############....######",
+                "##############...#######",
+                "#############....#######",
+                "##############...#######",
+                "############......######",
+                "#############...########",
+                "###########.....########",
+                ".##########.....########",
+                ".#.######......#########",
+                "...#..#.......#########.",
+                "..............#########.",
+                "...........############.",
+                "##.........############.",
+                "##.###.##############...",
+                "####################....",
+                "####################....",
+                "###################....#",
+            ],
+        },
+        // lscapes.dat's SCALE and CENTER.
+        Image {
+            center: [0.0, 2.0, 6.0],
+            scale: [0.001; 3],
+            x0: -0.03,
+            z0: 6.08,
+            step: 0.005,
+            rows: [
+                "################.......#",
+                "###################.....",
+                "####################....",
+                "####################....",
+                "###.##..#############...",
+                ".#.......#.###########..",
+                "............###########.",
+                "..............##########",
+                "....#.#.......##########",
+                ".#########....##########",
+                ".##########.....########",
+                "###########......#######",
+                "#############...########",
+                "#############....#######",
+                "#############.....######",
+                "##############...#######",
+                "#############....#######",
+                "##############....######",
+                "#############.....######",
+                "#############....#######",
+                "#############...########",
+                "############.....#######",
+                "##########......########",
+                ".#########.....#########",
+            ],
+        },
+        Image {
+            center: [0.5, 0.1, 0.7],
+            scale: [0.3, 2.0, 0.5],
+            x0: -10.0,
+            z0: 23.0,
+            step: 5.0 / 3.0,
+            rows: [
+                "............##########..",
+                ".....#.#......#########.",
+                "...#.#.#.......########.",
+                "...#####.#....#########.",
+                ".#########....#########.",
+                ".#########.#...########.",
+                ".###########....#######.",
+                "###########.....#######.",
+                "############....#######.",
+                "#############...########",
+                "############....########",
+                "############.....#######",
+                "#############....#######",
+                "#############....#######",
+                "############....#######.",
+                "#############...#######.",
+                "#############...#######.",
+                "#############....######.",
+                "############.....######.",
+                "############....########",
+                "############...#########",
+                "###########....#########",
+                "..#########....########.",
+                "..#######.#....########.",
+            ],
+        },
+    ];
+
+    fn v3(v: [f64; 3]) -> String {
+        format!("({}, {}, {})", v[0], v[1], v[2])
+    }
+
+    #[test]
+    fn wood_matches_tachyon() {
+        let light = [0.8f32, 1.0, 0.2, 1.0];
+        for img in &WOOD {
+            let t: TachyonWood = make(&format!(
+                "(center: {}, scale: {})",
+                v3(img.center),
+                v3(img.scale)
+            ))
+            .unwrap();
+            // The importer's mirror: z negated in the point, the centre and the scale.
+            let m: TachyonWood = make(&format!(
+                "(center: {}, scale: {})",
+                v3([img.center[0], img.center[1], -img.center[2]]),
+                v3([img.scale[0], img.scale[1], -img.scale[2]])
+            ))
+            .unwrap();
+            for (r, row) in img.rows.iter().enumerate() {
+                for (i, b) in row.bytes().enumerate() {
+                    let p = [
+                        img.x0 + (i + 1) as f64 * img.step,
+                        0.4,
+                        img.z0 - r as f64 * img.step,
+                    ];
+                    let want = if b == b'#' {
+                        light
+                    } else {
+                        [0.0, 0.0, 0.0, 1.0]
+                    };
+                    assert_eq!(at(&t, p), want, "{:?} row {r} column {i}", img.center);
+                    assert_eq!(
+                        at(&m, [p[0], p[1], -p[2]]),
+                        want,
+                        "mirrored, row {r} col {i}"
+                    );
+                }
+            }
+        }
+        for bad in [
+            "(scale: 0)",
+            "(scale: (1, NaN, 1))",
+            "(center: (inf, 0, 0))",
+            "(dark: (-1, 0, 0))",
+        ] {
+            assert!(make::<TachyonWood>(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// `tachyon-nox` images (24×24) of planes z = 0.37 and z = 0.28 facing the camera with
+    /// TEXFUNC 6 CENTER 0.3 −0.2 0.15: `#` (1, 0.2, 0), `.` (0, 0.2, 1). Pixel (r, i) is the
+    /// point (−1.1 + (i + 1)/8, 1.6 − r/8, z). The bands differ in parity: one image is the
+    /// other's negative.
+    const CYLINDER_037: [&str; 24] = [
+        "..######.....######.....",
+        "...#####.....#####......",
+        "....#####....#####......",
+        "....#####....####.......",
+        ".....####....####......#",
+        ".....####...####......##",
+        "#.....###...####.....###",
+        "##....###...###.....####",
+        "###....###..##....######",
+        "####....##..##...#######",
+        "#####...##.##...#######.",
+        ".######..#.##..#####....",
+        "....####.#.#..###.......",
+        ".......##..####.........",
+        "..........##............",
+        "#########...############",
+        "######...##.#..#########",
+        "####....#.#.##....######",
+        "#.....###.#..##......###",
+        ".....###..##.###.......#",
+        "....###...##..###.......",
+        "...####...##...####.....",
+        "..####...###...#####....",
+        "######...###....#####...",
+    ];
+    const CYLINDER_028: [&str; 24] = [
+        "##......#####......#####",
+        "###.....#####.....######",
+        "####.....####.....######",
+        "####.....####....#######",
+        "#####....####....######.",
+        "#####....###....######..",
+        ".#####...###....#####...",
+        "..####...###...#####....",
+        "...####...##..####......",
+        "....####..##..###.......",
+        ".....###..#..###.......#",
+        "#......##.#..##.....####",
+        "####....#.#.##...#######",
+        "#######..##....#########",
+        "##########..############",
+        ".........###............",
+        "......###..#.##.........",
+        "....####.#.#..####......",
+        ".#####...#.##..######...",
+        "#####...##..#...#######.",
+        "####...###..##...#######",
+        "###....###..###....#####",
+        "##....###...###.....####",
+        "......###...####.....###",
+    ];
+
+    #[test]
+    fn cylinder_checker_matches_tachyon() {
+        let t: TachyonCylinderChecker = make("(center: (0.3, -0.2, 0.15))").unwrap();
+        let odd = [1.0f32, 0.2, 0.0, 1.0];
+        let even = [0.0f32, 0.2, 1.0, 1.0];
+        for (z, rows) in [(0.37, CYLINDER_037), (0.28, CYLINDER_028)] {
+            for (r, row) in rows.iter().enumerate() {
+                for (i, b) in row.bytes().enumerate() {
+                    let p = [-1.1 + (i + 1) as f64 / 8.0, 1.6 - r as f64 / 8.0, z];
+                    let want = if b == b'#' { odd } else { even };
+                    assert_eq!(at(&t, p), want, "z {z} row {r} column {i}");
+                    // Mirrored about z = 0.15 (the importer's mirror negates z and the centre).
+                    assert_eq!(at(&t, [p[0], p[1], 0.3 - z]), want);
+                }
+            }
+        }
+        // On the axis: no NaN.
+        assert!(at(&t, [0.3, -0.2, 0.5]).iter().all(|c| c.is_finite()));
+        assert!(make::<TachyonCylinderChecker>("(odd: (0, -1, 0))").is_err());
+    }
+}
