@@ -386,14 +386,14 @@ fn what_cannot_be_moved_is_refused_at_the_build() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
-/// The README's animation walkthrough: its scene loads (as a file of `scenes/`), animates what
+/// The animation walkthrough (scenes/README.md): its scene loads (as a file of `scenes/`), animates what
 /// it says, and renders a frame that is not black.
 #[test]
 fn readme_walkthrough_scene_renders() {
-    let readme = std::fs::read_to_string(common::root().join("README.md")).unwrap();
+    let readme = std::fs::read_to_string(common::root().join("scenes/README.md")).unwrap();
     let at = readme
         .find("<!-- tested by tests/animation.rs")
-        .expect("marker in README.md");
+        .expect("marker in scenes/README.md");
     let start = readme[at..].find("```ron\n").unwrap() + at + "```ron\n".len();
     let end = readme[start..].find("```").unwrap() + start;
     let path = common::root().join("scenes/readme-animation.ron");
