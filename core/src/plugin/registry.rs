@@ -224,36 +224,10 @@ fn regular_file(path: &Path) -> Result<(), String> {
     if m.is_file() {
         return Ok(());
     }
-    let what = if m.is_dir() {
-        "a directory"
-    } else {
-        special_file_kind(&m)
-    };
+    let what = luxon_plugin::files::kind_of(m.file_type());
     Err(format!(
         "is {what}; expected a plugin library (a regular file)"
     ))
-}
-
-#[cfg(unix)]
-fn special_file_kind(m: &std::fs::Metadata) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
-    let t = m.file_type();
-    if t.is_fifo() {
-        "a FIFO (named pipe)"
-    } else if t.is_char_device() {
-        "a character device"
-    } else if t.is_block_device() {
-        "a block device"
-    } else if t.is_socket() {
-        "a socket"
-    } else {
-        "not a regular file"
-    }
-}
-
-#[cfg(not(unix))]
-fn special_file_kind(_: &std::fs::Metadata) -> &'static str {
-    "not a regular file"
 }
 
 /// The default search path after `extra`: `$LUXON_PLUGIN_PATH`, then the executable's directory

@@ -143,9 +143,10 @@ pub fn bytes(n: u64) -> String {
     format!("{n} bytes")
 }
 
-/// What a file system object that is not a regular file is, in words.
+/// What a file system object that is not a regular file is, in words ("a directory", "a FIFO
+/// (named pipe)", ...); the host's plugin loader says it the same way.
 #[cfg(unix)]
-fn kind_of(t: std::fs::FileType) -> &'static str {
+pub fn kind_of(t: std::fs::FileType) -> &'static str {
     use std::os::unix::fs::FileTypeExt;
     if t.is_dir() {
         "a directory"
@@ -163,7 +164,7 @@ fn kind_of(t: std::fs::FileType) -> &'static str {
 }
 
 #[cfg(not(unix))]
-fn kind_of(t: std::fs::FileType) -> &'static str {
+pub fn kind_of(t: std::fs::FileType) -> &'static str {
     if t.is_dir() {
         "a directory"
     } else {
