@@ -41,7 +41,7 @@
 //! | ray | [`ray`] | rays and robust ray spawning |
 //! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
 //! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |
-//! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
+//! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type and the log sink |
 
 // Unsafe code only in the modules that allow it by name below (each block says why it is sound).
 #![deny(unsafe_code)]

@@ -12,7 +12,7 @@
 //! error or panic anywhere ends the whole job through `abort::fail` (`MPI_Abort`), after rank 0 has
 //! printed the cause.
 
-use super::abort::{abort_job, fail, Injected, TAG_ERROR};
+use super::abort::{fail, Injected, TAG_ERROR};
 use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
 use super::{decompose, run_share, wire, RankStats, Share, Sink};
 use crate::error::Error;
@@ -296,8 +296,7 @@ impl Run<'_> {
                         }
                         TAG_ERROR => {
                             let m = String::from_utf8_lossy(&bytes);
-                            crate::error::print_error(&format!("rank {from}: {m}"));
-                            abort_job();
+                            fail(&format!("rank {from}: {m}"));
                         }
                         _ => {}
                     }
