@@ -24,6 +24,12 @@ pub enum Error {
     Render(String),
     #[error("{0}")]
     Usage(String),
+    /// A caller's buffers that cannot take the image (sizes, strides).
+    #[error("{0}")]
+    Target(String),
+    /// The caller asked the render to stop before it finished.
+    #[error("the render was cancelled")]
+    Cancelled,
 }
 
 impl Error {
@@ -69,9 +75,12 @@ impl Level {
 /// Where the library's log lines go: called from any thread, possibly several at once.
 pub type LogSink = Box<dyn Fn(Level, &str) + Send + Sync>;
 
-/// The process's sink. An `Arc` so [`log`] can call it without holding the lock (a sink may log
-/// or replace itself).
-static SINK: RwLock<Option<Arc<dyn Fn(Level, &str) + Send + Sync>>> = RwLock::new(None);
+/// The sink as [`log`] holds it: shared, so it is called without holding the lock (a sink may
+/// log or replace itself).
+type SharedSink = Arc<dyn Fn(Level, &str) + Send + Sync>;
+
+/// The process's sink.
+static SINK: RwLock<Option<SharedSink>> = RwLock::new(None);
 
 /// Sends the library's log lines (plugin messages among them) to `sink`; `None` drops them,
 /// which is the default: the library prints nothing unless its user asks (the `luxon` command

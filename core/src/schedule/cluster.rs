@@ -14,7 +14,7 @@
 
 use super::abort::{fail, Injected, TAG_ERROR};
 use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
-use super::{decompose, run_share, wire, RankStats, Share, Sink};
+use super::{decompose, run_share, wire, RankStats, RunOptions, Share, Sink};
 use crate::error::Error;
 use crate::framebuffer::Chunk;
 use crate::scene::Scene;
@@ -264,7 +264,8 @@ impl Run<'_> {
         let mut finished = 0;
         std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
-            let local = sc.spawn(|| run_share(scene, pool, share, &local_sink));
+            let options = RunOptions::default();
+            let local = sc.spawn(|| run_share(scene, pool, share, options, &local_sink));
             loop {
                 while let Some((msg, status)) = world.any_process().immediate_matched_probe() {
                     let (from, tag) = (status.source_rank(), status.tag());
@@ -352,7 +353,8 @@ impl Run<'_> {
         }
         let mut stats = std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
-            let local = sc.spawn(|| run_share(scene, pool, share, &to_main));
+            let options = RunOptions::default();
+            let local = sc.spawn(|| run_share(scene, pool, share, options, &to_main));
             loop {
                 let finished = local.is_finished();
                 match chunks.recv_timeout(POLL) {
