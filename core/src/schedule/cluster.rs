@@ -264,8 +264,8 @@ impl Run<'_> {
         let mut finished = 0;
         std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
-            let options = RunOptions::default();
-            let local = sc.spawn(|| run_share(scene, pool, share, options, &local_sink));
+            let local =
+                sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &local_sink));
             loop {
                 while let Some((msg, status)) = world.any_process().immediate_matched_probe() {
                     let (from, tag) = (status.source_rank(), status.tag());
@@ -353,8 +353,7 @@ impl Run<'_> {
         }
         let mut stats = std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
-            let options = RunOptions::default();
-            let local = sc.spawn(|| run_share(scene, pool, share, options, &to_main));
+            let local = sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &to_main));
             loop {
                 let finished = local.is_finished();
                 match chunks.recv_timeout(POLL) {
