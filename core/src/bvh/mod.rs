@@ -147,7 +147,6 @@ mod tests {
                     + binary.len() * 2
                     + n * 8
                     + wide.memory_bytes() as usize;
-                println!("{n}: {} bytes per primitive", peak / n);
                 assert!(
                     peak as u64 <= n as u64 * BUILD_BYTES_PER_PRIM + 4096,
                     "{n} primitives: {peak} bytes"

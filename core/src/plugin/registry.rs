@@ -186,7 +186,7 @@ pub struct Registry {
     by_name: HashMap<String, usize>,
 }
 
-/// `HostTable::log`: prints a plugin's message (debug ones only with `LUXON_DEBUG` set).
+/// `HostTable::log`: a plugin's message, as `{plugin}: {message}`, to the library's log sink.
 ///
 /// # Safety
 /// Both strings are readable for the call (the ABI's calling contract).
@@ -194,15 +194,8 @@ unsafe extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
     // SAFETY: the caller's promise; the strings are only used within this call.
     let (plugin, message) = unsafe { (plugin.as_str(), message.as_str()) };
     let (plugin, message) = (plugin.unwrap_or("?"), message.unwrap_or("(invalid UTF-8)"));
-    let level = match level {
-        0 => "error",
-        1 => "warning",
-        2 => "info",
-        _ => "debug",
-    };
-    if level != "debug" || std::env::var_os("LUXON_DEBUG").is_some() {
-        crate::error::print_line(level, &format!("{plugin}: {message}"));
-    }
+    let level = crate::error::Level::from_code(level);
+    crate::error::log(level, &format!("{plugin}: {message}"));
 }
 
 static HOST: abi::HostTable = abi::HostTable {
