@@ -141,6 +141,22 @@ fn flat_scenes() -> Vec<(&'static str, String)> {
                 cam("PROJECTION ORTHOGRAPHIC", "ZOOM 0.3 ASPECTRATIO 1")
             ),
         ),
+        // Tachyon's fisheye: a window of longitude and latitude in radians.
+        (
+            "fisheye",
+            format!(
+                "BEGIN_SCENE RESOLUTION 52 44\n{}{things}END_SCENE\n",
+                cam("PROJECTION FISHEYE", "ZOOM 0.8 ASPECTRATIO 1.1")
+            ),
+        ),
+        (
+            "fisheye frustum",
+            format!(
+                "BEGIN_SCENE RESOLUTION 60 40\n{}{things}END_SCENE\n",
+                cam("PROJECTION FISHEYE", "ZOOM 1 ASPECTRATIO 1")
+                    .replace("END_CAMERA", "FRUSTUM -1.6 1.3 -1.0 1.2 END_CAMERA")
+            ),
+        ),
         (
             "clip group",
             format!(

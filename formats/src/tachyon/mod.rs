@@ -60,6 +60,7 @@
 //! | `ANTIALIASING n` | `samples: n + 1` (Tachyon: one sample at that point plus n jittered; the noise differs) |
 //! | `RAYDEPTH n` | `max_depth: n - 1` (Tachyon's primary ray counts as one level) |
 //! | `PROJECTION ORTHOGRAPHIC` | `Orthographic` with the same window |
+//! | `PROJECTION FISHEYE` | not a circular fisheye: Tachyon's window (zoom, aspect or FRUSTUM) in radians of longitude and latitude around VIEWDIR, so `Equirectangular` with that `frustum` in degrees, half a pixel moved like the others |
 //! | `PERSPECTIVE_DOF FOCALLENGTH f APERTURE a` | Tachyon 0.99b6 ignores f and focuses at unit distance; its lens is a rectangle a × the window: a disc of the same area, radius `a·√(w·h/π)`, focused at distance 1; no lens without ANTIALIASING (Tachyon traces only the pinhole ray then) |
 //! | `... FOCALDIST f APERTURE a` (VMD) | the same lens, focused at distance f |
 //! | no CAMERA | zoom 1, aspect 1, no antialiasing, ray depth 6, at the origin looking along +z |
@@ -168,8 +169,7 @@
 //! ## Not yet
 //!
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
-//! renders them: BACKGROUND_GRADIENT; the FISHEYE projection (Tachyon's is a latitude/longitude
-//! window, rendered as Luxon's circular fisheye of the same height); vertex colours (VCSTRI,
+//! renders them: BACKGROUND_GRADIENT; vertex colours (VCSTRI,
 //! VERTEXARRAY COLORS); TEXFUNC 10 (IMAGEDEF volume textures), and image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
 //! Tachyon's two-pass volume compositing. Also different in
