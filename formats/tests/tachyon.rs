@@ -801,7 +801,18 @@ fn imagedef_and_volume_textures() {
         other => panic!("{other:?}"),
     }
     let d = load(&p).unwrap();
-    assert!(warned(&d, "TEXFUNC 10"));
+    let call = d.materials[0].1.value.texture.clone().unwrap().value;
+    let (plugin, params) = d
+        .textures
+        .iter()
+        .find(|(name, _)| *name == call)
+        .map(|(_, t)| (t.value.plugin.value.clone(), t.value.params.clone()))
+        .unwrap();
+    assert_eq!(plugin, "tachyon_volume_image");
+    assert!(params.contains("size: (2, 1, 1)"), "{params}");
+    assert!(params.contains("w: (0.0, 0.0, -1.0)"), "{params}");
+    assert!(params.contains("rgb: [255, 0, 0, 0, 255, 0]"), "{params}");
+    assert!(!warned(&d, "TEXFUNC 10"));
     assert!(warned(&d, "no IMAGEDEF named `::none`"));
     assert_eq!(d.materials[1].1.value.color, [1.0; 3]);
 }

@@ -179,7 +179,7 @@ impl Mapper {
                     .define(name, body, &mut self.notes, &mut self.warnings)?
             }
             Kind::TexAlias { name, target } => self.materials.alias(name, target, &mut self.notes),
-            Kind::ImageDef(def) => self.materials.imagedef(&def.name.value),
+            Kind::ImageDef(def) => self.materials.imagedef(def),
             Kind::Include { .. } => {}
             Kind::Sphere { center, rad, tex } => {
                 let m = self.material(tex)?;

@@ -146,6 +146,7 @@
 //! | 4 wood | the `tachyon_wood` texture: Tachyon's rings about the y axis through CENTER, the point divided by SCALE per axis, (0.8, 1, 0.2) and black; CENTER mirrored and SCALE.z negated, so the texture sees Tachyon's coordinates (the rings' wave is not symmetric in z); ROTATE and COLOR ignored, as in Tachyon; a SCALE with a 0 (Tachyon divides by it) shows COLOR, with a warning |
 //! | 5 gradient noise | the colour (Tachyon's noise value is clamped to 1 almost everywhere) |
 //! | 6 cylindrical checker | the `tachyon_cylinder_checker` texture: 18 sectors about the z axis through CENTER (the angle from +x toward +y) by bands 0.1 high along it, counted from CENTER by \|height\|, odd cells (1, 0.2, 0), even (0, 0.2, 1); CENTER mirrored; ROTATE, SCALE and COLOR ignored, as in Tachyon |
+//! | 10 volume image | the `tachyon_volume_image` texture with the IMAGEDEF's texels: u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x, likewise v (VAXIS, y) and w (WAXIS, z), wrapped into [0, 1), trilinear with the first and last texels' centres at 0 and 1 (measured against `tachyon-nox`: within 2 codes); CENTER and the axes mirrored; an undefined IMAGEDEF is white with a warning, as in Tachyon; blocks over a million texels show COLOR with a note |
 //! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: bilinear` (Tachyon's MIP blur grows with the distance travelled, not with the pixel's footprint: plain bilinear lookups look closer to it than Luxon's footprint MIP) |
 //!
 //! ## Geometry
@@ -170,7 +171,7 @@
 //!
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
 //! renders them: BACKGROUND_GRADIENT; vertex colours (VCSTRI,
-//! VERTEXARRAY COLORS); TEXFUNC 10 (IMAGEDEF volume textures), and image maps whose
+//! VERTEXARRAY COLORS); image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
 //! Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
