@@ -22,6 +22,12 @@ pub enum Error {
     Render(String),
     #[error("{0}")]
     Usage(String),
+    /// A library call given what it cannot take (an array's size, stride or type, say).
+    #[error("{0}")]
+    Api(String),
+    /// An allocation the system refused, sized by the caller's data.
+    #[error("cannot allocate {bytes} bytes for {what}; the system refused")]
+    OutOfMemory { what: String, bytes: u128 },
 }
 
 impl Error {
