@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 /// layers before its own. Keep in step with the table in core/src/lib.rs.
 const CORE: &[(&str, &[&str])] = &[
     ("math", &["math", "sampler", "error"]),
+    ("arrays", &["arrays"]),
     ("motion", &["motion"]),
     ("memory", &["budget"]),
     ("ray", &["ray"]),

@@ -30,6 +30,12 @@ pub enum Error {
     /// The caller asked the render to stop before it finished.
     #[error("the render was cancelled")]
     Cancelled,
+    /// A library call given what it cannot take (an array's size, stride or type, say).
+    #[error("{0}")]
+    Api(String),
+    /// An allocation the system refused, sized by the caller's data.
+    #[error("cannot allocate {bytes} bytes for {what}; the system refused")]
+    OutOfMemory { what: String, bytes: u128 },
 }
 
 impl Error {

@@ -41,12 +41,16 @@
 //! | ray | [`ray`] | rays and robust ray spawning |
 //! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
 //! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |
+//! | arrays | [`arrays`] | arrays read in place or copied: strided views, shared vectors, generations |
 //! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type and the log sink |
 
 // Unsafe code only in the modules that allow it by name below (each block says why it is sound).
 #![deny(unsafe_code)]
 
 pub mod adaptive;
+// Reads of memory shared with the caller (strided, unaligned, or handed over from C).
+#[allow(unsafe_code)]
+pub mod arrays;
 // The process's resource limits (getrlimit, sysconf).
 #[allow(unsafe_code)]
 pub mod budget;
