@@ -209,24 +209,40 @@ pub struct MeshData {
     pub uvs: *const f32,
 }
 
-/// A ray in world space, double precision.
+/// A ray in world space, double precision: the points `origin + t * direction` with
+/// `tmin < t < tmax`. Custom geometry sees it as [`Ray`](crate::Ray).
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct RayF64 {
+    /// Where the ray starts, in world space (the host has already moved it off the surface it
+    /// leaves, so a hit at `t` just above `tmin` is a real one).
     pub origin: [f64; 3],
+    /// Its direction, in world space; not necessarily of unit length, so `t` counts in units of
+    /// its length, not of distance.
     pub direction: [f64; 3],
+    /// Hits at or before this `t` do not count (0 for the rays the host traces).
     pub tmin: f64,
+    /// Hits at or beyond this `t` do not count: the nearest hit found so far, or the distance
+    /// to the light for a shadow ray.
     pub tmax: f64,
+    /// The ray's time within the frame's shutter (the scene's `render.time`, or a sample of
+    /// the shutter interval under motion blur), for shapes that move.
     pub time: f64,
 }
 
-/// A custom primitive's answer to `intersect`.
+/// A custom primitive's answer to `intersect` (the SDK's [`Hit`](crate::Hit)).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct HitF64 {
+    /// Where along the ray: the hit point is `origin + t * direction`, with
+    /// `tmin < t < tmax` (the host drops other answers).
     pub t: f64,
-    /// Geometric normal in world space, any length, any orientation.
+    /// Geometric normal in world space, any length, any orientation (the host normalises it
+    /// and turns it toward the ray; a zero normal drops the hit). It is also the shading
+    /// normal: custom geometry is shaded flat by its true normal.
     pub normal: [f64; 3],
+    /// Texture coordinates of the hit, passed on to textures as [`TexQuery::uv`]. Give
+    /// `[0, 0]` when the shape has none.
     pub uv: [f32; 2],
 }
 
@@ -334,20 +350,34 @@ pub struct TextureObject {
     pub vtable: *const TextureInstanceVTable,
 }
 
-/// Where and how a texture is looked up.
+/// Where and how a texture is looked up: one shading point (the SDK re-exports it as
+/// [`TexQuery`](crate::TexQuery)).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TexQuery {
-    /// Hit point in world space.
+    /// The hit point in world space (double precision, so solid textures stay sharp far from
+    /// the origin).
     pub p: [f64; 3],
-    /// Shading normal (unit).
+    /// The shading normal at `p`: unit length, turned toward the viewer (the interpolated
+    /// normal of a smooth mesh, else the geometric one).
     pub n: [f32; 3],
+    /// The surface's texture coordinates at `p`: spheres give longitude and latitude in [0, 1]
+    /// (`u` around the y axis, `v` from the top), planes the distances along two directions in
+    /// the plane (world units), meshes their per-vertex uvs interpolated (or `[0, 0]`), custom
+    /// shapes what their `intersect` returned.
     pub uv: [f32; 2],
-    /// Approximate world-space width of the ray's footprint at `p` (for filtering).
+    /// How wide the pixel's share of the scene is at `p`, in world units: rays are traced as
+    /// thin cones, about a pixel wide at the camera (an orthographic camera's pixel, or 0 at a
+    /// pinhole) and widening by the angle of one pixel per unit of distance, including the
+    /// path through mirrors and glass before it. A texture with detail finer than this should
+    /// average over a box of this width around `p` rather than return the value at `p`, or it
+    /// aliases (moiré, sparkle). It is measured across the ray, not along a slanted surface.
     pub footprint: f32,
-    /// The same footprint measured in `uv` units (0 when the surface has no uv parametrisation
-    /// the host can measure); image textures under UV mapping choose their MIP level from it.
+    /// The same footprint in `uv` units (0 when the host cannot measure the surface's uv
+    /// scale: planes, custom shapes); image textures under uv mapping choose their MIP level
+    /// from it.
     pub uv_footprint: f32,
+    /// The ray's time within the frame's shutter, for textures that change over time.
     pub time: f32,
 }
 
@@ -382,15 +412,20 @@ pub struct VolumeReaderVTable {
     ) -> Status,
 }
 
+/// A grid's description, sent by `begin` before its data (the SDK's
+/// [`GridInfo`](crate::GridInfo)).
 #[repr(C)]
 pub struct VolumeDesc {
-    /// Row-major 3x4 affine map from voxel index space to world space.
+    /// Row-major 3x4 affine map from voxel index space to world space: voxel `(i, j, k)` is at
+    /// `M · (i, j, k, 1)`.
     pub world_from_index: [f64; 12],
     /// Value outside every block and tile.
     pub background: f32,
-    /// Inclusive index-space bounds of the data.
+    /// Inclusive index-space bounds of the data: the smallest index along each axis...
     pub index_min: [i64; 3],
+    /// ... and the largest (inclusive). Blocks and tiles must lie within these bounds.
     pub index_max: [i64; 3],
+    /// The grid's name, for messages and `luxon check`.
     pub grid_name: Str,
 }
 
@@ -460,10 +495,13 @@ pub struct WriterVTable {
     ) -> Status,
 }
 
-/// A finished image: linear (not gamma-encoded) RGBA f32, rows top to bottom.
+/// A finished image: linear (not gamma-encoded) RGBA f32, rows top to bottom (the SDK's
+/// [`Image`](crate::Image)).
 #[repr(C)]
 pub struct ImageView {
+    /// Pixels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
     /// `width * height * 4` values (may be null when that is 0).
     pub rgba: *const f32,
