@@ -20,10 +20,8 @@
 
 #![forbid(unsafe_code)]
 
-use luxon_plugin::{
-    export, finite, invalid, Aabb, Context, CustomShape, Describe, Error, Geometry, Hit,
-    Primitive, Ray,
-};
+use luxon_plugin::{export, finite, invalid, Context, Describe, Error, Geometry, Primitive};
+use luxon_plugin::{Aabb, CustomShape, Hit, Ray};
 use serde::Deserialize;
 
 /// The scene's `params: (...)`. Fields left out take the defaults below; an unknown field is
@@ -37,7 +35,7 @@ pub struct {{Name}}Params {
 
 impl Default for {{Name}}Params {
     fn default() -> Self {
-        {{Name}}Params {
+        Self {
             center: [0.0; 3],
             radius: 1.0,
         }
@@ -66,7 +64,7 @@ impl Primitive for {{Name}}Primitive {
 
     /// Checks the parameters once: an error here stops the scene from loading, with the
     /// message and the scene's line and column.
-    fn create(p: {{Name}}Params, _ctx: &Context, out: &mut Geometry) -> Result<(), Error> {
+    fn create(p: Self::Params, _ctx: &Context, out: &mut Geometry) -> Result<(), Error> {
         let center = finite("center", p.center)?;
         if !(p.radius > 0.0 && p.radius.is_finite()) {
             return Err(invalid(format!("`radius` must be > 0, got {}", p.radius)));
@@ -101,7 +99,9 @@ impl CustomShape for {{Name}}Surface {
         let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         let d = ray.direction;
         // |oc + t d|² = r²: a t² + 2 h t + c = 0.
-        let (a, h, c) = (dot(d, d), dot(oc, d), dot(oc, oc) - self.radius * self.radius);
+        let a = dot(d, d);
+        let h = dot(oc, d);
+        let c = dot(oc, oc) - self.radius * self.radius;
         let disc = h * h - a * c;
         if a == 0.0 || disc.is_nan() || disc < 0.0 {
             return None;

@@ -32,7 +32,7 @@ pub struct {{Name}}Params {
 
 impl Default for {{Name}}Params {
     fn default() -> Self {
-        {{Name}}Params {
+        Self {
             even: [0.9, 0.9, 0.9],
             odd: [0.1, 0.3, 0.8],
             squares: 8.0,
@@ -66,13 +66,13 @@ impl Texture for {{Name}}Texture {
 
     /// Checks the parameters once: an error here stops the scene from loading, with the
     /// message and the scene's line and column.
-    fn create(p: {{Name}}Params, _ctx: &Context) -> Result<Self, Error> {
+    fn create(p: Self::Params, _ctx: &Context) -> Result<Self, Error> {
         let even = finite("even", p.even)?;
         let odd = finite("odd", p.odd)?;
         if !(p.squares > 0.0 && p.squares.is_finite()) {
             return Err(invalid(format!("`squares` must be > 0, got {}", p.squares)));
         }
-        Ok({{Name}}Texture {
+        Ok(Self {
             even: rgba(even),
             odd: rgba(odd),
             squares: p.squares as f32,

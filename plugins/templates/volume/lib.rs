@@ -28,7 +28,7 @@ pub struct {{Name}}Params {
 
 impl Default for {{Name}}Params {
     fn default() -> Self {
-        {{Name}}Params { size: 32 }
+        Self { size: 32 }
     }
 }
 
@@ -46,7 +46,7 @@ impl VolumeReader for {{Name}}Volume {
 
     /// Describes the grid (`begin`), then streams its voxels as blocks, here one z-slice at a
     /// time. An error stops the scene from loading, with the message.
-    fn read(p: {{Name}}Params, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
+    fn read(p: Self::Params, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
         if !(2..=256).contains(&p.size) {
             return Err(invalid(format!("`size` must be 2 to 256, got {}", p.size)));
         }

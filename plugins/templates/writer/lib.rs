@@ -44,15 +44,17 @@ impl Writer for {{Name}}Writer {
     /// `image` holds linear RGBA floats, rows from the top; what is written to `out` becomes
     /// the file (Luxon writes it whole or not at all).
     fn write(
-        p: {{Name}}Params,
+        p: Self::Params,
         _ctx: &Context,
         image: &Image,
         out: &mut dyn std::io::Write,
     ) -> Result<(), Error> {
-        if !p.exposure.is_finite() {
-            return Err(invalid(format!("`exposure` must be finite, got {}", p.exposure)));
+        let exposure = p.exposure;
+        if !exposure.is_finite() {
+            let message = format!("`exposure` must be finite, got {exposure}");
+            return Err(invalid(message));
         }
-        let gain = 2f32.powf(p.exposure as f32);
+        let gain = 2f32.powf(exposure as f32);
         // "PF": RGB; a negative scale: little-endian floats.
         write!(out, "PF\n{} {}\n-1.0\n", image.width, image.height)?;
         let width = image.width as usize;
