@@ -63,7 +63,11 @@ fn read_pfm(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
 #[test]
 fn every_kind_builds_outside_the_repository_and_renders() {
     let dir = temp_dir("templates");
-    assert!(!dir.starts_with(root()), "{} is inside the repository", dir.display());
+    assert!(
+        !dir.starts_with(root()),
+        "{} is inside the repository",
+        dir.display()
+    );
     // Another project's workspace around the crates.
     std::fs::write(dir.join("Cargo.toml"), "[workspace]\nmembers = []\n").unwrap();
     let sdk = root().join("plugins/sdk");
@@ -80,10 +84,17 @@ fn every_kind_builds_outside_the_repository_and_renders() {
             sdk.to_str().unwrap(),
         ]);
         ok("luxon new-plugin", &o);
-        assert!(stderr(&o).contains("cargo build --release"), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("cargo build --release"),
+            "{}",
+            stderr(&o)
+        );
         let manifest = std::fs::read_to_string(crate_dir.join("Cargo.toml")).unwrap();
         assert!(
-            manifest.contains(&format!("luxon-plugin = {{ path = \"{}\" }}", sdk.display())),
+            manifest.contains(&format!(
+                "luxon-plugin = {{ path = \"{}\" }}",
+                sdk.display()
+            )),
             "{manifest}"
         );
         let readme = std::fs::read_to_string(crate_dir.join("README.md")).unwrap();
@@ -119,7 +130,10 @@ fn every_kind_builds_outside_the_repository_and_renders() {
     let o = luxon_in("texture").arg("plugins").output().unwrap();
     ok("luxon plugins", &o);
     let listing = String::from_utf8_lossy(&o.stdout);
-    for (kind, shown) in KINDS.iter().zip(["primitive", "texture", "writer", "volume reader"]) {
+    for (kind, shown) in KINDS
+        .iter()
+        .zip(["primitive", "texture", "writer", "volume reader"])
+    {
         assert!(
             listing.contains(&format!("  {shown} `{}`", name(kind))),
             "{kind}: {listing}"
@@ -145,7 +159,10 @@ fn every_kind_builds_outside_the_repository_and_renders() {
     let png = image::open(dir.join("volume/x.png")).unwrap().to_rgb8();
     let centre = png.get_pixel(png.width() / 2, png.height() / 2);
     let corner = png.get_pixel(2, 2);
-    assert!(centre[0] > corner[0] + 100, "centre {centre:?}, corner {corner:?}");
+    assert!(
+        centre[0] > corner[0] + 100,
+        "centre {centre:?}, corner {corner:?}"
+    );
 
     // The writer writes the file the extension chose, and the scene's own output.
     let o = luxon_in("writer")
@@ -157,7 +174,10 @@ fn every_kind_builds_outside_the_repository_and_renders() {
         .args(["render", "scene.ron"])
         .output()
         .unwrap();
-    ok("rendering the writer template's scene to its own output", &o);
+    ok(
+        "rendering the writer template's scene to its own output",
+        &o,
+    );
     let x = std::fs::read(dir.join("writer/x.pfm")).unwrap();
     let own = std::fs::read(dir.join("writer").join(format!("{}.pfm", name("writer")))).unwrap();
     assert_eq!(x, own, "the same picture either way");
@@ -170,7 +190,10 @@ fn every_kind_builds_outside_the_repository_and_renders() {
             .zip([0.6, 0.7, 0.85])
             .all(|(v, s)| (v - s).abs() < 1e-5)
     };
-    assert!(sky(&rgb[(h - 1) * w * 3..][..3]), "the top row is not the sky");
+    assert!(
+        sky(&rgb[(h - 1) * w * 3..][..3]),
+        "the top row is not the sky"
+    );
     assert!(!sky(&rgb[..3]), "the bottom row is not the floor");
     let distinct = {
         let mut v: Vec<[u32; 3]> = rgb

@@ -342,7 +342,10 @@ mod tests {
             ("plugin", "the SDK's own name"),
         ] {
             let e = check_name(bad).unwrap_err().to_string();
-            assert!(e.contains(why) && e.contains(&format!("`{bad}`")), "{bad}: {e}");
+            assert!(
+                e.contains(why) && e.contains(&format!("`{bad}`")),
+                "{bad}: {e}"
+            );
         }
     }
 
@@ -363,7 +366,9 @@ mod tests {
                 manifest.contains("luxon-plugin = { path = \"/opt/luxon/plugins/sdk\" }"),
                 "{manifest}"
             );
-            assert!(files[1].1.contains("const NAME: &'static str = \"my-dots\";"));
+            assert!(files[1]
+                .1
+                .contains("const NAME: &'static str = \"my-dots\";"));
             assert!(files[1].1.contains("MyDots"));
             assert!(files[2].1.contains("plugin: \"my-dots\""));
         }
@@ -387,10 +392,8 @@ mod tests {
 
     /// A directory with a fake checkout: `plugins/sdk/Cargo.toml` and `target/release/luxon`.
     fn fake_checkout(name: &str, sdk_version: &str) -> PathBuf {
-        let root = std::env::temp_dir().join(format!(
-            "luxon-new-plugin-{}-{name}",
-            std::process::id()
-        ));
+        let root =
+            std::env::temp_dir().join(format!("luxon-new-plugin-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&root);
         std::fs::create_dir_all(root.join("plugins/sdk")).unwrap();
         std::fs::create_dir_all(root.join("target/release")).unwrap();
@@ -421,7 +424,8 @@ mod tests {
 
     #[test]
     fn a_non_empty_directory_is_left_alone() {
-        let dir = std::env::temp_dir().join(format!("luxon-new-plugin-{}-full", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("luxon-new-plugin-{}-full", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("notes.txt"), "mine").unwrap();

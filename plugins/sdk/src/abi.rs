@@ -57,7 +57,9 @@ pub type DeclareFn = unsafe extern "C" fn(host: *const HostTable) -> *const Plug
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct Str {
+    /// The first byte (null when `len` is 0).
     pub ptr: *const u8,
+    /// Length in bytes.
     pub len: usize,
 }
 
@@ -107,6 +109,7 @@ pub const KIND_WRITER: u32 = 4;
 /// A cdylib has its own statics, so logging goes through here rather than a `log` facade.
 #[repr(C)]
 pub struct HostTable {
+    /// The host's [`ABI_VERSION`].
     pub abi_version: u32,
     /// level: 0 error, 1 warning, 2 info, 3 debug. Callable from any thread.
     pub log: unsafe extern "C" fn(level: u32, plugin: Str, message: Str),
@@ -115,7 +118,9 @@ pub struct HostTable {
 /// Returned by the handshake; lives for the process lifetime (a static in the plugin).
 #[repr(C)]
 pub struct PluginHeader {
+    /// [`MAGIC`].
     pub magic: [u8; 8],
+    /// The [`ABI_VERSION`] the plugin was built for.
     pub abi_version: u32,
     /// Version of the `luxon-plugin` crate the plugin was built with, e.g. "0.2.0".
     pub sdk_version: Str,
@@ -127,16 +132,21 @@ pub struct PluginHeader {
 pub struct Declaration {
     /// The library's own name, e.g. "luxon-shapes"; used in messages.
     pub library: Str,
+    /// The library's entries: `entry_count` of them, a static array.
     pub entries: *const Entry,
+    /// How many entries.
     pub entry_count: usize,
 }
 
 /// One named thing a library provides.
 #[repr(C)]
 pub struct Entry {
+    /// What the entry is: [`KIND_PRIMITIVE`], [`KIND_TEXTURE`], [`KIND_VOLUME_READER`] or
+    /// [`KIND_WRITER`].
     pub kind: u32,
     /// The name a scene uses: `(plugin: "sphere", ...)`.
     pub name: Str,
+    /// One line: what it is (shown by `luxon plugins`).
     pub description: Str,
     /// The parameter table, one `name: type = default  description` per line.
     pub params_doc: Str,
@@ -151,7 +161,9 @@ pub struct Entry {
 /// was given (0 when the error has no position); the host maps them to the scene file.
 #[repr(C)]
 pub struct ErrorSink {
+    /// The host's state for this call, passed back to `set`.
     pub ctx: *mut c_void,
+    /// Records the error: its message (copied by the host) and position.
     pub set: unsafe extern "C" fn(ctx: *mut c_void, message: Str, line: u32, col: u32),
 }
 
@@ -197,9 +209,11 @@ pub struct PrimitiveVTable {
 pub struct MeshData {
     /// x, y, z per vertex.
     pub positions: *const f64,
+    /// Vertices in `positions` (and in each optional array).
     pub vertex_count: u64,
     /// Three vertex indices per triangle.
     pub indices: *const u64,
+    /// Triangles in `indices`.
     pub triangle_count: u64,
     /// x, y, z per vertex, or null.
     pub normals: *const f64,
@@ -251,18 +265,22 @@ pub struct HitF64 {
 /// plugin panicked (the host then stops the render with an error naming the plugin).
 #[repr(C)]
 pub struct CustomVTable {
+    /// Writes the world-space box of primitive `index` (`0..count`) to `min` and `max`.
     pub bounds: unsafe extern "C" fn(
         object: *const c_void,
         index: u64,
         min: *mut [f64; 3],
         max: *mut [f64; 3],
     ) -> Status,
+    /// The nearest hit of the ray with primitive `index` with `tmin < t < tmax`, written to
+    /// `hit`.
     pub intersect: unsafe extern "C" fn(
         object: *const c_void,
         index: u64,
         ray: *const RayF64,
         hit: *mut HitF64,
     ) -> u32,
+    /// Whether the ray hits primitive `index` anywhere with `tmin < t < tmax` (shadow rays).
     pub occluded:
         unsafe extern "C" fn(object: *const c_void, index: u64, ray: *const RayF64) -> u32,
     /// Called once by the host when it no longer needs the object.
@@ -274,7 +292,9 @@ pub const HIT_PANIC: u32 = 3;
 
 #[repr(C)]
 pub struct CustomGeometry {
+    /// The plugin's object, passed to every function of `vtable`.
     pub object: *mut c_void,
+    /// Primitives in the object, each with its own BVH leaf (`index` `0..count`).
     pub count: u64,
     /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const CustomVTable,
@@ -284,6 +304,7 @@ pub struct CustomGeometry {
 /// fills `err` when the data is unusable (NaN, bad index...).
 #[repr(C)]
 pub struct GeometrySink {
+    /// The host's builder for this call, passed back to every function.
     pub ctx: *mut c_void,
     /// `count` spheres as x, y, z, radius.
     pub add_spheres: unsafe extern "C" fn(
@@ -314,6 +335,7 @@ pub struct GeometrySink {
         count: u64,
         err: *const ErrorSink,
     ) -> Status,
+    /// A triangle mesh (see [`MeshData`]).
     pub add_mesh: unsafe extern "C" fn(
         ctx: *mut c_void,
         mesh: *const MeshData,
@@ -345,6 +367,7 @@ pub struct TextureVTable {
 
 #[repr(C)]
 pub struct TextureObject {
+    /// The plugin's object, passed to every function of `vtable`.
     pub object: *mut c_void,
     /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const TextureInstanceVTable,
@@ -393,6 +416,7 @@ pub struct TextureInstanceVTable {
         out: *mut [f32; 4],
         err: *const ErrorSink,
     ) -> Status,
+    /// Called once by the host when it no longer needs the object.
     pub destroy: unsafe extern "C" fn(object: *mut c_void),
 }
 
@@ -437,6 +461,7 @@ pub const VOXEL_F32: u32 = 3;
 
 #[repr(C)]
 pub struct VolumeSink {
+    /// The host's volume for this call, passed back to every function.
     pub ctx: *mut c_void,
     /// Called once, before any block or tile.
     pub begin: unsafe extern "C" fn(
@@ -509,6 +534,8 @@ pub struct ImageView {
 
 #[repr(C)]
 pub struct ByteSink {
+    /// The host's buffer for this call, passed back to `write`.
     pub ctx: *mut c_void,
+    /// Appends `len` bytes from `data` to the file's contents.
     pub write: unsafe extern "C" fn(ctx: *mut c_void, data: *const u8, len: usize) -> Status,
 }

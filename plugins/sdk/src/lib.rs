@@ -46,9 +46,9 @@ use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-pub use abi::ABI_VERSION;
 /// A texture's query, the one type of [`abi`] a texture plugin names.
 pub use abi::TexQuery;
+pub use abi::ABI_VERSION;
 /// The serde this crate deserializes parameters with. Plugins depend on `serde` themselves
 /// (see "Parameters" in the crate documentation); Cargo makes both the same crate.
 pub use serde;
