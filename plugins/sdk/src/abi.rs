@@ -373,8 +373,8 @@ pub struct TextureObject {
     pub vtable: *const TextureInstanceVTable,
 }
 
-/// Where and how a texture is looked up: one shading point (the SDK re-exports it as
-/// [`TexQuery`](crate::TexQuery)).
+/// Where and how a texture is looked up: one shading point (the SDK re-exports it at its
+/// root: `luxon_plugin::TexQuery`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TexQuery {
