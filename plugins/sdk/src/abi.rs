@@ -387,7 +387,7 @@ pub struct TexQuery {
     /// The surface's texture coordinates at `p`: spheres give longitude and latitude in [0, 1]
     /// (`u` around the y axis, `v` from the top), planes the distances along two directions in
     /// the plane (world units), meshes their per-vertex uvs interpolated (or `[0, 0]`), custom
-    /// shapes what their `intersect` returned.
+    /// shapes what their `intersect` returned; cylinders, cones and discs their own.
     pub uv: [f32; 2],
     /// How wide the pixel's share of the scene is at `p`, in world units: rays are traced as
     /// thin cones, about a pixel wide at the camera (an orthographic camera's pixel, or 0 at a
@@ -396,9 +396,9 @@ pub struct TexQuery {
     /// average over a box of this width around `p` rather than return the value at `p`, or it
     /// aliases (moiré, sparkle). It is measured across the ray, not along a slanted surface.
     pub footprint: f32,
-    /// The same footprint in `uv` units (0 when the host cannot measure the surface's uv
-    /// scale: planes, custom shapes); image textures under uv mapping choose their MIP level
-    /// from it.
+    /// The same footprint in `uv` units: measured on spheres and on meshes with uvs, 0 on
+    /// other surfaces (planes, cylinders and cones, discs, custom shapes); image textures
+    /// under uv mapping choose their MIP level from it.
     pub uv_footprint: f32,
     /// The ray's time within the frame's shutter, for textures that change over time.
     pub time: f32,
