@@ -6,10 +6,12 @@ use super::{clip_of, material_of, Clips, Counters, Hit, Kind, Surface};
 use crate::budget::{Budget, Use};
 use crate::bvh::Bvh;
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
+use crate::plugin::calls::take_plugin_panic;
 use crate::ray::Ray;
+use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 
 /// One object handed over by a plugin; destroyed through the plugin when the scene drops.
@@ -19,10 +21,15 @@ pub struct CustomObject {
     vtable: &'static abi::CustomVTable,
     pub plugin: String,
     pub count: u64,
+    /// The scene's object that made it ("object 3") and where that is in the scene.
+    pub name: String,
+    pub at: Origin,
+    /// Hits answered with a NaN distance or normal (ignored as misses), for the warning.
+    pub nan_hits: AtomicU64,
 }
 
 impl CustomObject {
-    /// Takes ownership of a plugin's object.
+    /// Takes ownership of a plugin's object, made for the scene's object `name` at `at`.
     ///
     /// # Safety
     /// `object` is a live object of the plugin that `vtable` serves, handed over to the host
@@ -32,13 +39,31 @@ impl CustomObject {
         vtable: &'static abi::CustomVTable,
         plugin: String,
         count: u64,
+        (name, at): (String, Origin),
     ) -> CustomObject {
         CustomObject {
             object,
             vtable,
             plugin,
             count,
+            name,
+            at,
+            nan_hits: AtomicU64::new(0),
         }
+    }
+
+    /// "scene.ron:7:9: object 3 (plugin `torus`)", as messages begin.
+    pub fn label(&self) -> String {
+        format!("{}: {} (plugin `{}`)", self.at, self.name, self.plugin)
+    }
+
+    /// The plugin's answer to a hit: counts NaN in it (the hit is then ignored).
+    fn is_nan(&self, h: &abi::HitF64) -> bool {
+        let nan = h.t.is_nan() || h.normal.iter().any(|v| v.is_nan());
+        if nan {
+            self.nan_hits.fetch_add(1, Ordering::Relaxed);
+        }
+        nan
     }
 }
 
@@ -61,13 +86,22 @@ impl Drop for CustomObject {
 #[derive(Default)]
 pub struct PluginFault {
     raised: AtomicBool,
-    message: Mutex<Option<String>>,
+    /// The first message, and whether it carries the plugin's own words.
+    message: Mutex<Option<(String, bool)>>,
 }
 
 impl PluginFault {
     pub fn raise(&self, message: String) {
-        if !self.raised.swap(true, Ordering::SeqCst) {
-            *self.message.lock().unwrap_or_else(|e| e.into_inner()) = Some(message);
+        self.raise_with(message, true);
+    }
+
+    /// Raises the fault; a message without the plugin's own words (`told` false: another
+    /// thread's panic in the same object carried them) gives way to one with them.
+    pub fn raise_with(&self, message: String, told: bool) {
+        self.raised.store(true, Ordering::SeqCst);
+        let mut m = self.message.lock().unwrap_or_else(|e| e.into_inner());
+        if m.as_ref().is_none_or(|(_, had)| !had && told) {
+            *m = Some((message, told));
         }
     }
 
@@ -79,7 +113,8 @@ impl PluginFault {
         self.message
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .clone()
+            .as_ref()
+            .map(|(m, _)| m.clone())
     }
 }
 
@@ -143,15 +178,17 @@ impl Customs {
             // SAFETY: `obj` is live (see `CustomObject`) and the out-pointers are our locals.
             let status = unsafe { (obj.vtable.bounds)(obj.object, i, &mut min, &mut max) };
             if status != abi::STATUS_OK {
+                let said = take_plugin_panic().map_or(String::new(), |m| format!(": {m}"));
                 return Err(format!(
-                    "plugin `{}` panicked computing bounds of primitive {i}",
-                    obj.plugin
+                    "{} panicked computing bounds of primitive {i}{said}",
+                    obj.label()
                 ));
             }
             if min.iter().chain(&max).any(|v| v.is_nan()) || (0..3).any(|k| min[k] > max[k]) {
                 return Err(format!(
-                    "plugin `{}` gave invalid bounds {min:?}..{max:?} for primitive {i}",
-                    obj.plugin
+                    "{} gave invalid bounds {min:?}..{max:?} for primitive {i}; expected \
+                     finite min <= max on every axis",
+                    obj.label()
                 ));
             }
             let lo = (DVec3::from(min) - self.world_offset).as_vec3();
@@ -180,10 +217,26 @@ impl Customs {
         }
     }
 
+    /// Raises the fault for a panic in object `o`'s `intersect` or `occluded`, with the
+    /// plugin's message when it sent one (the SDK does, once per object).
     fn panicked(&self, o: u32) {
-        let name = &self.objects[o as usize].plugin;
-        self.fault
-            .raise(format!("plugin `{name}` panicked while intersecting a ray"));
+        let label = self.objects[o as usize].label();
+        match take_plugin_panic() {
+            Some(m) => self
+                .fault
+                .raise(format!("{label} panicked while intersecting a ray: {m}")),
+            None => self
+                .fault
+                .raise_with(format!("{label} panicked while intersecting a ray"), false),
+        }
+    }
+
+    /// Objects whose plugin answered hits with NaN: (object, how many hits).
+    pub fn nan_hits(&self) -> impl Iterator<Item = (&CustomObject, u64)> {
+        self.objects
+            .iter()
+            .map(|o| (o, o.nan_hits.load(Ordering::Relaxed)))
+            .filter(|&(_, n)| n > 0)
     }
 
     #[inline]
@@ -208,6 +261,7 @@ impl Customs {
             // SAFETY: `obj` is live (see `CustomObject`), the ray and hit are our locals, and
             // the ABI allows concurrent calls.
             match unsafe { (obj.vtable.intersect)(obj.object, idx, &wr, &mut h) } {
+                1 if obj.is_nan(&h) => None,
                 1 => {
                     let t = h.t as f32;
                     let n = Vec3A::from(DVec3::from(h.normal).normalize_or_zero().as_vec3());

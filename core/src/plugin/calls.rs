@@ -28,6 +28,34 @@ unsafe extern "C" fn set_error(ctx: *mut c_void, message: abi::Str, line: u32, c
     r.col = col;
 }
 
+std::thread_local! {
+    /// The message a plugin logged about a panic it caught in a call without an error sink
+    /// (custom geometry's `bounds`, `intersect`, `occluded`), on the thread of that call.
+    static PLUGIN_PANIC: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// How the SDK begins the log message of a panic caught where no error sink can carry it
+/// ("panicked in `intersect`: ..."). Hosts before this convention print it as an error line.
+pub const PANIC_LOG_PREFIX: &str = "panicked in `";
+
+/// Keeps a plugin's panic message for [`take_plugin_panic`] when `message` is one (see
+/// [`PANIC_LOG_PREFIX`]); false when it is an ordinary log message.
+pub(crate) fn keep_plugin_panic(level: u32, message: &str) -> bool {
+    if level != 0 || !message.starts_with(PANIC_LOG_PREFIX) {
+        return false;
+    }
+    // The plugin's own words follow the call's name: "panicked in `intersect`: {words}".
+    let words = message.split_once("`: ").map_or(message, |(_, w)| w);
+    PLUGIN_PANIC.with(|p| *p.borrow_mut() = Some(words.to_string()));
+    true
+}
+
+/// The panic message a plugin logged during the call this thread just made, if it sent one
+/// (for "panicked in `intersect`: index out of bounds", "index out of bounds").
+pub fn take_plugin_panic() -> Option<String> {
+    PLUGIN_PANIC.with(|p| p.borrow_mut().take())
+}
+
 /// Maps a position inside params text that starts at `start` to the scene file.
 pub fn offset_origin(start: &Origin, line: u32, col: u32) -> Origin {
     if line == 0 {

@@ -346,6 +346,35 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The plugin instances that gave NaN since the last call, one warning each: textures
+    /// whose values were NaN or infinite, custom geometry whose hits had a NaN distance or
+    /// normal. Counts restart from 0 (each frame of a sequence is told its own).
+    pub fn nan_sources(&self) -> Vec<String> {
+        use std::sync::atomic::Ordering::Relaxed;
+        let mut out = Vec::new();
+        for t in &self.textures {
+            let n = t.nan_results.swap(0, Relaxed);
+            if n > 0 {
+                out.push(format!(
+                    "{}: texture `{}` (plugin `{}`) gave NaN or infinite values at {n} shading \
+                     point(s); expected finite RGBA",
+                    t.at, t.name, t.plugin
+                ));
+            }
+        }
+        for o in &self.customs.objects {
+            let n = o.nan_hits.swap(0, Relaxed);
+            if n > 0 {
+                out.push(format!(
+                    "{} answered {n} ray(s) with a hit at a NaN distance or normal; expected \
+                     finite numbers (those hits were taken as misses)",
+                    o.label()
+                ));
+            }
+        }
+        out
+    }
+
     /// The closest hit along `ray` before `t_max`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
