@@ -352,3 +352,25 @@ impl Customs {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The first message with the plugin's words wins; one without them gives way to it.
+    #[test]
+    fn a_fault_keeps_the_first_message_with_the_plugins_words() {
+        let f = PluginFault::default();
+        assert!(!f.is_raised());
+        f.raise_with("object 0 panicked".into(), false);
+        assert!(f.is_raised());
+        assert_eq!(f.message().as_deref(), Some("object 0 panicked"));
+        f.raise("object 0 panicked: index out of bounds".into());
+        f.raise("object 1 panicked: later".into());
+        f.raise_with("object 2 panicked".into(), false);
+        assert_eq!(
+            f.message().as_deref(),
+            Some("object 0 panicked: index out of bounds")
+        );
+    }
+}

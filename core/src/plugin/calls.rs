@@ -206,6 +206,19 @@ pub fn plugin_label(registry: &Registry, entry: &Entry) -> String {
 mod tests {
     use super::*;
 
+    /// A panic message logged by a plugin is kept for the thread's next `take`, once; other
+    /// log messages are not.
+    #[test]
+    fn a_logged_panic_is_taken_once_on_its_thread() {
+        assert!(!keep_plugin_panic(0, "panicked at src/lib.rs:3"));
+        assert!(!keep_plugin_panic(1, "panicked in `intersect`: boom"));
+        assert_eq!(take_plugin_panic(), None);
+        assert!(keep_plugin_panic(0, "panicked in `intersect`: boom: at 3"));
+        assert_eq!(std::thread::spawn(take_plugin_panic).join().unwrap(), None);
+        assert_eq!(take_plugin_panic().as_deref(), Some("boom: at 3"));
+        assert_eq!(take_plugin_panic(), None);
+    }
+
     /// Plugins are told what is left of the budget and the texture cache's share; without a
     /// budget or a limit, 0 ("unknown", "choose").
     #[test]

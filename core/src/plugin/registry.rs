@@ -548,3 +548,48 @@ impl Registry {
         &self.libraries[e.library]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Shared libraries not named like plugins get a note; plugins and other files do not.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn libraries_not_named_like_plugins_get_a_note() {
+        for name in ["libstripes.so", "luxon_stripes.so", "libfoo.so.1"] {
+            let note = name_note(name).unwrap_or_else(|| panic!("no note for {name}"));
+            assert!(
+                note.starts_with("not loaded: its name does not start with `libluxon_`"),
+                "{note}"
+            );
+        }
+        for name in [
+            "libluxon_stripes.so",
+            "stripes.txt",
+            "libstripes.a",
+            "scene.ron",
+        ] {
+            assert_eq!(name_note(name), None, "{name}");
+        }
+    }
+
+    /// A missing place the user named is a note; the executable's own directories are not.
+    #[test]
+    fn a_missing_named_directory_is_a_note() {
+        let missing = std::env::temp_dir().join(format!("luxon-no-dir-{}", std::process::id()));
+        let mut r = Registry::default();
+        r.add_path(&missing);
+        assert!(r.notes.is_empty());
+        let mut r = Registry::default();
+        r.add_named_path(&missing);
+        assert_eq!(r.notes.len(), 1);
+        assert_eq!(
+            r.notes[0].to_string(),
+            format!(
+                "{}: no such file or directory; expected a directory of plugins or a plugin file",
+                missing.display()
+            )
+        );
+    }
+}
