@@ -477,6 +477,14 @@ fn a_nan_is_counted_reported_and_clamped() {
     }
     assert!(black > 50 && red > 50, "black {black}, red {red}");
     assert_eq!(stats.counters.nan_pixels, black);
+    // Counted per plugin instance: the one texture, at least once per black pixel.
+    let warnings = scene.nan_warnings(&stats.nan_sources);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(stats.nan_sources[0] >= black, "{:?}", stats.nan_sources);
+    assert!(
+        warnings[0].contains("texture `half` (plugin `nan_texture`) gave NaN"),
+        "{warnings:?}"
+    );
     // The command line finishes, writes the image and reports the count.
     let out = run(&["render", path.to_str().unwrap(), "--stats"]);
     let err = stderr(&out);

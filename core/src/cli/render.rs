@@ -310,7 +310,7 @@ pub(super) fn warn_nan(scene: &Scene, stats: &RenderStats) {
             stats.counters.nan_pixels
         ));
     }
-    for w in scene.nan_sources() {
+    for w in scene.nan_warnings(&stats.nan_sources) {
         luxon::error::print_warning(&w);
     }
 }

@@ -59,6 +59,8 @@ pub struct RankStats {
     pub threads: Vec<WorkerStats>,
     /// Wall time of the rank's render phase.
     pub time: Duration,
+    /// NaN results per plugin instance, in the order of [`Scene::nan_counts`].
+    pub nan_sources: Vec<u64>,
 }
 
 impl RankStats {
@@ -179,6 +181,7 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
             .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
             .collect(),
         time: start.elapsed(),
+        nan_sources: scene.nan_counts(),
     }
 }
 

@@ -250,7 +250,7 @@ fn render_frame(scene: &Scene, plan: &Plan) -> Result<(Framebuffer, Duration), E
             stats.counters.nan_pixels
         ));
     }
-    for w in scene.nan_sources() {
+    for w in scene.nan_warnings(&stats.nan_sources) {
         luxon::error::print_warning(&w);
     }
     if plan.verbose {
