@@ -212,6 +212,14 @@ fn type_errors_in_params_name_the_parameter_what_was_expected_and_found() {
              `uv`, `planar`, `cylindrical`, `spherical` (written without quotes), found \
              `\"planar\"`",
         ),
+        // The plugin's own deserializer's words, with the parameter they are about.
+        (
+            r#"textures: { "t": (plugin: "checker", params: (scale: 2, even: "red")) },"#,
+            "\"red\"",
+            "plugin `checker` (libluxon_textures.so) failed: parameter `even`: unknown variant \
+             `red` (expected one of: Constant, Checker, Blend, Gradient, Marble, Wood, Noise, \
+             Image)",
+        ),
     ];
     for (line, value, want) in cases {
         let e = line4_error(&dir, line);

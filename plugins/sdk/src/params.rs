@@ -226,6 +226,23 @@ fn shorten(s: &str) -> String {
     }
 }
 
+/// `at`, or the opening quote of the string it is in (reading from `from`, outside any string).
+fn string_start(text: &str, from: usize, at: usize) -> usize {
+    let bytes = text.as_bytes();
+    let mut i = from;
+    while i < at {
+        if bytes[i] == b'"' {
+            let end = skip_string(bytes, i);
+            if at <= end {
+                return i;
+            }
+            i = end;
+        }
+        i += 1;
+    }
+    at
+}
+
 /// Where the bracketed group closed at byte `end` (a `)` or `]`) opens; `end` for anything else.
 fn group_start(text: &str, end: usize) -> usize {
     let bytes = text.as_bytes();
@@ -281,11 +298,12 @@ fn value_at(text: &str, at: usize) -> &str {
     &rest[..end]
 }
 
-/// A type error of RON at `line`:`col` of `text`, in words naming the parameter: "parameter
-/// `color`: expected (r, g, b), found `"red"`", and where the value found starts (RON's
-/// position may be the blank before it). `None` when the error is not about the value of one
-/// top-level parameter. `doc` is the plugin's parameter table: a parameter's type as written
-/// there is what was expected.
+/// An error of RON at `line`:`col` of `text` inside the value of a top-level parameter, in
+/// words naming it: for a type error "parameter `color`: expected (r, g, b), found `"red"`"
+/// (`doc` is the plugin's parameter table: a parameter's type as written there is what was
+/// expected), for any other "parameter `even`: " and RON's words. Also where the value found
+/// starts (RON's position may be the blank before it, or inside a string). `None` when the
+/// error is not inside one parameter's value (an unknown or missing parameter).
 pub(crate) fn type_error(
     text: &str,
     doc: &str,
@@ -293,7 +311,6 @@ pub(crate) fn type_error(
     line: usize,
     col: usize,
 ) -> Option<(String, (u32, u32))> {
-    let by_ron = expected_by_ron(code)?;
     let mut offset = skip_blank(text, offset_of(text, line, col)?);
     if matches!(code, ron::Error::ExpectedDifferentLength { .. }) {
         // RON stops at the closing bracket of a tuple of the wrong length: point at its start.
@@ -301,7 +318,22 @@ pub(crate) fn type_error(
     }
     let field = fields(text)
         .into_iter()
-        .rfind(|f| f.value_at <= offset && offset <= f.value_at + f.value.len())?;
+        .rfind(|f| f.value_at <= offset && offset < f.value_at + f.value.len())?;
+    offset = string_start(text, field.value_at, offset);
+    let Some(by_ron) = expected_by_ron(code) else {
+        if matches!(
+            code,
+            ron::Error::MissingStructField { .. } | ron::Error::ExceededRecursionLimit
+        ) {
+            return None;
+        }
+        let message = format!(
+            "parameter `{}`: {}",
+            field.name,
+            crate::describe_ron_error(code)
+        );
+        return Some((message, line_col(text, offset)));
+    };
     let expected = match (code, documented_type(doc, field.name)) {
         // The variants RON lists are exact; a documented type may say more (`f64 > 0`).
         (ron::Error::NoSuchEnumVariant { .. }, _) | (_, None) => by_ron,
@@ -438,6 +470,28 @@ mod tests {
         Z,
     }
 
+    #[derive(serde::Deserialize, Debug)]
+    #[allow(dead_code)]
+    struct P2 {
+        a: f64,
+        b: f64,
+    }
+
+    #[derive(serde::Deserialize, Debug)]
+    #[allow(dead_code)]
+    struct P3 {
+        a: f64,
+        #[serde(deserialize_with = "odd")]
+        b: f64,
+    }
+
+    fn odd<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        let s = <String as serde::Deserialize>::deserialize(d)?;
+        Err(serde::de::Error::custom(format!(
+            "expected an odd number, found {s:?}"
+        )))
+    }
+
     const DOC: &str = "width: f64 > 0 = 1  stripe width\ncolor: (r, g, b) = (1, 1, 1)  colour\n\
                        axis: x|y|z = x  across which axis\npoints: [(x, y, z), ...]  points";
 
@@ -502,6 +556,17 @@ mod tests {
             "parameter `points`: expected [(x, y, z), ...], found `true`"
         );
         assert_eq!(col, 26);
+        // Any other error inside a parameter's value names the parameter too.
+        let e = crate::parse_params::<P3>("(a: 1, b: \"7\")").unwrap_err();
+        assert_eq!(
+            (e.message.as_str(), e.line, e.col),
+            ("parameter `b`: expected an odd number, found \"7\"", 1, 11)
+        );
+        // A missing parameter is not blamed on the last one given.
+        assert_eq!(
+            crate::parse_params::<P2>("(a: 1)").unwrap_err().message,
+            "missing parameter `b`"
+        );
         // Without a table, RON's expectation in words.
         let e = crate::parse_params::<Stripes>("(width: (1))").unwrap_err();
         assert_eq!(
