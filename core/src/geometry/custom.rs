@@ -6,13 +6,40 @@ use super::{clip_of, material_of, Clips, Counters, Hit, Kind, Surface};
 use crate::budget::{Budget, Use};
 use crate::bvh::Bvh;
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
-use crate::plugin::calls::take_plugin_panic;
 use crate::ray::Ray;
 use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
+
+std::thread_local! {
+    /// The message a plugin logged about a panic it caught in a call without an error sink
+    /// (custom geometry's `bounds`, `intersect`, `occluded`), on the thread of that call.
+    static PLUGIN_PANIC: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// How the SDK begins the log message of a panic caught where no error sink can carry it
+/// ("panicked in `intersect`: ..."). Hosts before this convention print it as an error line.
+pub const PANIC_LOG_PREFIX: &str = "panicked in `";
+
+/// Keeps a plugin's panic message for [`take_plugin_panic`] when `message` is one (see
+/// [`PANIC_LOG_PREFIX`]); false when it is an ordinary log message.
+pub(crate) fn keep_plugin_panic(level: u32, message: &str) -> bool {
+    if level != 0 || !message.starts_with(PANIC_LOG_PREFIX) {
+        return false;
+    }
+    // The plugin's own words follow the call's name: "panicked in `intersect`: {words}".
+    let words = message.split_once("`: ").map_or(message, |(_, w)| w);
+    PLUGIN_PANIC.with(|p| *p.borrow_mut() = Some(words.to_string()));
+    true
+}
+
+/// The panic message a plugin logged during the call this thread just made, if it sent one
+/// (for "panicked in `intersect`: index out of bounds", "index out of bounds").
+pub fn take_plugin_panic() -> Option<String> {
+    PLUGIN_PANIC.with(|p| p.borrow_mut().take())
+}
 
 /// One object handed over by a plugin; destroyed through the plugin when the scene drops.
 pub struct CustomObject {
@@ -356,6 +383,19 @@ impl Customs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A panic message logged by a plugin is kept for the thread's next `take`, once; other
+    /// log messages are not.
+    #[test]
+    fn a_logged_panic_is_taken_once_on_its_thread() {
+        assert!(!keep_plugin_panic(0, "panicked at src/lib.rs:3"));
+        assert!(!keep_plugin_panic(1, "panicked in `intersect`: boom"));
+        assert_eq!(take_plugin_panic(), None);
+        assert!(keep_plugin_panic(0, "panicked in `intersect`: boom: at 3"));
+        assert_eq!(std::thread::spawn(take_plugin_panic).join().unwrap(), None);
+        assert_eq!(take_plugin_panic().as_deref(), Some("boom: at 3"));
+        assert_eq!(take_plugin_panic(), None);
+    }
 
     /// The first message with the plugin's words wins; one without them gives way to it.
     #[test]

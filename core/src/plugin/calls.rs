@@ -28,34 +28,6 @@ unsafe extern "C" fn set_error(ctx: *mut c_void, message: abi::Str, line: u32, c
     r.col = col;
 }
 
-std::thread_local! {
-    /// The message a plugin logged about a panic it caught in a call without an error sink
-    /// (custom geometry's `bounds`, `intersect`, `occluded`), on the thread of that call.
-    static PLUGIN_PANIC: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
-}
-
-/// How the SDK begins the log message of a panic caught where no error sink can carry it
-/// ("panicked in `intersect`: ..."). Hosts before this convention print it as an error line.
-pub const PANIC_LOG_PREFIX: &str = "panicked in `";
-
-/// Keeps a plugin's panic message for [`take_plugin_panic`] when `message` is one (see
-/// [`PANIC_LOG_PREFIX`]); false when it is an ordinary log message.
-pub(crate) fn keep_plugin_panic(level: u32, message: &str) -> bool {
-    if level != 0 || !message.starts_with(PANIC_LOG_PREFIX) {
-        return false;
-    }
-    // The plugin's own words follow the call's name: "panicked in `intersect`: {words}".
-    let words = message.split_once("`: ").map_or(message, |(_, w)| w);
-    PLUGIN_PANIC.with(|p| *p.borrow_mut() = Some(words.to_string()));
-    true
-}
-
-/// The panic message a plugin logged during the call this thread just made, if it sent one
-/// (for "panicked in `intersect`: index out of bounds", "index out of bounds").
-pub fn take_plugin_panic() -> Option<String> {
-    PLUGIN_PANIC.with(|p| p.borrow_mut().take())
-}
-
 /// Maps a position inside params text that starts at `start` to the scene file.
 pub fn offset_origin(start: &Origin, line: u32, col: u32) -> Origin {
     if line == 0 {
@@ -205,19 +177,6 @@ pub fn plugin_label(registry: &Registry, entry: &Entry) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A panic message logged by a plugin is kept for the thread's next `take`, once; other
-    /// log messages are not.
-    #[test]
-    fn a_logged_panic_is_taken_once_on_its_thread() {
-        assert!(!keep_plugin_panic(0, "panicked at src/lib.rs:3"));
-        assert!(!keep_plugin_panic(1, "panicked in `intersect`: boom"));
-        assert_eq!(take_plugin_panic(), None);
-        assert!(keep_plugin_panic(0, "panicked in `intersect`: boom: at 3"));
-        assert_eq!(std::thread::spawn(take_plugin_panic).join().unwrap(), None);
-        assert_eq!(take_plugin_panic().as_deref(), Some("boom: at 3"));
-        assert_eq!(take_plugin_panic(), None);
-    }
 
     /// Plugins are told what is left of the budget and the texture cache's share; without a
     /// budget or a limit, 0 ("unknown", "choose").

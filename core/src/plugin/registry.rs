@@ -203,7 +203,7 @@ unsafe extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
     let (plugin, message) = unsafe { (plugin.as_str(), message.as_str()) };
     let (plugin, message) = (plugin.unwrap_or("?"), message.unwrap_or("(invalid UTF-8)"));
     // A panic the SDK caught where no error sink reaches: it goes into the call's error.
-    if super::calls::keep_plugin_panic(level, message) {
+    if crate::geometry::custom::keep_plugin_panic(level, message) {
         return;
     }
     let level = match level {
