@@ -129,6 +129,8 @@ fn check_cpu() {
 fn main() -> ExitCode {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     check_cpu();
+    // Before anything can log: plugin messages reach stderr only through this sink.
+    cli::log_to_stderr();
     keep_large_blocks_returnable();
     cli::signals::install();
     let cli = match Cli::try_parse() {

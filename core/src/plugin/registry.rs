@@ -194,7 +194,7 @@ pub struct Registry {
     by_name: HashMap<String, usize>,
 }
 
-/// `HostTable::log`: prints a plugin's message (debug ones only with `LUXON_DEBUG` set).
+/// `HostTable::log`: a plugin's message, as `{plugin}: {message}`, to the library's log sink.
 ///
 /// # Safety
 /// Both strings are readable for the call (the ABI's calling contract).
@@ -206,15 +206,8 @@ unsafe extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
     if crate::geometry::custom::keep_plugin_panic(level, message) {
         return;
     }
-    let level = match level {
-        0 => "error",
-        1 => "warning",
-        2 => "info",
-        _ => "debug",
-    };
-    if level != "debug" || std::env::var_os("LUXON_DEBUG").is_some() {
-        crate::error::print_line(level, &format!("{plugin}: {message}"));
-    }
+    let level = crate::error::Level::from_code(level);
+    crate::error::log(level, &format!("{plugin}: {message}"));
 }
 
 static HOST: abi::HostTable = abi::HostTable {
