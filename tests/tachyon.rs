@@ -862,7 +862,7 @@ fn procedural_textures_give_tachyons_pixels() {
 /// TEXFUNC 10: a 3 × 2 × 2 IMAGEDEF on a tilted wall, unlit, so u, v and w all vary across the
 /// picture and the block repeats (u and v wrap).
 fn volume_image_scene() -> String {
-    format!(
+    String::from(
         "BEGIN_SCENE\nRESOLUTION 48 40\nCAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 1\n\
          CENTER 0 0 0 VIEWDIR 0 0 1 UPDIR 0 1 0 END_CAMERA\n\
          IMAGEDEF ::block FORMAT RGB24 RESOLUTION 3 2 2 ENCODING HEX\n\
