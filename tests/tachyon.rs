@@ -870,7 +870,7 @@ fn volume_image_scene() -> String {
          ffff00 00ffff ff00ff 404040 c0c0c0 102030\n\
          PLANE CENTER 0 0 6 NORMAL 0.5 0.3 -1 TEXTURE AMBIENT 1 DIFFUSE 0 SPECULAR 0 \
          OPACITY 1 COLOR 1 1 1 TEXFUNC 10 ::block CENTER 0.2 -0.1 5 ROTATE 0.1 0.3 0.2 \
-         SCALE 0.5 0.7 0.4 UAXIS 1 0 0 VAXIS 0 1 0.2 WAXIS 0.1 0 1\nEND_SCENE\n"
+         SCALE 0.5 0.7 0.4 UAXIS 1 0 0 VAXIS 0 1 0.2 WAXIS 0.1 0 1\nEND_SCENE\n",
     )
 }
 
