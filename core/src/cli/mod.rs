@@ -3,6 +3,7 @@
 pub mod check;
 pub mod convert;
 pub mod job;
+pub mod new_plugin;
 pub mod plugins;
 pub mod progress;
 pub mod render;

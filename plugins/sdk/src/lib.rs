@@ -6,12 +6,14 @@
 //! it, checks [`abi::ABI_VERSION`] before calling anything, and hands each instance its `params`
 //! subtree from the scene as RON text, which this crate deserializes into the type's own
 //! `#[derive(Deserialize)]` struct (use `#[serde(deny_unknown_fields)]` so typos are errors).
+//! `luxon new-plugin NAME --kind primitive|texture|writer|volume` writes a crate of each kind
+//! to start from.
 //!
 //! ```no_run
 //! use luxon_plugin::*;
 //!
 //! #[derive(serde::Deserialize)]
-//! #[serde(crate = "luxon_plugin::serde", deny_unknown_fields)]
+//! #[serde(deny_unknown_fields)]
 //! struct BallParams { center: [f64; 3], radius: f64 }
 //!
 //! struct Ball;
@@ -45,7 +47,11 @@ use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
+/// A texture's query, the one type of [`abi`] a texture plugin names.
+pub use abi::TexQuery;
 pub use abi::ABI_VERSION;
+/// The serde this crate deserializes parameters with. Plugins depend on `serde` themselves
+/// (see "Parameters" in the crate documentation); Cargo makes both the same crate.
 pub use serde;
 
 /// Version of this crate, sent in the handshake.
@@ -54,12 +60,17 @@ pub const SDK_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// An error a plugin reports; `line`/`col` (1-based, 0 = unknown) are positions in its params text.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Error {
+    /// What went wrong, in words for the scene's author (the host adds the plugin's name and
+    /// the scene position).
     pub message: String,
+    /// Line in the params text (1-based; 0: no position, the host points at `params`).
     pub line: u32,
+    /// Column in that line (1-based; 0: no position).
     pub col: u32,
 }
 
 impl Error {
+    /// An error without a position.
     pub fn new(message: impl Into<String>) -> Error {
         Error {
             message: message.into(),
@@ -118,7 +129,10 @@ pub fn finite<const N: usize>(name: &str, v: [f64; N]) -> Result<[f64; N], Error
 
 /// Name, description and parameter table of a plugin entry (shown by `luxon plugins`).
 pub trait Describe {
+    /// The name scenes use: `(plugin: "NAME", ...)`. Unique among the plugins of its kind on
+    /// the search path (the first library found that provides it wins).
     const NAME: &'static str;
+    /// One line: what it is.
     const DESCRIPTION: &'static str;
     /// One `name: type = default  meaning` per line.
     const PARAMS: &'static str;
@@ -279,7 +293,10 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 
 /// A primitive plugin: turns parameters into geometry.
 pub trait Primitive: Describe {
+    /// The scene's `params: (...)`, deserialized (see "Parameters" in the crate documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per scene object naming the plugin: checks the parameters and hands the
+    /// geometry to `out`. An error stops the scene from loading, naming the object.
     fn create(params: Self::Params, ctx: &Context, out: &mut Geometry) -> Result<(), Error>;
 }
 
@@ -291,23 +308,30 @@ pub struct Geometry<'a> {
 /// A triangle mesh to hand to the host. Optional arrays are empty or have one entry per vertex.
 #[derive(Default, Clone, Debug)]
 pub struct Mesh {
+    /// Vertex positions in world space.
     pub positions: Vec<[f64; 3]>,
+    /// Three indices into `positions` per triangle.
     pub indices: Vec<[u64; 3]>,
+    /// Per-vertex normals, interpolated for smooth shading (empty: flat shading).
     pub normals: Vec<[f64; 3]>,
+    /// Per-vertex linear RGB colours, interpolated and multiplied into the material's colour.
     pub colors: Vec<[f32; 3]>,
+    /// Per-vertex texture coordinates, interpolated into [`TexQuery::uv`].
     pub uvs: Vec<[f32; 2]>,
 }
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The smallest corner (x, y, z), world space.
     pub min: [f64; 3],
+    /// The largest corner.
     pub max: [f64; 3],
 }
 
-/// A ray as custom geometry sees it (world space, f64).
+/// A ray as custom geometry sees it (world space, f64): see [`abi::RayF64`] for its fields.
 pub type Ray = abi::RayF64;
-/// A custom geometry hit.
+/// A custom geometry hit: see [`abi::HitF64`] for its fields.
 pub type Hit = abi::HitF64;
 
 /// User geometry intersected by the plugin from inside the host's BVH.
@@ -404,6 +428,7 @@ impl Geometry<'_> {
         self.add(self.sink.add_discs, discs)
     }
 
+    /// A triangle mesh; its optional arrays have one entry per vertex or none.
     pub fn mesh(&mut self, mesh: &Mesh) -> Result<(), Error> {
         let n = mesh.positions.len();
         for (what, len) in [
@@ -576,9 +601,15 @@ unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
 /// A texture plugin: an instance created once, evaluated at every shading point (from many
 /// threads at once, hence `Sync`).
 pub trait Texture: Describe + Send + Sync + Sized + 'static {
+    /// The texture's `params: (...)`, deserialized (see "Parameters" in the crate documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per entry of the scene's `textures` naming the plugin. An error stops the
+    /// scene from loading, naming the texture.
     fn create(params: Self::Params, ctx: &Context) -> Result<Self, Error>;
-    /// Linear RGBA at the query point.
+    /// Linear RGBA at the query point (see [`TexQuery`] for its fields). A material's colour
+    /// takes red, green and blue (values above 1 are allowed); a reflect or transmit texture
+    /// the mean of the three. The host does not use alpha: give 1, or what your own nested
+    /// textures mix by.
     fn eval(&self, query: &abi::TexQuery) -> [f32; 4];
     /// What the host calls: [`eval`](Self::eval)'s value, or an error when no value can be
     /// given (an image that turns out not to decode). The host then stops the render with the
@@ -649,18 +680,27 @@ unsafe extern "C" fn texture_destroy<T: Texture>(object: *mut c_void) {
 
 /// A volume reader plugin: streams a scalar grid into the host.
 pub trait VolumeReader: Describe {
+    /// The volume's `params: (...)`, deserialized (see "Parameters" in the crate documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per volume of the scene naming the plugin: describes the grid with
+    /// [`VolumeOut::begin`], then sends its blocks and tiles. An error stops the scene from
+    /// loading, naming the volume.
     fn read(params: Self::Params, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error>;
 }
 
-/// Description of a grid, sent before its data.
+/// Description of a grid, sent before its data (see [`abi::VolumeDesc`]).
 #[derive(Clone, Debug)]
 pub struct GridInfo {
-    /// Row-major 3x4 affine map from voxel index to world space.
+    /// Row-major 3x4 affine map from voxel index to world space: voxel `(i, j, k)` is at
+    /// `M · (i, j, k, 1)`.
     pub world_from_index: [f64; 12],
+    /// The value outside every block and tile (where nothing was sent).
     pub background: f32,
+    /// The smallest voxel index along each axis.
     pub index_min: [i64; 3],
+    /// The largest voxel index along each axis (inclusive).
     pub index_max: [i64; 3],
+    /// The grid's name, for messages and `luxon check`.
     pub name: String,
 }
 
@@ -681,6 +721,7 @@ pub struct VolumeOut<'a> {
 }
 
 impl VolumeOut<'_> {
+    /// Describes the grid; called once, before any block or tile.
     pub fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
         let desc = abi::VolumeDesc {
             world_from_index: info.world_from_index,
@@ -765,6 +806,8 @@ impl VolumeOut<'_> {
         })
     }
 
+    /// A box of `dims` voxels from index `origin`, all of `value` (a sparse format's
+    /// constant tiles; cheaper than a dense block of one value).
     pub fn tile(&mut self, origin: [i64; 3], dims: [u64; 3], value: f32) -> Result<(), Error> {
         let sink = self.sink;
         // SAFETY: `sink` is the host's table for the running `read` and `ctx` its own.
@@ -778,8 +821,13 @@ impl VolumeOut<'_> {
 
 /// A finished image: linear RGBA f32, rows top to bottom.
 pub struct Image<'a> {
+    /// Pixels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
+    /// `width * height` pixels of four values each, red, green, blue and alpha, row by row
+    /// from the top. Colours are linear (encode them for the format: [`linear_to_srgb`] for
+    /// 8-bit sRGB) and may exceed 1; alpha is 1 (rendered pixels are opaque).
     pub rgba: &'a [f32],
 }
 
@@ -787,7 +835,12 @@ pub struct Image<'a> {
 pub trait Writer: Describe {
     /// Comma-separated file extensions, without dots, e.g. "ppm,pnm".
     const EXTENSIONS: &'static str;
+    /// The output's `params: (...)`, deserialized (see "Parameters" in the crate
+    /// documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per output written (once per frame of an animation): encodes `image` into
+    /// `out`, whose bytes become the file, written whole or not at all. An error fails the
+    /// run with the message, and the file is not written.
     fn write(
         params: Self::Params,
         ctx: &Context,
