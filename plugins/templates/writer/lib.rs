@@ -52,7 +52,8 @@ impl Writer for {{Name}}Writer {
         let exposure = p.exposure;
         if !exposure.is_finite() {
             // "parameter `exposure`..." first: Luxon reports it at `exposure:` in the scene.
-            let message = format!("parameter `exposure`: expected a finite number, found {exposure}");
+            let message =
+                format!("parameter `exposure`: expected a finite number, found {exposure}");
             return Err(invalid(message));
         }
         let gain = 2f32.powf(exposure as f32);
