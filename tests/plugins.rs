@@ -287,7 +287,7 @@ fn a_writer_panic_names_the_output_and_carries_its_message() {
 #[test]
 fn the_search_path_says_what_it_skipped_and_why() {
     let dir = temp_dir("search-notes");
-    let misnamed = install(&dir, "testplug_panics", "stripes");
+    let misnamed = install(&dir, "testplug_panics", "zigzag");
     let broken = dir.join(format!(
         "{}luxon_broken{}",
         std::env::consts::DLL_PREFIX,
@@ -326,7 +326,7 @@ fn the_search_path_says_what_it_skipped_and_why() {
     std::fs::write(
         &scene,
         "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), \
-         textures: { \"s\": (plugin: \"stripes\") }, render: (width: 4, height: 4))",
+         textures: { \"s\": (plugin: \"zigzag\") }, render: (width: 4, height: 4))",
     )
     .unwrap();
     let out = dir.join("out.png");
@@ -342,7 +342,7 @@ fn the_search_path_says_what_it_skipped_and_why() {
         .unwrap();
     let err = stderr(&r);
     assert_eq!(r.status.code(), Some(1), "{err}");
-    assert!(err.contains("no texture plugin named `stripes`"), "{err}");
+    assert!(err.contains("no texture plugin named `zigzag`"), "{err}");
     for note in [&name_note, &missing_note] {
         let reason = note.strip_prefix("skipped ").unwrap();
         assert!(err.contains(reason), "missing `{reason}` in {err}");
