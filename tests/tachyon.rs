@@ -862,7 +862,7 @@ fn procedural_textures_give_tachyons_pixels() {
 /// TEXFUNC 10: a 3 × 2 × 2 IMAGEDEF on a tilted wall, unlit, so u, v and w all vary across the
 /// picture and the block repeats (u and v wrap).
 fn volume_image_scene() -> String {
-    format!(
+    String::from(
         "BEGIN_SCENE\nRESOLUTION 48 40\nCAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 1\n\
          CENTER 0 0 0 VIEWDIR 0 0 1 UPDIR 0 1 0 END_CAMERA\n\
          IMAGEDEF ::block FORMAT RGB24 RESOLUTION 3 2 2 ENCODING HEX\n\
@@ -870,7 +870,7 @@ fn volume_image_scene() -> String {
          ffff00 00ffff ff00ff 404040 c0c0c0 102030\n\
          PLANE CENTER 0 0 6 NORMAL 0.5 0.3 -1 TEXTURE AMBIENT 1 DIFFUSE 0 SPECULAR 0 \
          OPACITY 1 COLOR 1 1 1 TEXFUNC 10 ::block CENTER 0.2 -0.1 5 ROTATE 0.1 0.3 0.2 \
-         SCALE 0.5 0.7 0.4 UAXIS 1 0 0 VAXIS 0 1 0.2 WAXIS 0.1 0 1\nEND_SCENE\n"
+         SCALE 0.5 0.7 0.4 UAXIS 1 0 0 VAXIS 0 1 0.2 WAXIS 0.1 0 1\nEND_SCENE\n",
     )
 }
 

@@ -23,13 +23,22 @@ pub struct RenderStats {
     pub tiles: usize,
     /// The work of every process (one entry without MPI), per thread.
     pub ranks: Vec<RankStats>,
+    /// NaN results per plugin instance over every process (see [`Scene::nan_counts`]).
+    pub nan_sources: Vec<u64>,
 }
 
 impl RenderStats {
     pub fn of(ranks: Vec<RankStats>, render_time: Duration) -> RenderStats {
         let mut total = WorkerStats::default();
+        let mut nan_sources: Vec<u64> = Vec::new();
         for r in &ranks {
             total.add(&r.total());
+            if nan_sources.len() < r.nan_sources.len() {
+                nan_sources.resize(r.nan_sources.len(), 0);
+            }
+            for (sum, n) in nan_sources.iter_mut().zip(&r.nan_sources) {
+                *sum += n;
+            }
         }
         RenderStats {
             counters: total.counters,
@@ -37,6 +46,7 @@ impl RenderStats {
             threads: ranks.first().map_or(0, |r| r.threads.len()),
             tiles: total.units as usize,
             ranks,
+            nan_sources,
         }
     }
 }

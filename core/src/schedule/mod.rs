@@ -61,6 +61,8 @@ pub struct RankStats {
     pub threads: Vec<WorkerStats>,
     /// Wall time of the rank's render phase.
     pub time: Duration,
+    /// NaN results per plugin instance, in the order of [`Scene::nan_counts`].
+    pub nan_sources: Vec<u64>,
 }
 
 impl RankStats {
@@ -225,6 +227,7 @@ pub fn run_share(
             .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
             .collect(),
         time: start.elapsed(),
+        nan_sources: scene.nan_counts(),
     }
 }
 

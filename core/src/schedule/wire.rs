@@ -81,7 +81,7 @@ pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
     r.0.is_empty().then_some(Chunk { spans, rgba, depth })
 }
 
-/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan volume_samples busy]*`
+/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan volume_samples busy]*[instances][nan]*`
 pub fn encode_stats(s: &RankStats) -> Vec<u8> {
     let mut b = Vec::new();
     put64(&mut b, s.rank as u64);
@@ -104,6 +104,10 @@ pub fn encode_stats(s: &RankStats) -> Vec<u8> {
         ] {
             put64(&mut b, v);
         }
+    }
+    put64(&mut b, s.nan_sources.len() as u64);
+    for &n in &s.nan_sources {
+        put64(&mut b, n);
     }
     b
 }
@@ -131,10 +135,16 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
             busy: Duration::from_nanos(r.u64()?),
         });
     }
+    let n = r.u64()? as usize;
+    let mut nan_sources = Vec::with_capacity(n.min(bytes.len() / 8));
+    for _ in 0..n {
+        nan_sources.push(r.u64()?);
+    }
     r.0.is_empty().then_some(RankStats {
         rank,
         threads,
         time,
+        nan_sources,
     })
 }
 
@@ -207,6 +217,7 @@ mod tests {
                 },
                 busy: Duration::from_micros(99),
             }],
+            nan_sources: vec![0, 12, 0],
         };
         assert_eq!(decode_stats(&encode_stats(&s)), Some(s));
     }

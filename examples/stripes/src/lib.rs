@@ -48,7 +48,7 @@
 
 #![forbid(unsafe_code)]
 
-use luxon_plugin::{export, finite, invalid, Context, Describe, Error, TexQuery, Texture};
+use luxon_plugin::{export, finite, invalid_at, Context, Describe, Error, TexQuery, Texture};
 use serde::Deserialize;
 
 /// The scene's `params: (...)`; fields left out take the defaults.
@@ -105,10 +105,13 @@ impl Texture for Stripes {
         let axis = finite("axis", p.axis)?;
         let length = axis.iter().map(|v| v * v).sum::<f64>().sqrt();
         if !(length > 0.0 && length.is_finite()) {
-            return Err(invalid("`axis` must be a non-zero direction"));
+            // Reported at `axis:` in the scene (see `Error::invalid_at`).
+            let message = format!("expected a non-zero direction, found {axis:?}");
+            return Err(invalid_at("axis", message));
         }
         if !(p.width > 0.0 && p.width.is_finite()) {
-            return Err(invalid(format!("`width` must be > 0, got {}", p.width)));
+            let found = p.width;
+            return Err(invalid_at("width", format!("expected > 0, found {found}")));
         }
         Ok(Stripes {
             a,
@@ -224,8 +227,11 @@ mod tests {
     #[test]
     fn bad_parameters_are_errors() {
         for (params, message) in [
-            ("(width: 0)", "`width` must be > 0, got 0"),
-            ("(axis: (0, 0, 0))", "`axis` must be a non-zero direction"),
+            ("(width: 0)", "parameter `width`: expected > 0, found 0"),
+            (
+                "(axis: (0, 0, 0))",
+                "parameter `axis`: expected a non-zero direction, found [0.0, 0.0, 0.0]",
+            ),
         ] {
             let p = luxon_plugin::parse_params(params).unwrap();
             let e = Stripes::create(p, &Context::default()).err().unwrap();

@@ -112,6 +112,12 @@ pub struct HostTable {
     /// The host's [`ABI_VERSION`].
     pub abi_version: u32,
     /// level: 0 error, 1 warning, 2 info, 3 debug. Callable from any thread.
+    ///
+    /// One convention rides on it: an error (level 0) beginning "panicked in `" (as in
+    /// "panicked in `intersect`: {message}"), sent on the thread of a [`CustomVTable`] call that
+    /// then returns [`HIT_PANIC`] or [`STATUS_PANIC`], is that panic's message. The host adds it
+    /// to the error that stops the render instead of printing it (a host that predates the
+    /// convention prints it as an error line, which still reads well).
     pub log: unsafe extern "C" fn(level: u32, plugin: Str, message: Str),
 }
 
@@ -262,7 +268,9 @@ pub struct HitF64 {
 
 /// Custom geometry: `count` primitives the host puts in its BVH.
 /// `intersect`/`occluded` return 1 for a hit, 0 for none, and [`STATUS_PANIC`] + 1 (= 3) when the
-/// plugin panicked (the host then stops the render with an error naming the plugin).
+/// plugin panicked (the host then stops the render with an error naming the plugin). These calls
+/// have no [`ErrorSink`]: a panic's message may be sent through [`HostTable::log`] first (see
+/// there).
 #[repr(C)]
 pub struct CustomVTable {
     /// Writes the world-space box of primitive `index` (`0..count`) to `min` and `max`.

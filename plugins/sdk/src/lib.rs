@@ -41,6 +41,7 @@
 
 pub mod abi;
 pub mod files;
+mod params;
 
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -77,6 +78,20 @@ impl Error {
             col: 0,
         }
     }
+
+    /// An error about parameter `field`: "parameter `field`: {message}". Returned from a
+    /// plugin's `create`/`read`/`write`, it is reported at that field in the scene file (the
+    /// SDK finds `field:` in the params text it was given); a field the scene leaves out (its
+    /// default was used) is reported at the start of the params. Any error without a position
+    /// whose message begins with "parameter `name`" is placed the same way.
+    ///
+    /// ```
+    /// let e = luxon_plugin::Error::invalid_at("width", "expected a number > 0, found -1");
+    /// assert_eq!(e.message, "parameter `width`: expected a number > 0, found -1");
+    /// ```
+    pub fn invalid_at(field: &str, message: impl std::fmt::Display) -> Error {
+        Error::new(format!("parameter `{field}`: {message}"))
+    }
 }
 
 impl std::fmt::Display for Error {
@@ -94,6 +109,11 @@ impl From<std::io::Error> for Error {
 /// Shorthand for a failed check on a parameter value.
 pub fn invalid(message: impl Into<String>) -> Error {
     Error::new(message)
+}
+
+/// Shorthand for [`Error::invalid_at`]: a failed check on parameter `field`, reported at it.
+pub fn invalid_at(field: &str, message: impl std::fmt::Display) -> Error {
+    Error::invalid_at(field, message)
 }
 
 /// Rejects NaN and infinities with a message naming the parameter.
@@ -182,17 +202,26 @@ impl Context {
 
 /// Deserializes a params subtree given as RON text; positions in errors are relative to `text`.
 pub fn parse_params<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Error> {
+    parse_documented_params(text, "")
+}
+
+/// [`parse_params`] for a plugin whose parameter table ([`Describe::PARAMS`]) is `doc`: a value
+/// of the wrong type is reported naming its parameter, the type the table gives it and what the
+/// text has there ("parameter `color`: expected (r, g, b), found `"red"`"). The SDK's entry
+/// points parse with the plugin's own table.
+pub fn parse_documented_params<T: serde::de::DeserializeOwned>(
+    text: &str,
+    doc: &str,
+) -> Result<T, Error> {
     let text = if text.trim().is_empty() { "()" } else { text };
     ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
         .from_str::<T>(text)
         .map_err(|e| {
-            let message = describe_ron_error(&e.code);
-            Error {
-                message,
-                line: e.span.start.line as u32,
-                col: e.span.start.col as u32,
-            }
+            let (line, col) = (e.span.start.line, e.span.start.col);
+            let (message, (line, col)) = params::type_error(text, doc, &e.code, line, col)
+                .unwrap_or_else(|| (describe_ron_error(&e.code), (line as u32, col as u32)));
+            Error { message, line, col }
         })
 }
 
@@ -439,7 +468,10 @@ impl Geometry<'_> {
     /// Hands `shape` to the host, which owns it from now on.
     pub fn custom<S: CustomShape>(&mut self, shape: S) -> Result<(), Error> {
         let count = shape.count();
-        let object = Box::into_raw(Box::new(shape)) as *mut c_void;
+        let object = Box::into_raw(Box::new(Shape {
+            shape,
+            told: std::sync::atomic::AtomicBool::new(false),
+        })) as *mut c_void;
         let geometry = abi::CustomGeometry {
             object,
             count,
@@ -450,6 +482,30 @@ impl Geometry<'_> {
         // SAFETY: `sink` is the host's table for the running `create` and `ctx` its own;
         // `geometry` lives across the call, its object is a live `S` whose table is `S`'s.
         call_sink(|err| unsafe { (sink.add_custom)(sink.ctx, &geometry, err) })
+    }
+}
+
+/// A custom shape as the host holds it: the plugin's shape, and whether the host has been told
+/// of a panic in it.
+struct Shape<S> {
+    shape: S,
+    told: std::sync::atomic::AtomicBool,
+}
+
+impl<S> Shape<S> {
+    /// What a panic caught in `call` gives the host. Its calls have no error sink, so the first
+    /// panic's message goes through the host log, on the thread of the call: "panicked in
+    /// `intersect`: {message}" (a host that knows this convention adds it to the error that
+    /// stops the render; an older one prints it as an error line). Later ones only return
+    /// `status`.
+    fn panicked<T>(&self, call: &str, p: Box<dyn std::any::Any + Send>, status: T) -> T {
+        if !self.told.swap(true, std::sync::atomic::Ordering::Relaxed) {
+            let message = shim::panic_message(p);
+            let words = message.strip_prefix("panicked: ").unwrap_or(&message);
+            let library = shim::LIBRARY.get().copied().unwrap_or("?");
+            host_log(library, 0, &format!("panicked in `{call}`: {words}"));
+        }
+        status
     }
 }
 
@@ -466,12 +522,12 @@ fn custom_vtable<S: CustomShape>() -> &'static abi::CustomVTable {
     &Holder::<S>::VTABLE
 }
 
-// The functions of a custom shape's table. Their `object` is the `Box<S>` that
+// The functions of a custom shape's table. Their `object` is the `Box<Shape<S>>` that
 // `Geometry::custom` leaked and handed to the host, which destroys it once, after every other
 // call (ABI contract); `S: Sync`, so concurrent calls from the host's render threads are fine.
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`]; `min` and `max` are writable.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`]; `min` and `max` are writable.
 unsafe extern "C" fn custom_bounds<S: CustomShape>(
     object: *const c_void,
     index: u64,
@@ -479,8 +535,8 @@ unsafe extern "C" fn custom_bounds<S: CustomShape>(
     max: *mut [f64; 3],
 ) -> abi::Status {
     // SAFETY: see the comment above these functions.
-    let shape = unsafe { &*(object as *const S) };
-    match catch_unwind(AssertUnwindSafe(|| shape.bounds(index))) {
+    let shape = unsafe { &*(object as *const Shape<S>) };
+    match catch_unwind(AssertUnwindSafe(|| shape.shape.bounds(index))) {
         Ok(b) => {
             // SAFETY: the host passes two writable `[f64; 3]` for the call (ABI contract).
             unsafe {
@@ -489,12 +545,12 @@ unsafe extern "C" fn custom_bounds<S: CustomShape>(
             }
             abi::STATUS_OK
         }
-        Err(_) => abi::STATUS_PANIC,
+        Err(p) => shape.panicked("bounds", p, abi::STATUS_PANIC),
     }
 }
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`]; `ray` is readable, `hit` writable.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`]; `ray` is readable, `hit` writable.
 unsafe extern "C" fn custom_intersect<S: CustomShape>(
     object: *const c_void,
     index: u64,
@@ -502,39 +558,39 @@ unsafe extern "C" fn custom_intersect<S: CustomShape>(
     hit: *mut abi::HitF64,
 ) -> u32 {
     // SAFETY: see the comment above these functions; the host's ray is valid for the call.
-    let (shape, ray) = unsafe { (&*(object as *const S), &*ray) };
-    match catch_unwind(AssertUnwindSafe(|| shape.intersect(index, ray))) {
+    let (shape, ray) = unsafe { (&*(object as *const Shape<S>), &*ray) };
+    match catch_unwind(AssertUnwindSafe(|| shape.shape.intersect(index, ray))) {
         Ok(Some(h)) => {
             // SAFETY: the host passes a writable `HitF64` for the call (ABI contract).
             unsafe { *hit = h };
             1
         }
         Ok(None) => 0,
-        Err(_) => abi::HIT_PANIC,
+        Err(p) => shape.panicked("intersect", p, abi::HIT_PANIC),
     }
 }
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`]; `ray` is readable.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`]; `ray` is readable.
 unsafe extern "C" fn custom_occluded<S: CustomShape>(
     object: *const c_void,
     index: u64,
     ray: *const abi::RayF64,
 ) -> u32 {
     // SAFETY: see the comment above these functions; the host's ray is valid for the call.
-    let (shape, ray) = unsafe { (&*(object as *const S), &*ray) };
-    match catch_unwind(AssertUnwindSafe(|| shape.occluded(index, ray))) {
+    let (shape, ray) = unsafe { (&*(object as *const Shape<S>), &*ray) };
+    match catch_unwind(AssertUnwindSafe(|| shape.shape.occluded(index, ray))) {
         Ok(b) => u32::from(b),
-        Err(_) => abi::HIT_PANIC,
+        Err(p) => shape.panicked("occluded", p, abi::HIT_PANIC),
     }
 }
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`], not used again after this call.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`], not used again after this call.
 unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
-    // SAFETY: `object` came from `Box::into_raw` of a `Box<S>` and the host destroys it once,
-    // after every other call on it (see the comment above these functions).
-    let shape = unsafe { Box::from_raw(object as *mut S) };
+    // SAFETY: `object` came from `Box::into_raw` of a `Box<Shape<S>>` and the host destroys it
+    // once, after every other call on it (see the comment above these functions).
+    let shape = unsafe { Box::from_raw(object as *mut Shape<S>) };
     let _ = catch_unwind(AssertUnwindSafe(|| drop(shape)));
 }
 
@@ -878,10 +934,20 @@ pub mod shim {
         }
     }
 
-    fn params<P: serde::de::DeserializeOwned>(
+    /// The params text of a call, or why it is unusable.
+    fn text(text: Result<&str, std::str::Utf8Error>) -> Result<&str, Error> {
+        text.map_err(|_| Error::new("params are not UTF-8"))
+    }
+
+    /// Parses the params of `D` and runs `f` with them; an error from `f` that names a
+    /// parameter is placed at it in `text` (see [`Error::invalid_at`]).
+    fn with_params<D: Describe, P: serde::de::DeserializeOwned>(
         text: Result<&str, std::str::Utf8Error>,
-    ) -> Result<P, Error> {
-        parse_params(text.map_err(|_| Error::new("params are not UTF-8"))?)
+        f: impl FnOnce(P) -> Result<(), Error>,
+    ) -> Result<(), Error> {
+        let text = self::text(text)?;
+        let p = parse_documented_params::<P>(text, D::PARAMS)?;
+        f(p).map_err(|e| params::place(e, text))
     }
 
     /// [`abi::PrimitiveVTable::create`] for `P`.
@@ -900,9 +966,10 @@ pub mod shim {
         let (text, ctx, sink, err) =
             unsafe { (text.as_str(), ctx.as_ref(), sink.as_ref(), err.as_ref()) };
         guarded(err, || {
-            let p = params::<P::Params>(text)?;
-            let sink = sink.ok_or_else(|| Error::new("no geometry sink"))?;
-            P::create(p, &context(ctx), &mut Geometry { sink })
+            with_params::<P, P::Params>(text, |p| {
+                let sink = sink.ok_or_else(|| Error::new("no geometry sink"))?;
+                P::create(p, &context(ctx), &mut Geometry { sink })
+            })
         })
     }
 
@@ -922,13 +989,14 @@ pub mod shim {
             unsafe { (text.as_str(), ctx.as_ref(), out.as_mut(), err.as_ref()) };
         guarded(err, || {
             let out = out.ok_or_else(|| Error::new("no place for the texture"))?;
-            let p = params::<T::Params>(text)?;
-            let tex = T::create(p, &context(ctx))?;
-            *out = abi::TextureObject {
-                object: Box::into_raw(Box::new(tex)) as *mut c_void,
-                vtable: texture_instance_vtable::<T>(),
-            };
-            Ok(())
+            with_params::<T, T::Params>(text, |p| {
+                let tex = T::create(p, &context(ctx))?;
+                *out = abi::TextureObject {
+                    object: Box::into_raw(Box::new(tex)) as *mut c_void,
+                    vtable: texture_instance_vtable::<T>(),
+                };
+                Ok(())
+            })
         })
     }
 
@@ -947,9 +1015,10 @@ pub mod shim {
         let (text, ctx, sink, err) =
             unsafe { (text.as_str(), ctx.as_ref(), sink.as_ref(), err.as_ref()) };
         guarded(err, || {
-            let p = params::<V::Params>(text)?;
-            let sink = sink.ok_or_else(|| Error::new("no volume sink"))?;
-            V::read(p, &context(ctx), &mut VolumeOut { sink })
+            with_params::<V, V::Params>(text, |p| {
+                let sink = sink.ok_or_else(|| Error::new("no volume sink"))?;
+                V::read(p, &context(ctx), &mut VolumeOut { sink })
+            })
         })
     }
 
@@ -977,29 +1046,30 @@ pub mod shim {
             )
         };
         guarded(err, || {
-            let p = params::<W::Params>(text)?;
-            let view = view.ok_or_else(|| Error::new("no image"))?;
-            let n = (view.width as usize)
-                .checked_mul(view.height as usize)
-                .and_then(|n| n.checked_mul(4))
-                .ok_or_else(|| Error::new("image too large"))?;
-            let rgba = if n == 0 {
-                &[][..]
-            } else if view.rgba.is_null() {
-                return Err(Error::new("no pixels"));
-            } else {
-                // SAFETY: the host's image holds `width * height * 4` values, unchanged while
-                // the call runs (ABI contract), and the slice does not outlive the call.
-                unsafe { std::slice::from_raw_parts(view.rgba, n) }
-            };
-            let image = Image {
-                width: view.width,
-                height: view.height,
-                rgba,
-            };
-            let sink = out.ok_or_else(|| Error::new("no byte sink"))?;
-            let mut w = ByteOut(sink);
-            W::write(p, &context(ctx), &image, &mut w)
+            with_params::<W, W::Params>(text, |p| {
+                let view = view.ok_or_else(|| Error::new("no image"))?;
+                let n = (view.width as usize)
+                    .checked_mul(view.height as usize)
+                    .and_then(|n| n.checked_mul(4))
+                    .ok_or_else(|| Error::new("image too large"))?;
+                let rgba = if n == 0 {
+                    &[][..]
+                } else if view.rgba.is_null() {
+                    return Err(Error::new("no pixels"));
+                } else {
+                    // SAFETY: the host's image holds `width * height * 4` values, unchanged while
+                    // the call runs (ABI contract), and the slice does not outlive the call.
+                    unsafe { std::slice::from_raw_parts(view.rgba, n) }
+                };
+                let image = Image {
+                    width: view.width,
+                    height: view.height,
+                    rgba,
+                };
+                let sink = out.ok_or_else(|| Error::new("no byte sink"))?;
+                let mut w = ByteOut(sink);
+                W::write(p, &context(ctx), &image, &mut w)
+            })
         })
     }
 
@@ -1080,6 +1150,8 @@ pub mod shim {
     /// The host's table, for `log`.
     pub(crate) static HOST: std::sync::OnceLock<&'static abi::HostTable> =
         std::sync::OnceLock::new();
+    /// The library's name (`export!`'s), for log messages the SDK sends on its behalf.
+    pub(crate) static LIBRARY: std::sync::OnceLock<&'static str> = std::sync::OnceLock::new();
 
     /// Called by the handshake. A cdylib has its own copy of std and so its own panic hook: the
     /// default one would print every caught panic (one per ray for a broken intersect). Ours
@@ -1097,6 +1169,7 @@ pub mod shim {
         if HOST.set(host).is_err() {
             return;
         }
+        let _ = LIBRARY.set(library);
         static REPORTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
         std::panic::set_hook(Box::new(move |info| {
             if !REPORTED.swap(true, std::sync::atomic::Ordering::Relaxed) {

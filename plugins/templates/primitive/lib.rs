@@ -67,7 +67,9 @@ impl Primitive for {{Name}}Primitive {
     fn create(p: Self::Params, _ctx: &Context, out: &mut Geometry) -> Result<(), Error> {
         let center = finite("center", p.center)?;
         if !(p.radius > 0.0 && p.radius.is_finite()) {
-            return Err(invalid(format!("`radius` must be > 0, got {}", p.radius)));
+            // "parameter `radius`..." first: Luxon reports it at `radius:` in the scene.
+            let message = format!("parameter `radius`: expected > 0, found {}", p.radius);
+            return Err(invalid(message));
         }
         out.custom({{Name}}Surface {
             center,

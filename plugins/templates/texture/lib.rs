@@ -70,7 +70,9 @@ impl Texture for {{Name}}Texture {
         let even = finite("even", p.even)?;
         let odd = finite("odd", p.odd)?;
         if !(p.squares > 0.0 && p.squares.is_finite()) {
-            return Err(invalid(format!("`squares` must be > 0, got {}", p.squares)));
+            // "parameter `squares`..." first: Luxon reports it at `squares:` in the scene.
+            let message = format!("parameter `squares`: expected > 0, found {}", p.squares);
+            return Err(invalid(message));
         }
         Ok(Self {
             even: rgba(even),

@@ -48,7 +48,9 @@ impl VolumeReader for {{Name}}Volume {
     /// time. An error stops the scene from loading, with the message.
     fn read(p: Self::Params, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error> {
         if !(2..=256).contains(&p.size) {
-            return Err(invalid(format!("`size` must be 2 to 256, got {}", p.size)));
+            // "parameter `size`..." first: Luxon reports it at `size:` in the scene.
+            let message = format!("parameter `size`: expected 2 to 256, found {}", p.size);
+            return Err(invalid(message));
         }
         let n = p.size;
         // Voxel (i, j, k) sits at -1 + i * step (and so on): the index box fills [-1, 1]³.

@@ -51,7 +51,9 @@ impl Writer for {{Name}}Writer {
     ) -> Result<(), Error> {
         let exposure = p.exposure;
         if !exposure.is_finite() {
-            let message = format!("`exposure` must be finite, got {exposure}");
+            // "parameter `exposure`..." first: Luxon reports it at `exposure:` in the scene.
+            let message =
+                format!("parameter `exposure`: expected a finite number, found {exposure}");
             return Err(invalid(message));
         }
         let gain = 2f32.powf(exposure as f32);
