@@ -881,6 +881,7 @@ fn features(
         transmission,
         // Transparent materials and the copies that cast no shadow.
         shadow_filters: used_mats.iter().any(|m| m.shadow.is_some()),
+        see_through: used_mats.iter().any(|m| m.shadow == Some(Vec3A::ONE)),
         outline: used_mats.iter().any(|m| m.outline > 0.0),
         tachyon_lights: (r.tachyon.light_threshold || r.tachyon.plain_highlights)
             && !lights.is_empty(),
