@@ -45,7 +45,9 @@ fn main() {
     while args.first().is_some_and(|a| a.starts_with("--")) {
         let flag = args.remove(0);
         let value = (!args.is_empty()).then(|| args.remove(0));
-        let number = value.and_then(|v| v.parse::<usize>().ok()).filter(|&n| n > 0);
+        let number = value
+            .and_then(|v| v.parse::<usize>().ok())
+            .filter(|&n| n > 0);
         match (flag.as_str(), number) {
             ("--runs", Some(n)) => runs = n,
             ("--threads", Some(n)) => threads = n,
@@ -200,13 +202,16 @@ fn run(
         .output()
         .map_err(|e| format!("{}: {e}", program.display()))?;
     let wall = t0.elapsed().as_secs_f64();
-    let text = String::from_utf8_lossy(&done.stdout).to_string()
-        + &String::from_utf8_lossy(&done.stderr);
+    let text =
+        String::from_utf8_lossy(&done.stdout).to_string() + &String::from_utf8_lossy(&done.stderr);
     if !image.exists() {
         let last = text.lines().last().unwrap_or("").trim().to_string();
         return Err(format!("{} wrote no image: {last}", program.display()));
     }
-    Ok((render_seconds(&text).ok_or("no render time reported")?, wall))
+    Ok((
+        render_seconds(&text).ok_or("no render time reported")?,
+        wall,
+    ))
 }
 
 /// The number after "Ray Tracing Time:" (both programs print it, Luxon in Tachyon's words).

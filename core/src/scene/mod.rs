@@ -427,11 +427,16 @@ impl Scene {
         let blocked = if self.features.see_through && min_weight <= 1.0 {
             let skip = |m: u32| self.materials[m as usize].shadow == Some(Vec3A::ONE);
             let clips = &self.clips;
-            self.spheres.any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+            self.spheres
+                .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
                 || (self.triangles.set).any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
                 || self.planes.any(ray, t_max, clips, c, &mut on_hit)
-                || self.cones.any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
-                || self.discs.any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+                || self
+                    .cones
+                    .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+                || self
+                    .discs
+                    .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
         } else {
             self.spheres.any(ray, t_max, &self.clips, c, &mut on_hit)
                 || self
