@@ -112,11 +112,16 @@ impl<S: Shape> Set<S> {
     pub fn build(&mut self) {
         let data = &self.data;
         let (bvh, order) = Bvh::build_with(data.len(), |i| data[i].bounds());
-        self.data = order.par_iter().map(|&i| self.data[i as usize]).collect();
-        self.material = order
-            .par_iter()
-            .map(|&i| self.material[i as usize])
-            .collect();
+        if crate::bvh::serial(order.len()) {
+            self.data = order.iter().map(|&i| self.data[i as usize]).collect();
+            self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        } else {
+            self.data = order.par_iter().map(|&i| self.data[i as usize]).collect();
+            self.material = order
+                .par_iter()
+                .map(|&i| self.material[i as usize])
+                .collect();
+        }
         self.bvh = bvh;
         self.clipped = self.material.iter().any(|&m| clip_of(m) != 0);
     }

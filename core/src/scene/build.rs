@@ -830,6 +830,17 @@ impl Stored {
             customs,
             ..
         } = self;
+        let total = spheres.len() + triangles.len() + cones.len() + discs.len() + customs.len();
+        if crate::bvh::serial(total) {
+            // Small: on this thread, leaving the thread pool asleep (see `bvh::serial`).
+            if native {
+                spheres.build();
+                triangles.set.build();
+                cones.build();
+                discs.build();
+            }
+            return customs.build().map_err(Error::Plugin);
+        }
         let (_, custom_result) = rayon::join(
             || {
                 if native {
