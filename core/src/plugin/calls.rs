@@ -125,7 +125,7 @@ fn pool_threads() -> usize {
         .ok()
         .and_then(|v| v.parse::<usize>().ok())
         .filter(|&n| n > 0)
-        .unwrap_or_else(crate::schedule::available_cpus)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// Reports `msg` through the plugin's error sink (if it gave one); the status to return.
