@@ -61,9 +61,95 @@ pub fn pixel_sample(px: u32, py: u32, i: u32, n: u32, frame: u32) -> (f32, f32) 
     }
 }
 
+/// [`pixel_sample`] for every pixel of one render (one sample count, one frame): what does not
+/// depend on the pixel is computed once, not per sample (the inner half of each `hash`, the
+/// square root, the grid cell's division), so a sample costs two hashes of two rounds. Same
+/// values, bit for bit.
+pub struct PixelSampler {
+    n: u32,
+    /// Side of the jittered grid when `n` is a square, else 0 (N-rooks).
+    grid: u32,
+    /// Per sample: `mix(frame ^ mix(dim))` of its two jitter dimensions, and its grid cell
+    /// (column, row; N-rooks: the column only).
+    per_sample: Vec<([u32; 2], [f32; 2])>,
+    /// `mix(frame ^ mix(dim))` of the N-rooks permutation's seed dimension.
+    seed_inner: u32,
+}
+
+impl PixelSampler {
+    pub fn new(n: u32, frame: u32) -> PixelSampler {
+        let inner = |dim: u32| mix(frame ^ mix(dim));
+        let m = (n as f64).sqrt() as u32;
+        let grid = if m * m == n { m } else { 0 };
+        let cell = |i: u32| match grid {
+            0 => [i as f32, 0.0],
+            m => [(i % m) as f32, (i / m) as f32],
+        };
+        let per_sample = if n <= 1 {
+            Vec::new()
+        } else {
+            (0..n)
+                .map(|i| ([inner(2 * i), inner(2 * i + 1)], cell(i)))
+                .collect()
+        };
+        PixelSampler {
+            n,
+            grid,
+            per_sample,
+            seed_inner: inner(0xffff_fff0),
+        }
+    }
+
+    /// The N-rooks permutation seed of pixel (`px`, `py`) (unused for square counts).
+    #[inline]
+    pub fn pixel_seed(&self, px: u32, py: u32) -> u32 {
+        if self.n <= 1 || self.grid != 0 {
+            return 0;
+        }
+        mix(px ^ mix(py ^ self.seed_inner))
+    }
+
+    /// Sample `i` of pixel (`px`, `py`), whose [`PixelSampler::pixel_seed`] is `seed`: equal
+    /// to `pixel_sample(px, py, i, n, frame)`.
+    #[inline]
+    pub fn sample(&self, px: u32, py: u32, seed: u32, i: u32) -> (f32, f32) {
+        let n = self.n;
+        if n <= 1 {
+            return (0.5, 0.5);
+        }
+        let (inner, [sx, sy]) = self.per_sample[i as usize];
+        let jx = to_unit(mix(px ^ mix(py ^ inner[0])));
+        let jy = to_unit(mix(px ^ mix(py ^ inner[1])));
+        match self.grid {
+            0 => {
+                let sy = permute(i, n, seed) as f32;
+                ((sx + jx) / n as f32, (sy + jy) / n as f32)
+            }
+            m => ((sx + jx) / m as f32, (sy + jy) / m as f32),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pixel_sampler_equals_pixel_sample() {
+        for n in [0u32, 1, 2, 3, 4, 5, 9, 16, 33] {
+            for frame in [0u32, 7] {
+                let s = PixelSampler::new(n, frame);
+                for (px, py) in [(0u32, 0u32), (3, 7), (511, 200)] {
+                    let seed = s.pixel_seed(px, py);
+                    for i in 0..n.max(1) {
+                        let (a, b) = s.sample(px, py, seed, i);
+                        let (c, d) = pixel_sample(px, py, i, n, frame);
+                        assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn permute_is_a_permutation() {

@@ -66,6 +66,15 @@ pub struct Bvh {
     nodes: Vec<Wide>,
 }
 
+/// Whether building over `n` primitives (or reordering them) is done on the calling thread:
+/// below the size at which the build splits its work anyway. Then a small scene never starts
+/// rayon's global pool, whose idle workers yield in a loop for a while after each job: on a
+/// busy machine each yield lasts a time slice, so they spun through small renders (costing a
+/// render thread its CPU).
+pub fn serial(n: usize) -> bool {
+    n <= PARALLEL_CUTOFF
+}
+
 impl Bvh {
     /// Builds over the given primitive bounds; returns the BVH and the leaf order.
     pub fn build(bounds: &[Aabb]) -> (Bvh, Vec<u64>) {
@@ -79,11 +88,18 @@ impl Bvh {
         if n == 0 {
             return (Bvh::default(), Vec::new());
         }
-        let mut prims: Vec<BuildPrim> = (0..n)
-            .into_par_iter()
-            .with_min_len(PARALLEL_CUTOFF)
-            .map(|i| BuildPrim::new(bound(i), i))
-            .collect();
+        let prim = |i| BuildPrim::new(bound(i), i);
+        // A small build stays on this thread: it never wakes (or starts) the thread pool,
+        // whose idle workers would then spin beside the render (see `serial`).
+        let mut prims: Vec<BuildPrim> = if serial(n) {
+            (0..n).map(prim).collect()
+        } else {
+            (0..n)
+                .into_par_iter()
+                .with_min_len(PARALLEL_CUTOFF)
+                .map(prim)
+                .collect()
+        };
         let mut binary = Vec::new();
         build_node(&mut prims, 0, 0, &mut binary);
         let order = prims.iter().map(|p| p.index).collect();

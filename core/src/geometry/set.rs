@@ -112,11 +112,16 @@ impl<S: Shape> Set<S> {
     pub fn build(&mut self) {
         let data = &self.data;
         let (bvh, order) = Bvh::build_with(data.len(), |i| data[i].bounds());
-        self.data = order.par_iter().map(|&i| self.data[i as usize]).collect();
-        self.material = order
-            .par_iter()
-            .map(|&i| self.material[i as usize])
-            .collect();
+        if crate::bvh::serial(order.len()) {
+            self.data = order.iter().map(|&i| self.data[i as usize]).collect();
+            self.material = order.iter().map(|&i| self.material[i as usize]).collect();
+        } else {
+            self.data = order.par_iter().map(|&i| self.data[i as usize]).collect();
+            self.material = order
+                .par_iter()
+                .map(|&i| self.material[i as usize])
+                .collect();
+        }
         self.bvh = bvh;
         self.clipped = self.material.iter().any(|&m| clip_of(m) != 0);
     }
@@ -204,6 +209,34 @@ impl<S: Shape> Set<S> {
         t_max: f32,
         clips: &Clips,
         c: &mut Counters,
+        on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        self.any_with::<false>(ray, t_max, clips, c, |_| false, on_hit)
+    }
+
+    /// [`Set::any`] passing over, untested, the primitives whose material `skip` names (those
+    /// a shadow ray crosses unchanged: testing them cannot change what it carries).
+    #[inline]
+    pub fn any_skipping(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        clips: &Clips,
+        c: &mut Counters,
+        skip: impl Fn(u32) -> bool,
+        on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        self.any_with::<true>(ray, t_max, clips, c, skip, on_hit)
+    }
+
+    #[inline(always)]
+    fn any_with<const SKIP: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        clips: &Clips,
+        c: &mut Counters,
+        skip: impl Fn(u32) -> bool,
         mut on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
         if self.data.is_empty() {
@@ -216,6 +249,9 @@ impl<S: Shape> Set<S> {
             t_max,
             #[inline(always)]
             |i| {
+                if SKIP && skip(material_of(self.material[i])) {
+                    return false;
+                }
                 c.tests += 1;
                 if !self.clipped {
                     let n = self.data[i].crossings(ray, &prep, t_max);

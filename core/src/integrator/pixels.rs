@@ -6,7 +6,7 @@ use crate::adaptive;
 use crate::framebuffer::Span;
 use crate::geometry::Counters;
 use crate::math::Vec3A;
-use crate::sampler::pixel_sample;
+use crate::sampler::PixelSampler;
 use crate::scene::Scene;
 
 /// Renders the pixels of `spans`, returning their RGBA values span after span.
@@ -19,6 +19,7 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     let inv_n = 1.0 / n as f32;
     let media = IorStack::default();
     let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
+    let sampler = PixelSampler::new(n, s.frame);
     for span in spans {
         let y = span.y;
         for x in span.xs() {
@@ -37,8 +38,9 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
                 Some(p) => p.pixel(x, y, s.frame, &mut shade),
                 None => {
                     let mut sum = Vec3A::ZERO;
+                    let seed = sampler.pixel_seed(x, y);
                     for i in 0..n {
-                        let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
+                        let (jx, jy) = sampler.sample(x, y, seed, i);
                         sum += shade(jx, jy);
                     }
                     sum * inv_n

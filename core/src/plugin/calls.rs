@@ -109,9 +109,23 @@ pub fn call_context<'a>(
         instance: abi::Str::new(instance),
         // 0 lets the plugin choose (1 GiB).
         texture_cache_bytes: budget.map_or(0, Budget::texture_cache),
-        threads: rayon::current_num_threads() as u32,
+        threads: pool_threads() as u32,
         memory_budget: memory_budget_for_plugins(budget),
     }
+}
+
+/// `rayon::current_num_threads()` without starting rayon's global pool when called outside
+/// every pool (as scene builds are): the size that pool would have (`RAYON_NUM_THREADS`, else
+/// every CPU). Started just to be counted, its idle workers spun beside small renders.
+fn pool_threads() -> usize {
+    if rayon::current_thread_index().is_some() {
+        return rayon::current_num_threads();
+    }
+    std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// Reports `msg` through the plugin's error sink (if it gave one); the status to return.

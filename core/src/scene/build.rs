@@ -832,6 +832,17 @@ impl Stored {
             customs,
             ..
         } = self;
+        let total = spheres.len() + triangles.len() + cones.len() + discs.len() + customs.len();
+        if crate::bvh::serial(total) {
+            // Small: on this thread, leaving the thread pool asleep (see `bvh::serial`).
+            if native {
+                spheres.build();
+                triangles.set.build();
+                cones.build();
+                discs.build();
+            }
+            return customs.build().map_err(Error::Plugin);
+        }
         let (_, custom_result) = rayon::join(
             || {
                 if native {
@@ -883,6 +894,7 @@ fn features(
         transmission,
         // Transparent materials and the copies that cast no shadow.
         shadow_filters: used_mats.iter().any(|m| m.shadow.is_some()),
+        see_through: used_mats.iter().any(|m| m.shadow == Some(Vec3A::ONE)),
         outline: used_mats.iter().any(|m| m.outline > 0.0),
         tachyon_lights: (r.tachyon.light_threshold || r.tachyon.plain_highlights)
             && !lights.is_empty(),

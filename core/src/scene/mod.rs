@@ -232,6 +232,9 @@ pub struct Features {
     /// Shadow rays can pass some surface (a transparent one, or one that casts no shadow), so
     /// they look at what they hit.
     pub shadow_filters: bool,
+    /// Some of those let a shadow ray through unchanged (filter one: a surface casting no
+    /// shadow), so shadow rays can pass them over untested.
+    pub see_through: bool,
     /// Some used material darkens its silhouette.
     pub outline: bool,
     /// Lights follow Tachyon's rules (its threshold, plain highlights).
@@ -462,14 +465,33 @@ impl Scene {
             }
             filter.max_element() < min_weight
         };
-        if self.spheres.any(ray, t_max, &self.clips, c, &mut on_hit)
-            || self
-                .triangles
-                .set
-                .any(ray, t_max, &self.clips, c, &mut on_hit)
-            || self.planes.any(ray, t_max, &self.clips, c, &mut on_hit)
-            || self.cones.any(ray, t_max, &self.clips, c, &mut on_hit)
-            || self.discs.any(ray, t_max, &self.clips, c, &mut on_hit)
+        // Surfaces a shadow ray crosses unchanged (the light spheres Tachyon draws: no shadow)
+        // are not tested: the filter times one is the filter. Unless `min_weight` exceeds 1,
+        // when even the first crossing would end the ray.
+        let blocked = if self.features.see_through && min_weight <= 1.0 {
+            let skip = |m: u32| self.materials[m as usize].shadow == Some(Vec3A::ONE);
+            let clips = &self.clips;
+            self.spheres
+                .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+                || (self.triangles.set).any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+                || self.planes.any(ray, t_max, clips, c, &mut on_hit)
+                || self
+                    .cones
+                    .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+                || self
+                    .discs
+                    .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+        } else {
+            self.spheres.any(ray, t_max, &self.clips, c, &mut on_hit)
+                || self
+                    .triangles
+                    .set
+                    .any(ray, t_max, &self.clips, c, &mut on_hit)
+                || self.planes.any(ray, t_max, &self.clips, c, &mut on_hit)
+                || self.cones.any(ray, t_max, &self.clips, c, &mut on_hit)
+                || self.discs.any(ray, t_max, &self.clips, c, &mut on_hit)
+        };
+        if blocked
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
             || (!self.moving.is_empty() && self.moving.any(ray, t_max, &self.clips, c, &mut on_hit))
         {
