@@ -68,6 +68,7 @@ pub fn render_depth(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     let mut out = Vec::with_capacity(count);
     let n = s.samples.max(1);
     let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
+    let sampler = PixelSampler::new(n, s.frame);
     for span in spans {
         let y = span.y;
         for x in span.xs() {
@@ -89,8 +90,9 @@ pub fn render_depth(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
                     p.pixel(x, y, s.frame, &mut probe);
                 }
                 None => {
+                    let seed = sampler.pixel_seed(x, y);
                     for i in 0..n {
-                        let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
+                        let (jx, jy) = sampler.sample(x, y, seed, i);
                         probe(jx, jy);
                     }
                 }
