@@ -6,6 +6,7 @@ pub mod job;
 pub mod plugins;
 pub mod progress;
 pub mod render;
+pub mod resume;
 pub mod sequence;
 pub mod shading;
 // The signal handlers and their pipe (libc).
