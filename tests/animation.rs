@@ -304,6 +304,13 @@ fn command_line_mistakes_are_one_line_errors() {
         "{}",
         stderr(&o)
     );
+    let o = run(&["render", still.to_str().unwrap(), "--force"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("still.ron has no `animation:`; --force needs one"),
+        "{}",
+        stderr(&o)
+    );
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -147,7 +147,7 @@ impl Job {
     }
 
     /// Rank 0's `value`, on every rank (collective).
-    pub fn from_root(&self, value: u64) -> u64 {
+    pub fn root_value(&self, value: u64) -> u64 {
         match self {
             Job::Local => value,
             #[cfg(feature = "mpi")]

@@ -76,7 +76,9 @@ pub struct Overrides {
     #[command(flatten)]
     pub shading: super::shading::ShadingArgs,
     /// Frames of an animated scene to render, A to B inclusive (or one frame K); default:
-    /// the scene's `animation: (frames: ...)`.
+    /// the scene's `animation: (frames: ...)`. Frames done by an earlier run (recorded in
+    /// `.NAME.luxon-frames/` beside the first output) are skipped, and processes started on
+    /// the same outputs share the frames.
     #[arg(long, value_name = "A..B|K", value_parser = super::sequence::parse_frames)]
     pub frames: Option<(u32, u32)>,
     /// Render every Nth frame from the first (with an animated scene).

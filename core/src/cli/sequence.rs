@@ -225,7 +225,7 @@ pub fn run(
             }
             _ => NO_FRAME,
         };
-        let next = job.from_root(next);
+        let next = job.root_value(next);
         if next == NO_FRAME {
             break;
         }
