@@ -317,6 +317,39 @@ fn command_line_errors_are_one_line_and_exit_1() {
     }
 }
 
+/// Plugin messages reach stderr through the sink the command installs (the library prints
+/// nothing by itself: tests/log.rs), one `luxon: warning:` line each.
+#[test]
+fn plugin_log_lines_are_printed_by_render() {
+    let dir = temp_dir("plugin-log");
+    let ron = dir.join("mesh.ron");
+    std::fs::write(
+        &ron,
+        r#"Scene(
+    camera: (position: (0, 0, -5), look_at: (0, 0, 0), fov: 40),
+    objects: [(plugin: "mesh", params: (positions: [(-1, -1, 0), (1, -1, 0), (0, 1, 0)], indices: [(0, 1, 2), (2, 2, 0)]))],
+)"#,
+    )
+    .unwrap();
+    let png = dir.join("mesh.png");
+    let out = run(&[
+        "render",
+        ron.to_str().unwrap(),
+        "--res",
+        "8x8",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let e = stderr(&out);
+    let lines: Vec<&str> = e.lines().filter(|l| l.contains("zero area")).collect();
+    assert_eq!(
+        lines,
+        ["luxon: warning: luxon-shapes: mesh object 0: dropped 1 of 2 triangles with zero area"],
+        "{e}"
+    );
+}
+
 #[test]
 fn loader_warnings_are_printed_by_render_and_check() {
     let dir = temp_dir("loader-warnings");

@@ -105,6 +105,14 @@ fn torus_custom_primitive() {
     check("torus");
 }
 
+/// The example texture plugin (examples/stripes), its scene beside it: unfiltered stripes
+/// aliasing on the left, filtered ones fading to grey on the right.
+#[test]
+fn stripes_texture_plugin() {
+    let fb = render_with(&root().join("examples/stripes/scene.ron"), small);
+    compare("stripes", &fb);
+}
+
 #[test]
 fn molecule_cylinders_cones_rings() {
     check("molecule");

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 /// layers before its own. Keep in step with the table in core/src/lib.rs.
 const CORE: &[(&str, &[&str])] = &[
     ("math", &["math", "sampler", "error"]),
+    ("arrays", &["arrays"]),
     ("motion", &["motion"]),
     ("memory", &["budget"]),
     ("ray", &["ray"]),
@@ -122,6 +123,58 @@ fn core_imports_only_from_lower_layers() {
 #[test]
 fn formats_imports_only_from_lower_layers() {
     assert_layered("formats/src", FORMATS);
+}
+
+/// The library prints nothing: it reports through errors and its log sink (tests/log.rs runs
+/// it). Printing belongs to the `luxon` command (`core/src/cli`, `main.rs`), the command's
+/// stderr line in `error.rs`, and the abort path of an MPI job Luxon owns (`schedule/abort.rs`).
+#[test]
+fn the_library_prints_nothing() {
+    const PRINTS: &[&str] = &[
+        "println!",
+        "print!",
+        "dbg!",
+        "stdout()",
+        "stderr()",
+        "print_error",
+        "print_warning",
+        "print_line",
+    ];
+    const ALLOWED: &[&str] = &["core/src/error.rs", "core/src/schedule/abort.rs"];
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    rust_files(&root.join("core/src"), &mut files);
+    rust_files(&root.join("formats/src"), &mut files);
+    for plugin in std::fs::read_dir(root.join("plugins")).unwrap().flatten() {
+        rust_files(&plugin.path().join("src"), &mut files);
+    }
+    assert!(files.len() > 50, "found only {} source files", files.len());
+    let mut problems = Vec::new();
+    for file in files {
+        let rel = file
+            .strip_prefix(root)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel.starts_with("core/src/cli/")
+            || rel == "core/src/main.rs"
+            || ALLOWED.contains(&rel.as_str())
+        {
+            continue;
+        }
+        let code = strip(&std::fs::read_to_string(&file).unwrap());
+        let code = String::from_utf8_lossy(&code).into_owned();
+        for (n, line) in code.lines().enumerate() {
+            for p in PRINTS.iter().filter(|p| line.contains(*p)) {
+                problems.push(format!("{rel}:{}: {p}", n + 1));
+            }
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "the library prints (log through luxon::error::log instead):\n{}",
+        problems.join("\n")
+    );
 }
 
 /// Checks the modules under `src_dir` against `layers` (name and modules of each layer, bottom

@@ -319,4 +319,65 @@ mod with_mpi {
         let names: Vec<String> = files(&out).into_iter().map(|(n, _)| n).collect();
         assert_eq!(names, ["f0.ppm", "f2.ppm"]);
     }
+
+    /// Each plugin instance's NaN results are counted on every rank and added up on rank 0:
+    /// the warning naming the texture gives the same count as a single process.
+    #[test]
+    fn nan_counts_of_every_rank_reach_the_warning() {
+        let dir = temp_dir("mpi-nan");
+        let file = |n: &str| {
+            format!(
+                "{}{n}{}",
+                std::env::consts::DLL_PREFIX,
+                std::env::consts::DLL_SUFFIX
+            )
+        };
+        ensure_plugins();
+        let exe = std::env::current_exe().unwrap();
+        let profile = exe.parent().unwrap().parent().unwrap();
+        std::fs::copy(
+            profile.join(file("testplug_nan")),
+            dir.join(file("luxon_nan")),
+        )
+        .unwrap();
+        let scene = dir.join("nan.ron");
+        std::fs::write(
+            &scene,
+            format!(
+                "Scene(plugin_path: [{:?}], camera: (position: (0, 0, -5), look_at: (0, 0, 0)), \
+                 lights: [Directional(direction: (0, 0, 1))], \
+                 textures: {{ \"half\": (plugin: \"nan_texture\") }}, \
+                 materials: {{ \"m\": (texture: \"half\") }}, \
+                 objects: [(plugin: \"sphere\", params: (center: (0, 0, 0), radius: 1.5), \
+                 material: \"m\")])",
+                dir.display().to_string()
+            ),
+        )
+        .unwrap();
+        let out = dir.join("nan.png");
+        let s = scene.display().to_string();
+        let args = [
+            "render",
+            &s,
+            "--res",
+            "24x24",
+            "--parallel",
+            "mpi",
+            "--decomposition",
+            "pixel-cyclic",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        let warning = |o: &Output| {
+            let e = stderr(o);
+            assert!(o.status.success(), "{e}");
+            e.lines()
+                .find(|l| l.contains("texture `half` (plugin `nan_texture`) gave NaN"))
+                .unwrap_or_else(|| panic!("no warning naming the texture in {e}"))
+                .to_string()
+        };
+        let one = warning(&luxon().args(&args[..4]).args(&args[8..]).output().unwrap());
+        let (o, _) = mpirun(2, &args, &[]);
+        assert_eq!(warning(&o), one);
+    }
 }

@@ -144,15 +144,210 @@ fn render_error(dir: &Path, objects: &str, extra: &str) -> String {
     }
 }
 
+/// A panic in custom geometry's `intersect` has no error sink to travel in: the SDK sends its
+/// message through the host log, and the host puts it in the error with the object and its place.
 #[test]
 fn panic_while_intersecting_stops_the_render_with_an_error() {
     let dir = temp_dir("panic-intersect");
     install(&dir, "testplug_panics", "luxon_panics");
     let e = render_error(&dir, r#"(plugin: "panic_intersect")"#, "");
-    assert!(
-        e.contains("plugin `panic_intersect` panicked while intersecting"),
-        "{e}"
+    let want = format!(
+        "{}:6:15: object 0 (plugin `panic_intersect`) panicked while intersecting a ray: \
+         deliberate panic in intersect",
+        dir.join("scene.ron").display()
     );
+    assert!(e.ends_with(&want), "{e}");
+}
+
+/// Builds a scene whose fourth line is `line`; returns the error message.
+fn line4_error(dir: &Path, line: &str) -> String {
+    let text = format!(
+        "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    {line}\n)\n",
+        dir.display()
+    );
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, text).unwrap();
+    let desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    match Scene::build(&desc, &registry(&desc)) {
+        Ok(_) => panic!("scene built, but an error was expected"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// `file:4:col` of `needle` in a scene's fourth line `line` (see [`line4_error`]).
+fn line4_at(dir: &Path, line: &str, needle: &str) -> String {
+    let col = 5 + line.find(needle).unwrap();
+    format!("{}:4:{col}", dir.join("scene.ron").display())
+}
+
+/// A value of the wrong type names its parameter, what the plugin's parameter table says it
+/// takes and what the scene has, at the value.
+#[test]
+fn type_errors_in_params_name_the_parameter_what_was_expected_and_found() {
+    let dir = temp_dir("param-types");
+    install(&dir, "testplug_nan", "luxon_nan");
+    let cases = [
+        (
+            r#"objects: [(plugin: "sphere", params: (center: (0, 0, 0), radius: "big"))],"#,
+            "\"big\"",
+            "plugin `sphere` (libluxon_shapes.so) failed: parameter `radius`: expected a number \
+             > 0, found `\"big\"`",
+        ),
+        (
+            r#"objects: [(plugin: "sphere", params: (center: (0, 0), radius: 1))],"#,
+            "(0, 0)",
+            "plugin `sphere` (libluxon_shapes.so) failed: parameter `center`: expected (x, y, z), \
+             found 2 value(s) `(0, 0)`",
+        ),
+        (
+            r#"textures: { "t": (plugin: "nan_texture", params: (color: "red")) },"#,
+            "\"red\"",
+            "plugin `nan_texture` (libluxon_nan.so) failed: parameter `color`: expected (r, g, b), \
+             found `\"red\"`",
+        ),
+        (
+            r#"textures: { "t": (plugin: "image", params: (file: "a.png", mapping: "planar")) },"#,
+            "\"planar\"",
+            "plugin `image` (libluxon_textures.so) failed: parameter `mapping`: expected one of \
+             `uv`, `planar`, `cylindrical`, `spherical` (written without quotes), found \
+             `\"planar\"`",
+        ),
+        // The plugin's own deserializer's words, with the parameter they are about.
+        (
+            r#"textures: { "t": (plugin: "checker", params: (scale: 2, even: "red")) },"#,
+            "\"red\"",
+            "plugin `checker` (libluxon_textures.so) failed: parameter `even`: unknown variant \
+             `red` (expected one of: Constant, Checker, Blend, Gradient, Marble, Wood, Noise, \
+             Image)",
+        ),
+    ];
+    for (line, value, want) in cases {
+        let e = line4_error(&dir, line);
+        let at = line4_at(&dir, line, value);
+        assert_eq!(e, format!("{at}: {want}"), "{line}");
+    }
+}
+
+/// A plugin's own check on a value (`Error::invalid_at`, or any error whose message begins with
+/// "parameter `name`") is reported at that parameter, not at the opening `(` of `params`.
+#[test]
+fn a_plugins_check_on_a_parameter_points_at_it() {
+    let dir = temp_dir("param-check");
+    let line = r#"objects: [(plugin: "sphere", params: (center: (0, 0, 0), radius: -1))],"#;
+    let e = line4_error(&dir, line);
+    assert_eq!(
+        e,
+        format!(
+            "{}: plugin `sphere` (libluxon_shapes.so) failed: parameter `radius`: expected a \
+             number > 0, found -1",
+            line4_at(&dir, line, "radius")
+        )
+    );
+    let line = r#"objects: [(plugin: "cone", params: (base: (0, 0, 0), base_radius: -2, apex: (0, 1, 0)))],"#;
+    let e = line4_error(&dir, line);
+    assert_eq!(
+        e,
+        format!(
+            "{}: plugin `cone` (libluxon_shapes.so) failed: parameter `base_radius`: expected a \
+             number >= 0, found -2",
+            line4_at(&dir, line, "base_radius")
+        )
+    );
+}
+
+/// A writer that fails while writing the rendered image names the output, the plugin and its
+/// message, at the output's place in the scene.
+#[test]
+fn a_writer_panic_names_the_output_and_carries_its_message() {
+    let dir = temp_dir("panic-writer");
+    install(&dir, "testplug_panics", "luxon_panics");
+    let scene = dir.join("scene.ron");
+    let text = format!(
+        "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    render: (width: 4, height: 4, outputs: [(path: \"out.panicimg\")]),\n)\n",
+        dir.display()
+    );
+    std::fs::write(&scene, &text).unwrap();
+    let out = run(&["render", scene.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let col = 1 + text.lines().nth(3).unwrap().find("(path:").unwrap();
+    let want = format!(
+        "luxon: error: {}:4:{col}: output `{}`: plugin `panic_writer` (libluxon_panics.so) \
+         panicked: deliberate panic writing a 4x4 image",
+        scene.display(),
+        dir.join("out.panicimg").display()
+    );
+    assert!(err.contains(&want), "{err}");
+    assert!(!dir.join("out.panicimg").exists(), "{err}");
+}
+
+/// Places on the search path that give nothing say why: a directory that does not exist, a
+/// library skipped for its name, a library that fails to load. `luxon plugins` lists them, and
+/// so does the error of a lookup that misses.
+#[test]
+fn the_search_path_says_what_it_skipped_and_why() {
+    let dir = temp_dir("search-notes");
+    let misnamed = install(&dir, "testplug_panics", "zigzag");
+    let broken = dir.join(format!(
+        "{}luxon_broken{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    std::fs::write(&broken, "not a library").unwrap();
+    std::fs::write(dir.join("notes.txt"), "not a library by its name either").unwrap();
+    let missing = dir.join("no-such-dir");
+    let path = std::env::join_paths([&dir, &missing]).unwrap();
+    let name_note = format!(
+        "skipped {}: not loaded: its name does not start with `libluxon_`; expected a file named \
+         libluxon_NAME.so (rename it, or give the file itself in the plugin path)",
+        misnamed.display()
+    );
+    let missing_note = format!(
+        "skipped {}: no such file or directory; expected a directory of plugins or a plugin file",
+        missing.display()
+    );
+    let r = luxon()
+        .env("LUXON_PLUGIN_PATH", &path)
+        .arg("plugins")
+        .output()
+        .unwrap();
+    let listed = String::from_utf8_lossy(&r.stdout);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(listed.contains(&name_note), "{listed}");
+    assert!(listed.contains(&missing_note), "{listed}");
+    assert!(
+        listed.contains(&format!("skipped {}: ", broken.display())),
+        "{listed}"
+    );
+    assert!(!listed.contains("notes.txt"), "{listed}");
+
+    // The lookup that misses lists the same, after what was searched.
+    let scene = dir.join("scene.ron");
+    std::fs::write(
+        &scene,
+        "Scene(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), \
+         textures: { \"s\": (plugin: \"zigzag\") }, render: (width: 4, height: 4))",
+    )
+    .unwrap();
+    let out = dir.join("out.png");
+    let r = luxon()
+        .env("LUXON_PLUGIN_PATH", &path)
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = stderr(&r);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains("no texture plugin named `zigzag`"), "{err}");
+    for note in [&name_note, &missing_note] {
+        let reason = note.strip_prefix("skipped ").unwrap();
+        assert!(err.contains(reason), "missing `{reason}` in {err}");
+    }
+    assert!(err.contains(&format!("{}: ", broken.display())), "{err}");
 }
 
 #[test]

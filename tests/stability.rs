@@ -477,6 +477,14 @@ fn a_nan_is_counted_reported_and_clamped() {
     }
     assert!(black > 50 && red > 50, "black {black}, red {red}");
     assert_eq!(stats.counters.nan_pixels, black);
+    // Counted per plugin instance: the one texture, at least once per black pixel.
+    let warnings = scene.nan_warnings(&stats.nan_sources);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(stats.nan_sources[0] >= black, "{:?}", stats.nan_sources);
+    assert!(
+        warnings[0].contains("texture `half` (plugin `nan_texture`) gave NaN"),
+        "{warnings:?}"
+    );
     // The command line finishes, writes the image and reports the count.
     let out = run(&["render", path.to_str().unwrap(), "--stats"]);
     let err = stderr(&out);
@@ -491,6 +499,84 @@ fn a_nan_is_counted_reported_and_clamped() {
         Some(black.to_string().as_str()),
         "{err}"
     );
+    // The warning names the texture that gave the NaN, its plugin and its place in the scene,
+    // with how many shading points it spoilt (at least one per black pixel).
+    let text = nan_scene(&dir);
+    let (row, line) = text
+        .lines()
+        .enumerate()
+        .find(|(_, l)| l.contains("\"half\""))
+        .unwrap();
+    let at = format!(
+        "{}:{}:{}",
+        path.display(),
+        row + 1,
+        1 + line.find("(color").unwrap()
+    );
+    let head = format!(
+        "luxon: warning: {at}: texture `half` (plugin `nan_texture`) gave NaN or infinite values \
+         at "
+    );
+    let warning = err
+        .lines()
+        .find(|l| l.starts_with(&head))
+        .unwrap_or_else(|| panic!("no `{head}` in {err}"));
+    let count: u64 = warning[head.len()..]
+        .split(' ')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{warning}"));
+    assert!(count >= black, "{warning}");
+    assert!(
+        warning.ends_with("shading point(s); expected finite RGBA"),
+        "{warning}"
+    );
+}
+
+/// Custom geometry answering hits at a NaN distance: the hits are misses (as before), and the
+/// warning names the object, its plugin and its place.
+#[test]
+fn nan_hits_of_custom_geometry_are_counted_per_object() {
+    let dir = temp_dir("nan-box");
+    install_nan_plugin(&dir);
+    let path = dir.join("scene.ron");
+    let text = format!(
+        "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    objects: [(plugin: \"sphere\", params: (center: (3, 0, 0), radius: 0.5)), (plugin: \"nan_box\")],\n    render: (width: 8, height: 8, outputs: [(path: \"nan.png\")]),\n)\n",
+        dir.display()
+    );
+    std::fs::write(&path, &text).unwrap();
+    let out = run(&["render", path.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let col = 1 + text
+        .lines()
+        .nth(3)
+        .unwrap()
+        .find("(plugin: \"nan_box")
+        .unwrap();
+    let head = format!(
+        "luxon: warning: {}:4:{col}: object 1 (plugin `nan_box`) answered ",
+        path.display()
+    );
+    let warning = err
+        .lines()
+        .find(|l| l.starts_with(&head))
+        .unwrap_or_else(|| panic!("no `{head}` in {err}"));
+    assert!(
+        warning.ends_with(
+            "ray(s) with a hit at a NaN distance or normal; expected finite numbers (those hits \
+             were taken as misses)"
+        ),
+        "{warning}"
+    );
+    // The primary rays through the middle of the image cross the box.
+    let n: u64 = warning[head.len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(n > 0, "{warning}");
 }
 
 // ------------------------------------------------------------------------------------------------

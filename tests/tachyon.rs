@@ -141,6 +141,22 @@ fn flat_scenes() -> Vec<(&'static str, String)> {
                 cam("PROJECTION ORTHOGRAPHIC", "ZOOM 0.3 ASPECTRATIO 1")
             ),
         ),
+        // Tachyon's fisheye: a window of longitude and latitude in radians.
+        (
+            "fisheye",
+            format!(
+                "BEGIN_SCENE RESOLUTION 52 44\n{}{things}END_SCENE\n",
+                cam("PROJECTION FISHEYE", "ZOOM 0.8 ASPECTRATIO 1.1")
+            ),
+        ),
+        (
+            "fisheye frustum",
+            format!(
+                "BEGIN_SCENE RESOLUTION 60 40\n{}{things}END_SCENE\n",
+                cam("PROJECTION FISHEYE", "ZOOM 1 ASPECTRATIO 1")
+                    .replace("END_CAMERA", "FRUSTUM -1.6 1.3 -1.0 1.2 END_CAMERA")
+            ),
+        ),
         (
             "clip group",
             format!(
@@ -842,3 +858,60 @@ fn procedural_textures_give_tachyons_pixels() {
     );
     assert!(far <= 8, "{far} pixels differ by more than 10");
 }
+
+/// TEXFUNC 10: a 3 × 2 × 2 IMAGEDEF on a tilted wall, unlit, so u, v and w all vary across the
+/// picture and the block repeats (u and v wrap).
+fn volume_image_scene() -> String {
+    String::from(
+        "BEGIN_SCENE\nRESOLUTION 48 40\nCAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 1\n\
+         CENTER 0 0 0 VIEWDIR 0 0 1 UPDIR 0 1 0 END_CAMERA\n\
+         IMAGEDEF ::block FORMAT RGB24 RESOLUTION 3 2 2 ENCODING HEX\n\
+         ff0000 00ff00 0000ff ffffff 000000 808080\n\
+         ffff00 00ffff ff00ff 404040 c0c0c0 102030\n\
+         PLANE CENTER 0 0 6 NORMAL 0.5 0.3 -1 TEXTURE AMBIENT 1 DIFFUSE 0 SPECULAR 0 \
+         OPACITY 1 COLOR 1 1 1 TEXFUNC 10 ::block CENTER 0.2 -0.1 5 ROTATE 0.1 0.3 0.2 \
+         SCALE 0.5 0.7 0.4 UAXIS 1 0 0 VAXIS 0 1 0.2 WAXIS 0.1 0 1\nEND_SCENE\n",
+    )
+}
+
+#[test]
+fn volume_image_gives_tachyons_pixels() {
+    let dir = temp_dir("tachyon-volume-image");
+    let text = volume_image_scene();
+    let (w, h, ours) = luxon_pixels(&dir, &text);
+    // Pixels of `tachyon-nox`'s picture.
+    for (at, want) in VOLUME_IMAGE_PIXELS {
+        let got = pixel(&ours, w, at);
+        assert!(
+            (0..3).all(|k| got[k].abs_diff(want[k]) <= 2),
+            "{at:?}: {got:?}, Tachyon {want:?}"
+        );
+    }
+    if !tachyon_present() {
+        eprintln!("skipped the whole-picture comparison: tachyon-nox is not installed");
+        return;
+    }
+    let (tw, th, theirs) = tachyon_pixels(&dir, &text).unwrap();
+    assert_eq!((w, h), (tw, th));
+    let within = ours
+        .chunks_exact(3)
+        .zip(theirs.chunks_exact(3))
+        .filter(|(a, b)| (0..3).all(|k| a[k].abs_diff(b[k]) <= 2))
+        .count();
+    // Only pixels on the block's wrap seams may fall on the other side.
+    assert!(
+        within * 100 >= 98 * (w * h) as usize,
+        "{within} of {} pixels within 2 of Tachyon's",
+        w * h
+    );
+}
+
+/// (row, column) → Tachyon's colour, read from its picture of `volume_image_scene`.
+const VOLUME_IMAGE_PIXELS: [((usize, usize), [u8; 3]); 6] = [
+    ((3, 5), [40, 114, 165]),
+    ((10, 30), [42, 55, 48]),
+    ((20, 20), [76, 99, 146]),
+    ((25, 40), [7, 222, 73]),
+    ((33, 8), [166, 212, 71]),
+    ((38, 44), [43, 90, 125]),
+];

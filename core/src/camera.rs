@@ -1,6 +1,6 @@
 //! Cameras: perspective, orthographic, angular fisheye and equirectangular projections, each
-//! optionally with a frustum override (perspective, orthographic), a thin lens (depth of field)
-//! and two eyes in one image (stereo). The world is re-centred on the camera, so its origin is
+//! optionally with a frustum override (perspective, orthographic, equirectangular), a thin lens
+//! (depth of field) and two eyes in one image (stereo). The world is re-centred on the camera, so its origin is
 //! (0, 0, 0) in render space and precision is best where the viewer looks from.
 //!
 //! A camera ray is built in up to three steps:
@@ -10,7 +10,8 @@
 //!    along `forward` from the window point `origin + shift + sx·right + sy·up`. Fisheye
 //!    (angular, equidistant): the angle from `forward` is proportional to the distance from the
 //!    image centre, `fov / 2` at half the image height. Equirectangular: longitude −180° at the
-//!    left edge to +180° at the right, latitude +90° at the top to −90° at the bottom.
+//!    left edge to +180° at the right, latitude +90° at the top to −90° at the bottom, or the
+//!    frustum's window in degrees (Tachyon's FISHEYE is such a window).
 //! 2. **Stereo**: the eye sits `eye_separation / 2` to the left or right of the camera (along
 //!    `right`; for equirectangular along the horizontal perpendicular of each ray's longitude:
 //!    omni-directional stereo, so every viewing direction of a VR panorama has a correct pair).
@@ -30,7 +31,7 @@ use crate::math::Vec3A;
 use crate::ray::Ray;
 use crate::sampler::{hash, to_unit};
 use luxon_formats::{CameraDesc, Projection, StereoLayout};
-use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Kind {
@@ -41,7 +42,14 @@ enum Kind {
         half_angle: f32,
         aspect: f32,
     },
-    Equirectangular,
+    /// The window's centre and half extents in radians of longitude and latitude (−π..π by
+    /// −π/2..π/2 unless a frustum says otherwise).
+    Equirectangular {
+        lon: f32,
+        lat: f32,
+        half_lon: f32,
+        half_lat: f32,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,7 +71,7 @@ pub struct Camera {
     pub forward: Vec3A,
     /// Right and up, scaled to the image window's half width and half height: at unit distance
     /// (perspective), in world units (orthographic), in radians (fisheye: the angle at the
-    /// window's edge; equirectangular: π and π/2).
+    /// window's edge; equirectangular: the window's half extents).
     pub right: Vec3A,
     pub up: Vec3A,
     /// The window's centre relative to `forward` (perspective) or to `origin` (orthographic):
@@ -110,10 +118,23 @@ impl Camera {
                 };
                 (kind, window(half_angle))
             }
-            Projection::Equirectangular => (
-                Kind::Equirectangular,
-                (std::f64::consts::PI, std::f64::consts::FRAC_PI_2, 0.0, 0.0),
-            ),
+            Projection::Equirectangular => {
+                // Degrees of longitude and latitude: the whole sphere or the frustum's window.
+                let [l, r, b, t] = desc
+                    .frustum
+                    .map_or([-180.0, 180.0, -90.0, 90.0], |f| {
+                        [f.left, f.right, f.bottom, f.top]
+                    })
+                    .map(f64::to_radians);
+                let (half_w, half_h) = ((r - l) * 0.5, (t - b) * 0.5);
+                let kind = Kind::Equirectangular {
+                    lon: ((r + l) * 0.5) as f32,
+                    lat: ((t + b) * 0.5) as f32,
+                    half_lon: half_w as f32,
+                    half_lat: half_h as f32,
+                };
+                (kind, (half_w, half_h, 0.0, 0.0))
+            }
         };
         let (half_w, half_h, cx, cy) = match (desc.frustum, kind) {
             (Some(f), Kind::Perspective | Kind::Orthographic) => (
@@ -225,9 +246,14 @@ impl Camera {
                 let d = (cos_t * self.forward + sin_t * radial).normalize();
                 (self.origin, d, false, self.right_unit)
             }
-            Kind::Equirectangular => {
-                let (sin_lon, cos_lon) = (sx * PI).sin_cos();
-                let (sin_lat, cos_lat) = (sy * FRAC_PI_2).sin_cos();
+            Kind::Equirectangular {
+                lon,
+                lat,
+                half_lon,
+                half_lat,
+            } => {
+                let (sin_lon, cos_lon) = (lon + sx * half_lon).sin_cos();
+                let (sin_lat, cos_lat) = (lat + sy * half_lat).sin_cos();
                 let horizontal = sin_lon * self.right_unit + cos_lon * self.forward;
                 let d = (cos_lat * horizontal + sin_lat * self.up_unit).normalize();
                 let axis = cos_lon * self.right_unit - sin_lon * self.forward;
@@ -298,6 +324,7 @@ fn basis(n: Vec3A) -> (Vec3A, Vec3A) {
 mod tests {
     use super::*;
     use luxon_formats::{DepthOfField, Frustum, Stereo};
+    use std::f32::consts::PI;
 
     const EPS: f32 = 1e-5;
 
@@ -466,6 +493,43 @@ mod tests {
         close(at(17.0, 180.0), Vec3A::new(0.0, -1.0, 0.0));
         close(at(180.0, 45.0), Vec3A::new(0.0, 1.0, -1.0).normalize());
         assert!((cam.footprint().1 - PI / 180.0).abs() < EPS);
+    }
+
+    #[test]
+    fn equirectangular_frustum_is_a_window_in_degrees() {
+        let mut d = desc(Projection::Equirectangular);
+        d.frustum = Some(Frustum {
+            left: -90.0,
+            right: 30.0,
+            bottom: -20.0,
+            top: 40.0,
+        });
+        let cam = Camera::new(&d, Vec3A::ZERO, 120, 60);
+        let at = |x: f32, y: f32| cam.ray(x, y, 120, 60, 0.0).dir;
+        // Longitude `lon`, latitude `lat` (degrees) around −z, +x at +90°.
+        let dir = |lon: f32, lat: f32| {
+            let (lon, lat) = (lon.to_radians(), lat.to_radians());
+            Vec3A::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos())
+        };
+        close(at(0.0, 60.0), dir(-90.0, -20.0));
+        close(at(120.0, 0.0), dir(30.0, 40.0));
+        close(at(60.0, 30.0), dir(-30.0, 10.0));
+        close(at(90.0, 60.0), dir(0.0, -20.0));
+        // One degree per pixel.
+        assert!((cam.footprint().1 - 1f32.to_radians()).abs() < EPS);
+        // The whole sphere as a frustum is the plain panorama, ray for ray.
+        d.frustum = Some(Frustum {
+            left: -180.0,
+            right: 180.0,
+            bottom: -90.0,
+            top: 90.0,
+        });
+        let window = Camera::new(&d, Vec3A::ZERO, 36, 18);
+        let plain = Camera::new(&desc(Projection::Equirectangular), Vec3A::ZERO, 36, 18);
+        for (x, y) in [(0.5, 0.5), (7.25, 3.0), (35.5, 17.5)] {
+            let (a, b) = (window.ray(x, y, 36, 18, 0.0), plain.ray(x, y, 36, 18, 0.0));
+            assert_eq!((a.origin, a.dir), (b.origin, b.dir));
+        }
     }
 
     fn stereo(projection: Projection, layout: StereoLayout) -> CameraDesc {

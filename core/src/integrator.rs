@@ -6,7 +6,7 @@
 pub mod march;
 mod pixels;
 
-pub use pixels::render_spans;
+pub use pixels::{render_depth, render_spans};
 
 use crate::geometry::{Counters, Hit, Surface};
 use crate::math::{gamma, reflect, refract, Vec3A};

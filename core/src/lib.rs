@@ -26,7 +26,7 @@
 //! |---|---|---|
 //! | cli | `main.rs`, `cli` (the binary) | the command line |
 //! | output | [`output`], [`sweep`] | writer plugins, outputs committed all or nothing, asynchronous PPM output; accuracy sweeps |
-//! | render | [`render`] | a whole image in this process |
+//! | render | [`render`] | a whole image in this process, into a framebuffer or the caller's buffers |
 //! | schedule | [`schedule`] | which thread or MPI rank renders which pixels |
 //! | integrator | [`integrator`] | a pixel's value: Whitted shading, volume marching, the pixel kernel |
 //! | cache | [`cache`] | the scene's built geometry on disk |
@@ -37,16 +37,20 @@
 //! | geometry | [`geometry`] | primitives and their sets, each with its BVH |
 //! | bvh | [`bvh`] | the wide BVH over boxes |
 //! | camera | [`camera`], [`adaptive`] | camera rays; where a pixel's samples go |
-//! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks; PPM bytes; image error measures; files written whole, claims between processes |
+//! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks, the caller's buffers (targets); PPM bytes; image error measures; files written whole, claims between processes |
 //! | ray | [`ray`] | rays and robust ray spawning |
 //! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
 //! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |
-//! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type |
+//! | arrays | [`arrays`] | arrays read in place or copied: strided views, shared vectors, generations |
+//! | math | [`math`], [`sampler`], [`error`] | vectors and rounding bounds; sample hashing; the error type and the log sink |
 
 // Unsafe code only in the modules that allow it by name below (each block says why it is sound).
 #![deny(unsafe_code)]
 
 pub mod adaptive;
+// Reads of memory shared with the caller (strided, unaligned, or handed over from C).
+#[allow(unsafe_code)]
+pub mod arrays;
 // The process's resource limits (getrlimit, sysconf).
 #[allow(unsafe_code)]
 pub mod budget;

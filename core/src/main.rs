@@ -67,6 +67,25 @@ enum Command {
         #[arg(short, long = "output", value_name = "OUT.ron", conflicts_with = "out")]
         output: Option<PathBuf>,
     },
+    /// Start a plugin: write a crate with a minimal plugin of the kind, its parameter table,
+    /// a scene that uses it and a README with the commands to build it and render.
+    #[command(after_long_help = cli::usage::NEW_PLUGIN)]
+    NewPlugin {
+        /// The plugin's name, as scenes write it: `plugin: "NAME"` (lowercase letters, digits,
+        /// `_` and `-`, starting with a letter).
+        name: String,
+        /// What the plugin provides.
+        #[arg(long, value_enum)]
+        kind: cli::new_plugin::Kind,
+        /// The directory to create (default: ./NAME); an existing one must be empty.
+        #[arg(long, value_name = "DIR")]
+        dir: Option<PathBuf>,
+        /// The SDK to build against: the directory of `luxon-plugin` (`plugins/sdk` of a
+        /// checkout) or a version of it. Default: this checkout's `plugins/sdk` when the
+        /// executable lies inside one, else the version this luxon speaks.
+        #[arg(long, value_name = "DIR|VERSION")]
+        sdk: Option<String>,
+    },
     /// Render Tachyon scene files (`.dat`) with Tachyon's own command line, for drop-in use by
     /// VMD: `luxon tachyon [Tachyon's options] scene.dat` (see `luxon tachyon -help`).
     #[command(disable_help_flag = true)]
@@ -129,6 +148,8 @@ fn check_cpu() {
 fn main() -> ExitCode {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     check_cpu();
+    // Before anything can log: plugin messages reach stderr only through this sink.
+    cli::log_to_stderr();
     keep_large_blocks_returnable();
     cli::signals::install();
     let cli = match Cli::try_parse() {
@@ -149,6 +170,12 @@ fn main() -> ExitCode {
                 "luxon convert: name the RON file to write: luxon convert SCENE OUT.ron".into(),
             )),
         },
+        Command::NewPlugin {
+            name,
+            kind,
+            dir,
+            sdk,
+        } => cli::new_plugin::run(&name, kind, dir.as_deref(), sdk.as_deref()),
         Command::Tachyon { args } => cli::tachyon::run(&args),
         Command::Spd { name, size, output } => {
             cli::spd::run(name.as_deref(), size, output.as_deref())

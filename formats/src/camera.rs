@@ -115,15 +115,16 @@ impl Checker<'_> {
         if *projection == Projection::Equirectangular {
             return Err(self.error(
                 field(node, "aspect"),
-                "`aspect` has no effect on an Equirectangular camera (it always spans 360° by \
-                 180°); expected no `aspect`",
+                "`aspect` has no effect on an Equirectangular camera (it spans 360° by 180°, or \
+                 a `frustum`'s window); expected no `aspect`",
             ));
         }
         Ok(Some(a))
     }
 
-    /// `frustum`: only on a Perspective or Orthographic camera not sized otherwise
-    /// (`sized_by`, `has_aspect`), with `left < right` and `bottom < top`.
+    /// `frustum`: on a Perspective, Orthographic or Equirectangular (a window in degrees of
+    /// longitude and latitude) camera not sized otherwise (`sized_by`, `has_aspect`), with
+    /// `left < right` and `bottom < top`.
     fn frustum(
         &self,
         f: &raw::Frustum,
@@ -133,18 +134,11 @@ impl Checker<'_> {
         node: &Node,
     ) -> Result<Frustum> {
         let at = field(node, "frustum");
-        let kind = match projection {
-            Projection::Fisheye { .. } => Some("Fisheye"),
-            Projection::Equirectangular => Some("Equirectangular"),
-            _ => None,
-        };
-        if let Some(kind) = kind {
+        if let Projection::Fisheye { .. } = projection {
             return Err(self.error(
                 at,
-                format!(
-                    "a `frustum` sets the image window of a Perspective or Orthographic \
-                     camera; expected no `frustum` with a {kind} projection"
-                ),
+                "a `frustum` sets the image window of a Perspective, Orthographic or \
+                 Equirectangular camera; expected no `frustum` with a Fisheye projection",
             ));
         }
         if let Some(name) = sized_by {

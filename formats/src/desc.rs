@@ -61,8 +61,9 @@ pub struct CameraDesc {
     /// Width / height of the image plane (of one eye's image in stereo); `None`: the image's
     /// width / height. Not used by `Equirectangular` nor with a `frustum`.
     pub aspect: Option<f64>,
-    /// Tachyon's explicit image-plane window; replaces the size `projection` gives (only with
-    /// `Perspective`, `PerspectiveZoom` and `Orthographic`).
+    /// An explicit image window; replaces the size `projection` gives (with `Perspective`,
+    /// `PerspectiveZoom`, `Orthographic`, and `Equirectangular`, where it is a window in
+    /// degrees of longitude and latitude).
     pub frustum: Option<Frustum>,
     pub depth_of_field: Option<DepthOfField>,
     pub stereo: Option<Stereo>,
@@ -80,12 +81,14 @@ pub enum Projection {
     /// Angular (equidistant) fisheye: the angle from the view direction grows linearly with
     /// the distance from the image centre; `fov_deg` (in (0, 360]) spans the image height.
     Fisheye { fov_deg: f64 },
-    /// Latitude-longitude panorama: 360° across the width, 180° down the height.
+    /// Latitude-longitude panorama: 360° across the width, 180° down the height, or the
+    /// `frustum`'s window (degrees of longitude left to right, latitude bottom to top).
     Equirectangular,
 }
 
 /// The image window: at unit distance from the eye for perspective cameras, in world units
-/// around the camera position for orthographic ones. `left < right`, `bottom < top`.
+/// around the camera position for orthographic ones, in degrees of longitude (left, right) and
+/// latitude (bottom, top) for equirectangular ones. `left < right`, `bottom < top`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frustum {
     pub left: f64,

@@ -63,6 +63,18 @@ fn projections_parse() {
         p("projection: Equirectangular"),
         Projection::Equirectangular
     );
+    // A window of the panorama, in degrees.
+    let window =
+        "projection: Equirectangular, frustum: (left: -90, right: 60, bottom: -30, top: 45)";
+    assert_eq!(
+        camera(window).frustum,
+        Some(Frustum {
+            left: -90.0,
+            right: 60.0,
+            bottom: -30.0,
+            top: 45.0
+        })
+    );
     // The shorthand of the first scenes.
     assert_eq!(p("fov: 40"), Projection::Perspective { fov_deg: 40.0 });
     assert_eq!(p("zoom: 1.5"), Projection::PerspectiveZoom { zoom: 1.5 });
@@ -218,9 +230,11 @@ fn frustum_errors() {
     let f = "aspect: 2, frustum: (left: 0, right: 1, bottom: 0, top: 1)";
     check_error(f, "2", &["both `aspect` and `frustum`"]);
     let f = "projection: Fisheye(), frustum: (left: 0, right: 1, bottom: 0, top: 1)";
-    check_error(f, "(left", &["Perspective or Orthographic", "Fisheye"]);
-    let f = "projection: Equirectangular, frustum: (left: 0, right: 1, bottom: 0, top: 1)";
-    check_error(f, "(left", &["Equirectangular"]);
+    check_error(
+        f,
+        "(left",
+        &["Perspective, Orthographic or Equirectangular", "Fisheye"],
+    );
     let f = "frustum: (left: 0, right: 1, bottom: 0)";
     check_error(f, "(left", &["top"]);
 }

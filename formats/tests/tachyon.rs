@@ -180,22 +180,27 @@ fn frustum_orthographic_and_depth_of_field() {
 }
 
 #[test]
-fn fisheye_is_read_and_warned_about() {
+fn fisheye_is_a_window_of_longitude_and_latitude() {
     let d = scene(
         "fisheye",
         "CAMERA PROJECTION FISHEYE ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 4 \
          CENTER 0 0 0 VIEWDIR 0 0 1 UPDIR 0 1 0 FRUSTUM -3 3 -1 1 END_CAMERA",
     );
-    assert!(matches!(
-        d.camera.value.projection,
-        Projection::Fisheye { .. }
-    ));
-    let w = d
-        .warnings
-        .iter()
-        .find(|w| w.message.contains("FISHEYE"))
-        .unwrap();
-    assert_eq!((w.at.line, w.at.col), (3, 19));
+    let c = &d.camera.value;
+    assert_eq!(c.projection, Projection::Equirectangular);
+    // The FRUSTUM in radians becomes degrees, moved by half a pixel (the scene is 64 × 32)
+    // right and up like Tachyon's other windows.
+    let f = c.frustum.unwrap();
+    let (dx, dy) = (6.0 / 128.0, 2.0 / 64.0);
+    for (got, want) in [
+        (f.left, -3.0 + dx),
+        (f.right, 3.0 + dx),
+        (f.bottom, -1.0 + dy),
+        (f.top, 1.0 + dy),
+    ] {
+        assert!((got - f64::to_degrees(want)).abs() < 1e-9, "{f:?}");
+    }
+    assert!(d.warnings.iter().all(|w| !w.message.contains("FISHEYE")));
 }
 
 #[test]
@@ -796,7 +801,18 @@ fn imagedef_and_volume_textures() {
         other => panic!("{other:?}"),
     }
     let d = load(&p).unwrap();
-    assert!(warned(&d, "TEXFUNC 10"));
+    let call = d.materials[0].1.value.texture.clone().unwrap().value;
+    let (plugin, params) = d
+        .textures
+        .iter()
+        .find(|(name, _)| *name == call)
+        .map(|(_, t)| (t.value.plugin.value.clone(), t.value.params.clone()))
+        .unwrap();
+    assert_eq!(plugin, "tachyon_volume_image");
+    assert!(params.contains("size: (2, 1, 1)"), "{params}");
+    assert!(params.contains("w: (0.0, 0.0, -1.0)"), "{params}");
+    assert!(params.contains("rgb: [255, 0, 0, 0, 255, 0]"), "{params}");
+    assert!(!warned(&d, "TEXFUNC 10"));
     assert!(warned(&d, "no IMAGEDEF named `::none`"));
     assert_eq!(d.materials[1].1.value.color, [1.0; 3]);
 }

@@ -5,11 +5,13 @@
 //! its own monomorphised loop with the intersection test inlined.
 //!
 //! By concern: `build` (the binned SAH build of the binary tree), `wide` (8-wide nodes: the
-//! collapse, their layout and words), `traversal` (closest- and any-hit loops), `simd` (the box
-//! tests of a wide node and the choice of AVX at run time) and `stack` (the traversal's stack
-//! and node fetches). All unsafe code of the BVH is in `simd` and `stack`.
+//! collapse, their layout and words), `refit` (new bounds into a built tree, and its SAH cost),
+//! `traversal` (closest- and any-hit loops), `simd` (the box tests of a wide node and the choice
+//! of AVX at run time) and `stack` (the traversal's stack and node fetches). All unsafe code of
+//! the BVH is in `simd` and `stack`.
 
 mod build;
+mod refit;
 // Intrinsics and the AVX dispatch.
 #[allow(unsafe_code)]
 mod simd;
@@ -22,6 +24,8 @@ mod wide;
 use crate::math::Aabb;
 use build::{build_node, BuildPrim, PARALLEL_CUTOFF};
 use wide::Wide;
+
+pub use refit::REBUILD_RATIO;
 
 /// Leaves hold at most this many primitives.
 const MAX_LEAF: usize = 8;
@@ -147,7 +151,6 @@ mod tests {
                     + binary.len() * 2
                     + n * 8
                     + wide.memory_bytes() as usize;
-                println!("{n}: {} bytes per primitive", peak / n);
                 assert!(
                     peak as u64 <= n as u64 * BUILD_BYTES_PER_PRIM + 4096,
                     "{n} primitives: {peak} bytes"

@@ -41,7 +41,7 @@ impl<'a, T: Copy> Stack<'a, T> {
     /// children, and after taking one of them hold at most `LANES - 1` entries per level above
     /// the current node; the links they follow go down the tree (an empty lane's inverted box
     /// is never hit: the loops `Bvh::closest` and `Bvh::first` trace only rays with finite
-    /// coordinates), and every inner node is less than `MAX_DEPTH` deep (`collapse` keeps the
+    /// coordinates, and `refit` leaves empty lanes alone), and every inner node is less than `MAX_DEPTH` deep (`collapse` keeps the
     /// binary tree's depth, and `from_words` refuses deeper cached trees along any path), so at
     /// most `(LANES - 1) * (MAX_DEPTH - 1) + LANES = STACK` entries are ever held.
     #[inline(always)]
@@ -91,8 +91,8 @@ impl Bvh {
         debug_assert!(i < self.nodes.len());
         // SAFETY: `i` is in bounds: the traversals ask for the root only when `nodes` is not
         // empty, and otherwise for an inner node's link, which `collapse` makes and
-        // `from_words` checks to be an index below `nodes.len()` (`nodes` is private to `bvh`
-        // and only ever set by those two).
+        // `from_words` checks to be an index below `nodes.len()` (`nodes` is private to `bvh`,
+        // only those two make its nodes, and `refit` changes boxes, never links).
         unsafe { self.nodes.get_unchecked(i) }
     }
 }

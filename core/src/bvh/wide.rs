@@ -33,22 +33,29 @@ impl Wide {
     };
 
     fn set(&mut self, lane: usize, b: &Aabb, link: u64) {
+        self.set_box(lane, b);
+        self.link[lane] = link;
+    }
+
+    pub(super) fn set_box(&mut self, lane: usize, b: &Aabb) {
         for k in 0..3 {
             self.b[k][lane] = b.min[k];
             self.b[3 + k][lane] = b.max[k];
         }
-        self.link[lane] = link;
+    }
+
+    pub(super) fn lane_box(&self, lane: usize) -> Aabb {
+        let b = &self.b;
+        Aabb::new(
+            Vec3A::new(b[0][lane], b[1][lane], b[2][lane]),
+            Vec3A::new(b[3][lane], b[4][lane], b[5][lane]),
+        )
     }
 
     pub(super) fn bounds(&self) -> Aabb {
         (0..LANES)
             .filter(|&l| self.link[l] != EMPTY)
-            .fold(Aabb::EMPTY, |acc, l| {
-                acc.union(Aabb::new(
-                    Vec3A::new(self.b[0][l], self.b[1][l], self.b[2][l]),
-                    Vec3A::new(self.b[3][l], self.b[4][l], self.b[5][l]),
-                ))
-            })
+            .fold(Aabb::EMPTY, |acc, l| acc.union(self.lane_box(l)))
     }
 }
 

@@ -2,7 +2,9 @@
 //! the `mpi` feature). Hides the feature from the rest of the command.
 
 use luxon::framebuffer::Chunk;
-use luxon::schedule::{launched_ranks, render_local, threads_for, RankStats, Sink};
+use luxon::schedule::{
+    launched_ranks, render_local, thread_pool, threads_for, RankStats, RunOptions, Sink,
+};
 use luxon::{Error, Scene};
 use luxon_formats::ParallelMode;
 use std::path::Path;
@@ -134,7 +136,9 @@ impl Job {
         match self {
             Job::Local => {
                 let _ = (gather, keep);
-                render_local(scene, threads[0], sink).map(|r| (vec![r], Vec::new()))
+                let pool = thread_pool(threads[0])?;
+                render_local(scene, &pool, RunOptions::default(), sink)
+                    .map(|r| (vec![r], Vec::new()))
             }
             #[cfg(feature = "mpi")]
             Job::Mpi(c) => {

@@ -3,6 +3,7 @@
 pub mod check;
 pub mod convert;
 pub mod job;
+pub mod new_plugin;
 pub mod plugins;
 pub mod progress;
 pub mod render;
@@ -17,7 +18,19 @@ pub mod sweep;
 pub mod tachyon;
 pub mod usage;
 
+use luxon::error::Level;
 use luxon::plugin::Registry;
+
+/// Sends the library's log lines (plugin messages) to stderr as `luxon: {level}: {message}`;
+/// debug lines only when `LUXON_DEBUG` is set. The library itself prints nothing.
+pub fn log_to_stderr() {
+    let debug = std::env::var_os("LUXON_DEBUG").is_some();
+    luxon::error::set_log(Some(Box::new(move |level, message| {
+        if level != Level::Debug || debug {
+            luxon::error::print_line(level.name(), message);
+        }
+    })));
+}
 
 /// Warns about every file on the plugin search path that was skipped (a truncated library, a
 /// FIFO named like a plugin...): the run goes on without it, but the user should know.

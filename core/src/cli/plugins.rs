@@ -33,7 +33,8 @@ pub fn run(extra: &[PathBuf]) {
     if registry.libraries.is_empty() {
         println!("no plugins found");
     }
-    for p in &registry.problems {
+    // Files that could not be used, then places named on the search path that gave nothing.
+    for p in registry.problems.iter().chain(&registry.notes) {
         println!("skipped {p}");
     }
     let dirs: Vec<String> = registry

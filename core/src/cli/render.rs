@@ -326,7 +326,7 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     if let Some(p) = cache_written {
         eprintln!("luxon: wrote geometry cache {}", p.display());
     }
-    warn_nan(&stats);
+    warn_nan(&scene, &stats);
     Ok(())
 }
 
@@ -337,13 +337,16 @@ pub(super) struct Image {
     pub write_time: Duration,
 }
 
-/// Warns when pixels came out NaN or infinite.
-pub(super) fn warn_nan(stats: &RenderStats) {
+/// Warns when pixels came out NaN or infinite, and names each plugin instance that gave NaN.
+pub(super) fn warn_nan(scene: &Scene, stats: &RenderStats) {
     if stats.counters.nan_pixels > 0 {
         luxon::error::print_warning(&format!(
             "{} pixel(s) came out NaN or infinite and were set to black",
             stats.counters.nan_pixels
         ));
+    }
+    for w in scene.nan_warnings(&stats.nan_sources) {
+        luxon::error::print_warning(&w);
     }
 }
 

@@ -268,7 +268,7 @@ pub fn run(
                     written.join(", "),
                     t.elapsed().as_secs_f64(),
                 );
-                warn_nan(&image.stats);
+                warn_nan(&scene, &image.stats);
             }
             Err(e) => {
                 if job.rank() == 0 {

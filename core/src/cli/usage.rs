@@ -1,6 +1,22 @@
 //! Command-line errors as one line: clap's several lines (message, tip, usage, "for more
 //! information") folded into the message, its tip and where to look.
 
+/// The end of `luxon help new-plugin`: what is written, and the two commands that follow.
+pub const NEW_PLUGIN: &str = "\
+Writes DIR/Cargo.toml (a cdylib named luxon_NAME, so the library is libluxon_NAME.so, in a
+workspace of its own), DIR/src/lib.rs (the plugin and its parameter table), DIR/scene.ron (a
+scene that uses it) and DIR/README.md. Then, in DIR:
+
+  cargo build --release
+  LUXON_PLUGIN_PATH=target/release luxon render scene.ron -o x.png
+
+(a writer plugin: -o x.pfm). The plugin SDK's documentation says how to write each kind:
+cargo doc -p luxon-plugin --open, or plugins/README.md in Luxon's repository.
+
+Examples:
+  luxon new-plugin stripes --kind texture
+  luxon new-plugin blob --kind primitive --dir ~/src/blob --sdk ~/src/luxon/plugins/sdk";
+
 /// The one-line form of clap's error text `text`; `subcommand`: the subcommand given, if any.
 pub fn one_line(text: &str, subcommand: Option<&str>) -> String {
     let mut parts: Vec<String> = Vec::new();

@@ -7,10 +7,39 @@ use crate::budget::{Budget, Use};
 use crate::bvh::Bvh;
 use crate::math::{gamma, Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
+use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
+
+std::thread_local! {
+    /// The message a plugin logged about a panic it caught in a call without an error sink
+    /// (custom geometry's `bounds`, `intersect`, `occluded`), on the thread of that call.
+    static PLUGIN_PANIC: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// How the SDK begins the log message of a panic caught where no error sink can carry it
+/// ("panicked in `intersect`: ..."). Hosts before this convention print it as an error line.
+pub const PANIC_LOG_PREFIX: &str = "panicked in `";
+
+/// Keeps a plugin's panic message for [`take_plugin_panic`] when `message` is one (see
+/// [`PANIC_LOG_PREFIX`]); false when it is an ordinary log message.
+pub(crate) fn keep_plugin_panic(level: u32, message: &str) -> bool {
+    if level != 0 || !message.starts_with(PANIC_LOG_PREFIX) {
+        return false;
+    }
+    // The plugin's own words follow the call's name: "panicked in `intersect`: {words}".
+    let words = message.split_once("`: ").map_or(message, |(_, w)| w);
+    PLUGIN_PANIC.with(|p| *p.borrow_mut() = Some(words.to_string()));
+    true
+}
+
+/// The panic message a plugin logged during the call this thread just made, if it sent one
+/// (for "panicked in `intersect`: index out of bounds", "index out of bounds").
+pub fn take_plugin_panic() -> Option<String> {
+    PLUGIN_PANIC.with(|p| p.borrow_mut().take())
+}
 
 /// One object handed over by a plugin; destroyed through the plugin when the scene drops.
 pub struct CustomObject {
@@ -19,10 +48,15 @@ pub struct CustomObject {
     vtable: &'static abi::CustomVTable,
     pub plugin: String,
     pub count: u64,
+    /// The scene's object that made it ("object 3") and where that is in the scene.
+    pub name: String,
+    pub at: Origin,
+    /// Hits answered with a NaN distance or normal (ignored as misses), for the warning.
+    pub nan_hits: AtomicU64,
 }
 
 impl CustomObject {
-    /// Takes ownership of a plugin's object.
+    /// Takes ownership of a plugin's object, made for the scene's object `name` at `at`.
     ///
     /// # Safety
     /// `object` is a live object of the plugin that `vtable` serves, handed over to the host
@@ -32,13 +66,31 @@ impl CustomObject {
         vtable: &'static abi::CustomVTable,
         plugin: String,
         count: u64,
+        (name, at): (String, Origin),
     ) -> CustomObject {
         CustomObject {
             object,
             vtable,
             plugin,
             count,
+            name,
+            at,
+            nan_hits: AtomicU64::new(0),
         }
+    }
+
+    /// "scene.ron:7:9: object 3 (plugin `torus`)", as messages begin.
+    pub fn label(&self) -> String {
+        format!("{}: {} (plugin `{}`)", self.at, self.name, self.plugin)
+    }
+
+    /// The plugin's answer to a hit: counts NaN in it (the hit is then ignored).
+    fn is_nan(&self, h: &abi::HitF64) -> bool {
+        let nan = h.t.is_nan() || h.normal.iter().any(|v| v.is_nan());
+        if nan {
+            self.nan_hits.fetch_add(1, Ordering::Relaxed);
+        }
+        nan
     }
 }
 
@@ -61,13 +113,22 @@ impl Drop for CustomObject {
 #[derive(Default)]
 pub struct PluginFault {
     raised: AtomicBool,
-    message: Mutex<Option<String>>,
+    /// The first message, and whether it carries the plugin's own words.
+    message: Mutex<Option<(String, bool)>>,
 }
 
 impl PluginFault {
     pub fn raise(&self, message: String) {
-        if !self.raised.swap(true, Ordering::SeqCst) {
-            *self.message.lock().unwrap_or_else(|e| e.into_inner()) = Some(message);
+        self.raise_with(message, true);
+    }
+
+    /// Raises the fault; a message without the plugin's own words (`told` false: another
+    /// thread's panic in the same object carried them) gives way to one with them.
+    pub fn raise_with(&self, message: String, told: bool) {
+        self.raised.store(true, Ordering::SeqCst);
+        let mut m = self.message.lock().unwrap_or_else(|e| e.into_inner());
+        if m.as_ref().is_none_or(|(_, had)| !had && told) {
+            *m = Some((message, told));
         }
     }
 
@@ -79,7 +140,8 @@ impl PluginFault {
         self.message
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .clone()
+            .as_ref()
+            .map(|(m, _)| m.clone())
     }
 }
 
@@ -143,15 +205,17 @@ impl Customs {
             // SAFETY: `obj` is live (see `CustomObject`) and the out-pointers are our locals.
             let status = unsafe { (obj.vtable.bounds)(obj.object, i, &mut min, &mut max) };
             if status != abi::STATUS_OK {
+                let said = take_plugin_panic().map_or(String::new(), |m| format!(": {m}"));
                 return Err(format!(
-                    "plugin `{}` panicked computing bounds of primitive {i}",
-                    obj.plugin
+                    "{} panicked computing bounds of primitive {i}{said}",
+                    obj.label()
                 ));
             }
             if min.iter().chain(&max).any(|v| v.is_nan()) || (0..3).any(|k| min[k] > max[k]) {
                 return Err(format!(
-                    "plugin `{}` gave invalid bounds {min:?}..{max:?} for primitive {i}",
-                    obj.plugin
+                    "{} gave invalid bounds {min:?}..{max:?} for primitive {i}; expected \
+                     finite min <= max on every axis",
+                    obj.label()
                 ));
             }
             let lo = (DVec3::from(min) - self.world_offset).as_vec3();
@@ -180,10 +244,26 @@ impl Customs {
         }
     }
 
+    /// Raises the fault for a panic in object `o`'s `intersect` or `occluded`, with the
+    /// plugin's message when it sent one (the SDK does, once per object).
     fn panicked(&self, o: u32) {
-        let name = &self.objects[o as usize].plugin;
-        self.fault
-            .raise(format!("plugin `{name}` panicked while intersecting a ray"));
+        let label = self.objects[o as usize].label();
+        match take_plugin_panic() {
+            Some(m) => self
+                .fault
+                .raise(format!("{label} panicked while intersecting a ray: {m}")),
+            None => self
+                .fault
+                .raise_with(format!("{label} panicked while intersecting a ray"), false),
+        }
+    }
+
+    /// Objects whose plugin answered hits with NaN: (object, how many hits).
+    pub fn nan_hits(&self) -> impl Iterator<Item = (&CustomObject, u64)> {
+        self.objects
+            .iter()
+            .map(|o| (o, o.nan_hits.load(Ordering::Relaxed)))
+            .filter(|&(_, n)| n > 0)
     }
 
     #[inline]
@@ -208,6 +288,7 @@ impl Customs {
             // SAFETY: `obj` is live (see `CustomObject`), the ray and hit are our locals, and
             // the ABI allows concurrent calls.
             match unsafe { (obj.vtable.intersect)(obj.object, idx, &wr, &mut h) } {
+                1 if obj.is_nan(&h) => None,
                 1 => {
                     let t = h.t as f32;
                     let n = Vec3A::from(DVec3::from(h.normal).normalize_or_zero().as_vec3());
@@ -296,5 +377,40 @@ impl Customs {
             lift: Vec3A::ZERO,
             uv_scale: 0.0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A panic message logged by a plugin is kept for the thread's next `take`, once; other
+    /// log messages are not.
+    #[test]
+    fn a_logged_panic_is_taken_once_on_its_thread() {
+        assert!(!keep_plugin_panic(0, "panicked at src/lib.rs:3"));
+        assert!(!keep_plugin_panic(1, "panicked in `intersect`: boom"));
+        assert_eq!(take_plugin_panic(), None);
+        assert!(keep_plugin_panic(0, "panicked in `intersect`: boom: at 3"));
+        assert_eq!(std::thread::spawn(take_plugin_panic).join().unwrap(), None);
+        assert_eq!(take_plugin_panic().as_deref(), Some("boom: at 3"));
+        assert_eq!(take_plugin_panic(), None);
+    }
+
+    /// The first message with the plugin's words wins; one without them gives way to it.
+    #[test]
+    fn a_fault_keeps_the_first_message_with_the_plugins_words() {
+        let f = PluginFault::default();
+        assert!(!f.is_raised());
+        f.raise_with("object 0 panicked".into(), false);
+        assert!(f.is_raised());
+        assert_eq!(f.message().as_deref(), Some("object 0 panicked"));
+        f.raise("object 0 panicked: index out of bounds".into());
+        f.raise("object 1 panicked: later".into());
+        f.raise_with("object 2 panicked".into(), false);
+        assert_eq!(
+            f.message().as_deref(),
+            Some("object 0 panicked: index out of bounds")
+        );
     }
 }

@@ -54,3 +54,47 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     }
     out
 }
+
+/// The depth of the pixels of `spans`, span after span: for each pixel, the smallest distance
+/// along its camera rays from where they start (the eye, a lens point, an orthographic camera's
+/// image plane) to the first surface they hit, [`f32::INFINITY`] where none hits (volumes are
+/// not surfaces). The rays are the colour's own sample positions (under adaptive sampling its
+/// base samples), one closest-hit query each; the colour path is not touched.
+pub fn render_depth(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
+    let s = &scene.settings;
+    let count: usize = spans.iter().map(|s| s.count as usize).sum();
+    let mut out = Vec::with_capacity(count);
+    let n = s.samples.max(1);
+    let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
+    for span in spans {
+        let y = span.y;
+        for x in span.xs() {
+            let mut nearest = f32::INFINITY;
+            let mut probe = |jx: f32, jy: f32| {
+                let (px, py) = (x as f32 + jx, y as f32 + jy);
+                if let Some(ray) = scene.camera.primary(px, py, s.width, s.height, s.time) {
+                    c.primary += 1;
+                    if let Some(hit) = scene.intersect(&ray, f32::INFINITY, c) {
+                        nearest = nearest.min(hit.t);
+                    }
+                }
+                // Every sample alike: adaptive sampling splits no cell, so only its base
+                // samples are probed.
+                Vec3A::ZERO
+            };
+            match &plan {
+                Some(p) => {
+                    p.pixel(x, y, s.frame, &mut probe);
+                }
+                None => {
+                    for i in 0..n {
+                        let (jx, jy) = pixel_sample(x, y, i, n, s.frame);
+                        probe(jx, jy);
+                    }
+                }
+            }
+            out.push(nearest);
+        }
+    }
+    out
+}

@@ -38,6 +38,10 @@ pub struct GeometryBuilder<'a> {
     pub budget: &'a Budget,
     /// The object, for messages: "object 3 (plugin `mesh`, scene.ron:20:9)".
     pub object: String,
+    /// The scene's name for the object ("object 3") and where it is, given to its custom
+    /// geometry for the messages of the render.
+    pub instance: String,
+    pub at: Origin,
 }
 
 impl GeometryBuilder<'_> {
@@ -368,9 +372,11 @@ unsafe extern "C" fn add_custom(
         let Some(vtable) = (unsafe { g.vtable.as_ref() }) else {
             return Err("custom geometry without a function table".into());
         };
+        let made_by = (b.instance.clone(), b.at.clone());
         // Own it first so it is destroyed even if we reject it.
         // SAFETY: the plugin hands over `object`, which `vtable` serves (ABI contract).
-        let object = unsafe { CustomObject::new(g.object, vtable, b.plugin.clone(), g.count) };
+        let object =
+            unsafe { CustomObject::new(g.object, vtable, b.plugin.clone(), g.count, made_by) };
         if b.record.is_some() {
             return Err(
                 "custom geometry (drawn by its plugin) cannot be moved by animation keys; \

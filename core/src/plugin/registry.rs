@@ -8,6 +8,11 @@
 //! a library's ELF headers must fit in its file ([`super::elf`]), so a truncated copy is skipped
 //! with its reason instead of killing every run. Skipped files are [`Problem`]s: `luxon plugins`
 //! lists them, `render` and `check` warn about them, and a lookup that misses names them.
+//!
+//! Places the user named that gave nothing are [`Registry::notes`]: a directory given by
+//! `$LUXON_PLUGIN_PATH` or a plugin path that does not exist, and a shared library in such a
+//! directory that is not loaded because of its name. They are not warnings (a directory may
+//! hold other libraries on purpose), but `luxon plugins` and a lookup that misses list them.
 
 use luxon_plugin::abi;
 use std::collections::HashMap;
@@ -183,12 +188,15 @@ pub struct Registry {
     /// Every directory (or file) searched, in order.
     pub searched: Vec<PathBuf>,
     pub problems: Vec<Problem>,
+    /// Places the user named that gave nothing, and why: a missing directory, a library not
+    /// loaded for its name (see the module comment).
+    pub notes: Vec<Problem>,
     by_name: HashMap<String, usize>,
     /// The libraries whose entries were looked up (by `get` or `writer_for_extension`).
     used: std::sync::Mutex<std::collections::BTreeSet<usize>>,
 }
 
-/// `HostTable::log`: prints a plugin's message (debug ones only with `LUXON_DEBUG` set).
+/// `HostTable::log`: a plugin's message, as `{plugin}: {message}`, to the library's log sink.
 ///
 /// # Safety
 /// Both strings are readable for the call (the ABI's calling contract).
@@ -196,15 +204,12 @@ unsafe extern "C" fn host_log(level: u32, plugin: abi::Str, message: abi::Str) {
     // SAFETY: the caller's promise; the strings are only used within this call.
     let (plugin, message) = unsafe { (plugin.as_str(), message.as_str()) };
     let (plugin, message) = (plugin.unwrap_or("?"), message.unwrap_or("(invalid UTF-8)"));
-    let level = match level {
-        0 => "error",
-        1 => "warning",
-        2 => "info",
-        _ => "debug",
-    };
-    if level != "debug" || std::env::var_os("LUXON_DEBUG").is_some() {
-        crate::error::print_line(level, &format!("{plugin}: {message}"));
+    // A panic the SDK caught where no error sink reaches: it goes into the call's error.
+    if crate::geometry::custom::keep_plugin_panic(level, message) {
+        return;
     }
+    let level = crate::error::Level::from_code(level);
+    crate::error::log(level, &format!("{plugin}: {message}"));
 }
 
 static HOST: abi::HostTable = abi::HostTable {
@@ -235,28 +240,56 @@ fn regular_file(path: &Path) -> Result<(), String> {
 /// The default search path after `extra`: `$LUXON_PLUGIN_PATH`, then the executable's directory
 /// (and its parent when that is cargo's `deps`, so test binaries find the workspace's plugins).
 pub fn search_path(extra: &[PathBuf]) -> Vec<PathBuf> {
-    let mut dirs: Vec<PathBuf> = extra.to_vec();
+    let (mut dirs, builtin) = search_places(extra);
+    dirs.extend(builtin);
+    dirs
+}
+
+/// The search path in two parts: the places the user named (`extra`, then
+/// `$LUXON_PLUGIN_PATH`), and the executable's own directories.
+fn search_places(extra: &[PathBuf]) -> (Vec<PathBuf>, Vec<PathBuf>) {
+    let mut named: Vec<PathBuf> = extra.to_vec();
     if let Some(env) = std::env::var_os("LUXON_PLUGIN_PATH") {
-        dirs.extend(std::env::split_paths(&env).filter(|p| !p.as_os_str().is_empty()));
+        named.extend(std::env::split_paths(&env).filter(|p| !p.as_os_str().is_empty()));
     }
+    let mut builtin = Vec::new();
     if let Ok(exe) = std::env::current_exe() {
         if let Some(dir) = exe.parent() {
-            dirs.push(dir.to_path_buf());
+            builtin.push(dir.to_path_buf());
             if dir.file_name().is_some_and(|n| n == "deps") {
                 if let Some(up) = dir.parent() {
-                    dirs.push(up.to_path_buf());
+                    builtin.push(up.to_path_buf());
                 }
             }
         }
     }
-    dirs
+    (named, builtin)
+}
+
+/// A shared library by its name (`.so`, `.so.1`; `.dylib`, `.dll` elsewhere) that the scanner
+/// does not load because of its name: the note that says why.
+fn name_note(name: &str) -> Option<String> {
+    let suffix = std::env::consts::DLL_SUFFIX;
+    let versioned = suffix == ".so" && name.contains(".so.");
+    if is_plugin_file_name(name) || !(name.ends_with(suffix) || versioned) {
+        return None;
+    }
+    let prefix = format!("{}luxon_", std::env::consts::DLL_PREFIX);
+    Some(format!(
+        "not loaded: its name does not start with `{prefix}`; expected a file named \
+         {prefix}NAME{suffix} (rename it, or give the file itself in the plugin path)"
+    ))
 }
 
 impl Registry {
     /// Loads every plugin found on `search_path(extra)`.
     pub fn discover(extra: &[PathBuf]) -> Registry {
         let mut r = Registry::default();
-        for dir in search_path(extra) {
+        let (named, builtin) = search_places(extra);
+        for dir in named {
+            r.add_named_path(&dir);
+        }
+        for dir in builtin {
             r.add_path(&dir);
         }
         r
@@ -264,29 +297,59 @@ impl Registry {
 
     /// Adds a directory (scanned for plugin file names) or a library file.
     pub fn add_path(&mut self, path: &Path) {
+        self.scan(path, false);
+    }
+
+    /// [`add_path`](Self::add_path) for a place the user named: if it gives nothing, the
+    /// registry's [`notes`](Self::notes) say why (it does not exist, or a library in it is not
+    /// named like a plugin).
+    pub fn add_named_path(&mut self, path: &Path) {
+        self.scan(path, true);
+    }
+
+    fn scan(&mut self, path: &Path, named: bool) {
         if self.searched.iter().any(|p| p == path) {
             return;
         }
         self.searched.push(path.to_path_buf());
         match std::fs::metadata(path) {
             Ok(m) if m.is_dir() => {}
-            // A missing directory is normal (the search path lists places that may not exist).
+            Err(e) if named => {
+                let why = if e.kind() == std::io::ErrorKind::NotFound {
+                    "no such file or directory".to_string()
+                } else {
+                    format!("cannot be read: {e}")
+                };
+                return self.notes.push(Problem {
+                    path: path.to_path_buf(),
+                    message: format!("{why}; expected a directory of plugins or a plugin file"),
+                });
+            }
+            // The executable's directories are searched whether they hold plugins or not.
             Err(_) => return,
             Ok(_) => return self.load(path),
         }
         let Ok(read) = std::fs::read_dir(path) else {
             return;
         };
-        let mut files: Vec<PathBuf> = read
-            .filter_map(|e| e.ok())
-            .map(|e| e.path())
-            .filter(|p| {
-                p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(is_plugin_file_name)
-            })
-            .collect();
+        let mut files = Vec::new();
+        let mut misnamed = Vec::new();
+        for p in read.filter_map(|e| e.ok()).map(|e| e.path()) {
+            let Some(name) = p.file_name().and_then(|n| n.to_str()) else {
+                continue;
+            };
+            if is_plugin_file_name(name) {
+                files.push(p);
+            } else if let Some(note) = name_note(name).filter(|_| named) {
+                misnamed.push(Problem {
+                    path: p,
+                    message: note,
+                });
+            }
+        }
         files.sort();
+        misnamed.sort_by(|a, b| a.path.cmp(&b.path));
+        self.notes.extend(misnamed);
         for f in files {
             self.load(&f);
         }
@@ -450,7 +513,7 @@ impl Registry {
                     kind,
                     suggestion: luxon_plugin::suggest(name, candidates).map(str::to_string),
                     searched: self.searched.clone(),
-                    problems: self.problems.clone(),
+                    problems: self.problems.iter().chain(&self.notes).cloned().collect(),
                 })
             }
         }
@@ -496,5 +559,50 @@ impl Registry {
 
     pub fn library_of(&self, e: &Entry) -> &Library {
         &self.libraries[e.library]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Shared libraries not named like plugins get a note; plugins and other files do not.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn libraries_not_named_like_plugins_get_a_note() {
+        for name in ["libstripes.so", "luxon_stripes.so", "libfoo.so.1"] {
+            let note = name_note(name).unwrap_or_else(|| panic!("no note for {name}"));
+            assert!(
+                note.starts_with("not loaded: its name does not start with `libluxon_`"),
+                "{note}"
+            );
+        }
+        for name in [
+            "libluxon_stripes.so",
+            "stripes.txt",
+            "libstripes.a",
+            "scene.ron",
+        ] {
+            assert_eq!(name_note(name), None, "{name}");
+        }
+    }
+
+    /// A missing place the user named is a note; the executable's own directories are not.
+    #[test]
+    fn a_missing_named_directory_is_a_note() {
+        let missing = std::env::temp_dir().join(format!("luxon-no-dir-{}", std::process::id()));
+        let mut r = Registry::default();
+        r.add_path(&missing);
+        assert!(r.notes.is_empty());
+        let mut r = Registry::default();
+        r.add_named_path(&missing);
+        assert_eq!(r.notes.len(), 1);
+        assert_eq!(
+            r.notes[0].to_string(),
+            format!(
+                "{}: no such file or directory; expected a directory of plugins or a plugin file",
+                missing.display()
+            )
+        );
     }
 }

@@ -7,6 +7,7 @@ use luxon_formats::Origin;
 use luxon_plugin::abi;
 use std::ffi::c_void;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A texture instance created by a plugin; destroyed through it on drop.
 pub struct TextureInstance {
@@ -17,6 +18,8 @@ pub struct TextureInstance {
     /// The scene's name for the texture, and where its parameters are.
     pub name: String,
     pub at: Origin,
+    /// Evaluations that gave NaN or an infinity, for the warning after the render.
+    pub nan_results: AtomicU64,
 }
 
 // SAFETY: the ABI requires a plugin's texture objects to take `eval` from several threads at
@@ -62,6 +65,9 @@ impl TextureInstance {
         // concurrent `eval`s.
         let status = unsafe { (self.vtable.eval)(self.object, q, &mut out, &err) };
         if status == abi::STATUS_OK {
+            if !out.iter().all(|v| v.is_finite()) {
+                self.nan_results.fetch_add(1, Ordering::Relaxed);
+            }
             Ok(out)
         } else {
             Err(EvalFailure { status, message })
@@ -82,6 +88,13 @@ impl TextureInstance {
             "{}: texture `{}` (plugin `{}`) {what} during the render: {message}",
             self.at, self.name, self.plugin
         )
+    }
+}
+
+impl TextureInstance {
+    /// How many evaluations gave NaN or an infinity so far.
+    pub fn nan_results(&self) -> u64 {
+        self.nan_results.load(Ordering::Relaxed)
     }
 }
 
@@ -132,5 +145,6 @@ pub fn create_texture(
         plugin: entry.name.clone(),
         name: instance.to_string(),
         at: params_at.clone(),
+        nan_results: AtomicU64::new(0),
     })
 }

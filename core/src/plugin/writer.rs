@@ -30,7 +30,8 @@ unsafe extern "C" fn collect_bytes(ctx: *mut c_void, data: *const u8, len: usize
     }
 }
 
-/// Encodes an image with a writer plugin into bytes.
+/// Encodes an image with a writer plugin into bytes. `instance` names the output for the
+/// plugin and for messages ("output `out.png`"): an error is "{instance}: {the plugin's}".
 #[allow(clippy::too_many_arguments)]
 pub fn encode_image(
     registry: &Registry,
@@ -38,6 +39,7 @@ pub fn encode_image(
     params: &str,
     params_at: &Origin,
     scene_dir: &Path,
+    instance: &str,
     width: u32,
     height: u32,
     rgba: &[f32],
@@ -70,12 +72,13 @@ pub fn encode_image(
         rgba: rgba.as_ptr(),
     };
     let dir = scene_dir.to_string_lossy();
-    let ctx = call_context(&dir, "", None);
+    let ctx = call_context(&dir, instance, None);
     call_plugin(registry, entry, params_at, |err| {
         // SAFETY: the calling contract: `params`, `ctx`, `image` (with its `width * height * 4`
         // values, checked above), `sink` and `err` live across the call; `sink.ctx` is `bytes`,
         // which we do not touch until the plugin returns.
         unsafe { (vt.write)(abi::Str::new(params), &ctx, &image, &sink, err) }
-    })?;
+    })
+    .map_err(|(at, m)| (at, format!("{instance}: {m}")))?;
     Ok(bytes)
 }

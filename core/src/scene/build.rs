@@ -473,6 +473,8 @@ impl<'a> Build<'a> {
                 record: keyed.map(|_| &mut recorded),
                 budget: &self.budget,
                 object: format!("object {i} (plugin `{}`, {})", entry.name, obj.at),
+                instance: format!("object {i}"),
+                at: obj.at.clone(),
             };
             create_primitive(
                 self.registry,

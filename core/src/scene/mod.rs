@@ -346,6 +346,50 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// How many NaN results each plugin instance gave since the last call, and restarts the
+    /// counts (each render, each frame of a sequence, is told its own): every texture's
+    /// values that were NaN or infinite, then every custom object's hits at a NaN distance or
+    /// normal. Every rank of a job has the same instances in the same order, so the counts of
+    /// ranks add up entry by entry.
+    pub fn nan_counts(&self) -> Vec<u64> {
+        use std::sync::atomic::Ordering::Relaxed;
+        let textures = self.textures.iter().map(|t| t.nan_results.swap(0, Relaxed));
+        let customs = self
+            .customs
+            .objects
+            .iter()
+            .map(|o| o.nan_hits.swap(0, Relaxed));
+        textures.chain(customs).collect()
+    }
+
+    /// One warning per plugin instance with NaN results in `counts` (as [`Self::nan_counts`]
+    /// gives them, possibly summed over ranks), naming it, its plugin and its place.
+    pub fn nan_warnings(&self, counts: &[u64]) -> Vec<String> {
+        let mut counts = counts.iter().copied();
+        let mut out = Vec::new();
+        for t in &self.textures {
+            let n = counts.next().unwrap_or(0);
+            if n > 0 {
+                out.push(format!(
+                    "{}: texture `{}` (plugin `{}`) gave NaN or infinite values at {n} shading \
+                     point(s); expected finite RGBA",
+                    t.at, t.name, t.plugin
+                ));
+            }
+        }
+        for o in &self.customs.objects {
+            let n = counts.next().unwrap_or(0);
+            if n > 0 {
+                out.push(format!(
+                    "{} answered {n} ray(s) with a hit at a NaN distance or normal; expected \
+                     finite numbers (those hits were taken as misses)",
+                    o.label()
+                ));
+            }
+        }
+        out
+    }
+
     /// The closest hit along `ray` before `t_max`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {

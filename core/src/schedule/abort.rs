@@ -1,5 +1,9 @@
 //! Ending an MPI job on failure (feature `mpi`): an error or panic on any rank, from any
 //! thread, reaches rank 0's stderr and ends every rank (`MPI_Abort`) within seconds.
+//!
+//! The one place outside the `luxon` command where the library prints: this path belongs to a
+//! job whose MPI Luxon owns (the command's), and it ends the process, so its message goes to
+//! stderr directly rather than through a log sink that may not exist.
 
 use crate::error::print_error;
 use mpi::ffi;
@@ -74,7 +78,7 @@ pub fn fail(message: &str) -> ! {
     abort_job()
 }
 
-pub(super) fn abort_job() -> ! {
+fn abort_job() -> ! {
     crate::files::discard_temp_files();
     if RANK.load(Ordering::SeqCst) >= 0 {
         // SAFETY: MPI is up with `MPI_THREAD_MULTIPLE` (`RANK` is set only then), and the call

@@ -12,9 +12,9 @@
 //! error or panic anywhere ends the whole job through `abort::fail` (`MPI_Abort`), after rank 0 has
 //! printed the cause.
 
-use super::abort::{abort_job, fail, Injected, TAG_ERROR};
+use super::abort::{fail, Injected, TAG_ERROR};
 use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
-use super::{decompose, run_share, wire, RankStats, Share, Sink};
+use super::{decompose, run_share, wire, RankStats, RunOptions, Share, Sink};
 use crate::error::Error;
 use crate::framebuffer::Chunk;
 use crate::scene::Scene;
@@ -271,7 +271,8 @@ impl Run<'_> {
         let mut finished = 0;
         std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
-            let local = sc.spawn(|| run_share(scene, pool, share, &local_sink));
+            let local =
+                sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &local_sink));
             loop {
                 while let Some((msg, status)) = world.any_process().immediate_matched_probe() {
                     let (from, tag) = (status.source_rank(), status.tag());
@@ -303,8 +304,7 @@ impl Run<'_> {
                         }
                         TAG_ERROR => {
                             let m = String::from_utf8_lossy(&bytes);
-                            crate::error::print_error(&format!("rank {from}: {m}"));
-                            abort_job();
+                            fail(&format!("rank {from}: {m}"));
                         }
                         _ => {}
                     }
@@ -360,7 +360,7 @@ impl Run<'_> {
         }
         let mut stats = std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, &self.pool);
-            let local = sc.spawn(|| run_share(scene, pool, share, &to_main));
+            let local = sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &to_main));
             loop {
                 let finished = local.is_finished();
                 match chunks.recv_timeout(POLL) {

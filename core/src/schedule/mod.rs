@@ -21,11 +21,13 @@ mod mpi_io;
 use crate::error::Error;
 use crate::framebuffer::{Chunk, Span};
 use crate::geometry::Counters;
-use crate::integrator::render_spans;
+use crate::integrator::{render_depth, render_spans};
 use crate::scene::Scene;
 pub use decompose::Rect;
 use luxon_formats::Decomposition;
 use rayon::prelude::*;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -59,6 +61,8 @@ pub struct RankStats {
     pub threads: Vec<WorkerStats>,
     /// Wall time of the rank's render phase.
     pub time: Duration,
+    /// NaN results per plugin instance, in the order of [`Scene::nan_counts`].
+    pub nan_sources: Vec<u64>,
 }
 
 impl RankStats {
@@ -90,6 +94,29 @@ pub enum Share<'a> {
     },
 }
 
+/// How a render runs, beside which pixels it takes on.
+#[derive(Clone, Copy)]
+pub struct RunOptions<'a> {
+    /// Stops the render when set (from any thread): no unit starts after it is seen, so the
+    /// render ends within a unit (a tile) of work per thread.
+    pub cancel: &'a AtomicBool,
+    /// Chunks also carry their pixels' depth (`integrator::render_depth`).
+    pub depth: bool,
+}
+
+/// The cancel flag of renders no one can cancel.
+static NEVER: AtomicBool = AtomicBool::new(false);
+
+impl Default for RunOptions<'_> {
+    /// Not cancellable, no depth: what the command line renders.
+    fn default() -> Self {
+        RunOptions {
+            cancel: &NEVER,
+            depth: false,
+        }
+    }
+}
+
 /// Every CPU this process may run on (affinity respected).
 pub fn available_cpus() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -107,20 +134,33 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, Error> {
 }
 
 /// Runs `share` on `pool`, handing each finished unit to `sink`. Stops early (leaving pixels
-/// out) once a plugin has faulted; the caller reports the fault.
-pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Sink) -> RankStats {
+/// out) once a plugin has faulted or `options.cancel` is set; the caller reports which. A unit
+/// that panics (a bug, in Luxon or in `sink`) raises the scene's fault instead of unwinding
+/// into the caller.
+pub fn run_share(
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    share: Share,
+    options: RunOptions,
+    sink: Sink,
+) -> RankStats {
     let start = Instant::now();
     let stats: Vec<Mutex<WorkerStats>> = (0..pool.current_num_threads())
         .map(|_| Mutex::default())
         .collect();
-    let one = |thread: usize, spans: Vec<Span>| {
+    let unit = |thread: usize, spans: Vec<Span>| {
         let t0 = Instant::now();
         let mut w = WorkerStats {
             units: 1,
             ..Default::default()
         };
         let rgba = render_spans(scene, &spans, &mut w.counters);
-        let chunk = Chunk { spans, rgba };
+        let depth = if options.depth {
+            render_depth(scene, &spans, &mut w.counters)
+        } else {
+            Vec::new()
+        };
+        let chunk = Chunk { spans, rgba, depth };
         w.pixels = chunk.pixels();
         w.busy = t0.elapsed();
         sink(chunk);
@@ -129,7 +169,15 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
             .unwrap_or_else(|e| e.into_inner())
             .add(&w);
     };
-    let faulted = || scene.customs.fault.is_raised();
+    let one = |thread: usize, spans: Vec<Span>| {
+        if let Err(p) = catch_unwind(AssertUnwindSafe(|| unit(thread, spans))) {
+            scene.customs.fault.raise(format!(
+                "internal error (a bug in Luxon; please report it): a render thread panicked: {}",
+                panic_message(p.as_ref())
+            ));
+        }
+    };
+    let stop = || scene.customs.fault.is_raised() || options.cancel.load(Ordering::Relaxed);
     let s = &scene.settings;
     match share {
         Share::Static {
@@ -147,7 +195,7 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
                     workers,
                 );
                 for unit in units {
-                    if faulted() {
+                    if stop() {
                         break;
                     }
                     one(ctx.index(), unit);
@@ -156,7 +204,7 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
         }
         Share::Steal(tiles) => pool.install(|| {
             tiles.par_iter().for_each(|t| {
-                if !faulted() {
+                if !stop() {
                     one(rayon::current_thread_index().unwrap_or(0), t.spans());
                 }
             })
@@ -164,7 +212,7 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
         Share::Queue { tiles, next } => {
             pool.broadcast(|ctx| {
                 while let Some(i) = next() {
-                    if faulted() {
+                    if stop() {
                         break;
                     }
                     one(ctx.index(), tiles[i].spans());
@@ -179,13 +227,28 @@ pub fn run_share(scene: &Scene, pool: &rayon::ThreadPool, share: Share, sink: Si
             .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
             .collect(),
         time: start.elapsed(),
+        nan_sources: scene.nan_counts(),
     }
 }
 
-/// Renders the whole image in this process on `threads` threads with the scene's decomposition
-/// (dynamic: work stealing over tiles), handing finished chunks to `sink`.
-pub fn render_local(scene: &Scene, threads: usize, sink: Sink) -> Result<RankStats, Error> {
-    let pool = thread_pool(threads)?;
+/// What a panic carried, when it is text.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> &str {
+    payload
+        .downcast_ref::<&str>()
+        .copied()
+        .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
+        .unwrap_or("(no message)")
+}
+
+/// Renders the whole image in this process on `pool` with the scene's decomposition (dynamic:
+/// work stealing over tiles), handing finished chunks to `sink`. A plugin fault is an error,
+/// and so is a cancel that left pixels out ([`Error::Cancelled`]).
+pub fn render_local(
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    options: RunOptions,
+    sink: Sink,
+) -> Result<RankStats, Error> {
     let s = &scene.settings;
     let tiles = decompose::tiles(s.width, s.height, s.tile_size);
     let share = match s.decomposition {
@@ -193,14 +256,18 @@ pub fn render_local(scene: &Scene, threads: usize, sink: Sink) -> Result<RankSta
         how => Share::Static {
             how,
             first: 0,
-            workers: threads,
+            workers: pool.current_num_threads(),
         },
     };
-    let stats = run_share(scene, &pool, share, sink);
-    match scene.customs.fault.message() {
-        Some(m) => Err(Error::Plugin(m)),
-        None => Ok(stats),
+    let stats = run_share(scene, pool, share, options, sink);
+    if let Some(m) = scene.customs.fault.message() {
+        return Err(Error::Plugin(m));
     }
+    let all = s.width as u64 * s.height as u64;
+    if options.cancel.load(Ordering::Relaxed) && stats.total().pixels < all {
+        return Err(Error::Cancelled);
+    }
+    Ok(stats)
 }
 
 /// Threads per process: the scene's (or command line's) count, else every CPU.

@@ -168,6 +168,7 @@ mod tests {
                 },
             ],
             rgba: vec![1.0; 16],
+            depth: Vec::new(),
         };
         let (r, data) = runs(11, b"P6\n4 2\n255\n", 4, std::slice::from_ref(&chunk));
         // Header (11 bytes); pixel (1,0); pixel (3,0) ends where row 1 begins: merged.

@@ -30,16 +30,18 @@ impl Reader<'_> {
     }
 }
 
-/// `[spans][y x0 step count]*[rgba f32]*`
+/// `[spans][has depth][y x0 step count]*[rgba f32]*[depth f32]*` (depth values only when
+/// `has depth` is 1).
 pub fn encode_chunk(c: &Chunk) -> Vec<u8> {
-    let mut b = Vec::with_capacity(4 + c.spans.len() * 16 + c.rgba.len() * 4);
+    let mut b = Vec::with_capacity(8 + c.spans.len() * 16 + (c.rgba.len() + c.depth.len()) * 4);
     put32(&mut b, c.spans.len() as u32);
+    put32(&mut b, u32::from(!c.depth.is_empty()));
     for s in &c.spans {
         for v in [s.y, s.x0, s.step, s.count] {
             put32(&mut b, v);
         }
     }
-    for v in &c.rgba {
+    for v in c.rgba.iter().chain(&c.depth) {
         put32(&mut b, v.to_bits());
     }
     b
@@ -48,6 +50,11 @@ pub fn encode_chunk(c: &Chunk) -> Vec<u8> {
 pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
     let mut r = Reader(bytes);
     let n = r.u32()? as usize;
+    let has_depth = match r.u32()? {
+        0 => false,
+        1 => true,
+        _ => return None,
+    };
     let mut spans = Vec::with_capacity(n.min(bytes.len() / 16));
     for _ in 0..n {
         spans.push(Span {
@@ -63,10 +70,18 @@ pub fn decode_chunk(bytes: &[u8]) -> Option<Chunk> {
     for _ in 0..pixels * 4 {
         rgba.push(f32::from_bits(r.u32()?));
     }
-    r.0.is_empty().then_some(Chunk { spans, rgba })
+    let mut depth = Vec::with_capacity(if has_depth {
+        pixels.min(r.0.len() / 4)
+    } else {
+        0
+    });
+    for _ in 0..if has_depth { pixels } else { 0 } {
+        depth.push(f32::from_bits(r.u32()?));
+    }
+    r.0.is_empty().then_some(Chunk { spans, rgba, depth })
 }
 
-/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan volume_samples busy]*`
+/// `[rank][time ns][threads][units pixels primary shadow reflection refraction occlusion tests nan volume_samples busy]*[instances][nan]*`
 pub fn encode_stats(s: &RankStats) -> Vec<u8> {
     let mut b = Vec::new();
     put64(&mut b, s.rank as u64);
@@ -89,6 +104,10 @@ pub fn encode_stats(s: &RankStats) -> Vec<u8> {
         ] {
             put64(&mut b, v);
         }
+    }
+    put64(&mut b, s.nan_sources.len() as u64);
+    for &n in &s.nan_sources {
+        put64(&mut b, n);
     }
     b
 }
@@ -116,10 +135,16 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
             busy: Duration::from_nanos(r.u64()?),
         });
     }
+    let n = r.u64()? as usize;
+    let mut nan_sources = Vec::with_capacity(n.min(bytes.len() / 8));
+    for _ in 0..n {
+        nan_sources.push(r.u64()?);
+    }
     r.0.is_empty().then_some(RankStats {
         rank,
         threads,
         time,
+        nan_sources,
     })
 }
 
@@ -133,6 +158,7 @@ mod tests {
     fn a_chunk_claiming_more_pixels_than_it_holds_is_refused() {
         let mut b = Vec::new();
         put32(&mut b, 2);
+        put32(&mut b, 1);
         for _ in 0..2 {
             for v in [0, 0, 1, u32::MAX] {
                 put32(&mut b, v);
@@ -160,10 +186,19 @@ mod tests {
                 },
             ],
             rgba: (0..12).map(|i| i as f32 * 0.37 - 1.0).collect(),
+            depth: Vec::new(),
+        };
+        let b = encode_chunk(&c);
+        assert_eq!(decode_chunk(&b), Some(c.clone()));
+        assert_eq!(decode_chunk(&b[..b.len() - 1]), None);
+        // With depth: one value per pixel, INFINITY (nothing hit) included.
+        let c = Chunk {
+            depth: vec![4.5, f32::INFINITY, 0.25],
+            ..c
         };
         let b = encode_chunk(&c);
         assert_eq!(decode_chunk(&b), Some(c));
-        assert_eq!(decode_chunk(&b[..b.len() - 1]), None);
+        assert_eq!(decode_chunk(&b[..b.len() - 4]), None);
         let s = RankStats {
             rank: 2,
             time: Duration::from_millis(1234),
@@ -182,6 +217,7 @@ mod tests {
                 },
                 busy: Duration::from_micros(99),
             }],
+            nan_sources: vec![0, 12, 0],
         };
         assert_eq!(decode_stats(&encode_stats(&s)), Some(s));
     }

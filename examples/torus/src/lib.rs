@@ -1,7 +1,11 @@
-//! # luxon-torus: a torus, and the template for your own primitive plugin
+//! # luxon-torus: a torus, the example primitive plugin
 //!
-//! Copy this crate when Luxon lacks a shape. A primitive plugin is a `cdylib` depending on
-//! `luxon-plugin` and `serde` only, and needs four things:
+//! A complete custom-geometry plugin with its tests. This crate is built inside Luxon's
+//! workspace (its `Cargo.toml` inherits the workspace's settings, and its tests use the
+//! renderer), so a copy does not build elsewhere: to start a primitive of your own,
+//! `luxon new-plugin NAME --kind primitive` writes a crate that builds anywhere, and this one
+//! shows how far it can go. A primitive plugin is a `cdylib` depending on `luxon-plugin` and
+//! `serde` only, and needs four things:
 //!
 //! 1. A params struct with `#[derive(serde::Deserialize)]` and `#[serde(deny_unknown_fields)]`:
 //!    the scene's `params: (...)` arrive as RON text and are parsed into it (unknown or missing
@@ -29,10 +33,11 @@
 //! ## Build and use
 //! ```text
 //! cargo build --release -p luxon-torus          # -> target/release/libluxon_torus.so
-//! LUXON_PLUGIN_PATH=target/release luxon render scene.ron
+//! target/release/luxon render scenes/torus.ron -o torus.png
 //! ```
-//! Instead of the environment variable a scene can name the directory (or the `.so` itself),
-//! relative to the scene file: `plugin_path: ["../target/release"]`.
+//! `luxon` finds the libraries beside its executable. A plugin built elsewhere is found
+//! through `LUXON_PLUGIN_PATH=DIR luxon render scene.ron`, or a scene names the directory (or
+//! the `.so` itself), relative to the scene file: `plugin_path: ["../target/release"]`.
 //!
 //! The library records the plugin ABI it was built for (ABI 2: `luxon-plugin` 0.2); Luxon
 //! skips a library built for another and says so, naming both versions: rebuild it against the

@@ -179,7 +179,7 @@ impl Mapper {
                     .define(name, body, &mut self.notes, &mut self.warnings)?
             }
             Kind::TexAlias { name, target } => self.materials.alias(name, target, &mut self.notes),
-            Kind::ImageDef(def) => self.materials.imagedef(&def.name.value),
+            Kind::ImageDef(def) => self.materials.imagedef(def),
             Kind::Include { .. } => {}
             Kind::Sphere { center, rad, tex } => {
                 let m = self.material(tex)?;
@@ -774,16 +774,17 @@ impl Mapper {
             Some((Projection::Orthographic, _)) => {
                 (LuxProjection::Orthographic { height: t - b }, Some(shifted))
             }
-            Some((Projection::Fisheye, p_at)) => {
-                self.notes.add(
-                    "PROJECTION FISHEYE",
-                    "(Tachyon's latitude/longitude window) is rendered as Luxon's circular \
-                     fisheye of the same height",
-                    &p_at,
-                );
-                let fov = (t - b).to_degrees().clamp(1e-3, 360.0);
-                (LuxProjection::Fisheye { fov_deg: fov }, None)
-            }
+            // Tachyon's fisheye is a window of longitude and latitude in radians (zoom 1: one
+            // radian tall), sampled like its other windows.
+            Some((Projection::Fisheye, _)) => (
+                LuxProjection::Equirectangular,
+                Some(Frustum {
+                    left: shifted.left.to_degrees(),
+                    right: shifted.right.to_degrees(),
+                    bottom: shifted.bottom.to_degrees(),
+                    top: shifted.top.to_degrees(),
+                }),
+            ),
             Some((
                 Projection::PerspectiveDof {
                     focal,

@@ -7,7 +7,7 @@ use std::collections::{HashMap, HashSet};
 use super::notes::Notes;
 use super::ron::{float, string, vec2, vec3};
 use super::syntax::{
-    Frame, ImageKind, PhongKind, SolidKind, Surface, TexBody, TexFunc, TexRef, V3,
+    Frame, ImageDef, ImageKind, PhongKind, SolidKind, Surface, TexBody, TexFunc, TexRef, V3,
 };
 use super::{mirror, Warnings};
 use crate::desc::{Highlight, HighlightColor, MaterialDesc, PluginCall, TransparencyAngle};
@@ -43,8 +43,8 @@ pub(super) struct Materials {
     /// The default texture's material, once made.
     default: Option<String>,
     next: usize,
-    /// IMAGEDEF names defined so far.
-    imagedefs: HashSet<String>,
+    /// IMAGEDEFs defined so far: name → (size, texels); the first definition of a name stays.
+    imagedefs: HashMap<String, ([u32; 3], Vec<[u8; 3]>)>,
     pub materials: Vec<(String, Spanned<MaterialDesc>)>,
     pub textures: Vec<(String, Spanned<PluginCall>)>,
 }
@@ -59,14 +59,16 @@ impl Materials {
             bodies: HashMap::new(),
             default: None,
             next: 0,
-            imagedefs: HashSet::new(),
+            imagedefs: HashMap::new(),
             materials: Vec::new(),
             textures: Vec::new(),
         }
     }
 
-    pub fn imagedef(&mut self, name: &str) {
-        self.imagedefs.insert(name.to_string());
+    pub fn imagedef(&mut self, def: &ImageDef) {
+        self.imagedefs
+            .entry(def.name.value.clone())
+            .or_insert_with(|| (def.res, def.texels.clone()));
     }
 
     /// `TEXDEF name body`: the first definition of a name stays (Tachyon's rule).
@@ -342,8 +344,8 @@ impl Materials {
                     }
                 },
             },
-            TexFunc::Volume { image, .. } => {
-                if !self.imagedefs.contains(&image.value) {
+            TexFunc::Volume { image, frame, axes } => {
+                let Some((size, texels)) = self.imagedefs.get(&image.value) else {
                     warnings.push(Spanned {
                         value: format!(
                             "no IMAGEDEF named `{}` precedes this; Tachyon renders the texture \
@@ -353,13 +355,19 @@ impl Materials {
                         at: image.at.clone(),
                     });
                     return (FAKE, None);
+                };
+                if texels.len() > MAX_VOLUME_TEXELS {
+                    notes.add(
+                        "TEXFUNC 10 (volume image)",
+                        &format!(
+                            "with more than {MAX_VOLUME_TEXELS} texels is not rendered; its \
+                             COLOR is shown instead"
+                        ),
+                        at,
+                    );
+                    return (c, None);
                 }
-                notes.add(
-                    "TEXFUNC 10 (volume image)",
-                    "is not rendered yet; its COLOR is shown instead",
-                    at,
-                );
-                (c, None)
+                (c, Some(volume_image(*size, texels, frame, axes)))
             }
         }
     }
@@ -592,6 +600,39 @@ fn wood(frame: &Frame) -> Option<(String, String)> {
             vec3([sx, sy, -sz])
         ),
     ))
+}
+
+/// IMAGEDEF blocks larger than this (a 100³ block) are not passed to the texture: their texels
+/// would travel as RON text.
+const MAX_VOLUME_TEXELS: usize = 1_000_000;
+
+/// TEXFUNC 10: `u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x` and likewise v, w, in Tachyon's
+/// world; in the mirrored one the same with CENTER and the axes mirrored.
+fn volume_image(
+    size: [u32; 3],
+    texels: &[[u8; 3]],
+    frame: &Frame,
+    axes: &[V3; 3],
+) -> (String, String) {
+    let [u, v, w] = [0, 1, 2].map(|k| vec3(mirror(axes[k]).map(|x| x * frame.scale[k])));
+    let mut rgb = String::with_capacity(texels.len() * 12);
+    for (i, b) in texels.iter().flatten().enumerate() {
+        if i > 0 {
+            rgb.push_str(", ");
+        }
+        rgb.push_str(&b.to_string());
+    }
+    (
+        "tachyon_volume_image".into(),
+        format!(
+            "(size: ({}, {}, {}), center: {}, u: {u}, v: {v}, w: {w}, offset: {}, rgb: [{rgb}])",
+            size[0],
+            size[1],
+            size[2],
+            vec3(mirror(frame.center)),
+            vec3(frame.rotate),
+        ),
+    )
 }
 
 /// TEXFUNC 6: Tachyon's sectors about the z axis through CENTER (symmetric in z, so the

@@ -60,6 +60,7 @@
 //! | `ANTIALIASING n` | `samples: n + 1` (Tachyon: one sample at that point plus n jittered; the noise differs) |
 //! | `RAYDEPTH n` | `max_depth: n - 1` (Tachyon's primary ray counts as one level) |
 //! | `PROJECTION ORTHOGRAPHIC` | `Orthographic` with the same window |
+//! | `PROJECTION FISHEYE` | not a circular fisheye: Tachyon's window (zoom, aspect or FRUSTUM) in radians of longitude and latitude around VIEWDIR, so `Equirectangular` with that `frustum` in degrees, half a pixel moved like the others |
 //! | `PERSPECTIVE_DOF FOCALLENGTH f APERTURE a` | Tachyon 0.99b6 ignores f and focuses at unit distance; its lens is a rectangle a × the window: a disc of the same area, radius `a·√(w·h/π)`, focused at distance 1; no lens without ANTIALIASING (Tachyon traces only the pinhole ray then) |
 //! | `... FOCALDIST f APERTURE a` (VMD) | the same lens, focused at distance f |
 //! | no CAMERA | zoom 1, aspect 1, no antialiasing, ray depth 6, at the origin looking along +z |
@@ -145,6 +146,7 @@
 //! | 4 wood | the `tachyon_wood` texture: Tachyon's rings about the y axis through CENTER, the point divided by SCALE per axis, (0.8, 1, 0.2) and black; CENTER mirrored and SCALE.z negated, so the texture sees Tachyon's coordinates (the rings' wave is not symmetric in z); ROTATE and COLOR ignored, as in Tachyon; a SCALE with a 0 (Tachyon divides by it) shows COLOR, with a warning |
 //! | 5 gradient noise | the colour (Tachyon's noise value is clamped to 1 almost everywhere) |
 //! | 6 cylindrical checker | the `tachyon_cylinder_checker` texture: 18 sectors about the z axis through CENTER (the angle from +x toward +y) by bands 0.1 high along it, counted from CENTER by \|height\|, odd cells (1, 0.2, 0), even (0, 0.2, 1); CENTER mirrored; ROTATE, SCALE and COLOR ignored, as in Tachyon |
+//! | 10 volume image | the `tachyon_volume_image` texture with the IMAGEDEF's texels: u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x, likewise v (VAXIS, y) and w (WAXIS, z), wrapped into [0, 1), trilinear with the first and last texels' centres at 0 and 1 (measured against `tachyon-nox`: within 2 codes); CENTER and the axes mirrored; an undefined IMAGEDEF is white with a warning, as in Tachyon; blocks over a million texels show COLOR with a note |
 //! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: bilinear` (Tachyon's MIP blur grows with the distance travelled, not with the pixel's footprint: plain bilinear lookups look closer to it than Luxon's footprint MIP) |
 //!
 //! ## Geometry
@@ -168,9 +170,8 @@
 //! ## Not yet
 //!
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
-//! renders them: BACKGROUND_GRADIENT; the FISHEYE projection (Tachyon's is a latitude/longitude
-//! window, rendered as Luxon's circular fisheye of the same height); vertex colours (VCSTRI,
-//! VERTEXARRAY COLORS); TEXFUNC 10 (IMAGEDEF volume textures), and image maps whose
+//! renders them: BACKGROUND_GRADIENT; vertex colours (VCSTRI,
+//! VERTEXARRAY COLORS); image maps whose
 //! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
 //! Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider

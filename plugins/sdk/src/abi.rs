@@ -57,7 +57,9 @@ pub type DeclareFn = unsafe extern "C" fn(host: *const HostTable) -> *const Plug
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct Str {
+    /// The first byte (null when `len` is 0).
     pub ptr: *const u8,
+    /// Length in bytes.
     pub len: usize,
 }
 
@@ -107,15 +109,24 @@ pub const KIND_WRITER: u32 = 4;
 /// A cdylib has its own statics, so logging goes through here rather than a `log` facade.
 #[repr(C)]
 pub struct HostTable {
+    /// The host's [`ABI_VERSION`].
     pub abi_version: u32,
     /// level: 0 error, 1 warning, 2 info, 3 debug. Callable from any thread.
+    ///
+    /// One convention rides on it: an error (level 0) beginning "panicked in `" (as in
+    /// "panicked in `intersect`: {message}"), sent on the thread of a [`CustomVTable`] call that
+    /// then returns [`HIT_PANIC`] or [`STATUS_PANIC`], is that panic's message. The host adds it
+    /// to the error that stops the render instead of printing it (a host that predates the
+    /// convention prints it as an error line, which still reads well).
     pub log: unsafe extern "C" fn(level: u32, plugin: Str, message: Str),
 }
 
 /// Returned by the handshake; lives for the process lifetime (a static in the plugin).
 #[repr(C)]
 pub struct PluginHeader {
+    /// [`MAGIC`].
     pub magic: [u8; 8],
+    /// The [`ABI_VERSION`] the plugin was built for.
     pub abi_version: u32,
     /// Version of the `luxon-plugin` crate the plugin was built with, e.g. "0.2.0".
     pub sdk_version: Str,
@@ -127,16 +138,21 @@ pub struct PluginHeader {
 pub struct Declaration {
     /// The library's own name, e.g. "luxon-shapes"; used in messages.
     pub library: Str,
+    /// The library's entries: `entry_count` of them, a static array.
     pub entries: *const Entry,
+    /// How many entries.
     pub entry_count: usize,
 }
 
 /// One named thing a library provides.
 #[repr(C)]
 pub struct Entry {
+    /// What the entry is: [`KIND_PRIMITIVE`], [`KIND_TEXTURE`], [`KIND_VOLUME_READER`] or
+    /// [`KIND_WRITER`].
     pub kind: u32,
     /// The name a scene uses: `(plugin: "sphere", ...)`.
     pub name: Str,
+    /// One line: what it is (shown by `luxon plugins`).
     pub description: Str,
     /// The parameter table, one `name: type = default  description` per line.
     pub params_doc: Str,
@@ -151,7 +167,9 @@ pub struct Entry {
 /// was given (0 when the error has no position); the host maps them to the scene file.
 #[repr(C)]
 pub struct ErrorSink {
+    /// The host's state for this call, passed back to `set`.
     pub ctx: *mut c_void,
+    /// Records the error: its message (copied by the host) and position.
     pub set: unsafe extern "C" fn(ctx: *mut c_void, message: Str, line: u32, col: u32),
 }
 
@@ -197,9 +215,11 @@ pub struct PrimitiveVTable {
 pub struct MeshData {
     /// x, y, z per vertex.
     pub positions: *const f64,
+    /// Vertices in `positions` (and in each optional array).
     pub vertex_count: u64,
     /// Three vertex indices per triangle.
     pub indices: *const u64,
+    /// Triangles in `indices`.
     pub triangle_count: u64,
     /// x, y, z per vertex, or null.
     pub normals: *const f64,
@@ -209,44 +229,66 @@ pub struct MeshData {
     pub uvs: *const f32,
 }
 
-/// A ray in world space, double precision.
+/// A ray in world space, double precision: the points `origin + t * direction` with
+/// `tmin < t < tmax`. Custom geometry sees it as [`Ray`](crate::Ray).
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct RayF64 {
+    /// Where the ray starts, in world space (the host has already moved it off the surface it
+    /// leaves, so a hit at `t` just above `tmin` is a real one).
     pub origin: [f64; 3],
+    /// Its direction, in world space; not necessarily of unit length, so `t` counts in units of
+    /// its length, not of distance.
     pub direction: [f64; 3],
+    /// Hits at or before this `t` do not count (0 for the rays the host traces).
     pub tmin: f64,
+    /// Hits at or beyond this `t` do not count: the nearest hit found so far, or the distance
+    /// to the light for a shadow ray.
     pub tmax: f64,
+    /// The ray's time within the frame's shutter (the scene's `render.time`, or a sample of
+    /// the shutter interval under motion blur), for shapes that move.
     pub time: f64,
 }
 
-/// A custom primitive's answer to `intersect`.
+/// A custom primitive's answer to `intersect` (the SDK's [`Hit`](crate::Hit)).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct HitF64 {
+    /// Where along the ray: the hit point is `origin + t * direction`, with
+    /// `tmin < t < tmax` (the host drops other answers).
     pub t: f64,
-    /// Geometric normal in world space, any length, any orientation.
+    /// Geometric normal in world space, any length, any orientation (the host normalises it
+    /// and turns it toward the ray; a zero normal drops the hit). It is also the shading
+    /// normal: custom geometry is shaded flat by its true normal.
     pub normal: [f64; 3],
+    /// Texture coordinates of the hit, passed on to textures as [`TexQuery::uv`]. Give
+    /// `[0, 0]` when the shape has none.
     pub uv: [f32; 2],
 }
 
 /// Custom geometry: `count` primitives the host puts in its BVH.
 /// `intersect`/`occluded` return 1 for a hit, 0 for none, and [`STATUS_PANIC`] + 1 (= 3) when the
-/// plugin panicked (the host then stops the render with an error naming the plugin).
+/// plugin panicked (the host then stops the render with an error naming the plugin). These calls
+/// have no [`ErrorSink`]: a panic's message may be sent through [`HostTable::log`] first (see
+/// there).
 #[repr(C)]
 pub struct CustomVTable {
+    /// Writes the world-space box of primitive `index` (`0..count`) to `min` and `max`.
     pub bounds: unsafe extern "C" fn(
         object: *const c_void,
         index: u64,
         min: *mut [f64; 3],
         max: *mut [f64; 3],
     ) -> Status,
+    /// The nearest hit of the ray with primitive `index` with `tmin < t < tmax`, written to
+    /// `hit`.
     pub intersect: unsafe extern "C" fn(
         object: *const c_void,
         index: u64,
         ray: *const RayF64,
         hit: *mut HitF64,
     ) -> u32,
+    /// Whether the ray hits primitive `index` anywhere with `tmin < t < tmax` (shadow rays).
     pub occluded:
         unsafe extern "C" fn(object: *const c_void, index: u64, ray: *const RayF64) -> u32,
     /// Called once by the host when it no longer needs the object.
@@ -258,7 +300,9 @@ pub const HIT_PANIC: u32 = 3;
 
 #[repr(C)]
 pub struct CustomGeometry {
+    /// The plugin's object, passed to every function of `vtable`.
     pub object: *mut c_void,
+    /// Primitives in the object, each with its own BVH leaf (`index` `0..count`).
     pub count: u64,
     /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const CustomVTable,
@@ -268,6 +312,7 @@ pub struct CustomGeometry {
 /// fills `err` when the data is unusable (NaN, bad index...).
 #[repr(C)]
 pub struct GeometrySink {
+    /// The host's builder for this call, passed back to every function.
     pub ctx: *mut c_void,
     /// `count` spheres as x, y, z, radius.
     pub add_spheres: unsafe extern "C" fn(
@@ -298,6 +343,7 @@ pub struct GeometrySink {
         count: u64,
         err: *const ErrorSink,
     ) -> Status,
+    /// A triangle mesh (see [`MeshData`]).
     pub add_mesh: unsafe extern "C" fn(
         ctx: *mut c_void,
         mesh: *const MeshData,
@@ -329,25 +375,40 @@ pub struct TextureVTable {
 
 #[repr(C)]
 pub struct TextureObject {
+    /// The plugin's object, passed to every function of `vtable`.
     pub object: *mut c_void,
     /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const TextureInstanceVTable,
 }
 
-/// Where and how a texture is looked up.
+/// Where and how a texture is looked up: one shading point (the SDK re-exports it at its
+/// root: `luxon_plugin::TexQuery`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TexQuery {
-    /// Hit point in world space.
+    /// The hit point in world space (double precision, so solid textures stay sharp far from
+    /// the origin).
     pub p: [f64; 3],
-    /// Shading normal (unit).
+    /// The shading normal at `p`: unit length, turned toward the viewer (the interpolated
+    /// normal of a smooth mesh, else the geometric one).
     pub n: [f32; 3],
+    /// The surface's texture coordinates at `p`: spheres give longitude and latitude in [0, 1]
+    /// (`u` around the y axis, `v` from the top), planes the distances along two directions in
+    /// the plane (world units), meshes their per-vertex uvs interpolated (or `[0, 0]`), custom
+    /// shapes what their `intersect` returned; cylinders, cones and discs their own.
     pub uv: [f32; 2],
-    /// Approximate world-space width of the ray's footprint at `p` (for filtering).
+    /// How wide the pixel's share of the scene is at `p`, in world units: rays are traced as
+    /// thin cones, about a pixel wide at the camera (an orthographic camera's pixel, or 0 at a
+    /// pinhole) and widening by the angle of one pixel per unit of distance, including the
+    /// path through mirrors and glass before it. A texture with detail finer than this should
+    /// average over a box of this width around `p` rather than return the value at `p`, or it
+    /// aliases (moiré, sparkle). It is measured across the ray, not along a slanted surface.
     pub footprint: f32,
-    /// The same footprint measured in `uv` units (0 when the surface has no uv parametrisation
-    /// the host can measure); image textures under UV mapping choose their MIP level from it.
+    /// The same footprint in `uv` units: measured on spheres and on meshes with uvs, 0 on
+    /// other surfaces (planes, cylinders and cones, discs, custom shapes); image textures
+    /// under uv mapping choose their MIP level from it.
     pub uv_footprint: f32,
+    /// The ray's time within the frame's shutter, for textures that change over time.
     pub time: f32,
 }
 
@@ -363,6 +424,7 @@ pub struct TextureInstanceVTable {
         out: *mut [f32; 4],
         err: *const ErrorSink,
     ) -> Status,
+    /// Called once by the host when it no longer needs the object.
     pub destroy: unsafe extern "C" fn(object: *mut c_void),
 }
 
@@ -382,15 +444,20 @@ pub struct VolumeReaderVTable {
     ) -> Status,
 }
 
+/// A grid's description, sent by `begin` before its data (the SDK's
+/// [`GridInfo`](crate::GridInfo)).
 #[repr(C)]
 pub struct VolumeDesc {
-    /// Row-major 3x4 affine map from voxel index space to world space.
+    /// Row-major 3x4 affine map from voxel index space to world space: voxel `(i, j, k)` is at
+    /// `M · (i, j, k, 1)`.
     pub world_from_index: [f64; 12],
     /// Value outside every block and tile.
     pub background: f32,
-    /// Inclusive index-space bounds of the data.
+    /// Inclusive index-space bounds of the data: the smallest index along each axis...
     pub index_min: [i64; 3],
+    /// ... and the largest (inclusive). Blocks and tiles must lie within these bounds.
     pub index_max: [i64; 3],
+    /// The grid's name, for messages and `luxon check`.
     pub grid_name: Str,
 }
 
@@ -402,6 +469,7 @@ pub const VOXEL_F32: u32 = 3;
 
 #[repr(C)]
 pub struct VolumeSink {
+    /// The host's volume for this call, passed back to every function.
     pub ctx: *mut c_void,
     /// Called once, before any block or tile.
     pub begin: unsafe extern "C" fn(
@@ -460,10 +528,13 @@ pub struct WriterVTable {
     ) -> Status,
 }
 
-/// A finished image: linear (not gamma-encoded) RGBA f32, rows top to bottom.
+/// A finished image: linear (not gamma-encoded) RGBA f32, rows top to bottom (the SDK's
+/// [`Image`](crate::Image)).
 #[repr(C)]
 pub struct ImageView {
+    /// Pixels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
     /// `width * height * 4` values (may be null when that is 0).
     pub rgba: *const f32,
@@ -471,6 +542,8 @@ pub struct ImageView {
 
 #[repr(C)]
 pub struct ByteSink {
+    /// The host's buffer for this call, passed back to `write`.
     pub ctx: *mut c_void,
+    /// Appends `len` bytes from `data` to the file's contents.
     pub write: unsafe extern "C" fn(ctx: *mut c_void, data: *const u8, len: usize) -> Status,
 }

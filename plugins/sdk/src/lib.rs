@@ -6,12 +6,14 @@
 //! it, checks [`abi::ABI_VERSION`] before calling anything, and hands each instance its `params`
 //! subtree from the scene as RON text, which this crate deserializes into the type's own
 //! `#[derive(Deserialize)]` struct (use `#[serde(deny_unknown_fields)]` so typos are errors).
+//! `luxon new-plugin NAME --kind primitive|texture|writer|volume` writes a crate of each kind
+//! to start from.
 //!
 //! ```no_run
 //! use luxon_plugin::*;
 //!
 //! #[derive(serde::Deserialize)]
-//! #[serde(crate = "luxon_plugin::serde", deny_unknown_fields)]
+//! #[serde(deny_unknown_fields)]
 //! struct BallParams { center: [f64; 3], radius: f64 }
 //!
 //! struct Ball;
@@ -39,12 +41,17 @@
 
 pub mod abi;
 pub mod files;
+mod params;
 
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
+/// A texture's query, the one type of [`abi`] a texture plugin names.
+pub use abi::TexQuery;
 pub use abi::ABI_VERSION;
+/// The serde this crate deserializes parameters with. Plugins depend on `serde` themselves
+/// (see "Parameters" in the crate documentation); Cargo makes both the same crate.
 pub use serde;
 
 /// Version of this crate, sent in the handshake.
@@ -53,18 +60,37 @@ pub const SDK_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// An error a plugin reports; `line`/`col` (1-based, 0 = unknown) are positions in its params text.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Error {
+    /// What went wrong, in words for the scene's author (the host adds the plugin's name and
+    /// the scene position).
     pub message: String,
+    /// Line in the params text (1-based; 0: no position, the host points at `params`).
     pub line: u32,
+    /// Column in that line (1-based; 0: no position).
     pub col: u32,
 }
 
 impl Error {
+    /// An error without a position.
     pub fn new(message: impl Into<String>) -> Error {
         Error {
             message: message.into(),
             line: 0,
             col: 0,
         }
+    }
+
+    /// An error about parameter `field`: "parameter `field`: {message}". Returned from a
+    /// plugin's `create`/`read`/`write`, it is reported at that field in the scene file (the
+    /// SDK finds `field:` in the params text it was given); a field the scene leaves out (its
+    /// default was used) is reported at the start of the params. Any error without a position
+    /// whose message begins with "parameter `name`" is placed the same way.
+    ///
+    /// ```
+    /// let e = luxon_plugin::Error::invalid_at("width", "expected a number > 0, found -1");
+    /// assert_eq!(e.message, "parameter `width`: expected a number > 0, found -1");
+    /// ```
+    pub fn invalid_at(field: &str, message: impl std::fmt::Display) -> Error {
+        Error::new(format!("parameter `{field}`: {message}"))
     }
 }
 
@@ -85,6 +111,11 @@ pub fn invalid(message: impl Into<String>) -> Error {
     Error::new(message)
 }
 
+/// Shorthand for [`Error::invalid_at`]: a failed check on parameter `field`, reported at it.
+pub fn invalid_at(field: &str, message: impl std::fmt::Display) -> Error {
+    Error::invalid_at(field, message)
+}
+
 /// Rejects NaN and infinities with a message naming the parameter.
 pub fn finite<const N: usize>(name: &str, v: [f64; N]) -> Result<[f64; N], Error> {
     if v.iter().all(|x| x.is_finite()) {
@@ -98,7 +129,10 @@ pub fn finite<const N: usize>(name: &str, v: [f64; N]) -> Result<[f64; N], Error
 
 /// Name, description and parameter table of a plugin entry (shown by `luxon plugins`).
 pub trait Describe {
+    /// The name scenes use: `(plugin: "NAME", ...)`. Unique among the plugins of its kind on
+    /// the search path (the first library found that provides it wins).
     const NAME: &'static str;
+    /// One line: what it is.
     const DESCRIPTION: &'static str;
     /// One `name: type = default  meaning` per line.
     const PARAMS: &'static str;
@@ -168,17 +202,26 @@ impl Context {
 
 /// Deserializes a params subtree given as RON text; positions in errors are relative to `text`.
 pub fn parse_params<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Error> {
+    parse_documented_params(text, "")
+}
+
+/// [`parse_params`] for a plugin whose parameter table ([`Describe::PARAMS`]) is `doc`: a value
+/// of the wrong type is reported naming its parameter, the type the table gives it and what the
+/// text has there ("parameter `color`: expected (r, g, b), found `"red"`"). The SDK's entry
+/// points parse with the plugin's own table.
+pub fn parse_documented_params<T: serde::de::DeserializeOwned>(
+    text: &str,
+    doc: &str,
+) -> Result<T, Error> {
     let text = if text.trim().is_empty() { "()" } else { text };
     ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
         .from_str::<T>(text)
         .map_err(|e| {
-            let message = describe_ron_error(&e.code);
-            Error {
-                message,
-                line: e.span.start.line as u32,
-                col: e.span.start.col as u32,
-            }
+            let (line, col) = (e.span.start.line, e.span.start.col);
+            let (message, (line, col)) = params::type_error(text, doc, &e.code, line, col)
+                .unwrap_or_else(|| (describe_ron_error(&e.code), (line as u32, col as u32)));
+            Error { message, line, col }
         })
 }
 
@@ -250,7 +293,10 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 
 /// A primitive plugin: turns parameters into geometry.
 pub trait Primitive: Describe {
+    /// The scene's `params: (...)`, deserialized (see "Parameters" in the crate documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per scene object naming the plugin: checks the parameters and hands the
+    /// geometry to `out`. An error stops the scene from loading, naming the object.
     fn create(params: Self::Params, ctx: &Context, out: &mut Geometry) -> Result<(), Error>;
 }
 
@@ -262,23 +308,30 @@ pub struct Geometry<'a> {
 /// A triangle mesh to hand to the host. Optional arrays are empty or have one entry per vertex.
 #[derive(Default, Clone, Debug)]
 pub struct Mesh {
+    /// Vertex positions in world space.
     pub positions: Vec<[f64; 3]>,
+    /// Three indices into `positions` per triangle.
     pub indices: Vec<[u64; 3]>,
+    /// Per-vertex normals, interpolated for smooth shading (empty: flat shading).
     pub normals: Vec<[f64; 3]>,
+    /// Per-vertex linear RGB colours, interpolated and multiplied into the material's colour.
     pub colors: Vec<[f32; 3]>,
+    /// Per-vertex texture coordinates, interpolated into [`TexQuery::uv`].
     pub uvs: Vec<[f32; 2]>,
 }
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The smallest corner (x, y, z), world space.
     pub min: [f64; 3],
+    /// The largest corner.
     pub max: [f64; 3],
 }
 
-/// A ray as custom geometry sees it (world space, f64).
+/// A ray as custom geometry sees it (world space, f64): see [`abi::RayF64`] for its fields.
 pub type Ray = abi::RayF64;
-/// A custom geometry hit.
+/// A custom geometry hit: see [`abi::HitF64`] for its fields.
 pub type Hit = abi::HitF64;
 
 /// User geometry intersected by the plugin from inside the host's BVH.
@@ -375,6 +428,7 @@ impl Geometry<'_> {
         self.add(self.sink.add_discs, discs)
     }
 
+    /// A triangle mesh; its optional arrays have one entry per vertex or none.
     pub fn mesh(&mut self, mesh: &Mesh) -> Result<(), Error> {
         let n = mesh.positions.len();
         for (what, len) in [
@@ -414,7 +468,10 @@ impl Geometry<'_> {
     /// Hands `shape` to the host, which owns it from now on.
     pub fn custom<S: CustomShape>(&mut self, shape: S) -> Result<(), Error> {
         let count = shape.count();
-        let object = Box::into_raw(Box::new(shape)) as *mut c_void;
+        let object = Box::into_raw(Box::new(Shape {
+            shape,
+            told: std::sync::atomic::AtomicBool::new(false),
+        })) as *mut c_void;
         let geometry = abi::CustomGeometry {
             object,
             count,
@@ -425,6 +482,30 @@ impl Geometry<'_> {
         // SAFETY: `sink` is the host's table for the running `create` and `ctx` its own;
         // `geometry` lives across the call, its object is a live `S` whose table is `S`'s.
         call_sink(|err| unsafe { (sink.add_custom)(sink.ctx, &geometry, err) })
+    }
+}
+
+/// A custom shape as the host holds it: the plugin's shape, and whether the host has been told
+/// of a panic in it.
+struct Shape<S> {
+    shape: S,
+    told: std::sync::atomic::AtomicBool,
+}
+
+impl<S> Shape<S> {
+    /// What a panic caught in `call` gives the host. Its calls have no error sink, so the first
+    /// panic's message goes through the host log, on the thread of the call: "panicked in
+    /// `intersect`: {message}" (a host that knows this convention adds it to the error that
+    /// stops the render; an older one prints it as an error line). Later ones only return
+    /// `status`.
+    fn panicked<T>(&self, call: &str, p: Box<dyn std::any::Any + Send>, status: T) -> T {
+        if !self.told.swap(true, std::sync::atomic::Ordering::Relaxed) {
+            let message = shim::panic_message(p);
+            let words = message.strip_prefix("panicked: ").unwrap_or(&message);
+            let library = shim::LIBRARY.get().copied().unwrap_or("?");
+            host_log(library, 0, &format!("panicked in `{call}`: {words}"));
+        }
+        status
     }
 }
 
@@ -441,12 +522,12 @@ fn custom_vtable<S: CustomShape>() -> &'static abi::CustomVTable {
     &Holder::<S>::VTABLE
 }
 
-// The functions of a custom shape's table. Their `object` is the `Box<S>` that
+// The functions of a custom shape's table. Their `object` is the `Box<Shape<S>>` that
 // `Geometry::custom` leaked and handed to the host, which destroys it once, after every other
 // call (ABI contract); `S: Sync`, so concurrent calls from the host's render threads are fine.
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`]; `min` and `max` are writable.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`]; `min` and `max` are writable.
 unsafe extern "C" fn custom_bounds<S: CustomShape>(
     object: *const c_void,
     index: u64,
@@ -454,8 +535,8 @@ unsafe extern "C" fn custom_bounds<S: CustomShape>(
     max: *mut [f64; 3],
 ) -> abi::Status {
     // SAFETY: see the comment above these functions.
-    let shape = unsafe { &*(object as *const S) };
-    match catch_unwind(AssertUnwindSafe(|| shape.bounds(index))) {
+    let shape = unsafe { &*(object as *const Shape<S>) };
+    match catch_unwind(AssertUnwindSafe(|| shape.shape.bounds(index))) {
         Ok(b) => {
             // SAFETY: the host passes two writable `[f64; 3]` for the call (ABI contract).
             unsafe {
@@ -464,12 +545,12 @@ unsafe extern "C" fn custom_bounds<S: CustomShape>(
             }
             abi::STATUS_OK
         }
-        Err(_) => abi::STATUS_PANIC,
+        Err(p) => shape.panicked("bounds", p, abi::STATUS_PANIC),
     }
 }
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`]; `ray` is readable, `hit` writable.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`]; `ray` is readable, `hit` writable.
 unsafe extern "C" fn custom_intersect<S: CustomShape>(
     object: *const c_void,
     index: u64,
@@ -477,39 +558,39 @@ unsafe extern "C" fn custom_intersect<S: CustomShape>(
     hit: *mut abi::HitF64,
 ) -> u32 {
     // SAFETY: see the comment above these functions; the host's ray is valid for the call.
-    let (shape, ray) = unsafe { (&*(object as *const S), &*ray) };
-    match catch_unwind(AssertUnwindSafe(|| shape.intersect(index, ray))) {
+    let (shape, ray) = unsafe { (&*(object as *const Shape<S>), &*ray) };
+    match catch_unwind(AssertUnwindSafe(|| shape.shape.intersect(index, ray))) {
         Ok(Some(h)) => {
             // SAFETY: the host passes a writable `HitF64` for the call (ABI contract).
             unsafe { *hit = h };
             1
         }
         Ok(None) => 0,
-        Err(_) => abi::HIT_PANIC,
+        Err(p) => shape.panicked("intersect", p, abi::HIT_PANIC),
     }
 }
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`]; `ray` is readable.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`]; `ray` is readable.
 unsafe extern "C" fn custom_occluded<S: CustomShape>(
     object: *const c_void,
     index: u64,
     ray: *const abi::RayF64,
 ) -> u32 {
     // SAFETY: see the comment above these functions; the host's ray is valid for the call.
-    let (shape, ray) = unsafe { (&*(object as *const S), &*ray) };
-    match catch_unwind(AssertUnwindSafe(|| shape.occluded(index, ray))) {
+    let (shape, ray) = unsafe { (&*(object as *const Shape<S>), &*ray) };
+    match catch_unwind(AssertUnwindSafe(|| shape.shape.occluded(index, ray))) {
         Ok(b) => u32::from(b),
-        Err(_) => abi::HIT_PANIC,
+        Err(p) => shape.panicked("occluded", p, abi::HIT_PANIC),
     }
 }
 
 /// # Safety
-/// `object` is a live `S` from [`Geometry::custom`], not used again after this call.
+/// `object` is a live `Shape<S>` from [`Geometry::custom`], not used again after this call.
 unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
-    // SAFETY: `object` came from `Box::into_raw` of a `Box<S>` and the host destroys it once,
-    // after every other call on it (see the comment above these functions).
-    let shape = unsafe { Box::from_raw(object as *mut S) };
+    // SAFETY: `object` came from `Box::into_raw` of a `Box<Shape<S>>` and the host destroys it
+    // once, after every other call on it (see the comment above these functions).
+    let shape = unsafe { Box::from_raw(object as *mut Shape<S>) };
     let _ = catch_unwind(AssertUnwindSafe(|| drop(shape)));
 }
 
@@ -520,9 +601,15 @@ unsafe extern "C" fn custom_destroy<S: CustomShape>(object: *mut c_void) {
 /// A texture plugin: an instance created once, evaluated at every shading point (from many
 /// threads at once, hence `Sync`).
 pub trait Texture: Describe + Send + Sync + Sized + 'static {
+    /// The texture's `params: (...)`, deserialized (see "Parameters" in the crate documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per entry of the scene's `textures` naming the plugin. An error stops the
+    /// scene from loading, naming the texture.
     fn create(params: Self::Params, ctx: &Context) -> Result<Self, Error>;
-    /// Linear RGBA at the query point.
+    /// Linear RGBA at the query point (see [`TexQuery`] for its fields). A material's colour
+    /// takes red, green and blue (values above 1 are allowed); a reflect or transmit texture
+    /// the mean of the three. The host does not use alpha: give 1, or what your own nested
+    /// textures mix by.
     fn eval(&self, query: &abi::TexQuery) -> [f32; 4];
     /// What the host calls: [`eval`](Self::eval)'s value, or an error when no value can be
     /// given (an image that turns out not to decode). The host then stops the render with the
@@ -593,18 +680,27 @@ unsafe extern "C" fn texture_destroy<T: Texture>(object: *mut c_void) {
 
 /// A volume reader plugin: streams a scalar grid into the host.
 pub trait VolumeReader: Describe {
+    /// The volume's `params: (...)`, deserialized (see "Parameters" in the crate documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per volume of the scene naming the plugin: describes the grid with
+    /// [`VolumeOut::begin`], then sends its blocks and tiles. An error stops the scene from
+    /// loading, naming the volume.
     fn read(params: Self::Params, ctx: &Context, out: &mut VolumeOut) -> Result<(), Error>;
 }
 
-/// Description of a grid, sent before its data.
+/// Description of a grid, sent before its data (see [`abi::VolumeDesc`]).
 #[derive(Clone, Debug)]
 pub struct GridInfo {
-    /// Row-major 3x4 affine map from voxel index to world space.
+    /// Row-major 3x4 affine map from voxel index to world space: voxel `(i, j, k)` is at
+    /// `M · (i, j, k, 1)`.
     pub world_from_index: [f64; 12],
+    /// The value outside every block and tile (where nothing was sent).
     pub background: f32,
+    /// The smallest voxel index along each axis.
     pub index_min: [i64; 3],
+    /// The largest voxel index along each axis (inclusive).
     pub index_max: [i64; 3],
+    /// The grid's name, for messages and `luxon check`.
     pub name: String,
 }
 
@@ -625,6 +721,7 @@ pub struct VolumeOut<'a> {
 }
 
 impl VolumeOut<'_> {
+    /// Describes the grid; called once, before any block or tile.
     pub fn begin(&mut self, info: &GridInfo) -> Result<(), Error> {
         let desc = abi::VolumeDesc {
             world_from_index: info.world_from_index,
@@ -709,6 +806,8 @@ impl VolumeOut<'_> {
         })
     }
 
+    /// A box of `dims` voxels from index `origin`, all of `value` (a sparse format's
+    /// constant tiles; cheaper than a dense block of one value).
     pub fn tile(&mut self, origin: [i64; 3], dims: [u64; 3], value: f32) -> Result<(), Error> {
         let sink = self.sink;
         // SAFETY: `sink` is the host's table for the running `read` and `ctx` its own.
@@ -722,8 +821,13 @@ impl VolumeOut<'_> {
 
 /// A finished image: linear RGBA f32, rows top to bottom.
 pub struct Image<'a> {
+    /// Pixels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
+    /// `width * height` pixels of four values each, red, green, blue and alpha, row by row
+    /// from the top. Colours are linear (encode them for the format: [`linear_to_srgb`] for
+    /// 8-bit sRGB) and may exceed 1; alpha is 1 (rendered pixels are opaque).
     pub rgba: &'a [f32],
 }
 
@@ -731,7 +835,12 @@ pub struct Image<'a> {
 pub trait Writer: Describe {
     /// Comma-separated file extensions, without dots, e.g. "ppm,pnm".
     const EXTENSIONS: &'static str;
+    /// The output's `params: (...)`, deserialized (see "Parameters" in the crate
+    /// documentation).
     type Params: serde::de::DeserializeOwned;
+    /// Called once per output written (once per frame of an animation): encodes `image` into
+    /// `out`, whose bytes become the file, written whole or not at all. An error fails the
+    /// run with the message, and the file is not written.
     fn write(
         params: Self::Params,
         ctx: &Context,
@@ -825,10 +934,20 @@ pub mod shim {
         }
     }
 
-    fn params<P: serde::de::DeserializeOwned>(
+    /// The params text of a call, or why it is unusable.
+    fn text(text: Result<&str, std::str::Utf8Error>) -> Result<&str, Error> {
+        text.map_err(|_| Error::new("params are not UTF-8"))
+    }
+
+    /// Parses the params of `D` and runs `f` with them; an error from `f` that names a
+    /// parameter is placed at it in `text` (see [`Error::invalid_at`]).
+    fn with_params<D: Describe, P: serde::de::DeserializeOwned>(
         text: Result<&str, std::str::Utf8Error>,
-    ) -> Result<P, Error> {
-        parse_params(text.map_err(|_| Error::new("params are not UTF-8"))?)
+        f: impl FnOnce(P) -> Result<(), Error>,
+    ) -> Result<(), Error> {
+        let text = self::text(text)?;
+        let p = parse_documented_params::<P>(text, D::PARAMS)?;
+        f(p).map_err(|e| params::place(e, text))
     }
 
     /// [`abi::PrimitiveVTable::create`] for `P`.
@@ -847,9 +966,10 @@ pub mod shim {
         let (text, ctx, sink, err) =
             unsafe { (text.as_str(), ctx.as_ref(), sink.as_ref(), err.as_ref()) };
         guarded(err, || {
-            let p = params::<P::Params>(text)?;
-            let sink = sink.ok_or_else(|| Error::new("no geometry sink"))?;
-            P::create(p, &context(ctx), &mut Geometry { sink })
+            with_params::<P, P::Params>(text, |p| {
+                let sink = sink.ok_or_else(|| Error::new("no geometry sink"))?;
+                P::create(p, &context(ctx), &mut Geometry { sink })
+            })
         })
     }
 
@@ -869,13 +989,14 @@ pub mod shim {
             unsafe { (text.as_str(), ctx.as_ref(), out.as_mut(), err.as_ref()) };
         guarded(err, || {
             let out = out.ok_or_else(|| Error::new("no place for the texture"))?;
-            let p = params::<T::Params>(text)?;
-            let tex = T::create(p, &context(ctx))?;
-            *out = abi::TextureObject {
-                object: Box::into_raw(Box::new(tex)) as *mut c_void,
-                vtable: texture_instance_vtable::<T>(),
-            };
-            Ok(())
+            with_params::<T, T::Params>(text, |p| {
+                let tex = T::create(p, &context(ctx))?;
+                *out = abi::TextureObject {
+                    object: Box::into_raw(Box::new(tex)) as *mut c_void,
+                    vtable: texture_instance_vtable::<T>(),
+                };
+                Ok(())
+            })
         })
     }
 
@@ -894,9 +1015,10 @@ pub mod shim {
         let (text, ctx, sink, err) =
             unsafe { (text.as_str(), ctx.as_ref(), sink.as_ref(), err.as_ref()) };
         guarded(err, || {
-            let p = params::<V::Params>(text)?;
-            let sink = sink.ok_or_else(|| Error::new("no volume sink"))?;
-            V::read(p, &context(ctx), &mut VolumeOut { sink })
+            with_params::<V, V::Params>(text, |p| {
+                let sink = sink.ok_or_else(|| Error::new("no volume sink"))?;
+                V::read(p, &context(ctx), &mut VolumeOut { sink })
+            })
         })
     }
 
@@ -924,29 +1046,30 @@ pub mod shim {
             )
         };
         guarded(err, || {
-            let p = params::<W::Params>(text)?;
-            let view = view.ok_or_else(|| Error::new("no image"))?;
-            let n = (view.width as usize)
-                .checked_mul(view.height as usize)
-                .and_then(|n| n.checked_mul(4))
-                .ok_or_else(|| Error::new("image too large"))?;
-            let rgba = if n == 0 {
-                &[][..]
-            } else if view.rgba.is_null() {
-                return Err(Error::new("no pixels"));
-            } else {
-                // SAFETY: the host's image holds `width * height * 4` values, unchanged while
-                // the call runs (ABI contract), and the slice does not outlive the call.
-                unsafe { std::slice::from_raw_parts(view.rgba, n) }
-            };
-            let image = Image {
-                width: view.width,
-                height: view.height,
-                rgba,
-            };
-            let sink = out.ok_or_else(|| Error::new("no byte sink"))?;
-            let mut w = ByteOut(sink);
-            W::write(p, &context(ctx), &image, &mut w)
+            with_params::<W, W::Params>(text, |p| {
+                let view = view.ok_or_else(|| Error::new("no image"))?;
+                let n = (view.width as usize)
+                    .checked_mul(view.height as usize)
+                    .and_then(|n| n.checked_mul(4))
+                    .ok_or_else(|| Error::new("image too large"))?;
+                let rgba = if n == 0 {
+                    &[][..]
+                } else if view.rgba.is_null() {
+                    return Err(Error::new("no pixels"));
+                } else {
+                    // SAFETY: the host's image holds `width * height * 4` values, unchanged while
+                    // the call runs (ABI contract), and the slice does not outlive the call.
+                    unsafe { std::slice::from_raw_parts(view.rgba, n) }
+                };
+                let image = Image {
+                    width: view.width,
+                    height: view.height,
+                    rgba,
+                };
+                let sink = out.ok_or_else(|| Error::new("no byte sink"))?;
+                let mut w = ByteOut(sink);
+                W::write(p, &context(ctx), &image, &mut w)
+            })
         })
     }
 
@@ -1027,6 +1150,8 @@ pub mod shim {
     /// The host's table, for `log`.
     pub(crate) static HOST: std::sync::OnceLock<&'static abi::HostTable> =
         std::sync::OnceLock::new();
+    /// The library's name (`export!`'s), for log messages the SDK sends on its behalf.
+    pub(crate) static LIBRARY: std::sync::OnceLock<&'static str> = std::sync::OnceLock::new();
 
     /// Called by the handshake. A cdylib has its own copy of std and so its own panic hook: the
     /// default one would print every caught panic (one per ray for a broken intersect). Ours
@@ -1044,6 +1169,7 @@ pub mod shim {
         if HOST.set(host).is_err() {
             return;
         }
+        let _ = LIBRARY.set(library);
         static REPORTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
         std::panic::set_hook(Box::new(move |info| {
             if !REPORTED.swap(true, std::sync::atomic::Ordering::Relaxed) {

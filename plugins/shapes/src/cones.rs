@@ -3,14 +3,18 @@
 
 use crate::params::positive;
 use crate::vector::{length, scale, sub};
-use luxon_plugin::{finite, invalid, Context, Describe, Error, Geometry, Primitive};
+use luxon_plugin::{finite, invalid, invalid_at, Context, Describe, Error, Geometry, Primitive};
 use serde::Deserialize;
 
+/// `x` if it is a number >= 0; else an error reported at parameter `name` in the scene.
 fn non_negative(name: &str, x: f64) -> Result<f64, Error> {
     if x.is_finite() && x >= 0.0 {
         Ok(x)
     } else {
-        Err(invalid(format!("parameter `{name}` must be >= 0, got {x}")))
+        Err(invalid_at(
+            name,
+            format!("expected a number >= 0, found {x}"),
+        ))
     }
 }
 

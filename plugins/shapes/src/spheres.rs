@@ -120,9 +120,12 @@ mod tests {
         let p = |center, radius| SphereParams { center, radius };
         assert_contains(
             &err(sphere(&p([0.0; 3], 0.0))),
-            "`radius` must be > 0, got 0",
+            "parameter `radius`: expected a number > 0, found 0",
         );
-        assert_contains(&err(sphere(&p([0.0; 3], -1.0))), "`radius` must be > 0");
+        assert_contains(
+            &err(sphere(&p([0.0; 3], -1.0))),
+            "`radius`: expected a number > 0",
+        );
         assert_contains(
             &err(sphere(&p([0.0; 3], f64::INFINITY))),
             "`radius` must be finite",
@@ -164,11 +167,11 @@ mod tests {
         );
         assert_contains(
             &e("(centers: [(0, 0, 0), (1, 1, 1)], radii: [1, 0])"),
-            "`radii[1]` must be > 0",
+            "`radii[1]`: expected a number > 0",
         );
         assert_contains(
             &e("(centers: [(0, 0, 0)], radius: -2)"),
-            "`radius` must be > 0",
+            "`radius`: expected a number > 0",
         );
         let p = SpheresParams {
             centers: vec![[0.0; 3], [f64::NAN, 0.0, 0.0]],

@@ -17,6 +17,7 @@
 //! | `tachyon_marble` | Tachyon's TEXFUNC 3 (marble), as Tachyon computes it |
 //! | `tachyon_wood` | Tachyon's TEXFUNC 4 (wood) |
 //! | `tachyon_cylinder_checker` | Tachyon's TEXFUNC 6 (cylindrical checker) |
+//! | `tachyon_volume_image` | Tachyon's TEXFUNC 10 (an IMAGEDEF block of texels) |
 //!
 //! ## Placement of solid textures
 //!
@@ -130,7 +131,7 @@
 //! divided by the total amplitude, so every octave count keeps the range. One octave of noise is
 //! exactly 0 (weight 0.5) at whole pattern coordinates.
 //!
-//! `tachyon_marble`, `tachyon_wood`, `tachyon_cylinder_checker`
+//! `tachyon_marble`, `tachyon_wood`, `tachyon_cylinder_checker`, `tachyon_volume_image`
 //!
 //! Tachyon's procedural textures, for scenes imported from Tachyon (`.dat`): the formulas of
 //! Tachyon 0.99b6, measured against `tachyon-nox` pixel by pixel (`tachyon.rs`). They take
@@ -147,6 +148,11 @@
 //! | `tachyon_cylinder_checker` | `center` | `(x, y, z)` | `(0, 0, 0)` | the axis runs through it along z |
 //! | | `even` | `(r, g, b)` | `(0, 0.2, 1)` | cells whose sector and band sum to an even number |
 //! | | `odd` | `(r, g, b)` | `(1, 0.2, 0)` | the others |
+//! | `tachyon_volume_image` | `size` | `(nx, ny, nz)`, each ≥ 1 | required | texels along u, v, w |
+//! | | `rgb` | `[u8, ...]` | required | 3·nx·ny·nz bytes, r, g, b per texel, u fastest, then v, then w |
+//! | | `center` | `(x, y, z)` | `(0, 0, 0)` | Tachyon's CENTER |
+//! | | `u`, `v`, `w` | `(x, y, z)` | the x, y, z axes | `u = u·(p − center) + offset.x` (UAXIS × SCALE.x), likewise v, w |
+//! | | `offset` | `(u, v, w)` | `(0, 0, 0)` | Tachyon's ROTATE |
 //!
 //! - Marble: with Tachyon's value noise `n(p)` (a 28³ lattice of integers 0..12000 filled from
 //!   the sequence s ← 1099087573·s mod 2³², s₀ = 1234567, interpolated from |x|, |y|, |z| in
@@ -157,6 +163,9 @@
 //!   q.y/150)`; `light` where `trunc(r + 0.5) mod 60 < 40` (C's remainder), else `dark`.
 //! - Cylindrical checker: with `q = p − center`, `u` = the angle of `(q.x, q.y)` from +x toward
 //!   +y in turns, cell `floor(18·u) + floor(10·|q.z|)`.
+//! - Volume image: `u, v, w` wrapped into [0, 1) (`t − floor(t)`), texel coordinates
+//!   `u·(nx − 1)` … (the first and last texels' centres at 0 and 1), trilinear between the 8
+//!   texels around, bytes / 255 (no gamma, like Tachyon's colours).
 //!
 //! `image`
 //!
@@ -257,7 +266,7 @@ mod testutil;
 
 pub use crate::image::ImageTexture;
 pub use procedural::{Checker, Constant, Gradient, Marble, Noise, Wood};
-pub use tachyon::{TachyonCylinderChecker, TachyonMarble, TachyonWood};
+pub use tachyon::{TachyonCylinderChecker, TachyonMarble, TachyonVolumeImage, TachyonWood};
 pub use tree::Blend;
 
 luxon_plugin::export!(
@@ -273,7 +282,8 @@ luxon_plugin::export!(
         ImageTexture,
         TachyonMarble,
         TachyonWood,
-        TachyonCylinderChecker
+        TachyonCylinderChecker,
+        TachyonVolumeImage
     ]
 );
 

@@ -946,6 +946,7 @@ mod tests {
             crate::tachyon::TachyonMarble::PARAMS,
             crate::tachyon::TachyonWood::PARAMS,
             crate::tachyon::TachyonCylinderChecker::PARAMS,
+            crate::tachyon::TachyonVolumeImage::PARAMS,
         ] {
             for line in params.lines() {
                 assert!(line.contains(": ") && line.contains(" = "), "{line}");

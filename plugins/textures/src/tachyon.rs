@@ -1,4 +1,5 @@
-//! Tachyon's procedural textures (TEXFUNC 3 marble, 4 wood, 6 cylindrical checker), computed
+//! Tachyon's procedural textures (TEXFUNC 3 marble, 4 wood, 6 cylindrical checker) and its
+//! volume image (TEXFUNC 10), computed
 //! as Tachyon 0.99b6 computes them, so that scenes imported from Tachyon look as Tachyon draws
 //! them. The formulas were measured against `tachyon-nox` pixel by pixel
 //! (`/work/notes/tachyon-mapping.md` §5.9); the tests hold values read from its images.
@@ -11,7 +12,7 @@
 
 use crate::params::{color, Factors};
 use luxon_plugin::abi::TexQuery;
-use luxon_plugin::{finite, Context, Describe, Error, Texture};
+use luxon_plugin::{finite, invalid, Context, Describe, Error, Texture};
 use serde::Deserialize;
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::sync::OnceLock;
@@ -259,6 +260,133 @@ impl Texture for TachyonCylinderChecker {
         } else {
             self.odd
         }
+    }
+}
+
+// ------------------------------------------------------------------------------------------------
+// volume image (TEXFUNC 10 with an IMAGEDEF)
+// ------------------------------------------------------------------------------------------------
+
+/// Tachyon's volume image: a block of RGB texels (an IMAGEDEF) filling a unit cube of texture
+/// space, repeated, looked up trilinearly.
+pub struct TachyonVolumeImage {
+    size: [usize; 3],
+    rgb: Vec<u8>,
+    center: [f64; 3],
+    axes: [[f64; 3]; 3],
+    offset: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeImageParams {
+    size: [u32; 3],
+    rgb: Vec<u8>,
+    #[serde(default)]
+    center: [f64; 3],
+    #[serde(default = "axis_u")]
+    u: [f64; 3],
+    #[serde(default = "axis_v")]
+    v: [f64; 3],
+    #[serde(default = "axis_w")]
+    w: [f64; 3],
+    #[serde(default)]
+    offset: [f64; 3],
+}
+
+fn axis_u() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+
+fn axis_v() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+fn axis_w() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+impl Describe for TachyonVolumeImage {
+    const NAME: &'static str = "tachyon_volume_image";
+    const DESCRIPTION: &'static str =
+        "Tachyon's TEXFUNC 10: an IMAGEDEF block of RGB texels repeated through space, looked up trilinearly, as Tachyon 0.99b6 does.";
+    const PARAMS: &'static str = concat!(
+        "size: (nx, ny, nz) = required  texels along u, v and w (each 1 or more)\n",
+        "rgb: [u8, ...] = required  3·nx·ny·nz bytes: r, g, b per texel, u fastest, then v, then w\n",
+        "center: (x, y, z) = (0, 0, 0)  Tachyon's CENTER\n",
+        "u: (x, y, z) = (1, 0, 0)  texture u = u·(p - center) + offset.x (Tachyon's UAXIS times SCALE.x)\n",
+        "v: (x, y, z) = (0, 1, 0)  likewise for v (VAXIS times SCALE.y)\n",
+        "w: (x, y, z) = (0, 0, 1)  likewise for w (WAXIS times SCALE.z)\n",
+        "offset: (u, v, w) = (0, 0, 0)  Tachyon's ROTATE"
+    );
+}
+
+impl Texture for TachyonVolumeImage {
+    type Params = VolumeImageParams;
+
+    fn create(p: VolumeImageParams, _ctx: &Context) -> Result<Self, Error> {
+        let size = p.size.map(|n| n as usize);
+        if size.contains(&0) {
+            return Err(invalid(format!(
+                "`size` is {:?}; expected at least 1 texel along each axis",
+                p.size
+            )));
+        }
+        let texels = size.iter().try_fold(1usize, |a, &n| a.checked_mul(n));
+        if texels.and_then(|t| t.checked_mul(3)) != Some(p.rgb.len()) {
+            return Err(invalid(format!(
+                "`rgb` has {} bytes; expected 3 per texel of a {} × {} × {} block",
+                p.rgb.len(),
+                p.size[0],
+                p.size[1],
+                p.size[2]
+            )));
+        }
+        Ok(TachyonVolumeImage {
+            size,
+            rgb: p.rgb,
+            center: finite("center", p.center)?,
+            axes: [finite("u", p.u)?, finite("v", p.v)?, finite("w", p.w)?],
+            offset: finite("offset", p.offset)?,
+        })
+    }
+
+    fn eval(&self, q: &TexQuery) -> [f32; 4] {
+        let d: [f64; 3] = std::array::from_fn(|k| q.p[k] - self.center[k]);
+        // Texture coordinates wrapped into [0, 1), then texel coordinates with the first and
+        // last texel centres at 0 and 1 (as Tachyon's image maps).
+        let at: [f64; 3] = std::array::from_fn(|k| {
+            let a = self.axes[k];
+            let t = a[0] * d[0] + a[1] * d[1] + a[2] * d[2] + self.offset[k];
+            let t = t - t.floor();
+            // NaN (a point at infinity) looks up the first texel.
+            if t.is_finite() {
+                t * (self.size[k] - 1) as f64
+            } else {
+                0.0
+            }
+        });
+        let i: [usize; 3] = std::array::from_fn(|k| (at[k] as usize).min(self.size[k] - 1));
+        let f: [f64; 3] = std::array::from_fn(|k| at[k] - i[k] as f64);
+        let next: [usize; 3] = std::array::from_fn(|k| (i[k] + 1).min(self.size[k] - 1));
+        let [nx, ny, _] = self.size;
+        let texel = |x: usize, y: usize, z: usize| {
+            let o = 3 * ((z * ny + y) * nx + x);
+            [0, 1, 2].map(|c| f64::from(self.rgb[o + c]))
+        };
+        let lerp = |a: [f64; 3], b: [f64; 3], t: f64| [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * t);
+        let plane = |z: usize| {
+            let y0 = lerp(texel(i[0], i[1], z), texel(next[0], i[1], z), f[0]);
+            let y1 = lerp(texel(i[0], next[1], z), texel(next[0], next[1], z), f[0]);
+            lerp(y0, y1, f[1])
+        };
+        let c = lerp(plane(i[2]), plane(next[2]), f[2]);
+        [
+            (c[0] / 255.0) as f32,
+            (c[1] / 255.0) as f32,
+            (c[2] / 255.0) as f32,
+            1.0,
+        ]
     }
 }
 
@@ -588,5 +716,46 @@ mod tests {
         // On the axis: no NaN.
         assert!(at(&t, [0.3, -0.2, 0.5]).iter().all(|c| c.is_finite()));
         assert!(make::<TachyonCylinderChecker>("(odd: (0, -1, 0))").is_err());
+    }
+
+    #[test]
+    fn volume_image_is_trilinear_and_wraps() {
+        // 2 × 1 × 2: red, green on the first slice; blue, white on the second.
+        let t: TachyonVolumeImage =
+            make("(size: (2, 1, 2), rgb: [255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])")
+                .unwrap();
+        let close = |a: [f32; 4], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-6);
+        assert!(close(at(&t, [0.0, 0.0, 0.0]), [1.0, 0.0, 0.0]));
+        assert!(close(at(&t, [0.5, 0.0, 0.0]), [0.5, 0.5, 0.0]));
+        assert!(close(at(&t, [0.25, 0.7, 0.5]), [0.5, 0.25, 0.5]));
+        // u, v and w repeat every unit.
+        assert!(close(
+            at(&t, [-0.75, 3.7, 2.5]),
+            at(&t, [0.25, 0.7, 0.5])[..3].try_into().unwrap()
+        ));
+        // Axes, centre and offset: u = 2·(x − 1) + 0.25.
+        let t: TachyonVolumeImage = make(
+            "(size: (2, 1, 1), rgb: [0, 0, 0, 255, 255, 255], center: (1, 0, 0), u: (2, 0, 0), offset: (0.25, 0, 0))",
+        )
+        .unwrap();
+        assert!(close(at(&t, [1.125, 0.0, 0.0]), [0.5, 0.5, 0.5]));
+        // Points at infinity look up the first texel.
+        assert!(close(at(&t, [f64::INFINITY, 0.0, 0.0]), [0.0, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn volume_image_checks_its_block() {
+        let e = make::<TachyonVolumeImage>("(size: (2, 0, 1), rgb: [])")
+            .err()
+            .unwrap();
+        assert!(e.to_string().contains("at least 1 texel"), "{e}");
+        let e = make::<TachyonVolumeImage>("(size: (2, 1, 1), rgb: [1, 2, 3])")
+            .err()
+            .unwrap();
+        assert!(
+            e.to_string()
+                .contains("`rgb` has 3 bytes; expected 3 per texel of a 2 × 1 × 1 block"),
+            "{e}"
+        );
     }
 }

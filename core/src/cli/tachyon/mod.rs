@@ -250,6 +250,9 @@ fn render_frame(scene: &Scene, plan: &Plan) -> Result<(Framebuffer, Duration), E
             stats.counters.nan_pixels
         ));
     }
+    for w in scene.nan_warnings(&stats.nan_sources) {
+        luxon::error::print_warning(&w);
+    }
     if plan.verbose {
         let c = &stats.counters;
         let secs = seconds(stats.render_time).max(1e-9);

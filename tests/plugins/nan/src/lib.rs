@@ -2,6 +2,7 @@
 //! render: it is counted, reported by `--stats` and its pixel clamped.
 //!
 //! - `nan_texture` (texture): NaN where the hit point has `x < 0`, else `color`.
+//! - `nan_box` (primitive): custom geometry in [-1, 1]³ whose every hit is at a NaN distance.
 //!
 //! | name    | type        | default   | meaning |
 //! |---------|-------------|-----------|---------|
@@ -14,7 +15,9 @@
 #![forbid(unsafe_code)]
 
 use luxon_plugin::abi::TexQuery;
-use luxon_plugin::{finite, Context, Describe, Error, Texture};
+use luxon_plugin::{
+    finite, Aabb, Context, CustomShape, Describe, Error, Geometry, Hit, Primitive, Ray, Texture,
+};
 
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -55,4 +58,51 @@ impl Texture for NanTexture {
     }
 }
 
-luxon_plugin::export!(library: "luxon-test-nan", textures: [NanTexture]);
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoParams {}
+
+pub struct NanBox;
+
+impl Describe for NanBox {
+    const NAME: &'static str = "nan_box";
+    const DESCRIPTION: &'static str = "Test plugin: custom geometry whose hits are at NaN.";
+    const PARAMS: &'static str = "";
+}
+
+impl Primitive for NanBox {
+    type Params = NoParams;
+    fn create(_: NoParams, _: &Context, out: &mut Geometry) -> Result<(), Error> {
+        out.custom(NanShape)
+    }
+}
+
+pub struct NanShape;
+
+impl CustomShape for NanShape {
+    fn count(&self) -> u64 {
+        1
+    }
+    fn bounds(&self, _: u64) -> Aabb {
+        Aabb {
+            min: [-1.0; 3],
+            max: [1.0; 3],
+        }
+    }
+    fn intersect(&self, _: u64, _: &Ray) -> Option<Hit> {
+        Some(Hit {
+            t: f64::NAN,
+            normal: [0.0, 0.0, -1.0],
+            uv: [0.0; 2],
+        })
+    }
+    fn occluded(&self, _: u64, _: &Ray) -> bool {
+        false
+    }
+}
+
+luxon_plugin::export!(
+    library: "luxon-test-nan",
+    primitives: [NanBox],
+    textures: [NanTexture]
+);

@@ -7,12 +7,15 @@
 //! - `panic_texture` (texture): created fine, panics in `eval`.
 //! - `fail_texture` (texture): created fine, `try_eval` fails with a message where the hit
 //!   point has `x < 0` (plugin ABI 2's error sink for `eval`); elsewhere it is grey.
+//! - `panic_writer` (writer, `.panicimg`): writes a 1x1 image (the check before a render),
+//!   panics for anything larger.
 
 #![forbid(unsafe_code)]
 
 use luxon_plugin::abi::TexQuery;
 use luxon_plugin::{
-    Aabb, Context, CustomShape, Describe, Error, Geometry, Hit, Primitive, Ray, Texture,
+    Aabb, Context, CustomShape, Describe, Error, Geometry, Hit, Image, Primitive, Ray, Texture,
+    Writer,
 };
 
 #[derive(serde::Deserialize)]
@@ -112,10 +115,38 @@ impl Texture for FailTexture {
     }
 }
 
+pub struct PanicWriter;
+
+impl Describe for PanicWriter {
+    const NAME: &'static str = "panic_writer";
+    const DESCRIPTION: &'static str = "Test plugin: a writer that panics for images over 1x1.";
+    const PARAMS: &'static str = "";
+}
+
+impl Writer for PanicWriter {
+    const EXTENSIONS: &'static str = "panicimg";
+    type Params = NoParams;
+    fn write(
+        _: NoParams,
+        _: &Context,
+        image: &Image,
+        out: &mut dyn std::io::Write,
+    ) -> Result<(), Error> {
+        if image.width * image.height > 1 {
+            panic!(
+                "deliberate panic writing a {}x{} image",
+                image.width, image.height
+            );
+        }
+        Ok(out.write_all(b"1x1")?)
+    }
+}
+
 luxon_plugin::export!(
     library: "luxon-test-panics",
     primitives: [PanicCreate, PanicIntersect],
     textures: [PanicTexture, FailTexture],
+    writers: [PanicWriter],
 );
 
 #[cfg(test)]
