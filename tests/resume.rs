@@ -200,6 +200,20 @@ fn a_killed_sequence_resumes_to_the_same_frames() {
     assert!(frames(&b) != want);
     let o = finished(render(&scene, &b, &["--force"]));
     assert_eq!(wrote(&o).len(), 100);
+    // The same scene and outputs named from another directory keep the frames.
+    let o = luxon()
+        .current_dir(&dir)
+        .args([
+            "render",
+            "scene.ron",
+            "--frames",
+            "0..99",
+            "-o",
+            "b/f%03d.ppm",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success() && wrote(&o).is_empty(), "{}", stderr(&o));
     // A setting that changes no pixel keeps the frames.
     let o = finished(render(&scene, &b, &["--threads", "2", "--block-size", "5"]));
     assert!(wrote(&o).is_empty(), "{}", stderr(&o));

@@ -5,8 +5,8 @@
 //! The scene hash covers luxon's version and plugin ABI; the text of every scene file the
 //! loader read; the size and modification time of every file a string in those files names
 //! (textures, volumes, meshes: plugins read their own files, so every path-like string that
-//! names an existing file is stamped rather than guessing which ones are read); the path,
-//! size and modification time of each plugin library the scene used; and the render settings
+//! names an existing file is stamped rather than guessing which ones are read); the size and
+//! modification time of each plugin library the scene used; and the render settings
 //! after the command line's overrides, except those proven not to change a pixel (threads,
 //! tile size, decomposition, parallel mode, output I/O). The hash is 64-bit FNV-1a, our own
 //! code: std's hashers are not stable across releases.
@@ -88,7 +88,8 @@ pub fn scene_hash(i: &SceneInputs) -> u64 {
     h.field(env!("CARGO_PKG_VERSION").as_bytes())
         .u64(u64::from(luxon_plugin::abi::ABI_VERSION));
     for f in i.files {
-        h.field(f.path.to_string_lossy().as_bytes()).u64(f.text);
+        // Not the paths: a scene run from another directory (or node) is the same scene.
+        h.u64(f.text);
         let dir = f.path.parent().unwrap_or(Path::new(""));
         for s in &f.strings {
             if let Some(p) = named_file(dir, s) {
@@ -137,9 +138,9 @@ fn named_file(dir: &Path, s: &str) -> Option<PathBuf> {
     std::fs::metadata(&p).ok()?.is_file().then_some(p)
 }
 
-/// Path, size and modification time of `p` (a file that vanished hashes as such).
+/// Size and modification time of `p` (a file that vanished hashes as such); which file it is
+/// follows from the text that names it.
 fn stamp(h: &mut Fnv, p: &Path) {
-    h.field(p.to_string_lossy().as_bytes());
     match std::fs::metadata(p) {
         Ok(m) => {
             let mtime = m
