@@ -160,12 +160,13 @@ fn the_camera_follows_its_keys() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
-/// The P6 files of `dir`, by name.
+/// The P6 files of `dir`, by name (not the hidden directory of frame records).
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
         .unwrap()
+        .map(|e| e.unwrap())
+        .filter(|e| !e.file_name().to_string_lossy().ends_with(".luxon-frames"))
         .map(|e| {
-            let e = e.unwrap();
             (
                 e.file_name().to_string_lossy().to_string(),
                 std::fs::read(e.path()).unwrap(),
@@ -300,6 +301,13 @@ fn command_line_mistakes_are_one_line_errors() {
     assert_eq!(o.status.code(), Some(1));
     assert!(
         stderr(&o).contains("still.ron has no `animation:`; --frames needs one"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&["render", still.to_str().unwrap(), "--force"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("still.ron has no `animation:`; --force needs one"),
         "{}",
         stderr(&o)
     );

@@ -255,8 +255,9 @@ mod with_mpi {
         let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
             let mut v: Vec<_> = std::fs::read_dir(d)
                 .unwrap()
+                .map(|e| e.unwrap())
+                .filter(|e| !e.file_name().to_string_lossy().ends_with(".luxon-frames"))
                 .map(|e| {
-                    let e = e.unwrap();
                     let name = e.file_name().to_string_lossy().to_string();
                     (name, std::fs::read(e.path()).unwrap())
                 })
@@ -282,6 +283,15 @@ mod with_mpi {
             let (o, _) = mpirun(ranks, &args, &[]);
             assert!(o.status.success(), "-np {ranks}: {}", stderr(&o));
             assert!(files(&out) == want, "-np {ranks}: the frames differ");
+            // Run again: every frame is done, none is rendered.
+            let (o, _) = mpirun(ranks, &args, &[]);
+            assert!(o.status.success(), "-np {ranks}: {}", stderr(&o));
+            assert!(
+                stderr(&o).contains("all 3 frames are done already")
+                    && !stderr(&o).contains("luxon: wrote"),
+                "-np {ranks}: {}",
+                stderr(&o)
+            );
         }
         // At frame 1 the camera's `up` passes through zero length.
         let studio = root().join("scenes/include/studio.ron");

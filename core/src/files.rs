@@ -192,6 +192,83 @@ fn lock(_: &File, _: &Path) -> std::io::Result<bool> {
     Ok(true)
 }
 
+/// A claim on one piece of work shared by several processes (a frame of a sequence): an
+/// `flock`ed file that the kernel releases when its process ends, however it ends, so a claim
+/// expires with its owner. The file holds "pid P on HOST" for the messages of the others, and
+/// stays when the claim is dropped (removing it would race with a process opening it).
+pub struct Claim {
+    _file: File,
+}
+
+impl Claim {
+    /// Takes the claim at `path` (creating the file): `None` when a live process holds it.
+    /// A file system without `flock` cannot share work: every claim is then taken.
+    pub fn try_take(path: &Path) -> std::io::Result<Option<Claim>> {
+        // The file is checked to be the one at `path` once locked: if someone replaced it in
+        // between, the lock protects nothing and is taken again.
+        for _ in 0..16 {
+            let mut file = std::fs::OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(path)?;
+            match lock(&file, path) {
+                Ok(true) => {}
+                Ok(false) if held_elsewhere(&file) => return Ok(None),
+                Ok(false) => continue,
+                Err(e) => return Err(e),
+            }
+            let note = format!("pid {} on {}\n", std::process::id(), host_name());
+            file.set_len(0)?;
+            file.write_all(note.as_bytes())?;
+            return Ok(Some(Claim { _file: file }));
+        }
+        Err(std::io::Error::other(
+            "the claim file kept being replaced by another program",
+        ))
+    }
+
+    /// Who holds the claim at `path`, as its owner wrote it ("pid 4411 on node7").
+    pub fn holder(path: &Path) -> Option<String> {
+        let text = std::fs::read_to_string(path).ok()?;
+        let line = text.lines().next()?.trim();
+        (!line.is_empty()).then(|| line.to_string())
+    }
+}
+
+/// Whether another open file holds the lock of `file` (a try that would block).
+#[cfg(unix)]
+fn held_elsewhere(file: &File) -> bool {
+    use std::os::unix::io::AsRawFd;
+    // SAFETY: a valid open descriptor; a lock taken here is dropped with the file.
+    let r = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    r != 0 && std::io::Error::last_os_error().raw_os_error() == Some(libc::EWOULDBLOCK)
+}
+
+#[cfg(not(unix))]
+fn held_elsewhere(_: &File) -> bool {
+    false
+}
+
+/// This machine's name (for messages about other processes).
+#[cfg(unix)]
+pub fn host_name() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: the buffer is writable for its length; the name is NUL-terminated when it fits.
+    let r = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) };
+    if r != 0 {
+        return "this host".into();
+    }
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
+    String::from_utf8_lossy(&buf[..end]).into_owned()
+}
+
+#[cfg(not(unix))]
+pub fn host_name() -> String {
+    "this host".into()
+}
+
 /// Removes the temporary files of dead processes in `dir`: every `*.luxon-tmp` whose lock can be
 /// taken, and the old `.{name}.{pid}.tmp` of `name` whose process is gone. Silent: what cannot be
 /// removed stays.
@@ -319,6 +396,25 @@ mod tests {
         assert!(t.path().exists());
         drop(t);
         assert!(names(&d).is_empty());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_claim_is_held_until_dropped_and_names_its_owner() {
+        let d = dir("claim");
+        let p = d.join("7");
+        let first = Claim::try_take(&p).unwrap().expect("a free claim is taken");
+        // flock locks belong to an open file: a second open is another claimant.
+        assert!(Claim::try_take(&p).unwrap().is_none());
+        let holder = Claim::holder(&p).unwrap();
+        assert!(
+            holder.starts_with(&format!("pid {} on ", std::process::id())),
+            "{holder}"
+        );
+        drop(first);
+        assert!(Claim::try_take(&p).unwrap().is_some());
+        assert!(p.exists(), "the claim file stays");
         std::fs::remove_dir_all(&d).unwrap();
     }
 

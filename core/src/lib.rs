@@ -37,7 +37,7 @@
 //! | geometry | [`geometry`] | primitives and their sets, each with its BVH |
 //! | bvh | [`bvh`] | the wide BVH over boxes |
 //! | camera | [`camera`], [`adaptive`] | camera rays; where a pixel's samples go |
-//! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks, the caller's buffers (targets); PPM bytes; image error measures; files written whole |
+//! | image | [`framebuffer`], [`ppm`], [`metrics`], [`files`] | pixels, spans and chunks, the caller's buffers (targets); PPM bytes; image error measures; files written whole, claims between processes |
 //! | ray | [`ray`] | rays and robust ray spawning |
 //! | memory | [`budget`] | the memory budget: what the input may make Luxon allocate, the machine's limits |
 //! | motion | [`motion`] | keyed values at any time: interpolation, rotations, object transforms |

@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 
 pub mod commit;
 pub mod frames;
+pub mod inputs;
+pub mod manifest;
 pub mod stream;
 
 pub use commit::OutputSet;

@@ -150,6 +150,17 @@ impl Job {
         }
     }
 
+    /// Rank 0's `value`, on every rank (collective).
+    pub fn root_value(&self, value: u64) -> u64 {
+        match self {
+            Job::Local => value,
+            #[cfg(feature = "mpi")]
+            Job::Mpi(c) => c.broadcast_u64(value),
+            #[cfg(not(feature = "mpi"))]
+            Job::Mpi(c) => match *c {},
+        }
+    }
+
     /// Every rank writes its `chunks` of an 8-bit PPM with MPI-IO into the temporary file `tmp`
     /// that rank 0 created (and gives here; other ranks `None`); it is committed with the other
     /// outputs afterwards.

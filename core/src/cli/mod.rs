@@ -7,6 +7,7 @@ pub mod new_plugin;
 pub mod plugins;
 pub mod progress;
 pub mod render;
+pub mod resume;
 pub mod sequence;
 pub mod shading;
 // The signal handlers and their pipe (libc).

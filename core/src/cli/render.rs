@@ -6,6 +6,7 @@ use super::progress::Progress;
 use luxon::budget::{Budget, Use};
 use luxon::cache::{self, Lookup};
 use luxon::framebuffer::Chunk;
+use luxon::output::inputs::SceneFile;
 use luxon::output::stream::{is_ppm8, AsyncOutput};
 use luxon::output::{Output, OutputSet};
 use luxon::plugin::Registry;
@@ -75,12 +76,18 @@ pub struct Overrides {
     #[command(flatten)]
     pub shading: super::shading::ShadingArgs,
     /// Frames of an animated scene to render, A to B inclusive (or one frame K); default:
-    /// the scene's `animation: (frames: ...)`.
+    /// the scene's `animation: (frames: ...)`. Frames done by an earlier run (recorded in
+    /// `.NAME.luxon-frames/` beside the first output) are skipped, and processes started on
+    /// the same outputs share the frames.
     #[arg(long, value_name = "A..B|K", value_parser = super::sequence::parse_frames)]
     pub frames: Option<(u32, u32)>,
     /// Render every Nth frame from the first (with an animated scene).
     #[arg(long, value_name = "N")]
     pub step: Option<u32>,
+    /// Render every frame again, even those a completion record says are done (an animated
+    /// scene; by default a sequence renders only the frames missing or stale).
+    #[arg(long)]
+    pub force: bool,
 }
 
 fn parse_adaptive(s: &str) -> Result<AdaptiveArg, String> {
@@ -101,17 +108,27 @@ const CACHE_MIN_PRIMITIVES: usize = 100_000;
 /// Loads the scene within the memory budget of `--memory` (or the machine's), shared by
 /// `node_ranks` processes; `skeleton`: the non-geometry lines of an NFF file from its geometry
 /// cache.
+/// `read`: the RON scene files read, for the inputs hash of a sequence's frames.
 pub(super) fn load(
     path: &Path,
     o: &Overrides,
     node_ranks: usize,
     skeleton: Option<&str>,
+    read: &mut Vec<SceneFile>,
 ) -> Result<SceneDesc, Error> {
     let mut desc = match skeleton {
         Some(text) => luxon_formats::nff::parse_str(text, path)?.desc,
         None => {
             let options = Budget::for_load(o.memory, node_ranks).load_options();
-            luxon_formats::load_with(path, &options)?
+            let ron = path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+            if ron {
+                let mut source = Recorder { read };
+                luxon_formats::load_ron_with(&mut source, path, &options)?
+            } else {
+                luxon_formats::load_with(path, &options)?
+            }
         }
     };
     o.shading.apply(&mut desc)?;
@@ -182,6 +199,23 @@ pub(super) fn load(
     Ok(desc)
 }
 
+/// Scene files from the disk, each recorded as it is read.
+struct Recorder<'a> {
+    read: &'a mut Vec<SceneFile>,
+}
+
+impl luxon_formats::Source for Recorder<'_> {
+    fn key(&self, path: &Path) -> PathBuf {
+        luxon_formats::DiskSource.key(path)
+    }
+
+    fn read(&mut self, path: &Path, max: u64) -> Result<String, luxon_formats::input::FileError> {
+        let text = luxon_formats::DiskSource.read(path, max)?;
+        self.read.push(SceneFile::new(path, &text));
+        Ok(text)
+    }
+}
+
 /// How rank 0 writes: outputs split between its writer (async or after the render) and MPI-IO,
 /// each with its index in the output set.
 pub(super) struct Plan<'r> {
@@ -235,7 +269,8 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let mut cache = CacheUse::new(path, o);
     let cached = cache.open(path);
     let skeleton = cached.as_ref().map(|c| c.skeleton.as_str());
-    let desc = load(path, o, job.node_ranks(), skeleton);
+    let mut read = Vec::new();
+    let desc = load(path, o, job.node_ranks(), skeleton, &mut read);
     let job = match &desc {
         Ok(d) => job.for_mode(d.render.parallel.mode)?,
         Err(_) => job,
@@ -250,8 +285,8 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     }
     let load_time = t0.elapsed();
     let animated = desc.as_ref().is_ok_and(|d| d.animation.is_some());
-    if animated || o.frames.is_some() || o.step.is_some() {
-        return super::sequence::run(o, desc, &registry, job);
+    if animated || o.frames.is_some() || o.step.is_some() || o.force {
+        return super::sequence::run(o, desc, &read, &registry, job);
     }
     let ready = desc.and_then(|desc| prepare(path, o, desc, cached, &registry, &job, &mut cache));
     let (ready, status) = match ready {
@@ -464,7 +499,7 @@ fn prepare<'r>(
         None => {
             if from_cache {
                 // The cache's view of the scene did not fit: read the source itself.
-                desc = load(path, o, job.node_ranks(), None)?;
+                desc = load(path, o, job.node_ranks(), None, &mut Vec::new())?;
             }
             // Held until the build has taken the imported geometry into the scene's arrays.
             let held = desc.inline.iter().map(InlineGeometry::bytes).sum();

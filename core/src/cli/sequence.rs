@@ -7,16 +7,27 @@
 //! `animation: (frames: ...)`. A frame that fails (a camera that degenerates at that frame, an
 //! unwritable output) is reported at once with its number, the others are rendered, and the
 //! command ends with an error naming the failed frames.
+//!
+//! Sequences resume: a frame whose completion record says it is done for the same inputs is
+//! not rendered again (`--force` renders it anyway), and processes started on the same outputs
+//! share the frames by claiming them ([`super::resume`]).
 
 use super::job::Job;
 use super::render::{plan, print_stats, warn_nan, write_image, Image, Overrides};
+use super::resume::Resume;
 use luxon::budget::Budget;
 use luxon::output::frames::FrameNames;
+use luxon::output::inputs::{absolute, SceneFile, SceneInputs};
+use luxon::output::manifest::Manifest;
 use luxon::plugin::Registry;
 use luxon::{Error, Scene};
 use luxon_formats::SceneDesc;
-use std::path::Path;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// Broadcast by rank 0 when no frame is left.
+const NO_FRAME: u64 = u64::MAX;
 use std::time::{Duration, Instant};
 
 /// `--frames A..B` or `--frames K`.
@@ -44,8 +55,10 @@ fn frame_list(o: &Overrides, desc: &SceneDesc) -> Result<Vec<u32>, Error> {
     let Some(a) = &desc.animation else {
         let flag = if o.frames.is_some() {
             "--frames"
-        } else {
+        } else if o.step.is_some() {
             "--step"
+        } else {
+            "--force"
         };
         return Err(Error::Usage(format!(
             "{} has no `animation:`; {flag} needs one (e.g. `animation: (frames: (0, 47))`)",
@@ -61,14 +74,25 @@ fn frame_list(o: &Overrides, desc: &SceneDesc) -> Result<Vec<u32>, Error> {
     Ok((first..=last).step_by(step as usize).collect())
 }
 
+/// What every rank has before the first frame; rank 0 also the frame records.
+struct Ready {
+    desc: SceneDesc,
+    scene: Scene,
+    frames: Vec<u32>,
+    names: FrameNames,
+    resume: Option<Resume>,
+}
+
 /// Loads nothing (the caller did), builds the scene once (within the memory budget, which
-/// every frame's keyed objects and image are charged to as well) and names the outputs.
+/// every frame's keyed objects and image are charged to as well), names the outputs and, on
+/// rank 0, opens the frame records. `read`: the scene files the load read.
 fn prepare(
     o: &Overrides,
     mut desc: SceneDesc,
+    read: &[SceneFile],
     registry: &Registry,
     job: &Job,
-) -> Result<(SceneDesc, Scene, Vec<u32>, FrameNames), Error> {
+) -> Result<Ready, Error> {
     let frames = frame_list(o, &desc)?;
     let scene_last = desc.animation.as_ref().map_or(0, |a| a.value.last);
     let last = frames.last().copied().unwrap_or(0).max(scene_last);
@@ -77,7 +101,74 @@ fn prepare(
     luxon::output::resolve(&desc.render.outputs, registry)?;
     let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
     let scene = Scene::build_taking_geometry(&mut desc, registry, Arc::new(budget))?;
-    Ok((desc, scene, frames, names))
+    let resume = match job.rank() {
+        0 => {
+            let hash = scene_hash(o, &desc, read, registry, &names, &frames);
+            let about = about(&desc, &frames, hash, o);
+            Some(Resume::start(&names, &frames, hash, o.force, &about)?)
+        }
+        _ => None,
+    };
+    Ok(Ready {
+        desc,
+        scene,
+        frames,
+        names,
+        resume,
+    })
+}
+
+/// The hash of everything the frames are rendered from (see [`luxon::output::inputs`]), after
+/// the build (which looks the plugins up).
+fn scene_hash(
+    o: &Overrides,
+    desc: &SceneDesc,
+    read: &[SceneFile],
+    registry: &Registry,
+    names: &FrameNames,
+    frames: &[u32],
+) -> u64 {
+    let records = names.first().map(|p| absolute(Manifest::beside(p).dir()));
+    let outputs: HashSet<PathBuf> = frames
+        .iter()
+        .flat_map(|&k| names.outputs_for(k))
+        .map(|o| absolute(&o.path))
+        .collect();
+    let skip = |p: &Path| {
+        let p = absolute(p);
+        outputs.contains(&p) || records.as_ref().is_some_and(|r| p.starts_with(r))
+    };
+    let libraries = registry.used_libraries();
+    luxon::output::inputs::scene_hash(&SceneInputs {
+        files: read,
+        render: &desc.render,
+        libraries: libraries.iter().map(|l| l.path.as_path()).collect(),
+        extra: format!("{:?}", o.shading),
+        skip: &skip,
+    })
+}
+
+/// The `manifest` file: what the sequence is, for people.
+fn about(desc: &SceneDesc, frames: &[u32], hash: u64, o: &Overrides) -> String {
+    let r = &desc.render;
+    let outputs: Vec<String> = desc
+        .render
+        .outputs
+        .iter()
+        .map(|o| o.path.display().to_string())
+        .collect();
+    let step = o.step.unwrap_or(1);
+    let range = match (frames.first(), frames.last()) {
+        (Some(a), Some(b)) => format!("{a}..{b} step {step}"),
+        _ => "none".into(),
+    };
+    format!(
+        "luxon-frames 1\nscene {hash:016x}\noutputs {}\nframes {range}\nsettings {}x{}, {} spp\n",
+        outputs.join(" "),
+        r.width,
+        r.height,
+        r.samples
+    )
 }
 
 /// Renders the frames of an animated scene (`desc` is loaded with the command line's
@@ -85,14 +176,15 @@ fn prepare(
 pub fn run(
     o: &Overrides,
     desc: Result<SceneDesc, Error>,
+    read: &[SceneFile],
     registry: &Registry,
     job: Job,
 ) -> Result<(), Error> {
     let t0 = Instant::now();
-    let ready = desc.and_then(|d| prepare(o, d, registry, &job));
+    let ready = desc.and_then(|d| prepare(o, d, read, registry, &job));
     let (ready, status) = match ready {
         Ok(r) => {
-            let threads = job.threads(&r.1);
+            let threads = job.threads(&r.scene);
             (Some(r), Ok(threads))
         }
         Err(e) => (None, Err(e)),
@@ -102,22 +194,59 @@ pub fn run(
         Err(Some(e)) => return Err(e),
         Err(None) => job.exit_quietly(),
     }
-    let Some((desc, mut scene, frames, names)) = ready else {
+    let Some(Ready {
+        desc,
+        mut scene,
+        frames,
+        names,
+        mut resume,
+    }) = ready
+    else {
         return Err(Error::Render("not ready to render".into()));
     };
     let build_time = t0.elapsed();
     let scene_dir = desc.source.parent().unwrap_or(Path::new(".")).to_path_buf();
     let total = frames.len();
+    if let Some(note) = resume.as_ref().and_then(Resume::start_note) {
+        eprintln!("luxon: {note}");
+    }
+    let to_render = total - resume.as_ref().map_or(0, |r| r.done_at_start);
     let mut failed = Vec::new();
     let mut spent = Duration::ZERO;
-    for (n, &k) in frames.iter().enumerate() {
+    let mut done = 0;
+    loop {
+        // Rank 0 picks (and claims) the next frame; every rank renders it.
+        let next = match resume.as_mut().map(Resume::next) {
+            Some(Ok(Some(k))) => u64::from(k),
+            Some(Err((k, e))) => {
+                luxon::error::print_error(&format!("frame {k}: {e}"));
+                failed.push(k);
+                continue;
+            }
+            _ => NO_FRAME,
+        };
+        let next = job.root_value(next);
+        if next == NO_FRAME {
+            break;
+        }
+        let k = next as u32;
         let t = Instant::now();
-        match frame(k, &mut scene, &desc, &names, registry, &job, &scene_dir) {
+        let result = frame(k, &mut scene, &desc, &names, registry, &job, &scene_dir);
+        let result = match (result, resume.as_mut()) {
+            (Ok(Some(image)), Some(r)) => r.finished(k).map(|()| Some(image)),
+            (Err(e), Some(r)) => {
+                r.failed();
+                Err(e)
+            }
+            (result, _) => result,
+        };
+        match result {
             Ok(None) => {}
             Ok(Some(image)) => {
                 spent += t.elapsed();
-                let done = n + 1;
-                let eta = spent.as_secs_f64() / done as f64 * (total - done) as f64;
+                done += 1;
+                let left = resume.as_ref().map_or(0, Resume::left);
+                let eta = spent.as_secs_f64() / done as f64 * left as f64;
                 let written: Vec<String> = image
                     .written
                     .iter()
@@ -135,7 +264,7 @@ pub fn run(
                     );
                 }
                 eprintln!(
-                    "luxon: wrote {} (frame {k}, {done} of {total}, {:.2} s, ETA {eta:.1} s)",
+                    "luxon: wrote {} (frame {k}, {done} of {to_render}, {:.2} s, ETA {eta:.1} s)",
                     written.join(", "),
                     t.elapsed().as_secs_f64(),
                 );
@@ -148,6 +277,9 @@ pub fn run(
                 failed.push(k);
             }
         }
+    }
+    if let Some(note) = resume.as_ref().and_then(Resume::others) {
+        eprintln!("luxon: {note}");
     }
     if failed.is_empty() || job.rank() != 0 {
         return Ok(());

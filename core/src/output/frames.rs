@@ -53,6 +53,11 @@ impl FrameNames {
         Ok(FrameNames { outputs })
     }
 
+    /// The first output's name as given (pattern or plain), which the frame records sit beside.
+    pub fn first(&self) -> Option<&std::path::Path> {
+        self.outputs.first().map(|(o, _)| o.path.as_path())
+    }
+
     /// The outputs of frame `k`.
     pub fn outputs_for(&self, k: u32) -> Vec<OutputDesc> {
         self.outputs

@@ -192,6 +192,8 @@ pub struct Registry {
     /// loaded for its name (see the module comment).
     pub notes: Vec<Problem>,
     by_name: HashMap<String, usize>,
+    /// The libraries whose entries were looked up (by `get` or `writer_for_extension`).
+    used: std::sync::Mutex<std::collections::BTreeSet<usize>>,
 }
 
 /// `HostTable::log`: a plugin's message, as `{plugin}: {message}`, to the library's log sink.
@@ -497,6 +499,7 @@ impl Registry {
                         library: self.libraries[e.library].path.clone(),
                     });
                 }
+                self.mark_used(e);
                 Ok(e)
             }
             None => {
@@ -519,9 +522,26 @@ impl Registry {
     /// The writer claiming a file extension (first in search order).
     pub fn writer_for_extension(&self, ext: &str) -> Option<&Entry> {
         let ext = ext.to_ascii_lowercase();
-        self.entries
+        let e = self
+            .entries
             .iter()
-            .find(|e| e.kind == PluginKind::Writer && e.extensions.contains(&ext))
+            .find(|e| e.kind == PluginKind::Writer && e.extensions.contains(&ext));
+        if let Some(e) = e {
+            self.mark_used(e);
+        }
+        e
+    }
+
+    fn mark_used(&self, e: &Entry) {
+        let mut used = self.used.lock().unwrap_or_else(|e| e.into_inner());
+        used.insert(e.library);
+    }
+
+    /// The libraries a scene used so far (whose entries were looked up), in search order:
+    /// what a frame's completion record stamps.
+    pub fn used_libraries(&self) -> Vec<&Library> {
+        let used = self.used.lock().unwrap_or_else(|e| e.into_inner());
+        used.iter().map(|&i| &self.libraries[i]).collect()
     }
 
     /// Every extension some writer claims.

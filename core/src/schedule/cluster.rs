@@ -186,6 +186,13 @@ impl Cluster {
         std::path::PathBuf::from(std::ffi::OsStr::from_bytes(&bytes))
     }
 
+    /// Collective: rank 0's `value`, on every rank.
+    pub fn broadcast_u64(&self, value: u64) -> u64 {
+        let mut v = value;
+        self.world.process_at_rank(0).broadcast_into(&mut v);
+        v
+    }
+
     pub fn barrier(&self) {
         self.world.barrier();
     }
