@@ -11,6 +11,8 @@
 //! - The loader reads from an in-memory source that holds only the fragment: `include` fails.
 //! - A fragment is one value: text that closes the wrapper and adds other parts of a scene
 //!   (`(...), lights: [...]`) is refused.
+//! - Render settings refuse `width`, `height`, `outputs` and `parallel`: an embedded scene's
+//!   target and renderer decide them.
 //! - A material's texture names are not looked up: the scene that holds the material defines
 //!   its textures (so fragments are read by the loader's reading stage, before the scene-wide
 //!   checks of names).
@@ -18,11 +20,15 @@
 use std::path::Path;
 
 use crate::convert::Part;
-use crate::desc::{AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, Origin};
+use crate::desc::{
+    AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, Origin, RenderDesc,
+};
 use crate::error::SceneError;
 use crate::includes::resolve;
 use crate::input::{file_error, LoadOptions, MemorySource, Source};
-use crate::print;
+use crate::print::{self, NOT_RENDER_SETTINGS};
+use crate::scanner::scan;
+use crate::spans::SourceMap;
 
 /// A kind of fragment: its name in messages and the scene text around it.
 struct Kind {
@@ -55,6 +61,11 @@ const FOG: Kind = Kind {
 const AMBIENT_OCCLUSION: Kind = Kind {
     name: "ambient_occlusion",
     before: "Scene(ambient_occlusion: ",
+    after: ")",
+};
+const RENDER_SETTINGS: Kind = Kind {
+    name: "render_settings",
+    before: "Scene(render: ",
     after: ")",
 };
 const CLIP_PLANES: Kind = Kind {
@@ -141,6 +152,29 @@ pub fn clip_planes(text: &str) -> Result<Vec<ClipPlaneDesc>, SceneError> {
     }
 }
 
+/// Render settings: `(samples: 4, max_depth: 8, adaptive: (threshold: 0.05))`. An embedded
+/// scene's target and renderer decide `width`, `height`, `outputs` and `parallel`: they are
+/// refused (the result holds their defaults).
+pub fn render_settings(text: &str) -> Result<RenderDesc, SceneError> {
+    let (mut part, at) = read(&RENDER_SETTINGS, text)?;
+    let render = part.render.take();
+    // `outputs` are kept apart from the rest of `render` (refused below).
+    part.outputs.clear();
+    only(&RENDER_SETTINGS, part, at.clone())?;
+    // The text is valid RON (it was read): where it writes a refused field, in its own columns.
+    let root = scan(text).map_err(|e| SceneError::at(at.clone(), e.message))?;
+    let src = SourceMap::new(at.file.to_path_buf(), text.to_string());
+    for (name, why) in NOT_RENDER_SETTINGS {
+        if let Some(node) = root.raw_field(name) {
+            return Err(SceneError::at(
+                src.origin(node.start),
+                format!("`{name}` is not a render setting of an embedded scene; {why}"),
+            ));
+        }
+    }
+    render.ok_or_else(|| missing(&RENDER_SETTINGS, at))
+}
+
 /// Checks a camera as [`camera`] checks its text: `Err` holds the message (without a
 /// position, which would point into the printed text).
 pub fn check_camera(c: &CameraDesc) -> Result<(), String> {
@@ -165,6 +199,12 @@ pub fn check_fog(f: &FogDesc) -> Result<(), String> {
 /// Checks ambient occlusion as [`ambient_occlusion`] checks its text.
 pub fn check_ambient_occlusion(a: &AoDesc) -> Result<(), String> {
     checked(ambient_occlusion(&print::ambient_occlusion(a)))
+}
+
+/// Checks render settings as [`render_settings`] checks their text (the fields it refuses are
+/// not printed, so not checked).
+pub fn check_render_settings(r: &RenderDesc) -> Result<(), String> {
+    checked(render_settings(&print::render_settings(r)))
 }
 
 /// Checks clip planes as [`clip_planes`] checks their text.

@@ -7,7 +7,11 @@
 //! The text is `luxon convert`'s (`ron_text`): a scene and its fragments are written by the
 //! same code.
 
-use crate::desc::{AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc};
+use std::path::Path;
+
+use crate::desc::{
+    AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, RenderDesc,
+};
 use crate::ron_text;
 
 /// `(position: (..), look_at: (..), up: (..), fov: ..)`, on one line.
@@ -39,4 +43,30 @@ pub fn ambient_occlusion(a: &AoDesc) -> String {
 /// A clip group's planes: `[(point: (..), normal: (..)), ...]`.
 pub fn clip_planes(planes: &[ClipPlaneDesc]) -> String {
     ron_text::clip_planes(planes)
+}
+
+/// The fields of a render block that an embedded scene does not take: the caller's target and
+/// renderer decide them. With what decides each (the end of `fragment`'s message).
+pub(crate) const NOT_RENDER_SETTINGS: &[(&str, &str)] = &[
+    ("width", "the target's size decides it"),
+    ("height", "the target's size decides it"),
+    (
+        "outputs",
+        "write images with write_image (luxon_write_image)",
+    ),
+    (
+        "parallel",
+        "the renderer's options decide it (its threads and communicator)",
+    ),
+];
+
+/// The fields of a render block that an embedded scene takes (all but
+/// [`NOT_RENDER_SETTINGS`]): `(samples: .., max_depth: .., ...)`.
+pub fn render_settings(r: &RenderDesc) -> String {
+    let fields: Vec<String> = ron_text::render_fields(r, Path::new(""), true)
+        .into_iter()
+        .filter(|(name, _)| NOT_RENDER_SETTINGS.iter().all(|(not, _)| not != name))
+        .map(|(_, field)| field)
+        .collect();
+    format!("({})", fields.join(", "))
 }

@@ -900,6 +900,20 @@ fn write_keyed(w: &mut Vec<u8>, map: &str, entries: Vec<(&String, Vec<String>)>)
 
 /// `clock`: whether to write `frame` and `time` (an animated scene takes neither).
 fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
+    w.extend_from_slice(b"    render: (\n");
+    for (_, field) in render_fields(r, base, clock) {
+        let _ = writeln!(w, "        {field},");
+    }
+    w.extend_from_slice(b"    ),\n");
+}
+
+/// The render settings' fields, each `(name, "name: value")` (a scene writes them a line
+/// each); `clock`: with `frame` and `time`; output paths relative to `base`.
+pub(crate) fn render_fields(
+    r: &RenderDesc,
+    base: &Path,
+    clock: bool,
+) -> Vec<(&'static str, String)> {
     let RenderDesc {
         width,
         height,
@@ -919,26 +933,27 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
         memory,
         texture_cache,
     } = r;
-    let _ = writeln!(w, "    render: (");
-    let _ = writeln!(w, "        width: {width},\n        height: {height},");
-    let _ = writeln!(
-        w,
-        "        samples: {samples},\n        max_depth: {max_depth},\n        min_weight: {},",
-        num(*min_weight)
-    );
+    let mut f = vec![
+        ("width", format!("width: {width}")),
+        ("height", format!("height: {height}")),
+        ("samples", format!("samples: {samples}")),
+        ("max_depth", format!("max_depth: {max_depth}")),
+        ("min_weight", format!("min_weight: {}", num(*min_weight))),
+    ];
     if clock {
-        let _ = writeln!(w, "        frame: {frame},\n        time: {},", num(*time));
+        f.push(("frame", format!("frame: {frame}")));
+        f.push(("time", format!("time: {}", num(*time))));
     }
     if !outputs.is_empty() {
-        w.extend_from_slice(b"        outputs: [\n");
+        let mut list = String::from("outputs: [\n");
         for o in outputs {
-            let _ = write!(w, "            (path: {}", string(&relative(&o.path, base)));
+            list += &format!("            (path: {}", string(&relative(&o.path, base)));
             if let Some(p) = &o.plugin {
-                let _ = write!(w, ", plugin: {}", string(&p.value));
+                list += &format!(", plugin: {}", string(&p.value));
             }
-            let _ = writeln!(w, ", params: {}),", o.params);
+            list += &format!(", params: {}),\n", o.params);
         }
-        w.extend_from_slice(b"        ],\n");
+        f.push(("outputs", list + "        ]"));
     }
     let ParallelDesc {
         mode,
@@ -964,11 +979,13 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
         OutputIo::MpiIo => "MpiIo",
     };
     let threads = threads.map_or(String::new(), |t| format!(" threads: {t},"));
-    let _ = writeln!(
-        w,
-        "        parallel: (mode: {mode},{threads} decomposition: {decomposition}, tile_size: \
-         {tile_size}, io: {io}),"
-    );
+    f.push((
+        "parallel",
+        format!(
+            "parallel: (mode: {mode},{threads} decomposition: {decomposition}, tile_size: \
+             {tile_size}, io: {io})"
+        ),
+    ));
     let TransparencyDesc {
         mode,
         angle: transparency_angle,
@@ -993,43 +1010,49 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
         TransparentShadows::Untinted => "Untinted",
         TransparentShadows::Off => "Off",
     };
-    let _ = writeln!(
-        w,
-        "        transparency: (mode: {mode}, angle: {}{max}, beyond_max: {beyond_max}, shadows: \
-         {shadows}, scale_reflection: {scale_reflection}),",
-        angle(*transparency_angle)
-    );
+    f.push((
+        "transparency",
+        format!(
+            "transparency: (mode: {mode}, angle: {}{max}, beyond_max: {beyond_max}, shadows: \
+             {shadows}, scale_reflection: {scale_reflection})",
+            angle(*transparency_angle)
+        ),
+    ));
     let TachyonDesc {
         light_threshold,
         plain_highlights,
         depth_limit_background,
     } = tachyon;
-    let _ = writeln!(
-        w,
-        "        light_scale: {},\n        tachyon: (light_threshold: {light_threshold}, \
-         plain_highlights: {plain_highlights}, depth_limit_background: {depth_limit_background}),",
-        num(*light_scale)
-    );
-    let _ = writeln!(
-        w,
-        "        volume_step: {},\n        volume_skip: {volume_skip},",
-        num(*volume_step)
-    );
+    f.push(("light_scale", format!("light_scale: {}", num(*light_scale))));
+    f.push((
+        "tachyon",
+        format!(
+            "tachyon: (light_threshold: {light_threshold}, plain_highlights: \
+             {plain_highlights}, depth_limit_background: {depth_limit_background})"
+        ),
+    ));
+    f.push(("volume_step", format!("volume_step: {}", num(*volume_step))));
+    f.push(("volume_skip", format!("volume_skip: {volume_skip}")));
     if let Some(a) = adaptive {
-        let _ = writeln!(
-            w,
-            "        adaptive: (threshold: {}, max_depth: {}),",
-            num(a.threshold),
-            a.max_depth
-        );
+        f.push((
+            "adaptive",
+            format!(
+                "adaptive: (threshold: {}, max_depth: {})",
+                num(a.threshold),
+                a.max_depth
+            ),
+        ));
     }
     if let Some(m) = memory {
-        let _ = writeln!(w, "        memory: \"{m}\",");
+        f.push(("memory", format!("memory: \"{m}\"")));
     }
     if let Some(n) = texture_cache {
-        let _ = writeln!(w, "        texture_cache: \"{}\",", MemorySize::Bytes(*n));
+        f.push((
+            "texture_cache",
+            format!("texture_cache: \"{}\"", MemorySize::Bytes(*n)),
+        ));
     }
-    w.extend_from_slice(b"    ),\n");
+    f
 }
 
 /// `s` with line breaks (and other control characters) as spaces: it must stay in its `//`

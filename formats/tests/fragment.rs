@@ -1,7 +1,7 @@
 //! Scene parts read from RON fragments (`fragment`) and printed as fragments (`print`): each
 //! kind's good case, its errors at the fragment's own `<kind>:line:col`, and the round trip
-//! of every camera, light, material, fog, ambient occlusion and clip group of the shipped
-//! scenes.
+//! of every camera, light, material, fog, ambient occlusion, clip group and render block of
+//! the shipped scenes.
 
 use std::path::{Path, PathBuf};
 
@@ -198,6 +198,42 @@ fn fog_ambient_occlusion_and_clip_planes_read_with_their_errors() {
 }
 
 #[test]
+fn render_settings_read_without_what_the_target_and_renderer_decide() {
+    let r = fragment::render_settings("(samples: 4, max_depth: 8, adaptive: (threshold: 0.05))")
+        .unwrap();
+    assert_eq!((r.samples, r.max_depth), (4, 8));
+    assert_eq!(r.adaptive.map(|a| a.threshold), Some(0.05));
+    let e = error(fragment::render_settings("(samples: 4,\n width: 640)"));
+    is_at(
+        &e,
+        "<render_settings>:2:9",
+        "`width` is not a render setting of an embedded scene; the target's size decides it",
+    );
+    let e = error(fragment::render_settings("(outputs: [(path: \"a.png\")])"));
+    is_at(
+        &e,
+        "<render_settings>:1:11",
+        "`outputs` is not a render setting of an embedded scene; write images with write_image",
+    );
+    let e = error(fragment::render_settings("(parallel: (threads: 2))"));
+    is_at(
+        &e,
+        "<render_settings>:1:12",
+        "`parallel` is not a render setting",
+    );
+    let e = error(fragment::render_settings("(samples: -2)"));
+    is_at(&e, "<render_settings>:1:11", "`samples` is -2");
+    let e = error(fragment::render_settings("(sampels: 2)"));
+    is_at(&e, "<render_settings>:1:2", "did you mean `samples`?");
+    let m = fragment::check_render_settings(&RenderDesc {
+        samples: 0,
+        ..RenderDesc::default()
+    })
+    .unwrap_err();
+    assert!(m.starts_with("`samples` is 0"), "{m}");
+}
+
+#[test]
 fn typed_values_obey_the_fragments_rules() {
     let good = fragment::camera(CAMERA).unwrap();
     assert_eq!(fragment::check_camera(&good), Ok(()));
@@ -330,6 +366,18 @@ fn every_part_of_every_shipped_scene_prints_and_reads_back() {
             assert_eq!(back, planes.value, "{name}");
             others += 1;
         }
+        let r = &scene.render;
+        let text = print::render_settings(r);
+        let back = fragment::render_settings(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // What the embedded scene's target and renderer decide is not printed.
+        let expected = RenderDesc {
+            width: back.width,
+            height: back.height,
+            outputs: back.outputs.clone(),
+            parallel: back.parallel.clone(),
+            ..r.clone()
+        };
+        assert_eq!(back, expected, "{name}: {text}");
     }
     // The scenes hold each kind (so the loop above checked something of each).
     assert!(
