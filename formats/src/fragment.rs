@@ -6,15 +6,19 @@
 //! in a scene file. [`crate::print`] writes fragments; `check_*` print a typed value and read
 //! it back, so typed values obey the same rules as text.
 //!
+//! Kinds: [`camera`], [`light`], [`material`], [`fog`], [`ambient_occlusion`],
+//! [`render_settings`], [`clip_planes`], [`volume_render`].
+//!
 //! - The file name in messages is the kind in angle brackets, and columns on the fragment's
-//!   first line are its own: `<light>:1:23: unknown field `positon`, did you mean `position`?`.
+//!   first line are its own: ``<light>:1:7: unknown field `positon` in `Point`; did you mean
+//!   `position`? ...``.
 //! - The loader reads from an in-memory source that holds only the fragment: `include` fails.
 //! - A fragment is one value: text that closes the wrapper and adds other parts of a scene
 //!   (`(...), lights: [...]`) is refused.
 //! - Render settings refuse `width`, `height`, `outputs` and `parallel`: an embedded scene's
 //!   target and renderer decide them.
-//! - A material's texture names are not looked up: the scene that holds the material defines
-//!   its textures (so fragments are read by the loader's reading stage, before the scene-wide
+//! - A material's texture names and a volume's clip group are not looked up: the scene that
+//!   holds them defines those names (so fragments are read by the loader's reading stage, before the scene-wide
 //!   checks of names).
 
 use std::path::Path;
@@ -22,6 +26,7 @@ use std::path::Path;
 use crate::convert::Part;
 use crate::desc::{
     AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, Origin, RenderDesc,
+    VolumeRenderDesc,
 };
 use crate::error::SceneError;
 use crate::includes::resolve;
@@ -67,6 +72,12 @@ const RENDER_SETTINGS: Kind = Kind {
     name: "render_settings",
     before: "Scene(render: ",
     after: ")",
+};
+const VOLUME_RENDER: Kind = Kind {
+    name: "volume_render",
+    // The plugin is not loaded here: the reading stage takes any name.
+    before: "Scene(volumes: [(plugin: \"volume\", params: (), render: ",
+    after: ")])",
 };
 const CLIP_PLANES: Kind = Kind {
     name: "clip_planes",
@@ -175,6 +186,23 @@ pub fn render_settings(text: &str) -> Result<RenderDesc, SceneError> {
     render.ok_or_else(|| missing(&RENDER_SETTINGS, at))
 }
 
+/// How a volume is drawn: `(transfer: (preset: "viridis"), step: 0.5)`. A clip group name is
+/// taken as written (the scene that holds the volume defines its groups).
+pub fn volume_render(text: &str) -> Result<VolumeRenderDesc, SceneError> {
+    let (mut part, at) = read(&VOLUME_RENDER, text)?;
+    let mut volumes = std::mem::take(&mut part.volumes);
+    only(&VOLUME_RENDER, part, at.clone())?;
+    let render = match (volumes.pop(), volumes.is_empty()) {
+        (Some(v), true) => v.value.render,
+        _ => None,
+    };
+    let mut r = render.ok_or_else(|| missing(&VOLUME_RENDER, at))?.value;
+    if let Some(clip) = &mut r.clip {
+        shift(&mut clip.at, &VOLUME_RENDER);
+    }
+    Ok(r)
+}
+
 /// Checks a camera as [`camera`] checks its text: `Err` holds the message (without a
 /// position, which would point into the printed text).
 pub fn check_camera(c: &CameraDesc) -> Result<(), String> {
@@ -205,6 +233,11 @@ pub fn check_ambient_occlusion(a: &AoDesc) -> Result<(), String> {
 /// not printed, so not checked).
 pub fn check_render_settings(r: &RenderDesc) -> Result<(), String> {
     checked(render_settings(&print::render_settings(r)))
+}
+
+/// Checks a volume's render block as [`volume_render`] checks its text.
+pub fn check_volume_render(r: &VolumeRenderDesc) -> Result<(), String> {
+    checked(volume_render(&print::volume_render(r)))
 }
 
 /// Checks clip planes as [`clip_planes`] checks their text.

@@ -7,7 +7,7 @@
 //! generates the SPD scenes; [`geometry`] holds the inline arrays importers hand the core.
 //! [`fragment`] reads one part of a scene (a camera, a light, a material...) from a RON
 //! fragment, by the scene loader's own rules, and checks typed values by the same rules;
-//! [`print`] writes those parts as fragments (with `luxon convert`'s writer, `to_ron`).
+//! [`print`](mod@print) writes those parts as fragments (with `luxon convert`'s writer, `to_ron`).
 //!
 //! Modules import only modules of lower layers (bottom first; `tests/layers.rs` keeps this):
 //!

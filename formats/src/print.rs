@@ -11,6 +11,7 @@ use std::path::Path;
 
 use crate::desc::{
     AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, RenderDesc,
+    VolumeRenderDesc,
 };
 use crate::ron_text;
 
@@ -45,6 +46,11 @@ pub fn clip_planes(planes: &[ClipPlaneDesc]) -> String {
     ron_text::clip_planes(planes)
 }
 
+/// A volume's render block: `(transfer: (preset: "..."), step: .., ...)`.
+pub fn volume_render(r: &VolumeRenderDesc) -> String {
+    ron_text::volume_render(r)
+}
+
 /// The fields of a render block that an embedded scene does not take: the caller's target and
 /// renderer decide them. With what decides each (the end of `fragment`'s message).
 pub(crate) const NOT_RENDER_SETTINGS: &[(&str, &str)] = &[
@@ -60,8 +66,8 @@ pub(crate) const NOT_RENDER_SETTINGS: &[(&str, &str)] = &[
     ),
 ];
 
-/// The fields of a render block that an embedded scene takes (all but
-/// [`NOT_RENDER_SETTINGS`]): `(samples: .., max_depth: .., ...)`.
+/// The fields of a render block that an embedded scene takes (all but `width`, `height`,
+/// `outputs` and `parallel`): `(samples: .., max_depth: .., ...)`.
 pub fn render_settings(r: &RenderDesc) -> String {
     let fields: Vec<String> = ron_text::render_fields(r, Path::new(""), true)
         .into_iter()

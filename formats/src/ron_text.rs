@@ -693,67 +693,72 @@ fn volume(v: &VolumeDescEntry) -> String {
         s += &format!(", name: {}", string(&n.value));
     }
     if let Some(r) = render {
-        let VolumeRenderDesc {
-            transfer,
-            step,
-            interpolation,
-            shading,
-            clip,
-            bounds,
-        } = &r.value;
-        let TransferDesc {
-            preset,
-            points,
-            range,
-            opacity,
-        } = transfer;
-        // A preset's points come back from its name.
-        let mut t = match preset {
-            Some(p) => format!("preset: {}", string(p)),
-            None => {
-                let points: Vec<String> = points
-                    .iter()
-                    .map(|p| {
-                        format!(
-                            "(x: {}, color: {}, opacity: {})",
-                            num(p.x),
-                            v3(&p.color),
-                            num(p.opacity)
-                        )
-                    })
-                    .collect();
-                format!("points: [{}]", points.join(", "))
-            }
-        };
-        if let Some([a, b]) = range {
-            t += &format!(", range: ({}, {})", num(*a), num(*b));
+        s += &format!(", render: {}", volume_render(&r.value));
+    }
+    s + ")"
+}
+
+/// A volume's render block, `(transfer: (...), ...)`.
+pub(crate) fn volume_render(r: &VolumeRenderDesc) -> String {
+    let VolumeRenderDesc {
+        transfer,
+        step,
+        interpolation,
+        shading,
+        clip,
+        bounds,
+    } = r;
+    let TransferDesc {
+        preset,
+        points,
+        range,
+        opacity,
+    } = transfer;
+    // A preset's points come back from its name.
+    let mut t = match preset {
+        Some(p) => format!("preset: {}", string(p)),
+        None => {
+            let points: Vec<String> = points
+                .iter()
+                .map(|p| {
+                    format!(
+                        "(x: {}, color: {}, opacity: {})",
+                        num(p.x),
+                        v3(&p.color),
+                        num(p.opacity)
+                    )
+                })
+                .collect();
+            format!("points: [{}]", points.join(", "))
         }
-        t += &format!(", opacity: {}", num(*opacity));
-        s += &format!(", render: (transfer: ({t})");
-        if let Some(step) = step {
-            s += &format!(", step: {}", num(*step));
-        }
-        s += match interpolation {
-            Interpolation::Nearest => ", interpolation: Nearest",
-            Interpolation::Trilinear => ", interpolation: Trilinear",
-        };
-        if let Some(sh) = shading {
-            s += &format!(
-                ", shading: (ambient: {}, diffuse: {}, specular: {}, shininess: {}, shadows: {})",
-                num(sh.ambient),
-                num(sh.diffuse),
-                num(sh.specular),
-                num(sh.shininess),
-                sh.shadows
-            );
-        }
-        if let Some(c) = clip {
-            s += &format!(", clip: {}", string(&c.value));
-        }
-        if let Some((lo, hi)) = bounds {
-            s += &format!(", bounds: (min: {}, max: {})", v3(lo), v3(hi));
-        }
-        s += ")";
+    };
+    if let Some([a, b]) = range {
+        t += &format!(", range: ({}, {})", num(*a), num(*b));
+    }
+    t += &format!(", opacity: {}", num(*opacity));
+    let mut s = format!("(transfer: ({t})");
+    if let Some(step) = step {
+        s += &format!(", step: {}", num(*step));
+    }
+    s += match interpolation {
+        Interpolation::Nearest => ", interpolation: Nearest",
+        Interpolation::Trilinear => ", interpolation: Trilinear",
+    };
+    if let Some(sh) = shading {
+        s += &format!(
+            ", shading: (ambient: {}, diffuse: {}, specular: {}, shininess: {}, shadows: {})",
+            num(sh.ambient),
+            num(sh.diffuse),
+            num(sh.specular),
+            num(sh.shininess),
+            sh.shadows
+        );
+    }
+    if let Some(c) = clip {
+        s += &format!(", clip: {}", string(&c.value));
+    }
+    if let Some((lo, hi)) = bounds {
+        s += &format!(", bounds: (min: {}, max: {})", v3(lo), v3(hi));
     }
     s + ")"
 }

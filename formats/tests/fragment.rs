@@ -234,6 +234,33 @@ fn render_settings_read_without_what_the_target_and_renderer_decide() {
 }
 
 #[test]
+fn a_volume_render_block_reads_with_its_errors() {
+    let r =
+        fragment::volume_render("(transfer: (preset: \"hot\"), step: 0.5, clip: \"cut\")").unwrap();
+    assert_eq!(r.step, Some(0.5));
+    // The clip group is the holding scene's to define; its position is in the fragment.
+    assert_eq!(r.clip.unwrap().at.to_string(), "<volume_render>:1:46");
+    let e = error(fragment::volume_render(
+        "(transfer: (preset: \"hot\"), stepp: 0.5)",
+    ));
+    is_at(&e, "<volume_render>:1:29", "did you mean `step`?");
+    let e = error(fragment::volume_render(
+        "(transfer: (preset: \"hot\"), step: NaN)",
+    ));
+    is_at(&e, "<volume_render>:1:35", "NaN is not allowed here");
+    let e = error(fragment::volume_render(
+        "(transfer: (preset: \"hot\"), step: -1.0)",
+    ));
+    is_at(&e, "<volume_render>:1:35", "`step` is -1.0");
+    let e = error(fragment::volume_render("(transfer: (preset: \"hott\"))"));
+    is_at(
+        &e,
+        "<volume_render>:1:21",
+        "unknown transfer-function preset `hott`; did you mean `hot`?",
+    );
+}
+
+#[test]
 fn typed_values_obey_the_fragments_rules() {
     let good = fragment::camera(CAMERA).unwrap();
     assert_eq!(fragment::check_camera(&good), Ok(()));
@@ -364,6 +391,18 @@ fn every_part_of_every_shipped_scene_prints_and_reads_back() {
         for (_, planes) in &scene.clip_groups {
             let back = fragment::clip_planes(&print::clip_planes(&planes.value)).unwrap();
             assert_eq!(back, planes.value, "{name}");
+            others += 1;
+        }
+        for v in &scene.volumes {
+            let Some(r) = &v.value.render else { continue };
+            let text = print::volume_render(&r.value);
+            let mut back = fragment::volume_render(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(fragment::check_volume_render(&back), Ok(()), "{name}");
+            back.clip = back.clip.map(|c| Spanned {
+                value: c.value,
+                at: r.value.clip.clone().unwrap().at,
+            });
+            assert_eq!(back, r.value, "{name}: {text}");
             others += 1;
         }
         let r = &scene.render;
