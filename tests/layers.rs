@@ -40,7 +40,7 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("leaves", &["error", "geometry", "spans", "raw", "pattern"]),
     ("description", &["desc"]),
     ("text", &["ron_text"]),
-    ("input", &["input"]),
+    ("input", &["input", "print"]),
     ("scanner", &["scanner"]),
     ("checks", &["validate", "ron_error"]),
     (
@@ -50,7 +50,7 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("importers", &["nff", "obj", "tachyon"]),
     ("includes", &["includes"]),
     ("formats", &["ron_scene", "spd"]),
-    ("front door", &["load"]),
+    ("front door", &["load", "fragment"]),
 ];
 
 fn assert_layered(crate_dir: &str, layers: &[(&str, &[&str])]) {

@@ -5,6 +5,9 @@
 //! [`load`] reads any supported file, [`load_ron_str`] RON text; both give a [`SceneDesc`]
 //! (module [`desc`]) or a [`SceneError`]. The importers are [`nff`], [`obj`] and [`tachyon`]; [`spd`]
 //! generates the SPD scenes; [`geometry`] holds the inline arrays importers hand the core.
+//! [`fragment`] reads one part of a scene (a camera, a light, a material...) from a RON
+//! fragment, by the scene loader's own rules, and checks typed values by the same rules;
+//! [`print`](mod@print) writes those parts as fragments (with `luxon convert`'s writer, `to_ron`).
 //!
 //! Modules import only modules of lower layers (bottom first; `tests/layers.rs` keeps this):
 //!
@@ -14,14 +17,14 @@
 //! | leaves      | `error`, `geometry`, `spans`, `raw`, `pattern`   |
 //! | description | `desc`                                           |
 //! | text        | `ron_text`                                       |
-//! | input       | `input`                                          |
+//! | input       | `input`, `print`                                 |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
 //! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation` |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
 //! | includes    | `includes`                                       |
 //! | formats     | `ron_scene`, `spd`                               |
-//! | front door  | `load`                                           |
+//! | front door  | `load`, `fragment`                               |
 
 #![forbid(unsafe_code)]
 
@@ -31,6 +34,7 @@ mod convert;
 pub mod desc;
 mod effects;
 mod error;
+pub mod fragment;
 pub mod geometry;
 mod includes;
 pub mod input;
@@ -39,6 +43,7 @@ pub mod nff;
 pub mod obj;
 mod origin;
 mod pattern;
+pub mod print;
 mod raw;
 mod ron_error;
 mod ron_scene;

@@ -283,51 +283,15 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     if !lights.is_empty() {
         w.extend_from_slice(b"    lights: [\n");
         for (i, l) in lights.iter().enumerate() {
-            let _ = writeln!(w, "        {},", light(&l.value, light_name(i)));
+            let _ = writeln!(w, "        {},", named_light(&l.value, light_name(i)));
         }
         w.extend_from_slice(b"    ],\n");
     }
     if let Some(f) = fog {
-        let mode = match f.mode {
-            FogMode::Linear { start, end } => {
-                format!("Linear(start: {}, end: {})", num(start), num(end))
-            }
-            FogMode::Exp { density, start } => {
-                format!("Exp(density: {}, start: {})", num(density), num(start))
-            }
-            FogMode::Exp2 { density, start } => {
-                format!("Exp2(density: {}, start: {})", num(density), num(start))
-            }
-        };
-        let _ = writeln!(
-            w,
-            "    fog: (mode: {mode}, color: {}, planar: {}, every_ray: {}, misses: {}),",
-            v3(&f.color),
-            f.planar,
-            f.every_ray,
-            f.misses
-        );
+        let _ = writeln!(w, "    fog: {},", fog_text(f));
     }
     if let Some(a) = ambient_occlusion {
-        let AoDesc {
-            samples,
-            max_distance,
-            color,
-            intensity,
-            direct,
-        } = a;
-        let distance = match max_distance.is_finite() {
-            true => format!(" distance: {},", num(*max_distance)),
-            false => String::new(),
-        };
-        let _ = writeln!(
-            w,
-            "    ambient_occlusion: (samples: {samples},{distance} color: {}, intensity: {}, \
-             direct: {}),",
-            v3(color),
-            num(*intensity),
-            num(*direct)
-        );
+        let _ = writeln!(w, "    ambient_occlusion: {},", ambient_occlusion_text(a));
     }
     if !textures.is_empty() {
         w.extend_from_slice(b"    textures: {\n");
@@ -352,12 +316,12 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     if !clip_groups.is_empty() {
         w.extend_from_slice(b"    clip_groups: {\n");
         for (name, planes) in clip_groups {
-            let planes: Vec<String> = planes
-                .value
-                .iter()
-                .map(|p| format!("(point: {}, normal: {})", v3(&p.point), v3(&p.normal)))
-                .collect();
-            let _ = writeln!(w, "        {}: [{}],", string(name), planes.join(", "));
+            let _ = writeln!(
+                w,
+                "        {}: {},",
+                string(name),
+                clip_planes(&planes.value)
+            );
         }
         w.extend_from_slice(b"    },\n");
     }
@@ -403,6 +367,16 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
 }
 
 fn write_camera(w: &mut Vec<u8>, c: &CameraDesc) {
+    w.extend_from_slice(b"    camera: (\n");
+    for field in camera_fields(c) {
+        let _ = writeln!(w, "        {field},");
+    }
+    w.extend_from_slice(b"    ),\n");
+}
+
+/// The camera's fields, `name: value` each (the scene writes them a line each, a fragment on
+/// one line).
+pub(crate) fn camera_fields(c: &CameraDesc) -> Vec<String> {
     let CameraDesc {
         position,
         look_at,
@@ -413,71 +387,111 @@ fn write_camera(w: &mut Vec<u8>, c: &CameraDesc) {
         depth_of_field,
         stereo,
     } = c;
-    let _ = writeln!(w, "    camera: (");
-    let _ = writeln!(w, "        position: {},", v3(position));
-    let _ = writeln!(w, "        look_at: {},", v3(look_at));
-    let _ = writeln!(w, "        up: {},", v3(up));
+    let mut f = vec![
+        format!("position: {}", v3(position)),
+        format!("look_at: {}", v3(look_at)),
+        format!("up: {}", v3(up)),
+    ];
     // A frustum sizes the window itself: RON takes no fov, zoom or height beside it.
     let sized = frustum.is_none();
     match projection {
-        Projection::Perspective { fov_deg } if sized => {
-            let _ = writeln!(w, "        fov: {},", num(*fov_deg));
-        }
-        Projection::PerspectiveZoom { zoom } if sized => {
-            let _ = writeln!(w, "        zoom: {},", num(*zoom));
-        }
+        Projection::Perspective { fov_deg } if sized => f.push(format!("fov: {}", num(*fov_deg))),
+        Projection::PerspectiveZoom { zoom } if sized => f.push(format!("zoom: {}", num(*zoom))),
         Projection::Perspective { .. } | Projection::PerspectiveZoom { .. } => {}
-        Projection::Orthographic { height } if sized => {
-            let _ = writeln!(
-                w,
-                "        projection: Orthographic(height: {}),",
-                num(*height)
-            );
-        }
-        Projection::Orthographic { .. } => {
-            let _ = writeln!(w, "        projection: Orthographic(),");
-        }
+        Projection::Orthographic { height } if sized => f.push(format!(
+            "projection: Orthographic(height: {})",
+            num(*height)
+        )),
+        Projection::Orthographic { .. } => f.push("projection: Orthographic()".into()),
         Projection::Fisheye { fov_deg } => {
-            let _ = writeln!(w, "        projection: Fisheye(fov: {}),", num(*fov_deg));
+            f.push(format!("projection: Fisheye(fov: {})", num(*fov_deg)))
         }
-        Projection::Equirectangular => {
-            let _ = writeln!(w, "        projection: Equirectangular,");
-        }
+        Projection::Equirectangular => f.push("projection: Equirectangular".into()),
     }
     if let Some(a) = aspect {
-        let _ = writeln!(w, "        aspect: {},", num(*a));
+        f.push(format!("aspect: {}", num(*a)));
     }
-    if let Some(f) = frustum {
-        let _ = writeln!(
-            w,
-            "        frustum: (left: {}, right: {}, bottom: {}, top: {}),",
-            num(f.left),
-            num(f.right),
-            num(f.bottom),
-            num(f.top)
-        );
+    if let Some(w) = frustum {
+        f.push(format!(
+            "frustum: (left: {}, right: {}, bottom: {}, top: {})",
+            num(w.left),
+            num(w.right),
+            num(w.bottom),
+            num(w.top)
+        ));
     }
     if let Some(d) = depth_of_field {
-        let _ = writeln!(
-            w,
-            "        depth_of_field: (aperture: {}, focal_distance: {}),",
+        f.push(format!(
+            "depth_of_field: (aperture: {}, focal_distance: {})",
             num(d.aperture),
             num(d.focal_distance)
-        );
+        ));
     }
     if let Some(s) = stereo {
         let layout = match s.layout {
             StereoLayout::SideBySide => "SideBySide",
             StereoLayout::OverUnder => "OverUnder",
         };
-        let _ = writeln!(
-            w,
-            "        stereo: (layout: {layout}, eye_separation: {}, convergence: {}),",
+        f.push(format!(
+            "stereo: (layout: {layout}, eye_separation: {}, convergence: {})",
             num(s.eye_separation),
             num(s.convergence)
-        );
+        ));
     }
-    w.extend_from_slice(b"    ),\n");
+    f
+}
+
+/// Fog's RON text, `(mode: ..., ...)`.
+pub(crate) fn fog_text(f: &FogDesc) -> String {
+    let mode = match f.mode {
+        FogMode::Linear { start, end } => {
+            format!("Linear(start: {}, end: {})", num(start), num(end))
+        }
+        FogMode::Exp { density, start } => {
+            format!("Exp(density: {}, start: {})", num(density), num(start))
+        }
+        FogMode::Exp2 { density, start } => {
+            format!("Exp2(density: {}, start: {})", num(density), num(start))
+        }
+    };
+    format!(
+        "(mode: {mode}, color: {}, planar: {}, every_ray: {}, misses: {})",
+        v3(&f.color),
+        f.planar,
+        f.every_ray,
+        f.misses
+    )
+}
+
+/// Ambient occlusion's RON text, `(samples: ..., ...)`.
+pub(crate) fn ambient_occlusion_text(a: &AoDesc) -> String {
+    let AoDesc {
+        samples,
+        max_distance,
+        color,
+        intensity,
+        direct,
+    } = a;
+    // An unlimited distance is the default, which RON writes by leaving the field out.
+    let distance = match max_distance.is_finite() {
+        true => format!(" distance: {},", num(*max_distance)),
+        false => String::new(),
+    };
+    format!(
+        "(samples: {samples},{distance} color: {}, intensity: {}, direct: {})",
+        v3(color),
+        num(*intensity),
+        num(*direct)
+    )
+}
+
+/// A clip group's planes, `[(point: ..., normal: ...), ...]`.
+pub(crate) fn clip_planes(planes: &[ClipPlaneDesc]) -> String {
+    let planes: Vec<String> = planes
+        .iter()
+        .map(|p| format!("(point: {}, normal: {})", v3(&p.point), v3(&p.normal)))
+        .collect();
+    format!("[{}]", planes.join(", "))
 }
 
 fn attenuation(a: &Attenuation) -> String {
@@ -485,8 +499,8 @@ fn attenuation(a: &Attenuation) -> String {
 }
 
 /// The light's RON text, with `name` when it has one.
-fn light(l: &LightDesc, name: Option<&str>) -> String {
-    let text = light_fields(l);
+fn named_light(l: &LightDesc, name: Option<&str>) -> String {
+    let text = light(l);
     match name {
         // "Point(" + "name: ..., " + the fields.
         Some(n) => match text.split_once('(') {
@@ -497,7 +511,8 @@ fn light(l: &LightDesc, name: Option<&str>) -> String {
     }
 }
 
-fn light_fields(l: &LightDesc) -> String {
+/// A light's RON text, e.g. `Point(position: ..., ...)`.
+pub(crate) fn light(l: &LightDesc) -> String {
     match l {
         LightDesc::Point {
             position,
@@ -587,7 +602,8 @@ fn light_fields(l: &LightDesc) -> String {
     }
 }
 
-fn material(m: &MaterialDesc) -> String {
+/// A material's RON text, `(color: ..., ...)`.
+pub(crate) fn material(m: &MaterialDesc) -> String {
     let MaterialDesc {
         color,
         texture,
@@ -677,67 +693,72 @@ fn volume(v: &VolumeDescEntry) -> String {
         s += &format!(", name: {}", string(&n.value));
     }
     if let Some(r) = render {
-        let VolumeRenderDesc {
-            transfer,
-            step,
-            interpolation,
-            shading,
-            clip,
-            bounds,
-        } = &r.value;
-        let TransferDesc {
-            preset,
-            points,
-            range,
-            opacity,
-        } = transfer;
-        // A preset's points come back from its name.
-        let mut t = match preset {
-            Some(p) => format!("preset: {}", string(p)),
-            None => {
-                let points: Vec<String> = points
-                    .iter()
-                    .map(|p| {
-                        format!(
-                            "(x: {}, color: {}, opacity: {})",
-                            num(p.x),
-                            v3(&p.color),
-                            num(p.opacity)
-                        )
-                    })
-                    .collect();
-                format!("points: [{}]", points.join(", "))
-            }
-        };
-        if let Some([a, b]) = range {
-            t += &format!(", range: ({}, {})", num(*a), num(*b));
+        s += &format!(", render: {}", volume_render(&r.value));
+    }
+    s + ")"
+}
+
+/// A volume's render block, `(transfer: (...), ...)`.
+pub(crate) fn volume_render(r: &VolumeRenderDesc) -> String {
+    let VolumeRenderDesc {
+        transfer,
+        step,
+        interpolation,
+        shading,
+        clip,
+        bounds,
+    } = r;
+    let TransferDesc {
+        preset,
+        points,
+        range,
+        opacity,
+    } = transfer;
+    // A preset's points come back from its name.
+    let mut t = match preset {
+        Some(p) => format!("preset: {}", string(p)),
+        None => {
+            let points: Vec<String> = points
+                .iter()
+                .map(|p| {
+                    format!(
+                        "(x: {}, color: {}, opacity: {})",
+                        num(p.x),
+                        v3(&p.color),
+                        num(p.opacity)
+                    )
+                })
+                .collect();
+            format!("points: [{}]", points.join(", "))
         }
-        t += &format!(", opacity: {}", num(*opacity));
-        s += &format!(", render: (transfer: ({t})");
-        if let Some(step) = step {
-            s += &format!(", step: {}", num(*step));
-        }
-        s += match interpolation {
-            Interpolation::Nearest => ", interpolation: Nearest",
-            Interpolation::Trilinear => ", interpolation: Trilinear",
-        };
-        if let Some(sh) = shading {
-            s += &format!(
-                ", shading: (ambient: {}, diffuse: {}, specular: {}, shininess: {}, shadows: {})",
-                num(sh.ambient),
-                num(sh.diffuse),
-                num(sh.specular),
-                num(sh.shininess),
-                sh.shadows
-            );
-        }
-        if let Some(c) = clip {
-            s += &format!(", clip: {}", string(&c.value));
-        }
-        if let Some((lo, hi)) = bounds {
-            s += &format!(", bounds: (min: {}, max: {})", v3(lo), v3(hi));
-        }
-        s += ")";
+    };
+    if let Some([a, b]) = range {
+        t += &format!(", range: ({}, {})", num(*a), num(*b));
+    }
+    t += &format!(", opacity: {}", num(*opacity));
+    let mut s = format!("(transfer: ({t})");
+    if let Some(step) = step {
+        s += &format!(", step: {}", num(*step));
+    }
+    s += match interpolation {
+        Interpolation::Nearest => ", interpolation: Nearest",
+        Interpolation::Trilinear => ", interpolation: Trilinear",
+    };
+    if let Some(sh) = shading {
+        s += &format!(
+            ", shading: (ambient: {}, diffuse: {}, specular: {}, shininess: {}, shadows: {})",
+            num(sh.ambient),
+            num(sh.diffuse),
+            num(sh.specular),
+            num(sh.shininess),
+            sh.shadows
+        );
+    }
+    if let Some(c) = clip {
+        s += &format!(", clip: {}", string(&c.value));
+    }
+    if let Some((lo, hi)) = bounds {
+        s += &format!(", bounds: (min: {}, max: {})", v3(lo), v3(hi));
     }
     s + ")"
 }
@@ -884,6 +905,20 @@ fn write_keyed(w: &mut Vec<u8>, map: &str, entries: Vec<(&String, Vec<String>)>)
 
 /// `clock`: whether to write `frame` and `time` (an animated scene takes neither).
 fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
+    w.extend_from_slice(b"    render: (\n");
+    for (_, field) in render_fields(r, base, clock) {
+        let _ = writeln!(w, "        {field},");
+    }
+    w.extend_from_slice(b"    ),\n");
+}
+
+/// The render settings' fields, each `(name, "name: value")` (a scene writes them a line
+/// each); `clock`: with `frame` and `time`; output paths relative to `base`.
+pub(crate) fn render_fields(
+    r: &RenderDesc,
+    base: &Path,
+    clock: bool,
+) -> Vec<(&'static str, String)> {
     let RenderDesc {
         width,
         height,
@@ -903,26 +938,27 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
         memory,
         texture_cache,
     } = r;
-    let _ = writeln!(w, "    render: (");
-    let _ = writeln!(w, "        width: {width},\n        height: {height},");
-    let _ = writeln!(
-        w,
-        "        samples: {samples},\n        max_depth: {max_depth},\n        min_weight: {},",
-        num(*min_weight)
-    );
+    let mut f = vec![
+        ("width", format!("width: {width}")),
+        ("height", format!("height: {height}")),
+        ("samples", format!("samples: {samples}")),
+        ("max_depth", format!("max_depth: {max_depth}")),
+        ("min_weight", format!("min_weight: {}", num(*min_weight))),
+    ];
     if clock {
-        let _ = writeln!(w, "        frame: {frame},\n        time: {},", num(*time));
+        f.push(("frame", format!("frame: {frame}")));
+        f.push(("time", format!("time: {}", num(*time))));
     }
     if !outputs.is_empty() {
-        w.extend_from_slice(b"        outputs: [\n");
+        let mut list = String::from("outputs: [\n");
         for o in outputs {
-            let _ = write!(w, "            (path: {}", string(&relative(&o.path, base)));
+            list += &format!("            (path: {}", string(&relative(&o.path, base)));
             if let Some(p) = &o.plugin {
-                let _ = write!(w, ", plugin: {}", string(&p.value));
+                list += &format!(", plugin: {}", string(&p.value));
             }
-            let _ = writeln!(w, ", params: {}),", o.params);
+            list += &format!(", params: {}),\n", o.params);
         }
-        w.extend_from_slice(b"        ],\n");
+        f.push(("outputs", list + "        ]"));
     }
     let ParallelDesc {
         mode,
@@ -948,11 +984,13 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
         OutputIo::MpiIo => "MpiIo",
     };
     let threads = threads.map_or(String::new(), |t| format!(" threads: {t},"));
-    let _ = writeln!(
-        w,
-        "        parallel: (mode: {mode},{threads} decomposition: {decomposition}, tile_size: \
-         {tile_size}, io: {io}),"
-    );
+    f.push((
+        "parallel",
+        format!(
+            "parallel: (mode: {mode},{threads} decomposition: {decomposition}, tile_size: \
+             {tile_size}, io: {io})"
+        ),
+    ));
     let TransparencyDesc {
         mode,
         angle: transparency_angle,
@@ -977,43 +1015,49 @@ fn write_render(w: &mut Vec<u8>, r: &RenderDesc, base: &Path, clock: bool) {
         TransparentShadows::Untinted => "Untinted",
         TransparentShadows::Off => "Off",
     };
-    let _ = writeln!(
-        w,
-        "        transparency: (mode: {mode}, angle: {}{max}, beyond_max: {beyond_max}, shadows: \
-         {shadows}, scale_reflection: {scale_reflection}),",
-        angle(*transparency_angle)
-    );
+    f.push((
+        "transparency",
+        format!(
+            "transparency: (mode: {mode}, angle: {}{max}, beyond_max: {beyond_max}, shadows: \
+             {shadows}, scale_reflection: {scale_reflection})",
+            angle(*transparency_angle)
+        ),
+    ));
     let TachyonDesc {
         light_threshold,
         plain_highlights,
         depth_limit_background,
     } = tachyon;
-    let _ = writeln!(
-        w,
-        "        light_scale: {},\n        tachyon: (light_threshold: {light_threshold}, \
-         plain_highlights: {plain_highlights}, depth_limit_background: {depth_limit_background}),",
-        num(*light_scale)
-    );
-    let _ = writeln!(
-        w,
-        "        volume_step: {},\n        volume_skip: {volume_skip},",
-        num(*volume_step)
-    );
+    f.push(("light_scale", format!("light_scale: {}", num(*light_scale))));
+    f.push((
+        "tachyon",
+        format!(
+            "tachyon: (light_threshold: {light_threshold}, plain_highlights: \
+             {plain_highlights}, depth_limit_background: {depth_limit_background})"
+        ),
+    ));
+    f.push(("volume_step", format!("volume_step: {}", num(*volume_step))));
+    f.push(("volume_skip", format!("volume_skip: {volume_skip}")));
     if let Some(a) = adaptive {
-        let _ = writeln!(
-            w,
-            "        adaptive: (threshold: {}, max_depth: {}),",
-            num(a.threshold),
-            a.max_depth
-        );
+        f.push((
+            "adaptive",
+            format!(
+                "adaptive: (threshold: {}, max_depth: {})",
+                num(a.threshold),
+                a.max_depth
+            ),
+        ));
     }
     if let Some(m) = memory {
-        let _ = writeln!(w, "        memory: \"{m}\",");
+        f.push(("memory", format!("memory: \"{m}\"")));
     }
     if let Some(n) = texture_cache {
-        let _ = writeln!(w, "        texture_cache: \"{}\",", MemorySize::Bytes(*n));
+        f.push((
+            "texture_cache",
+            format!("texture_cache: \"{}\"", MemorySize::Bytes(*n)),
+        ));
     }
-    w.extend_from_slice(b"    ),\n");
+    f
 }
 
 /// `s` with line breaks (and other control characters) as spaces: it must stay in its `//`
