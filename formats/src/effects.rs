@@ -53,8 +53,9 @@ impl Checker<'_> {
                 attenuation,
                 ..
             } => {
-                let cone =
-                    self.range(f.field("angle"), "angle", angle, f64::MIN_POSITIVE, 179.0)?;
+                // Above 0 (a cone of no width lights nothing) and at most 179.
+                let cone = self.positive(f.field("angle"), "angle", angle)?;
+                let cone = self.range(f.field("angle"), "angle", cone, 0.0, 179.0)?;
                 let falloff = match falloff {
                     Some(v) => self.range(f.field("falloff"), "falloff", v, 0.0, cone)?,
                     None => 0.0,

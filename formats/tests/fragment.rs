@@ -135,6 +135,22 @@ fn a_light_reads_and_its_errors_point_into_the_fragment() {
         "Point(name: \"key\", position: (1.0, 2.0, 3.0))",
     ));
     is_at(&e, "<light>:1:13", "a light fragment takes no `name`");
+    // A spot's cone: above 0, at most 179 degrees, said in plain numbers.
+    let spot = |angle: &str| {
+        error(fragment::light(&format!(
+            "Spot(position: (0.0, 4.0, 0.0), direction: (0.0, -1.0, 0.0), angle: {angle})"
+        )))
+    };
+    is_at(
+        &spot("190"),
+        "<light>:1:69",
+        "`angle` is 190; expected a value from 0 to 179",
+    );
+    is_at(
+        &spot("0"),
+        "<light>:1:69",
+        "`angle` is 0; expected a number greater than 0",
+    );
 }
 
 #[test]
