@@ -816,7 +816,7 @@ fn procedural_textures_give_tachyons_pixels() {
     let (w, h, ours) = luxon_pixels(&dir, &text);
     // Pixels of `tachyon-nox`'s picture: marble on the wall, wood's rings and gaps, the
     // checker's two colours.
-    for (at, want) in [
+    let tachyons = [
         ((10, 5), [122, 68, 160]),
         ((20, 40), [58, 227, 32]),
         ((50, 10), [126, 59, 178]),
@@ -829,24 +829,11 @@ fn procedural_textures_give_tachyons_pixels() {
         ((40, 42), [255, 51, 0]),
         ((44, 36), [0, 51, 255]),
         ((36, 45), [255, 51, 0]),
-    ] {
-        let got = pixel(&ours, w, at);
-        assert!(
-            (0..3).all(|k| got[k].abs_diff(want[k]) <= 2),
-            "{at:?}: {got:?}, Tachyon {want:?}"
-        );
-    }
-    if !tachyon_present() {
-        eprintln!("skipped the whole-picture comparison: tachyon-nox is not installed");
+    ];
+    assert_pixels_near(&ours, w, &tachyons);
+    let Some(diff) = differences_from_tachyon(&dir, &text, (w, h, &ours)) else {
         return;
-    }
-    let (tw, th, theirs) = tachyon_pixels(&dir, &text).unwrap();
-    assert_eq!((w, h), (tw, th));
-    let diff: Vec<u8> = ours
-        .chunks_exact(3)
-        .zip(theirs.chunks_exact(3))
-        .map(|(a, b)| (0..3).map(|k| a[k].abs_diff(b[k])).max().unwrap())
-        .collect();
+    };
     // Marble moves by a few codes where Tachyon's single-precision hit points differ from
     // Luxon's, and jumps on its discontinuities (3 pixels measured).
     let close = diff.iter().filter(|&&d| d <= 2).count();
@@ -857,6 +844,39 @@ fn procedural_textures_give_tachyons_pixels() {
         diff.len()
     );
     assert!(far <= 8, "{far} pixels differ by more than 10");
+}
+
+/// Each `(row, column)` pixel of `ours` (`w` wide) within 2 codes of Tachyon's colour there.
+#[track_caller]
+fn assert_pixels_near(ours: &[u8], w: u32, tachyons: &[((usize, usize), [u8; 3])]) {
+    for &(at, want) in tachyons {
+        let got = pixel(ours, w, at);
+        assert!(
+            (0..3).all(|k| got[k].abs_diff(want[k]) <= 2),
+            "{at:?}: {got:?}, Tachyon {want:?}"
+        );
+    }
+}
+
+/// Per pixel, the largest channel difference between `ours` (w, h, RGB) and `tachyon-nox`'s
+/// picture of `text`; `None` (said on stderr) when Tachyon is not installed.
+fn differences_from_tachyon(
+    dir: &Path,
+    text: &str,
+    (w, h, ours): (u32, u32, &[u8]),
+) -> Option<Vec<u8>> {
+    if !tachyon_present() {
+        eprintln!("skipped the whole-picture comparison: tachyon-nox is not installed");
+        return None;
+    }
+    let (tw, th, theirs) = tachyon_pixels(dir, text).unwrap();
+    assert_eq!((w, h), (tw, th));
+    Some(
+        ours.chunks_exact(3)
+            .zip(theirs.chunks_exact(3))
+            .map(|(a, b)| (0..3).map(|k| a[k].abs_diff(b[k])).max().unwrap())
+            .collect(),
+    )
 }
 
 /// TEXFUNC 10: a 3 × 2 × 2 IMAGEDEF on a tilted wall, unlit, so u, v and w all vary across the
@@ -879,25 +899,11 @@ fn volume_image_gives_tachyons_pixels() {
     let dir = temp_dir("tachyon-volume-image");
     let text = volume_image_scene();
     let (w, h, ours) = luxon_pixels(&dir, &text);
-    // Pixels of `tachyon-nox`'s picture.
-    for (at, want) in VOLUME_IMAGE_PIXELS {
-        let got = pixel(&ours, w, at);
-        assert!(
-            (0..3).all(|k| got[k].abs_diff(want[k]) <= 2),
-            "{at:?}: {got:?}, Tachyon {want:?}"
-        );
-    }
-    if !tachyon_present() {
-        eprintln!("skipped the whole-picture comparison: tachyon-nox is not installed");
+    assert_pixels_near(&ours, w, &VOLUME_IMAGE_PIXELS);
+    let Some(diff) = differences_from_tachyon(&dir, &text, (w, h, &ours)) else {
         return;
-    }
-    let (tw, th, theirs) = tachyon_pixels(&dir, &text).unwrap();
-    assert_eq!((w, h), (tw, th));
-    let within = ours
-        .chunks_exact(3)
-        .zip(theirs.chunks_exact(3))
-        .filter(|(a, b)| (0..3).all(|k| a[k].abs_diff(b[k]) <= 2))
-        .count();
+    };
+    let within = diff.iter().filter(|&&d| d <= 2).count();
     // Only pixels on the block's wrap seams may fall on the other side.
     assert!(
         within * 100 >= 98 * (w * h) as usize,
