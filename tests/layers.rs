@@ -31,6 +31,7 @@ const CORE: &[(&str, &[&str])] = &[
     ("schedule", &["schedule"]),
     ("render", &["render"]),
     ("output", &["output", "sweep"]),
+    ("api", &["api"]),
     ("cli", &["cli"]),
 ];
 

@@ -2,17 +2,22 @@
 //!
 //! The renderer is a library first; the `luxon` command is a thin shell over it. Data flows one
 //! way: scene file → [`luxon_formats::SceneDesc`] → [`Scene`] (plugins resolved, geometry built,
-//! BVHs) → [`render::render`] (tiles over threads, Whitted integrator) → [`Framebuffer`] →
-//! writer plugins ([`output`]).
+//! BVHs) → [`render`] (tiles over threads, Whitted integrator) → pixels → writer plugins
+//! ([`output`]). Programs use it through [`api`] (its module documentation is the user guide):
+//! a [`api::Context`] (plugins, a thread pool), an [`api::Scene`] kept between renders (which
+//! holds the built [`Scene`]) and an [`api::Renderer`].
 //!
 //! ```no_run
-//! use luxon::{plugin::Registry, Scene};
-//! let desc = luxon_formats::load("scenes/spheres.ron".as_ref())?;
-//! let registry = Registry::discover(&desc.plugin_path);
-//! let scene = Scene::build(&desc, &registry)?;
-//! let (image, stats) = luxon::render::render(&scene, &|_, _| {})?;
-//! let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
-//! luxon::output::write_all(&outputs, &image, &registry, ".".as_ref())?;
+//! use luxon::api::{write_image, Color, Context, Plane, Renderer, Scene, Target};
+//! let ctx = Context::new(Default::default())?;
+//! let renderer = Renderer::new(&ctx, Default::default())?;
+//! let mut scene = Scene::load(&ctx, "scenes/spheres.ron".as_ref())?;
+//! let (w, h) = (480, 320);
+//! let mut rgba = vec![[0f32; 4]; w * h];
+//! let color = Color::Rgba32fLinear(Plane::new(&mut rgba, w));
+//! let target = Target { width: w as u32, height: h as u32, color, depth: None };
+//! renderer.render(&mut scene, target)?;
+//! write_image(&ctx, "spheres.png".as_ref(), rgba.as_flattened(), w as u32, h as u32)?;
 //! # Ok::<(), luxon::Error>(())
 //! ```
 //!
@@ -25,6 +30,7 @@
 //! | layer | modules | what they hold |
 //! |---|---|---|
 //! | cli | `main.rs`, `cli` (the binary) | the command line |
+//! | api | [`api`] | the Rust API: a context (plugins, thread pool), retained scenes, renderers |
 //! | output | [`output`], [`sweep`] | writer plugins, outputs committed all or nothing, asynchronous PPM output; accuracy sweeps |
 //! | render | [`render`] | a whole image in this process, into a framebuffer or the caller's buffers |
 //! | schedule | [`schedule`] | which thread or MPI rank renders which pixels |
@@ -48,6 +54,7 @@
 #![deny(unsafe_code)]
 
 pub mod adaptive;
+pub mod api;
 // Reads of memory shared with the caller (strided, unaligned, or handed over from C).
 #[allow(unsafe_code)]
 pub mod arrays;

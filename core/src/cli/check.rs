@@ -1,7 +1,7 @@
 //! `luxon check`: validate a scene and describe it.
 
+use luxon::api::{self, Context, ContextOptions, Renderer, RendererOptions};
 use luxon::budget::{Budget, Use};
-use luxon::plugin::Registry;
 use luxon::{Error, Scene};
 use luxon_formats::{InlineGeometry, MemorySize, SceneDesc};
 use std::path::Path;
@@ -10,18 +10,27 @@ use std::sync::Arc;
 pub fn run(path: &Path, memory: Option<MemorySize>) -> Result<(), Error> {
     let desc = luxon_formats::load_with(path, &Budget::for_load(memory, 1).load_options())?;
     super::warn_scene(&desc);
-    let registry = Registry::discover(&desc.plugin_path);
-    super::warn_skipped(&registry);
+    // The build runs on every CPU, as a render's would by default.
+    let ctx = Context::new(ContextOptions {
+        plugin_path: desc.plugin_path.clone(),
+        threads: 0,
+    })?;
+    let renderer = Renderer::new(&ctx, RendererOptions::default())?;
+    let registry = ctx.registry();
+    super::warn_skipped(registry);
     let budget = Arc::new(Budget::for_render(&desc.render, memory, 1));
-    // The imported geometry stays in `desc` while the scene is built from it.
+    // The imported geometry stays in the description while the scene is built from it.
     let held = desc.inline.iter().map(InlineGeometry::bytes).sum();
     let imported = budget.charge(Use::Import, held, || {
         format!("the geometry imported from `{}`", desc.source.display())
     })?;
-    let scene = Scene::build_with(&desc, &registry, budget.clone())?;
+    let mut scene = api::Scene::from_desc(&ctx, desc)?;
+    scene.set_budget(budget.clone());
+    scene.commit(&renderer)?;
     drop(imported);
-    let outputs = luxon::output::resolve(&scene.outputs, &registry)?;
-    describe(&desc, &scene, &outputs);
+    let built = super::render::built(&scene)?;
+    let outputs = luxon::output::resolve(&built.outputs, registry)?;
+    describe(scene.desc(), built, &outputs);
     Ok(())
 }
 

@@ -1,12 +1,11 @@
 //! The processes of one `luxon render`: this process alone, or the ranks of an MPI job (with
 //! the `mpi` feature). Hides the feature from the rest of the command.
 
+use luxon::api::{Renderer, Scene};
 use luxon::framebuffer::Chunk;
-use luxon::schedule::{
-    launched_ranks, render_local, thread_pool, threads_for, RankStats, RunOptions, Sink,
-};
-use luxon::{Error, Scene};
-use luxon_formats::ParallelMode;
+use luxon::schedule::{available_cpus, launched_ranks, RankStats, Sink};
+use luxon::Error;
+use luxon_formats::{ParallelMode, RenderDesc};
 use std::path::Path;
 
 #[cfg(feature = "mpi")]
@@ -99,12 +98,15 @@ impl Job {
 }
 
 impl Job {
-    /// Render threads of this process.
-    pub fn threads(&self, scene: &Scene) -> usize {
+    /// Render threads of this process for a scene's render settings.
+    pub fn threads(&self, r: &RenderDesc) -> usize {
         match self {
-            Job::Local => threads_for(scene),
+            Job::Local => r
+                .parallel
+                .threads
+                .map_or_else(available_cpus, |n| n as usize),
             #[cfg(feature = "mpi")]
-            Job::Mpi(c) => c.threads(scene),
+            Job::Mpi(c) => c.threads_for(r.parallel.threads, r.parallel.mode),
             #[cfg(not(feature = "mpi"))]
             Job::Mpi(c) => match *c {},
         }
@@ -122,12 +124,13 @@ impl Job {
         }
     }
 
-    /// Renders this process's share: rank 0's `sink` gets its own chunks and, when `gather`,
-    /// every rank's. Returns every rank's statistics (on rank 0) and, with `keep`, the chunks
-    /// this rank rendered.
+    /// Renders this process's share with `renderer` (whose pool has this rank's `threads`):
+    /// rank 0's `sink` gets its own chunks and, when `gather`, every rank's. Returns every
+    /// rank's statistics (on rank 0) and, with `keep`, the chunks this rank rendered.
     pub fn render(
         &self,
-        scene: &Scene,
+        renderer: &Renderer,
+        scene: &mut Scene,
         threads: &[usize],
         gather: bool,
         keep: bool,
@@ -135,14 +138,14 @@ impl Job {
     ) -> Result<(Vec<RankStats>, Vec<Chunk>), Error> {
         match self {
             Job::Local => {
-                let _ = (gather, keep);
-                let pool = thread_pool(threads[0])?;
-                render_local(scene, &pool, RunOptions::default(), sink)
+                let _ = (threads, gather, keep);
+                renderer
+                    .render_chunks(scene, sink)
                     .map(|r| (vec![r], Vec::new()))
             }
             #[cfg(feature = "mpi")]
             Job::Mpi(c) => {
-                let r = c.render(scene, threads, gather, keep, sink);
+                let r = renderer.render_cluster(scene, c, threads, gather, keep, sink)?;
                 Ok((r.ranks, r.kept))
             }
             #[cfg(not(feature = "mpi"))]

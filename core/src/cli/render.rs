@@ -3,6 +3,7 @@
 
 use super::job::Job;
 use super::progress::Progress;
+use luxon::api::{self, Context, ContextOptions, Renderer, RendererOptions};
 use luxon::budget::{Budget, Use};
 use luxon::cache::{self, Lookup};
 use luxon::framebuffer::Chunk;
@@ -11,6 +12,7 @@ use luxon::output::stream::{is_ppm8, AsyncOutput};
 use luxon::output::{Output, OutputSet};
 use luxon::plugin::Registry;
 use luxon::render::RenderStats;
+use luxon::scene::Settings;
 use luxon::schedule::RankStats;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{
@@ -275,10 +277,19 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         Ok(d) => job.for_mode(d.render.parallel.mode)?,
         Err(_) => job,
     };
-    let empty = Vec::new();
-    let registry = Registry::discover(desc.as_ref().map_or(&empty, |d| &d.plugin_path));
+    let (plugin_path, threads) = match &desc {
+        Ok(d) => (d.plugin_path.clone(), job.threads(&d.render)),
+        Err(_) => (Vec::new(), 1),
+    };
+    // The context's pool renders and builds (never rayon's global pool).
+    let ctx = Context::new(ContextOptions {
+        plugin_path,
+        threads,
+    })?;
+    let renderer = Renderer::new(&ctx, RendererOptions::default())?;
+    let registry = ctx.registry();
     if job.rank() == 0 {
-        super::warn_skipped(&registry);
+        super::warn_skipped(registry);
         if let Ok(d) = &desc {
             super::warn_scene(d);
         }
@@ -286,14 +297,12 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let load_time = t0.elapsed();
     let animated = desc.as_ref().is_ok_and(|d| d.animation.is_some());
     if animated || o.frames.is_some() || o.step.is_some() || o.force {
-        return super::sequence::run(o, desc, &read, &registry, job);
+        return super::sequence::run(o, desc, &read, &ctx, &renderer, job);
     }
-    let ready = desc.and_then(|desc| prepare(path, o, desc, cached, &registry, &job, &mut cache));
+    let ready =
+        desc.and_then(|desc| prepare(path, o, desc, cached, &ctx, &renderer, &job, &mut cache));
     let (ready, status) = match ready {
-        Ok(r) => {
-            let threads = job.threads(&r.1);
-            (Some(r), Ok(threads))
-        }
+        Ok(r) => (Some(r), Ok(renderer.threads())),
         Err(e) => (None, Err(e)),
     };
     let threads = match job.agree(status) {
@@ -301,13 +310,17 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
         Err(Some(e)) => return Err(e),
         Err(None) => job.exit_quietly(),
     };
-    let Some((desc, scene, plan)) = ready else {
+    let Some((mut scene, plan)) = ready else {
         return Err(Error::Render("not ready to render".into()));
     };
-    let scene_dir = desc.source.parent().unwrap_or(Path::new("."));
-    let Some(image) = write_image(&scene, plan, &job, &threads, &registry, scene_dir)? else {
+    let scene_dir = scene_dir_of(scene.desc());
+    let written = write_image(
+        &mut scene, plan, &job, &renderer, &threads, registry, &scene_dir,
+    )?;
+    let Some(image) = written else {
         return Ok(());
     };
+    let scene = built(&scene)?;
     let Image {
         written,
         stats,
@@ -315,9 +328,9 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     } = image;
     let total = t0.elapsed();
     // After the image: writing the cache delays no picture.
-    let cache_written = cache.write_after(path, &scene);
+    let cache_written = cache.write_after(path, scene);
     if o.stats {
-        print_stats(&scene, &job, &stats, load_time, write_time, total);
+        print_stats(scene, &job, &stats, load_time, write_time, total);
         eprintln!("  geometry cache   {}", cache.note);
     }
     for w in written {
@@ -326,8 +339,20 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     if let Some(p) = cache_written {
         eprintln!("luxon: wrote geometry cache {}", p.display());
     }
-    warn_nan(&scene, &stats);
+    warn_nan(scene, &stats);
     Ok(())
+}
+
+/// Where a scene's relative paths start.
+pub(super) fn scene_dir_of(desc: &SceneDesc) -> PathBuf {
+    desc.source.parent().unwrap_or(Path::new(".")).to_path_buf()
+}
+
+/// The built form of a committed scene.
+pub(super) fn built(scene: &api::Scene) -> Result<&Scene, Error> {
+    scene
+        .built()
+        .ok_or_else(|| Error::Render("the scene is not built".into()))
 }
 
 /// What rank 0 has after writing an image.
@@ -353,14 +378,15 @@ pub(super) fn warn_nan(scene: &Scene, stats: &RenderStats) {
 /// Renders `scene` on every rank and writes its outputs as `plan` says, all or none; rank 0
 /// gets what it wrote, the other ranks `None`.
 pub(super) fn write_image(
-    scene: &Scene,
+    scene: &mut api::Scene,
     plan: Plan,
     job: &Job,
+    renderer: &Renderer,
     threads: &[usize],
     registry: &Registry,
     scene_dir: &Path,
 ) -> Result<Option<Image>, Error> {
-    let s = &scene.settings;
+    let s = &built(scene)?.settings.clone();
     let Plan {
         written_by_root,
         concurrent,
@@ -374,7 +400,7 @@ pub(super) fn write_image(
         gather,
         keep,
     };
-    let r = render(scene, job, &shares, streams, registry, scene_dir)?;
+    let r = render(scene, job, renderer, &shares, streams, registry, scene_dir)?;
 
     let t_write = Instant::now();
     // Rank 0's output files: kept here, or back from the stream writer.
@@ -463,58 +489,79 @@ impl CacheUse {
     }
 }
 
-/// Builds the scene (from the geometry cache when it fits the scene, else from the source),
-/// resolves its outputs and plans who writes them.
+/// Builds the scene (from the geometry cache when it fits the scene, else from the source) on
+/// the renderer's pool, resolves its outputs and plans who writes them.
+#[allow(clippy::too_many_arguments)]
 fn prepare<'r>(
     path: &Path,
     o: &Overrides,
-    mut desc: SceneDesc,
+    desc: SceneDesc,
     cached: Option<Box<cache::Cached>>,
-    registry: &'r Registry,
+    ctx: &'r Context,
+    renderer: &Renderer,
     job: &Job,
     cache: &mut CacheUse,
-) -> Result<(SceneDesc, Scene, Plan<'r>), Error> {
+) -> Result<(api::Scene, Plan<'r>), Error> {
+    let registry = ctx.registry();
     // Outputs first: an unwritable path or a writer's bad parameter fails before any work.
     let outputs = luxon::output::resolve(&desc.render.outputs, registry)?;
-    let scene_dir = desc.source.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let scene_dir = scene_dir_of(&desc);
     let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
     let budget = Arc::new(budget);
     let plan = plan(&desc.render, outputs, job, registry, &scene_dir, &budget)?;
     let had_objects = !desc.objects.is_empty();
-    let from_cache = cached.is_some();
-    let prebuilt = match cached {
+    let scene = match cached {
         Some(c) => {
-            let cache::Cached { path, geometry, .. } = *c;
-            Scene::build_prebuilt(&desc, geometry, registry, budget.clone())
-                .ok()
-                .map(|s| (s, path))
-        }
-        None => None,
-    };
-    let scene = match prebuilt {
-        Some((scene, from)) => {
-            cache.note = format!("read {}", from.display());
-            scene
-        }
-        None => {
-            if from_cache {
-                // The cache's view of the scene did not fit: read the source itself.
-                desc = load(path, o, job.node_ranks(), None, &mut Vec::new())?;
+            let cache::Cached {
+                path: from,
+                geometry,
+                ..
+            } = *c;
+            let mut scene = api::Scene::from_prebuilt(ctx, desc, geometry)?;
+            scene.set_budget(budget.clone());
+            match scene.commit(renderer) {
+                Ok(_) => {
+                    cache.note = format!("read {}", from.display());
+                    scene
+                }
+                Err(_) => {
+                    // The cache's view of the scene did not fit: read the source itself.
+                    drop(scene);
+                    let desc = load(path, o, job.node_ranks(), None, &mut Vec::new())?;
+                    build_source(desc, ctx, renderer, &budget, o, cache, had_objects)?
+                }
             }
-            // Held until the build has taken the imported geometry into the scene's arrays.
-            let held = desc.inline.iter().map(InlineGeometry::bytes).sum();
-            let imported = budget.charge(Use::Import, held, || {
-                format!("the geometry imported from `{}`", desc.source.display())
-            })?;
-            let scene = Scene::build_taking_geometry(&mut desc, registry, budget.clone())?;
-            drop(imported);
-            cache.write = cache.on
-                && (o.cache || scene.primitive_count() >= CACHE_MIN_PRIMITIVES)
-                && cache::cacheable(&scene, had_objects);
-            scene
         }
+        None => build_source(desc, ctx, renderer, &budget, o, cache, had_objects)?,
     };
-    Ok((desc, scene, plan))
+    Ok((scene, plan))
+}
+
+/// Builds the scene from its source, consuming its imported geometry group by group, and says
+/// whether to write its geometry cache afterwards.
+fn build_source(
+    desc: SceneDesc,
+    ctx: &Context,
+    renderer: &Renderer,
+    budget: &Arc<Budget>,
+    o: &Overrides,
+    cache: &mut CacheUse,
+    had_objects: bool,
+) -> Result<api::Scene, Error> {
+    // Held until the build has taken the imported geometry into the scene's arrays.
+    let held = desc.inline.iter().map(InlineGeometry::bytes).sum();
+    let imported = budget.charge(Use::Import, held, || {
+        format!("the geometry imported from `{}`", desc.source.display())
+    })?;
+    let mut scene = api::Scene::from_desc_frozen(ctx, desc)?;
+    scene.set_budget(budget.clone());
+    scene.commit(renderer)?;
+    drop(imported);
+    let built = built(&scene)?;
+    cache.write = cache.on
+        && (o.cache || built.primitive_count() >= CACHE_MIN_PRIMITIVES)
+        && cache::cacheable(built, had_objects);
+    Ok(scene)
 }
 
 /// How the ranks share the render: threads per rank, whether rank 0 gathers every rank's
@@ -541,14 +588,17 @@ struct Rendered {
 /// Renders this rank's share with a progress bar, handing finished chunks to the writer thread
 /// (asynchronous output), to a framebuffer (synchronous output, rank 0), or to nobody.
 fn render(
-    scene: &Scene,
+    scene: &mut api::Scene,
     job: &Job,
+    renderer: &Renderer,
     shares: &Shares,
     streams: Option<AsyncOutput>,
     registry: &Registry,
     scene_dir: &Path,
 ) -> Result<Rendered, Error> {
-    let s = &scene.settings;
+    let built = built(scene)?;
+    let s: &Settings = &built.settings.clone();
+    let budget = built.budget.clone();
     let bar = Progress::new();
     let total = s.width as u64 * s.height as u64;
     let done = AtomicU64::new(0);
@@ -557,7 +607,7 @@ fn render(
     // Held while rendering: the image's bytes in the memory budget.
     let mut _image = None;
     if sync {
-        let (fb, charge) = Framebuffer::charged(s.width, s.height, &scene.budget)?;
+        let (fb, charge) = Framebuffer::charged(s.width, s.height, &budget)?;
         *sync_fb.lock().unwrap_or_else(|e| e.into_inner()) = fb;
         _image = Some(charge);
     }
@@ -578,7 +628,14 @@ fn render(
             }
             bar.tick(done.fetch_add(n, Ordering::Relaxed) + n, total);
         };
-        let rendered = job.render(scene, shares.threads, shares.gather, shares.keep, &sink);
+        let rendered = job.render(
+            renderer,
+            scene,
+            shares.threads,
+            shares.gather,
+            shares.keep,
+            &sink,
+        );
         let render_end = Instant::now();
         drop(tx);
         if let Some(w) = &writer {

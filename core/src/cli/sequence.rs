@@ -13,14 +13,17 @@
 //! share the frames by claiming them ([`super::resume`]).
 
 use super::job::Job;
-use super::render::{plan, print_stats, warn_nan, write_image, Image, Overrides};
+use super::render::{
+    built, plan, print_stats, scene_dir_of, warn_nan, write_image, Image, Overrides,
+};
 use super::resume::Resume;
+use luxon::api::{Context, Renderer, Scene};
 use luxon::budget::Budget;
 use luxon::output::frames::FrameNames;
 use luxon::output::inputs::{absolute, SceneFile, SceneInputs};
 use luxon::output::manifest::Manifest;
 use luxon::plugin::Registry;
-use luxon::{Error, Scene};
+use luxon::Error;
 use luxon_formats::SceneDesc;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -76,7 +79,6 @@ fn frame_list(o: &Overrides, desc: &SceneDesc) -> Result<Vec<u32>, Error> {
 
 /// What every rank has before the first frame; rank 0 also the frame records.
 struct Ready {
-    desc: SceneDesc,
     scene: Scene,
     frames: Vec<u32>,
     names: FrameNames,
@@ -88,11 +90,13 @@ struct Ready {
 /// rank 0, opens the frame records. `read`: the scene files the load read.
 fn prepare(
     o: &Overrides,
-    mut desc: SceneDesc,
+    desc: SceneDesc,
     read: &[SceneFile],
-    registry: &Registry,
+    ctx: &Context,
+    renderer: &Renderer,
     job: &Job,
 ) -> Result<Ready, Error> {
+    let registry = ctx.registry();
     let frames = frame_list(o, &desc)?;
     let scene_last = desc.animation.as_ref().map_or(0, |a| a.value.last);
     let last = frames.last().copied().unwrap_or(0).max(scene_last);
@@ -100,7 +104,10 @@ fn prepare(
     // Writers first: an output no writer takes fails before any work.
     luxon::output::resolve(&desc.render.outputs, registry)?;
     let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
-    let scene = Scene::build_taking_geometry(&mut desc, registry, Arc::new(budget))?;
+    let mut scene = Scene::from_desc_frozen(ctx, desc)?;
+    scene.set_budget(Arc::new(budget));
+    scene.commit(renderer)?;
+    let desc = scene.desc();
     let resume = match job.rank() {
         0 => {
             let hash = scene_hash(o, &desc, read, registry, &names, &frames);
@@ -110,7 +117,6 @@ fn prepare(
         _ => None,
     };
     Ok(Ready {
-        desc,
         scene,
         frames,
         names,
@@ -177,16 +183,15 @@ pub fn run(
     o: &Overrides,
     desc: Result<SceneDesc, Error>,
     read: &[SceneFile],
-    registry: &Registry,
+    ctx: &Context,
+    renderer: &Renderer,
     job: Job,
 ) -> Result<(), Error> {
     let t0 = Instant::now();
-    let ready = desc.and_then(|d| prepare(o, d, read, registry, &job));
+    let registry = ctx.registry();
+    let ready = desc.and_then(|d| prepare(o, d, read, ctx, renderer, &job));
     let (ready, status) = match ready {
-        Ok(r) => {
-            let threads = job.threads(&r.scene);
-            (Some(r), Ok(threads))
-        }
+        Ok(r) => (Some(r), Ok(renderer.threads())),
         Err(e) => (None, Err(e)),
     };
     match job.agree(status) {
@@ -195,7 +200,6 @@ pub fn run(
         Err(None) => job.exit_quietly(),
     }
     let Some(Ready {
-        desc,
         mut scene,
         frames,
         names,
@@ -205,7 +209,7 @@ pub fn run(
         return Err(Error::Render("not ready to render".into()));
     };
     let build_time = t0.elapsed();
-    let scene_dir = desc.source.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let scene_dir = scene_dir_of(scene.desc());
     let total = frames.len();
     if let Some(note) = resume.as_ref().and_then(Resume::start_note) {
         eprintln!("luxon: {note}");
@@ -231,7 +235,7 @@ pub fn run(
         }
         let k = next as u32;
         let t = Instant::now();
-        let result = frame(k, &mut scene, &desc, &names, registry, &job, &scene_dir);
+        let result = frame(k, &mut scene, &names, renderer, registry, &job, &scene_dir);
         let result = match (result, resume.as_mut()) {
             (Ok(Some(image)), Some(r)) => r.finished(k).map(|()| Some(image)),
             (Err(e), Some(r)) => {
@@ -255,7 +259,7 @@ pub fn run(
                 if o.stats {
                     eprintln!("luxon: frame {k}");
                     print_stats(
-                        &scene,
+                        built(&scene)?,
                         &job,
                         &image.stats,
                         build_time,
@@ -268,7 +272,7 @@ pub fn run(
                     written.join(", "),
                     t.elapsed().as_secs_f64(),
                 );
-                warn_nan(&scene, &image.stats);
+                warn_nan(built(&scene)?, &image.stats);
             }
             Err(e) => {
                 if job.rank() == 0 {
@@ -297,25 +301,27 @@ pub fn run(
 fn frame(
     k: u32,
     scene: &mut Scene,
-    desc: &SceneDesc,
     names: &FrameNames,
+    renderer: &Renderer,
     registry: &Registry,
     job: &Job,
     scene_dir: &Path,
 ) -> Result<Option<Image>, Error> {
     let ready = scene.set_frame(k).and_then(|()| {
+        scene.commit(renderer)?;
         let outputs = luxon::output::resolve(&names.outputs_for(k), registry)?;
+        let budget = &built(scene)?.budget;
         plan(
-            &desc.render,
+            &scene.desc().render,
             outputs,
             job,
             registry,
             scene_dir,
-            &scene.budget,
+            budget,
         )
     });
     let (ready, status) = match ready {
-        Ok(p) => (Some(p), Ok(job.threads(scene))),
+        Ok(p) => (Some(p), Ok(renderer.threads())),
         Err(e) => (None, Err(e)),
     };
     let threads = match job.agree(status) {
@@ -326,5 +332,5 @@ fn frame(
     let Some(plan) = ready else {
         return Err(Error::Render(format!("frame {k} is not ready")));
     };
-    write_image(scene, plan, job, &threads, registry, scene_dir)
+    write_image(scene, plan, job, renderer, &threads, registry, scene_dir)
 }

@@ -94,6 +94,31 @@ impl Scene {
         Scene::build_from(desc, Box::new(groups), shadowless, None, registry, budget)
     }
 
+    /// One full build of a retained scene ([`crate::api::Scene`]): `build_with`, or
+    /// `build_taking_geometry` when `take_geometry`, or `build_prebuilt` when `prebuilt` is
+    /// given; render space's origin at `origin` when given (else the camera, as always).
+    pub(crate) fn build_retained(
+        desc: &mut SceneDesc,
+        take_geometry: bool,
+        prebuilt: Option<Prebuilt>,
+        origin: Option<DVec3>,
+        registry: &Registry,
+        budget: Arc<Budget>,
+    ) -> Result<Scene, Error> {
+        let shadowless = shadowless_groups(desc);
+        let taken = match take_geometry {
+            true => std::mem::take(&mut desc.inline),
+            false => Vec::new(),
+        };
+        let desc = &*desc;
+        let inline: Inline = match take_geometry {
+            true => Box::new(taken.into_iter().map(Cow::Owned)),
+            false => Box::new(desc.inline.iter().map(Cow::Borrowed)),
+        };
+        let b = Build::at(desc, registry, budget, origin);
+        Scene::build_stages(b, desc, inline, shadowless, prebuilt)
+    }
+
     /// The build, stage after stage (errors are reported in this order too).
     fn build_from(
         desc: &SceneDesc,
@@ -104,6 +129,17 @@ impl Scene {
         budget: Arc<Budget>,
     ) -> Result<Scene, Error> {
         let b = Build::new(desc, registry, budget);
+        Scene::build_stages(b, desc, inline, shadowless, prebuilt)
+    }
+
+    /// The stages of `build_from`, with render space's origin already chosen (`b.world_offset`).
+    fn build_stages(
+        b: Build,
+        desc: &SceneDesc,
+        inline: Inline,
+        shadowless: Vec<Option<Spanned<String>>>,
+        prebuilt: Option<Prebuilt>,
+    ) -> Result<Scene, Error> {
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
@@ -144,7 +180,13 @@ impl Scene {
             &render_volumes,
         );
         let r = &desc.render;
-        let camera = Camera::new(&desc.camera.value, Vec3A::ZERO, r.width, r.height);
+        // The eye sits at render space's origin unless a retained scene fixed it elsewhere.
+        let eye = (DVec3::from(desc.camera.value.position) - b.world_offset).as_vec3();
+        let eye = match b.origin_given {
+            false => Vec3A::ZERO,
+            true => Vec3A::from(eye),
+        };
+        let camera = Camera::new(&desc.camera.value, eye, r.width, r.height);
         let keyed = std::mem::take(&mut stored.keyed);
         let mut scene = Scene {
             source: desc.source.clone(),
@@ -198,6 +240,8 @@ pub(super) struct Build<'a> {
     registry: &'a Registry,
     scene_dir: PathBuf,
     world_offset: DVec3,
+    /// `world_offset` was given (a retained scene's origin), not taken from the camera.
+    origin_given: bool,
     budget: Arc<Budget>,
 }
 
@@ -257,7 +301,23 @@ impl<'a> Build<'a> {
                 .map(Path::to_path_buf)
                 .unwrap_or_default(),
             world_offset: frame::world_offset(desc),
+            origin_given: false,
         }
+    }
+
+    /// `new` with render space's origin at `origin` when given.
+    fn at(
+        desc: &'a SceneDesc,
+        registry: &'a Registry,
+        budget: Arc<Budget>,
+        origin: Option<DVec3>,
+    ) -> Build<'a> {
+        let mut b = Build::new(desc, registry, budget);
+        if let Some(o) = origin {
+            b.world_offset = o;
+            b.origin_given = true;
+        }
+        b
     }
 
     /// Stage: an instance of every texture, through its plugin; and their names. A scene with
@@ -910,7 +970,7 @@ fn features(
 }
 
 /// The render settings (after command-line overrides, which change the description).
-fn settings(r: &RenderDesc) -> Settings {
+pub(super) fn settings(r: &RenderDesc) -> Settings {
     Settings {
         width: r.width,
         height: r.height,
@@ -932,7 +992,7 @@ fn settings(r: &RenderDesc) -> Settings {
     }
 }
 
-fn v3(a: [f64; 3]) -> Vec3A {
+pub(super) fn v3(a: [f64; 3]) -> Vec3A {
     Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32)
 }
 

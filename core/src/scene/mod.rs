@@ -5,6 +5,7 @@
 
 mod build;
 mod frame;
+mod update;
 
 pub use build::Prebuilt;
 pub use frame::Animation;

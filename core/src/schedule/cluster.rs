@@ -103,7 +103,12 @@ impl Cluster {
     /// Render threads for this rank: the settings' count, else one in pure MPI mode, else this
     /// rank's share of the CPUs it may run on.
     pub fn threads(&self, scene: &Scene) -> usize {
-        match (scene.settings.threads, scene.settings.mode) {
+        self.threads_for(scene.settings.threads, scene.settings.mode)
+    }
+
+    /// `threads` for render settings' thread count and mode (known before the scene is built).
+    pub fn threads_for(&self, threads: Option<u32>, mode: ParallelMode) -> usize {
+        match (threads, mode) {
             (Some(n), _) => n as usize,
             (None, ParallelMode::Mpi) => 1,
             (None, _) => (super::available_cpus() / self.sharing).max(1),
@@ -144,12 +149,14 @@ impl Cluster {
         }
     }
 
-    /// Renders this rank's share with `threads[rank]` threads. On rank 0, `sink` gets rank 0's
-    /// chunks, and every other rank's when `gather`. With `keep`, each rank also returns the
-    /// chunks it rendered (for MPI-IO). Any failure ends the job.
+    /// Renders this rank's share on `pool` (of `threads[rank]` threads). On rank 0, `sink` gets
+    /// rank 0's chunks, and every other rank's when `gather`. With `keep`, each rank also
+    /// returns the chunks it rendered (for MPI-IO). Any failure ends the job.
+    #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
         scene: &Scene,
+        pool: &rayon::ThreadPool,
         threads: &[usize],
         gather: bool,
         keep: bool,
@@ -159,7 +166,7 @@ impl Cluster {
         let run = Run {
             cluster: self,
             scene,
-            pool: super::thread_pool(threads[self.rank]).unwrap_or_else(|e| fail(&e.to_string())),
+            pool,
             tiles: decompose::tiles(s.width, s.height, s.tile_size),
             threads,
             gather,
@@ -215,7 +222,7 @@ impl Cluster {
 struct Run<'a> {
     cluster: &'a Cluster,
     scene: &'a Scene,
-    pool: rayon::ThreadPool,
+    pool: &'a rayon::ThreadPool,
     tiles: Vec<decompose::Rect>,
     threads: &'a [usize],
     gather: bool,
@@ -270,7 +277,7 @@ impl Run<'_> {
         let mut done_sent = vec![false; size];
         let mut finished = 0;
         std::thread::scope(|sc| {
-            let (scene, pool) = (self.scene, &self.pool);
+            let (scene, pool) = (self.scene, self.pool);
             let local =
                 sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &local_sink));
             loop {
@@ -359,7 +366,7 @@ impl Run<'_> {
             root.send_with_tag(&bytes_of(ahead as u64)[..], TAG_REQUEST);
         }
         let mut stats = std::thread::scope(|sc| {
-            let (scene, pool) = (self.scene, &self.pool);
+            let (scene, pool) = (self.scene, self.pool);
             let local = sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &to_main));
             loop {
                 let finished = local.is_finished();
