@@ -110,8 +110,8 @@ fn prepare(
     let desc = scene.desc();
     let resume = match job.rank() {
         0 => {
-            let hash = scene_hash(o, &desc, read, registry, &names, &frames);
-            let about = about(&desc, &frames, hash, o);
+            let hash = scene_hash(o, desc, read, registry, &names, &frames);
+            let about = about(desc, &frames, hash, o);
             Some(Resume::start(&names, &frames, hash, o.force, &about)?)
         }
         _ => None,

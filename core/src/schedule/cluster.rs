@@ -152,7 +152,6 @@ impl Cluster {
     /// Renders this rank's share on `pool` (of `threads[rank]` threads). On rank 0, `sink` gets
     /// rank 0's chunks, and every other rank's when `gather`. With `keep`, each rank also
     /// returns the chunks it rendered (for MPI-IO). Any failure ends the job.
-    #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
         scene: &Scene,
