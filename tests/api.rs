@@ -349,3 +349,51 @@ fn write_image_writes_through_the_writer_plugins_whole() {
         .collect();
     assert_eq!(names.len(), 1, "no temporary file is left: {names:?}");
 }
+
+#[test]
+fn an_animated_scene_renders_its_frames_as_the_one_shot_path_does() {
+    let desc = load("carousel");
+    let (w, h) = (desc.render.width, desc.render.height);
+    let reg = registry(&desc);
+    let mut built = luxon::Scene::build(&desc, &reg).unwrap_or_else(|e| panic!("{e}"));
+    built.set_frame(17).unwrap();
+    let (fb, _) = luxon::render::render(&built, &|_, _| {}).unwrap();
+    let want: Vec<u32> = fb.rgba.iter().map(|v| v.to_bits()).collect();
+
+    let ctx = context(&desc, 2);
+    let r = Renderer::new(&ctx, RendererOptions::default()).unwrap();
+    let mut scene = Scene::from_desc(&ctx, desc).unwrap();
+    let first = render(&r, &mut scene, w, h).unwrap();
+    scene.set_frame(17).unwrap();
+    assert_eq!(scene.commit(&r).unwrap().rebuilt, 0);
+    let got = render(&r, &mut scene, w, h).unwrap();
+    assert!(bits(&got) == want);
+    assert!(bits(&first) != want, "frame 0 differs from frame 17");
+    // The animation places the camera.
+    let e = scene
+        .set_camera_ron("(position: (0, 0, 5))")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("animated"), "{e}");
+}
+
+#[test]
+fn a_scene_renders_on_another_thread_with_a_shared_renderer() {
+    let desc = load("spheres");
+    let (w, h) = (desc.render.width, desc.render.height);
+    let ctx = context(&desc, 2);
+    let r = Renderer::new(&ctx, RendererOptions::default()).unwrap();
+    let mut here = Scene::from_desc(&ctx, desc.clone()).unwrap();
+    let want = render(&r, &mut here, w, h).unwrap();
+    // A scene moves to another thread (`Send`); the renderer is shared (`Sync`).
+    let there = Scene::from_desc(&ctx, desc).unwrap();
+    let got = std::thread::scope(|s| {
+        s.spawn(|| {
+            let mut there = there;
+            render(&r, &mut there, w, h).unwrap()
+        })
+        .join()
+        .unwrap()
+    });
+    assert!(bits(&got) == bits(&want));
+}

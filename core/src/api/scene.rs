@@ -139,11 +139,7 @@ impl Scene {
     /// The camera (checked by the scene files' rules). An animated scene's camera is its
     /// animation's.
     pub fn set_camera(&mut self, camera: CameraDesc) -> Result<(), Error> {
-        if self.desc.animation.is_some() {
-            return Err(Error::Api(
-                "this scene is animated: its frame places the camera (Scene::set_frame)".into(),
-            ));
-        }
+        self.camera_not_animated()?;
         fragment::check_camera(&camera).map_err(|m| Error::Api(format!("camera: {m}")))?;
         self.desc.camera.value = camera;
         Ok(())
@@ -152,8 +148,18 @@ impl Scene {
     /// The camera from RON text, e.g. `(position: (0, 0, 5), look_at: (0, 0, 0))`; errors
     /// point into the text as `<camera>:line:col`.
     pub fn set_camera_ron(&mut self, text: &str) -> Result<(), Error> {
+        self.camera_not_animated()?;
         let camera = fragment::camera(text)?;
         self.set_camera(camera)
+    }
+
+    fn camera_not_animated(&self) -> Result<(), Error> {
+        match self.desc.animation {
+            Some(_) => Err(Error::Api(
+                "this scene is animated: its frame places the camera (Scene::set_frame)".into(),
+            )),
+            None => Ok(()),
+        }
     }
 
     /// The render settings (checked by the scene files' rules). The image size is the

@@ -1,7 +1,9 @@
 //! `Scene`: a `SceneDesc` with plugins resolved and called, geometry stored natively and
 //! re-centred, BVHs built, and the set of effects the scene calls for; and the queries the
 //! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`;
-//! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`.
+//! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`;
+//! what a retained scene ([`crate::api::Scene`]) changes without a build (settings, size,
+//! camera, background) in `update`.
 
 mod build;
 mod frame;

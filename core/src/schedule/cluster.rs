@@ -1,5 +1,6 @@
 //! Rendering across MPI ranks (feature `mpi`). Every rank builds the whole scene and renders its
-//! share on its own thread pool; only rank 0 writes outputs (unless MPI-IO).
+//! share on the thread pool it is given (a renderer's); only rank 0 writes outputs (unless
+//! MPI-IO).
 //!
 //! - Static decompositions: workers are numbered across ranks (rank r's threads follow rank
 //!   r-1's), so pixel-, scanline- and block-cyclic deal units over every thread of the job.
