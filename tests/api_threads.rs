@@ -1,6 +1,6 @@
 //! Threads of the API: a context's pool is the only one a load, build and render use (rayon's
-//! global pool, which would start one unnamed thread per CPU, is never reached), and dropping
-//! the context and renderer ends its threads. One test in its own binary, so no other test's
+//! global pool, which would start one unnamed thread per CPU, is never reached), its threads
+//! sleep between renders, and dropping the context and renderer ends them. One test in its own binary, so no other test's
 //! threads are counted.
 #![cfg(target_os = "linux")]
 
@@ -19,8 +19,30 @@ fn threads() -> Vec<String> {
         .collect()
 }
 
+/// User and system CPU time (clock ticks) of the threads named `luxon-render-*`.
+fn pool_ticks() -> u64 {
+    let mut sum = 0;
+    for t in std::fs::read_dir("/proc/self/task").unwrap().flatten() {
+        let comm = std::fs::read_to_string(t.path().join("comm")).unwrap_or_default();
+        if !comm.starts_with("luxon-render-") {
+            continue;
+        }
+        let stat = std::fs::read_to_string(t.path().join("stat")).unwrap_or_default();
+        // Fields after the name (which may hold spaces): state is field 3, utime 14, stime 15.
+        let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+        let f: Vec<u64> = rest
+            .split_whitespace()
+            .skip(11)
+            .take(2)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        sum += f.iter().sum::<u64>();
+    }
+    sum
+}
+
 #[test]
-fn a_context_pool_is_the_only_one_used_and_its_threads_end_with_it() {
+fn a_context_pool_is_the_only_one_used_sleeps_when_idle_and_ends_with_it() {
     ensure_plugins();
     let before = threads();
     let path = root().join("scenes/spheres.ron");
@@ -75,6 +97,17 @@ fn a_context_pool_is_the_only_one_used_and_its_threads_end_with_it() {
     assert!(
         new.iter().all(|n| n.starts_with("luxon-render-")),
         "only the context's pool: {new:?}"
+    );
+
+    // Idle, the pool's threads sleep: once the last render's workers have gone to sleep, a
+    // second passes with (nearly) no CPU time spent by them.
+    std::thread::sleep(Duration::from_millis(300));
+    let busy = pool_ticks();
+    std::thread::sleep(Duration::from_secs(1));
+    let idle = pool_ticks() - busy;
+    assert!(
+        idle <= 2,
+        "the idle pool used {idle} clock ticks in a second"
     );
 
     drop(scene);
