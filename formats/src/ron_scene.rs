@@ -10,6 +10,7 @@ use crate::error::{quoted_list, unknown_name, SceneError};
 use crate::geometry::InlineGeometry;
 use crate::includes::{resolve, upsert, Names};
 use crate::input::{file_error, DiskSource, LoadOptions, Source};
+use crate::instances::resolve_instances;
 use crate::obj::{is_obj_path, load_obj_with};
 use crate::spans::SourceMap;
 use crate::validate::references;
@@ -79,9 +80,17 @@ fn load_root(
         plugin_path: part.plugin_path,
         warnings: merged.warnings,
         animation: part.animation,
+        prototypes: part.prototypes,
+        instances: part.instances,
     };
     references(&scene)?;
-    resolve_animation(&mut scene, &part.light_names, &part.object_names)?;
+    resolve_instances(&scene, &part.object_names, &part.instance_names)?;
+    resolve_animation(
+        &mut scene,
+        &part.light_names,
+        &part.object_names,
+        &part.instance_names,
+    )?;
     add_meshes(&mut scene, meshes, options)?;
     Ok(scene)
 }

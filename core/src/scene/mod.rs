@@ -5,9 +5,12 @@
 
 mod build;
 mod frame;
+mod instances;
+mod place;
 
 pub use build::Prebuilt;
 pub use frame::Animation;
+pub use instances::PrototypeUse;
 
 use crate::budget::Budget;
 use crate::camera::Camera;
@@ -341,6 +344,8 @@ pub struct Scene {
     pub plugin_time: Duration,
     /// Keyed objects placed at the current frame (empty in a still scene).
     pub moving: Group,
+    /// The prototypes with instances, and how each was realised.
+    pub prototypes: Vec<PrototypeUse>,
     /// How the scene changes from frame to frame; `None`: a still scene.
     pub animation: Option<Box<Animation>>,
     /// The memory budget the build charged (geometry, BVHs, volumes, texture cache) and the
