@@ -589,3 +589,83 @@ fn a_keyed_matrix_instance_is_refused() {
         "{e}"
     );
 }
+
+/// A tetrahedron with normals and uvs, as an OBJ file moved by `m`.
+fn obj(m: &dyn Move) -> String {
+    let v = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.2],
+        [0.1, 1.0, 0.0],
+        [0.4, 0.3, 0.9],
+    ];
+    let n = [
+        [0.0, 0.0, -1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.3, 0.3, 0.9],
+    ];
+    let mut s = String::new();
+    for p in v {
+        let p = m.point(p);
+        let _ = writeln!(s, "v {:?} {:?} {:?}", p[0], p[1], p[2]);
+    }
+    for q in n {
+        let q = m.normal(q);
+        let _ = writeln!(s, "vn {:?} {:?} {:?}", q[0], q[1], q[2]);
+    }
+    s.push_str("vt 0 0\nvt 1 0\nvt 0 1\nvt 0.5 0.5\n");
+    s.push_str(
+        "f 1/1/1 3/3/3 2/2/2\nf 1/1/1 2/2/2 4/4/4\nf 2/2/2 3/3/3 4/4/4\nf 3/3/3 1/1/1 4/4/4\n",
+    );
+    s
+}
+
+#[test]
+fn mesh_files_in_prototypes_bake_like_the_moved_file() {
+    let dir = temp_dir("inst-obj");
+    std::fs::write(dir.join("tetra.obj"), obj(&Stay)).unwrap();
+    let transforms = [
+        "(translate: (-1, -0.5, 0))",
+        "(rotate: (axis: (1, 2, 3), degrees: 37), translate: (1, 0, 0))",
+        "(matrix: ((-1.2, 0, 0, 0.2), (0, 1.2, 0, 0.5), (0, 0, 1.2, -1)))",
+    ];
+    let head = r#"Scene(
+    camera: (position: (0, 1, -5), look_at: (0, 0, 0), fov: 50),
+    lights: [Point(position: (-3, 4, -5))],
+    materials: { "red": (color: (0.8, 0.2, 0.1), specular: 0.5), "blue": (color: (0.2, 0.3, 0.9)) },
+"#;
+    let mut inst = format!(
+        "{head}    prototypes: {{ \"t\": (objects: [(plugin: \"sphere\", params: (center: (0, 0, 0), radius: 0.2), material: \"blue\")], meshes: [(file: \"tetra.obj\", material: \"red\")]) }},\n    instances: [\n"
+    );
+    for t in transforms {
+        let _ = writeln!(inst, "        (prototype: \"t\", world_from_object: {t}),");
+    }
+    inst.push_str("    ],\n    render: (width: 80, height: 60),\n)\n");
+    let inst = load(&dir, "instanced.ron", &inst);
+    let mut spheres = Vec::new();
+    let mut meshes = Vec::new();
+    for (k, i) in inst.instances.iter().enumerate() {
+        let p = Placement::from_desc(&i.value.world_from_object.value);
+        std::fs::write(dir.join(format!("t{k}.obj")), obj(&p)).unwrap();
+        spheres.push(format!(
+            "{}, material: \"blue\")",
+            Obj::Sphere([0.0; 3], 0.2).text(&p)
+        ));
+        meshes.push(format!("(file: \"t{k}.obj\", material: \"red\")"));
+    }
+    let flat = format!(
+        "{head}    objects: [{}],\n    meshes: [{}],\n    render: (width: 80, height: 60),\n)\n",
+        spheres.join(", "),
+        meshes.join(", ")
+    );
+    let flat = load(&dir, "flat.ron", &flat);
+    let scene = build(&inst).unwrap();
+    assert_eq!(scene.triangles.len(), 12);
+    assert_eq!(
+        (scene.prototypes[0].objects, scene.prototypes[0].meshes),
+        (1, 1)
+    );
+    let want = render(&flat, 2);
+    assert!(want.rgba.chunks(4).filter(|p| p[0] > 0.3).count() > 100);
+    assert!(bits(&render(&inst, 2)) == bits(&want));
+}

@@ -23,7 +23,7 @@ pub(crate) struct Part {
     pub objects: Vec<Spanned<ObjectDesc>>,
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
     /// `meshes:` entries, read after merging (see `ron_scene`).
-    pub meshes: Vec<MeshRef>,
+    pub meshes: Vec<MeshFile>,
     /// Without outputs: those are merged as a list, the rest as a whole.
     pub render: Option<RenderDesc>,
     pub outputs: Vec<OutputDesc>,
@@ -38,13 +38,6 @@ pub(crate) struct Part {
     pub instance_names: Vec<(usize, Spanned<String>)>,
     /// Where this part's `render` gives `frame` or `time` (which an animation decides).
     pub render_clock: Option<Origin>,
-}
-
-/// A mesh file named by a scene: the path resolved against that scene file, at the `file`
-/// string; the material that replaces the file's own, at its string.
-pub(crate) struct MeshRef {
-    pub file: Spanned<PathBuf>,
-    pub material: Option<Spanned<String>>,
 }
 
 type Result<T> = std::result::Result<T, crate::error::SceneError>;
@@ -157,20 +150,7 @@ impl Checker<'_> {
         }
         for (i, mesh) in scene.meshes.into_iter().enumerate() {
             let node = field("meshes").item(i).unwrap_or(root);
-            let file_node = node.field("file").unwrap_or(node);
-            if mesh.file.trim().is_empty() {
-                return Err(self.error(
-                    file_node,
-                    "the mesh file name is empty; expected a path such as \"teapot.obj\"",
-                ));
-            }
-            let material = mesh
-                .material
-                .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
-            part.meshes.push(MeshRef {
-                file: self.spanned(dir.join(&mesh.file), file_node),
-                material,
-            });
+            part.meshes.push(self.mesh(mesh, node)?);
         }
         if let Some(a) = scene.animation {
             let at = field("animation");
@@ -187,6 +167,26 @@ impl Checker<'_> {
             part.outputs = outputs;
         }
         Ok(part)
+    }
+
+    /// A `meshes:` entry (of the scene or of a prototype) at `node`, its path resolved against
+    /// this file's directory.
+    pub(crate) fn mesh(&self, mesh: raw::Mesh, node: &Node) -> Result<MeshFile> {
+        let file_node = node.field("file").unwrap_or(node);
+        if mesh.file.trim().is_empty() {
+            return Err(self.error(
+                file_node,
+                "the mesh file name is empty; expected a path such as \"teapot.obj\"",
+            ));
+        }
+        let dir = self.src.file.parent().unwrap_or(Path::new(""));
+        let material = mesh
+            .material
+            .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
+        Ok(MeshFile {
+            file: self.spanned(dir.join(&mesh.file), file_node),
+            material,
+        })
     }
 
     /// An object of `objects:` (or of a prototype) at `node`.

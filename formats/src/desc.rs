@@ -350,11 +350,31 @@ pub struct ObjectDesc {
     pub shadows: bool,
 }
 
-/// A named group of objects, placed any number of times by instances. Its objects use no clip
-/// groups (clip planes are in world space).
+/// A named group of objects and meshes, placed any number of times by instances. Its objects
+/// use no clip groups (clip planes are in world space).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PrototypeDesc {
     pub objects: Vec<Spanned<ObjectDesc>>,
+    /// The geometry of its `meshes:` files (read after merging, like the scene's), in file
+    /// order, in the prototype's coordinates.
+    pub inline: Vec<InlineGeometry>,
+    /// The `meshes:` entries, until the loader reads them into `inline` (then empty).
+    pub mesh_files: Vec<MeshFile>,
+}
+
+impl PrototypeDesc {
+    /// Whether it holds nothing to place.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty() && self.inline.iter().all(InlineGeometry::is_empty)
+    }
+}
+
+/// A mesh file named by a scene: the path resolved against that scene file, at the `file`
+/// string; the material that replaces the file's own, at its string.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFile {
+    pub file: Spanned<PathBuf>,
+    pub material: Option<Spanned<String>>,
 }
 
 /// A copy of a prototype in the world.

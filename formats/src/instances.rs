@@ -40,7 +40,17 @@ impl Checker<'_> {
             }
             objects.push(self.object(o, at)?);
         }
-        Ok(self.spanned(PrototypeDesc { objects }, key))
+        let list = node.field("meshes").unwrap_or(node);
+        let mut mesh_files = Vec::with_capacity(p.meshes.len());
+        for (i, m) in p.meshes.into_iter().enumerate() {
+            mesh_files.push(self.mesh(m, list.item(i).unwrap_or(list))?);
+        }
+        let p = PrototypeDesc {
+            objects,
+            inline: Vec::new(),
+            mesh_files,
+        };
+        Ok(self.spanned(p, key))
     }
 
     /// The instance at `node`.
@@ -146,6 +156,9 @@ pub(crate) fn resolve_instances(
         for o in &p.value.objects {
             material(&o.value.material)?;
         }
+        for m in &p.value.mesh_files {
+            material(&m.material)?;
+        }
     }
     let names: Vec<&str> = scene.prototypes.iter().map(|(n, _)| n.as_str()).collect();
     for instance in &scene.instances {
@@ -155,7 +168,7 @@ pub(crate) fn resolve_instances(
             let message = unknown_name("prototype", &wanted.value, "", names.iter().copied());
             return Err(SceneError::at(wanted.at.clone(), message));
         };
-        if p.value.objects.is_empty() {
+        if p.value.objects.is_empty() && p.value.mesh_files.is_empty() {
             return Err(SceneError::at(
                 wanted.at.clone(),
                 format!(

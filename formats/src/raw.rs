@@ -340,13 +340,15 @@ pub(crate) struct Object {
     pub shadows: Option<bool>,
 }
 
-/// A named group of objects placed by `instances:`. Only objects: lights, volumes and other
+/// A named group of objects and mesh files placed by `instances:`. Lights, volumes and other
 /// instances have no place in it (serde rejects them by name).
 #[derive(Deserialize)]
 #[serde(rename = "Prototype", deny_unknown_fields)]
 pub(crate) struct Prototype {
     #[serde(default)]
     pub objects: Vec<Object>,
+    #[serde(default)]
+    pub meshes: Vec<Mesh>,
 }
 
 /// A copy of a prototype, placed by `world_from_object` (the identity when absent).

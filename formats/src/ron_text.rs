@@ -386,7 +386,13 @@ fn write_instances(
         w.extend_from_slice(b"    prototypes: {\n");
         for (name, p) in prototypes {
             let _ = writeln!(w, "        {}: (objects: [", string(name));
-            for o in &p.value.objects {
+            // Its meshes as objects after its own, as for the scene's (see the module docs).
+            let meshes = p
+                .value
+                .inline
+                .iter()
+                .flat_map(|g| inline_as_objects(g, &p.at));
+            for o in p.value.objects.iter().cloned().chain(meshes) {
                 let _ = writeln!(w, "            {},", object(&o.value, None));
             }
             w.extend_from_slice(b"        ]),\n");

@@ -133,7 +133,9 @@ fn transforms_must_be_invertible() {
         &["the `matrix` is singular", "expected an invertible transform"],
     );
     check(
-        &format!("{GEAR}    instances: [(prototype: \"gear\", world_from_object: (scale: (1, 0, 1)))],"),
+        &format!(
+            "{GEAR}    instances: [(prototype: \"gear\", world_from_object: (scale: (1, 0, 1)))],"
+        ),
         6,
         "0, 1)))",
         &["`scale` has a zero component"],
@@ -170,7 +172,7 @@ fn prototypes_hold_objects_only() {
         r#"    prototypes: { "p": (objects: [], lights: []) },"#,
         5,
         "lights",
-        &["unknown field `lights`", "`objects`"],
+        &["unknown field `lights`", "`objects`, `meshes`"],
     );
     check(
         r#"    prototypes: { "p": (instances: []) },"#,
@@ -266,7 +268,10 @@ fn keyed_instances_are_found_by_name() {
     ));
     let a = s.animation.unwrap().value;
     assert_eq!(a.instances.len(), 1);
-    assert_eq!((a.instances[0].object, a.instances[0].name.value.as_str()), (1, "g1"));
+    assert_eq!(
+        (a.instances[0].object, a.instances[0].name.value.as_str()),
+        (1, "g1")
+    );
     assert_eq!(a.objects.len(), 1);
     assert_eq!(a.objects[0].name.value, "ball");
     check(
@@ -276,7 +281,11 @@ fn keyed_instances_are_found_by_name() {
         ),
         7,
         "\"g9\"",
-        &["unknown object `g9`", "did you mean `g0`?", "expected one of `ball`, `g0`"],
+        &[
+            "unknown object `g9`",
+            "did you mean `g0`?",
+            "expected one of `ball`, `g0`",
+        ],
     );
 }
 
@@ -289,7 +298,10 @@ fn convert_writes_them_back() {
     ],"#
     ));
     let text = to_ron(&s, Path::new("")).unwrap();
-    assert!(text.contains("    prototypes: {\n        \"gear\": (objects: [\n"), "{text}");
+    assert!(
+        text.contains("    prototypes: {\n        \"gear\": (objects: [\n"),
+        "{text}"
+    );
     let back = load_ron_str(&text, Path::new("b.ron")).unwrap_or_else(|e| panic!("{e}\n{text}"));
     let values = |d: &SceneDesc| {
         let i: Vec<(String, TransformDesc, Option<String>, Option<String>)> = d
@@ -310,11 +322,67 @@ fn convert_writes_them_back() {
             .iter()
             .map(|(n, p)| {
                 let o = p.value.objects.iter();
-                let o = o.map(|o| (o.value.call.plugin.value.clone(), o.value.call.params.clone()));
+                let o = o.map(|o| {
+                    (
+                        o.value.call.plugin.value.clone(),
+                        o.value.call.params.clone(),
+                    )
+                });
                 (n.clone(), o.collect())
             })
             .collect();
         (i, p)
     };
     assert_eq!(values(&back), values(&s));
+}
+
+#[test]
+fn prototype_meshes_are_read_after_merging() {
+    let dir = std::env::temp_dir().join(format!("luxon-fmt-inst-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("tri.obj"),
+        "mtllib tri.mtl\nusemtl shiny\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("tri.mtl"), "newmtl shiny\nKd 0.5 0.5 0.5\n").unwrap();
+    let path = dir.join("s.ron");
+    let text = |mesh: &str| {
+        format!(
+            "Scene(\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    materials: {{ \"red\": (color: (1, 0, 0)) }},\n    prototypes: {{ \"t\": (meshes: [{mesh}]) }},\n    instances: [(prototype: \"t\")],\n)\n"
+        )
+    };
+    let s = load_ron_str(&text(r#"(file: "tri.obj")"#), &path).unwrap_or_else(|e| panic!("{e}"));
+    let p = &s.prototypes[0].1.value;
+    assert!(p.mesh_files.is_empty() && s.inline.is_empty());
+    assert_eq!(p.inline.len(), 1);
+    assert_eq!(p.inline[0].mesh.indices.len(), 1);
+    // The file's own material joins the scene's.
+    let own = &p.inline[0].material.as_ref().unwrap().value;
+    assert_eq!(own, "obj:tri:shiny");
+    assert!(s.materials.iter().any(|(n, _)| n == own));
+    let s = load_ron_str(&text(r#"(file: "tri.obj", material: "red")"#), &path).unwrap();
+    assert_eq!(
+        s.prototypes[0].1.value.inline[0]
+            .material
+            .as_ref()
+            .unwrap()
+            .value,
+        "red"
+    );
+    let e = load_ron_str(&text(r#"(file: "tri.obj", material: "rd")"#), &path).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("s.ron:4:62: unknown material `rd`; did you mean `red`?"),
+        "{e}"
+    );
+    let e = load_ron_str(&text(r#"(file: "missing.obj")"#), &path).unwrap_err();
+    assert!(e.to_string().contains("s.ron:4:41:"), "{e}");
+    let e = load_ron_str(&text(r#"(file: "")"#), &path).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("s.ron:4:41: the mesh file name is empty"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -157,10 +157,16 @@ fn prototype(p: &luxon::scene::PrototypeUse) -> String {
     if p.keyed > 0 {
         how.push(format!("{} keyed (placed anew each frame)", p.keyed));
     }
+    let mut size = plural(p.objects, "object", "objects");
+    if p.meshes > 0 {
+        size.push_str(&format!(
+            ", {}",
+            plural(p.meshes, "mesh group", "mesh groups")
+        ));
+    }
     format!(
-        "`{}`: {}, {} per copy; {}: {}",
+        "`{}`: {size}, {} per copy; {}: {}",
         p.name,
-        plural(p.objects, "object", "objects"),
         plural(p.primitives, "primitive", "primitives"),
         plural(p.baked + p.keyed, "instance", "instances"),
         how.join(", ")

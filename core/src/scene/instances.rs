@@ -27,10 +27,11 @@ use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
 use crate::math::DVec3;
 use crate::motion::Placement;
-use crate::plugin::primitive::{create_primitive, GeometryBuilder, Recorded};
+use crate::plugin::primitive::{create_primitive, GeometryBuilder, Recorded, RecordedMesh};
 use crate::plugin::{PluginKind, Registry};
 use luxon_formats::{
-    InstanceDesc, Key, ObjectTracks, Origin, SceneDesc, Spanned, Track, TransformDesc,
+    InlineGeometry, InstanceDesc, Key, ObjectTracks, Origin, SceneDesc, Spanned, Track,
+    TransformDesc,
 };
 use std::path::Path;
 use std::sync::Arc;
@@ -41,6 +42,8 @@ pub struct PrototypeUse {
     pub name: String,
     /// Objects in the prototype.
     pub objects: usize,
+    /// Groups of its mesh files (one per material).
+    pub meshes: usize,
     /// Instances stored as flat copies.
     pub baked: usize,
     /// Instances keyed by the animation, placed anew at every frame.
@@ -88,8 +91,8 @@ pub(super) fn bake(
     if desc.instances.is_empty() {
         return Ok(baked);
     }
-    // Each prototype with an instance, recorded once: (its objects' recordings, its report).
-    let mut recorded: Vec<Option<Vec<Recorded>>> = vec![None; desc.prototypes.len()];
+    // Each prototype with an instance, recorded once.
+    let mut recorded: Vec<Option<Vec<Part>>> = vec![None; desc.prototypes.len()];
     let mut instance_of = Vec::with_capacity(desc.instances.len());
     for inst in &desc.instances {
         let want = &inst.value.prototype;
@@ -111,25 +114,28 @@ pub(super) fn bake(
         .map(|((name, p), r)| PrototypeUse {
             name: name.clone(),
             objects: p.value.objects.len(),
+            meshes: p.value.inline.len(),
             baked: 0,
             keyed: 0,
-            primitives: r.as_ref().map_or(0, |r| r.iter().map(primitives).sum()),
+            primitives: r
+                .as_ref()
+                .map_or(0, |r| r.iter().map(|p| primitives(&p.geometry)).sum()),
         })
         .collect();
     let keyed_tracks = desc.animation.as_ref().map(|a| &a.value.instances);
     for (k, (inst, &p)) in desc.instances.iter().zip(&instance_of).enumerate() {
-        let (name, proto) = &desc.prototypes[p];
-        let copies = recorded[p].as_ref().expect("recorded above");
+        let name = &desc.prototypes[p].0;
+        let parts = recorded[p].as_ref().expect("recorded above");
         let what = || describe(k, inst, name);
         let tracks = keyed_tracks.and_then(|t| t.iter().find(|t| t.object == k));
         if let Some(tracks) = tracks {
             let tracks = with_static(tracks, &inst.value.world_from_object, &what)?;
-            for (o, g) in proto.value.objects.iter().zip(copies) {
-                let m = material(material_of, &inst.value, &o.value.material, o.value.shadows)?;
+            for part in parts {
+                let m = material(material_of, &inst.value, &part.material, part.shadows)?;
                 used[m] = true;
                 baked.keyed.push(Keyed {
                     tracks: tracks.clone(),
-                    geometry: g.clone(),
+                    geometry: part.geometry.clone(),
                     material: pack(m as u32, 0),
                     at: inst.at.clone(),
                 });
@@ -138,8 +144,9 @@ pub(super) fn bake(
             continue;
         }
         let placement = Placement::from_desc(&inst.value.world_from_object.value);
-        let round = copies
+        let round = parts
             .iter()
+            .map(|p| &p.geometry)
             .any(|g| !(g.spheres.is_empty() && g.cones.is_empty() && g.discs.is_empty()));
         if round && placement.uniform_scale().is_none() {
             return Err(Error::at(
@@ -154,8 +161,8 @@ pub(super) fn bake(
                 ),
             ));
         }
-        for (j, (o, g)) in proto.value.objects.iter().zip(copies).enumerate() {
-            let m = material(material_of, &inst.value, &o.value.material, o.value.shadows)?;
+        for part in parts {
+            let m = material(material_of, &inst.value, &part.material, part.shadows)?;
             used[m] = true;
             let into = Sets {
                 spheres: &mut *sets.spheres,
@@ -165,14 +172,14 @@ pub(super) fn bake(
                 discs: &mut *sets.discs,
             };
             baked.dropped += place(
-                g,
+                &part.geometry,
                 &placement,
                 cx.world_offset,
                 pack(m as u32, 0),
                 into,
                 cx.budget,
             )
-            .map_err(|e| Error::at(&inst.at, format!("{}, object {j}: {e}", what())))?;
+            .map_err(|e| Error::at(&inst.at, format!("{}, {}: {e}", what(), part.label)))?;
         }
         uses[p].baked += 1;
     }
@@ -212,8 +219,47 @@ fn primitives(g: &Recorded) -> usize {
         + g.meshes.iter().map(|m| m.indices.len() / 3).sum::<usize>()
 }
 
-/// Runs prototype `p`'s objects through their plugins into recordings (object space).
-fn record(cx: &Context, p: usize) -> Result<Vec<Recorded>, Error> {
+/// A part of a prototype as recorded: an object's plugin output, or a group of a mesh file.
+#[derive(Clone)]
+struct Part {
+    geometry: Recorded,
+    material: Option<Spanned<String>>,
+    shadows: bool,
+    /// "object 2", "mesh group 0", for messages.
+    label: String,
+}
+
+/// Group `k` of a prototype's mesh files as a recording (its arrays as a plugin would give
+/// them).
+fn inline_part(k: usize, g: &InlineGeometry) -> Part {
+    let m = &g.mesh;
+    let mut geometry = Recorded {
+        spheres: g.spheres.clone(),
+        planes: g.planes.clone(),
+        cones: g.cones.clone(),
+        discs: g.discs.clone(),
+        meshes: Vec::new(),
+    };
+    if !m.indices.is_empty() {
+        geometry.meshes.push(RecordedMesh {
+            positions: m.positions.as_flattened().to_vec(),
+            indices: m.indices.as_flattened().to_vec(),
+            normals: m.normals.as_flattened().to_vec(),
+            colors: Vec::new(),
+            uvs: m.uvs.iter().flat_map(|u| u.map(|x| x as f32)).collect(),
+        });
+    }
+    Part {
+        geometry,
+        material: g.material.clone(),
+        shadows: !g.shadowless,
+        label: format!("mesh group {k}"),
+    }
+}
+
+/// Runs prototype `p`'s objects through their plugins into recordings (object space), then
+/// its mesh files' groups.
+fn record(cx: &Context, p: usize) -> Result<Vec<Part>, Error> {
     let (name, proto) = &cx.desc.prototypes[p];
     let mut out = Vec::with_capacity(proto.value.objects.len());
     // Recording stores nothing in these; the builder wants somewhere to point.
@@ -256,8 +302,21 @@ fn record(cx: &Context, p: usize) -> Result<Vec<Recorded>, Error> {
             &mut b,
         )
         .map_err(|(at, m)| Error::at(&at, m))?;
-        out.push(geometry);
+        out.push(Part {
+            geometry,
+            material: obj.value.material.clone(),
+            shadows: obj.value.shadows,
+            label: format!("object {j}"),
+        });
     }
+    out.extend(
+        proto
+            .value
+            .inline
+            .iter()
+            .enumerate()
+            .map(|(k, g)| inline_part(k, g)),
+    );
     Ok(out)
 }
 
@@ -318,8 +377,14 @@ pub(super) fn shadowless(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
         let Some((_, p)) = desc.prototypes.iter().find(|(n, _)| n == want) else {
             continue;
         };
-        for o in p.value.objects.iter().filter(|o| !o.value.shadows) {
-            let name = inst.value.material.as_ref().or(o.value.material.as_ref());
+        let objects = p
+            .value
+            .objects
+            .iter()
+            .map(|o| (&o.value.material, o.value.shadows));
+        let groups = p.value.inline.iter().map(|g| (&g.material, !g.shadowless));
+        for (own, _) in objects.chain(groups).filter(|(_, shadows)| !shadows) {
+            let name = inst.value.material.as_ref().or(own.as_ref());
             out.push(name.cloned());
         }
     }
