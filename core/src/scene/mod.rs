@@ -1,7 +1,9 @@
 //! `Scene`: a `SceneDesc` with plugins resolved and called, geometry stored natively and
 //! re-centred, BVHs built, and the set of effects the scene calls for; and the queries the
 //! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`;
-//! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`.
+//! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`;
+//! instances of prototypes, baked into flat copies, in `instances`; moving recorded geometry
+//! by a transform (for both) in `place`.
 
 mod build;
 mod frame;
