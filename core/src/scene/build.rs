@@ -1,9 +1,9 @@
 //! Building a [`Scene`] from its description, in the stages [`Scene::build_from`] runs in order:
 //! textures, volumes, materials, clip groups, render volumes, objects (plugins, then imported
-//! geometry, then baked instances, then a cache's prebuilt geometry), BVHs, lights, and the effects the scene calls
-//! for; an animated scene then goes to its first frame (keyed objects are recorded by the
-//! objects stage, not stored, see `frame`). A new kind of scene content gets a stage of its own
-//! here.
+//! geometry, then baked instances, then a cache's prebuilt geometry), BVHs, lights, and the
+//! effects the scene calls for; an animated scene then goes to its first frame (keyed objects
+//! and instances are recorded, not stored, see `frame`). A new kind of scene content gets a
+//! stage of its own here.
 
 use super::frame::{self, Animation, Keyed};
 use super::instances::{self, PrototypeUse};

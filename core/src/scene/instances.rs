@@ -79,7 +79,7 @@ pub(super) struct Baked {
 pub(super) fn bake(
     cx: &Context,
     material_of: &MaterialOf,
-    sets: Sets,
+    mut sets: Sets,
     used: &mut [bool],
 ) -> Result<Baked, Error> {
     let desc = cx.desc;
@@ -164,19 +164,12 @@ pub(super) fn bake(
         for part in parts {
             let m = material(material_of, &inst.value, &part.material, part.shadows)?;
             used[m] = true;
-            let into = Sets {
-                spheres: &mut *sets.spheres,
-                triangles: &mut *sets.triangles,
-                planes: &mut *sets.planes,
-                cones: &mut *sets.cones,
-                discs: &mut *sets.discs,
-            };
             baked.dropped += place(
                 &part.geometry,
                 &placement,
                 cx.world_offset,
                 pack(m as u32, 0),
-                into,
+                sets.reborrow(),
                 cx.budget,
             )
             .map_err(|e| Error::at(&inst.at, format!("{}, {}: {e}", what(), part.label)))?;
