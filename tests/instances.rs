@@ -547,6 +547,16 @@ fn keyed_instances_move_like_keyed_objects() {
     let (mut sa, mut sb) = (build(&a).unwrap(), build(&b).unwrap());
     assert_eq!(sb.prototypes[0].keyed, 1);
     assert_eq!(sb.cones.len(), 0, "a keyed instance is not baked");
+    let out = run(&["check", dir.join("instance.ron").to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("1 instance: 1 keyed (placed anew each frame)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("keyed: instance `b` translate (Linear, 2 keys), rotate"),
+        "{text}"
+    );
     for k in 0..3 {
         sa.set_frame(k).unwrap();
         sb.set_frame(k).unwrap();
