@@ -76,6 +76,11 @@ fn animation_carousel_frames() {
 }
 
 #[test]
+fn instances_ring_of_molecules() {
+    check("instances");
+}
+
+#[test]
 fn spheres() {
     check("spheres");
 }

@@ -46,7 +46,14 @@ const FORMATS: &[(&str, &[&str])] = &[
     ("checks", &["validate", "ron_error"]),
     (
         "conversion",
-        &["convert", "camera", "effects", "volume_render", "animation"],
+        &[
+            "convert",
+            "camera",
+            "effects",
+            "volume_render",
+            "animation",
+            "instances",
+        ],
     ),
     ("importers", &["nff", "obj", "tachyon"]),
     ("includes", &["includes"]),

@@ -173,6 +173,7 @@ impl Checker<'_> {
             lights,
             materials,
             objects,
+            instances: Vec::new(),
         })
     }
 
@@ -415,11 +416,13 @@ impl Value for [f64; 3] {
 /// After merging: light and object names resolved to indices (unknown names, and names given
 /// twice, are errors), and every keyed property checked against its target — material names
 /// defined, the light kind having that property, `fov` on a perspective camera, and so on.
-/// `lights` and `objects` are the names in the merged lists.
+/// `lights`, `objects` and `instances` are the names in the merged lists; an entry of
+/// `objects:` that names an instance moves to `AnimationDesc::instances`.
 pub(crate) fn resolve_animation(
     scene: &mut SceneDesc,
     lights: &ItemNames,
     objects: &ItemNames,
+    instances: &ItemNames,
 ) -> Result<()> {
     once(lights, "light")?;
     once(objects, "object")?;
@@ -495,18 +498,30 @@ pub(crate) fn resolve_animation(
             return Err(SceneError::at(m.material.at.clone(), message));
         }
     }
-    for o in &mut a.objects {
-        let Some((i, _)) = objects.iter().find(|(_, n)| n.value == o.name.value) else {
-            let known = objects.iter().map(|(_, n)| n.value.as_str());
+    for mut o in std::mem::take(&mut a.objects) {
+        let found = |names: &ItemNames| {
+            let named = names.iter().find(|(_, n)| n.value == o.name.value);
+            named.map(|(i, _)| *i)
+        };
+        if let Some(i) = found(objects) {
+            o.object = i;
+            a.objects.push(o);
+        } else if let Some(i) = found(instances) {
+            o.object = i;
+            a.instances.push(o);
+        } else {
+            let known = objects
+                .iter()
+                .chain(instances)
+                .map(|(_, n)| n.value.as_str());
             let message = unknown_name(
                 "object",
                 &o.name.value,
-                " (objects are named by `name:`)",
+                " (objects and instances are named by `name:`)",
                 known,
             );
             return Err(SceneError::at(o.name.at.clone(), message));
-        };
-        o.object = *i;
+        }
     }
     Ok(())
 }

@@ -23,7 +23,7 @@ pub(crate) struct Part {
     pub objects: Vec<Spanned<ObjectDesc>>,
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
     /// `meshes:` entries, read after merging (see `ron_scene`).
-    pub meshes: Vec<MeshRef>,
+    pub meshes: Vec<MeshFile>,
     /// Without outputs: those are merged as a list, the rest as a whole.
     pub render: Option<RenderDesc>,
     pub outputs: Vec<OutputDesc>,
@@ -32,15 +32,12 @@ pub(crate) struct Part {
     /// The named lights and objects (index within this part's list).
     pub light_names: Vec<(usize, Spanned<String>)>,
     pub object_names: Vec<(usize, Spanned<String>)>,
+    pub prototypes: Vec<(String, Spanned<PrototypeDesc>)>,
+    pub instances: Vec<Spanned<InstanceDesc>>,
+    /// The named instances (index within this part's list).
+    pub instance_names: Vec<(usize, Spanned<String>)>,
     /// Where this part's `render` gives `frame` or `time` (which an animation decides).
     pub render_clock: Option<Origin>,
-}
-
-/// A mesh file named by a scene: the path resolved against that scene file, at the `file`
-/// string; the material that replaces the file's own, at its string.
-pub(crate) struct MeshRef {
-    pub file: Spanned<PathBuf>,
-    pub material: Option<Spanned<String>>,
 }
 
 type Result<T> = std::result::Result<T, crate::error::SceneError>;
@@ -131,27 +128,21 @@ impl Checker<'_> {
         }
         for (i, object) in scene.objects.into_iter().enumerate() {
             let node = field("objects").item(i).unwrap_or(root);
-            let plugin = self.plugin_name(
-                node.field("plugin").unwrap_or(node),
-                object.plugin,
-                "sphere",
-            )?;
-            let material = object
-                .material
-                .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
-            let clip = object
-                .clip
-                .map(|c| self.spanned(c, node.field("clip").unwrap_or(node)));
-            let call = self.call(plugin, node);
-            part.objects.push(self.spanned(
-                ObjectDesc {
-                    call,
-                    material,
-                    clip,
-                    shadows: object.shadows.unwrap_or(true),
-                },
-                node,
-            ));
+            part.objects.push(self.object(object, node)?);
+        }
+        self.names_once(field("prototypes"), "prototype", &scene.prototypes.0)?;
+        for (i, (name, p)) in scene.prototypes.0.into_iter().enumerate() {
+            let (key, node) = field("prototypes").entry(i).unwrap_or((root, root));
+            part.prototypes.push((name, self.prototype(p, key, node)?));
+        }
+        part.instance_names = self.item_names(
+            field("instances"),
+            scene.instances.iter().map(|o| o.name.as_deref()),
+            "instance",
+        )?;
+        for (i, instance) in scene.instances.into_iter().enumerate() {
+            let node = field("instances").item(i).unwrap_or(root);
+            part.instances.push(self.instance(instance, node)?);
         }
         for (i, volume) in scene.volumes.into_iter().enumerate() {
             let node = field("volumes").item(i).unwrap_or(root);
@@ -159,20 +150,7 @@ impl Checker<'_> {
         }
         for (i, mesh) in scene.meshes.into_iter().enumerate() {
             let node = field("meshes").item(i).unwrap_or(root);
-            let file_node = node.field("file").unwrap_or(node);
-            if mesh.file.trim().is_empty() {
-                return Err(self.error(
-                    file_node,
-                    "the mesh file name is empty; expected a path such as \"teapot.obj\"",
-                ));
-            }
-            let material = mesh
-                .material
-                .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
-            part.meshes.push(MeshRef {
-                file: self.spanned(dir.join(&mesh.file), file_node),
-                material,
-            });
+            part.meshes.push(self.mesh(mesh, node)?);
         }
         if let Some(a) = scene.animation {
             let at = field("animation");
@@ -191,10 +169,60 @@ impl Checker<'_> {
         Ok(part)
     }
 
+    /// A `meshes:` entry (of the scene or of a prototype) at `node`, its path resolved against
+    /// this file's directory.
+    pub(crate) fn mesh(&self, mesh: raw::Mesh, node: &Node) -> Result<MeshFile> {
+        let file_node = node.field("file").unwrap_or(node);
+        if mesh.file.trim().is_empty() {
+            return Err(self.error(
+                file_node,
+                "the mesh file name is empty; expected a path such as \"teapot.obj\"",
+            ));
+        }
+        let dir = self.src.file.parent().unwrap_or(Path::new(""));
+        let material = mesh
+            .material
+            .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
+        Ok(MeshFile {
+            file: self.spanned(dir.join(&mesh.file), file_node),
+            material,
+        })
+    }
+
+    /// An object of `objects:` (or of a prototype) at `node`.
+    pub(crate) fn object(&self, object: raw::Object, node: &Node) -> Result<Spanned<ObjectDesc>> {
+        let plugin = self.plugin_name(
+            node.field("plugin").unwrap_or(node),
+            object.plugin,
+            "sphere",
+        )?;
+        let material = object
+            .material
+            .map(|m| self.spanned(m, node.field("material").unwrap_or(node)));
+        let clip = object
+            .clip
+            .map(|c| self.spanned(c, node.field("clip").unwrap_or(node)));
+        let call = self.call(plugin, node);
+        Ok(self.spanned(
+            ObjectDesc {
+                call,
+                material,
+                clip,
+                shadows: object.shadows.unwrap_or(true),
+            },
+            node,
+        ))
+    }
+
     /// Each name of a map (`node`, holding `entries`) once: a second definition in the same
     /// file is an error at its key, naming the first (a file that includes this one may still
     /// redefine the name: later files win).
-    fn names_once<T>(&self, node: &Node, what: &str, entries: &[(String, T)]) -> Result<()> {
+    pub(crate) fn names_once<T>(
+        &self,
+        node: &Node,
+        what: &str,
+        entries: &[(String, T)],
+    ) -> Result<()> {
         let mut seen: HashMap<&str, usize> = HashMap::new();
         for (i, (name, _)) in entries.iter().enumerate() {
             if let Some(&first) = seen.get(name.as_str()) {

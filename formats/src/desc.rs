@@ -50,6 +50,12 @@ pub struct SceneDesc {
     pub warnings: Vec<Warning>,
     /// The `animation:` block (RON scenes only); `None`: a still scene.
     pub animation: Option<Spanned<AnimationDesc>>,
+    /// Named groups of objects that `instances` place (RON scenes only), in file order (later
+    /// definitions of a name replace earlier ones).
+    pub prototypes: Vec<(String, Spanned<PrototypeDesc>)>,
+    /// Copies of prototypes, in file order (includes first); stored after `objects` and
+    /// `inline`.
+    pub instances: Vec<Spanned<InstanceDesc>>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -342,6 +348,68 @@ pub struct ObjectDesc {
     /// Whether the object casts shadows (false: shadow and occlusion rays pass through it, as
     /// through a light's visible sphere).
     pub shadows: bool,
+}
+
+/// A named group of objects and meshes, placed any number of times by instances. Its objects
+/// use no clip groups (clip planes are in world space).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrototypeDesc {
+    pub objects: Vec<Spanned<ObjectDesc>>,
+    /// The geometry of its `meshes:` files (read after merging, like the scene's), in file
+    /// order, in the prototype's coordinates.
+    pub inline: Vec<InlineGeometry>,
+    /// The `meshes:` entries, until the loader reads them into `inline` (then empty).
+    pub mesh_files: Vec<MeshFile>,
+}
+
+impl PrototypeDesc {
+    /// Whether it holds nothing to place.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty() && self.inline.iter().all(InlineGeometry::is_empty)
+    }
+}
+
+/// A mesh file named by a scene: the path resolved against that scene file, at the `file`
+/// string; the material that replaces the file's own, at its string.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFile {
+    pub file: Spanned<PathBuf>,
+    pub material: Option<Spanned<String>>,
+}
+
+/// A copy of a prototype in the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceDesc {
+    /// The prototype's name, where the instance names it.
+    pub prototype: Spanned<String>,
+    /// Names the instance for `animation: (objects: ...)`.
+    pub name: Option<Spanned<String>>,
+    pub world_from_object: Spanned<TransformDesc>,
+    /// Replaces the material of every object of the prototype.
+    pub material: Option<Spanned<String>>,
+}
+
+/// Where an instance's prototype goes: `world_from_object`, in f64. Always invertible (the
+/// loader checks it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TransformDesc {
+    /// Scaled by `scale`, then rotated by `rotate`, then moved by `translate` (the order of
+    /// keyed transforms).
+    Trs {
+        translate: [f64; 3],
+        rotate: Option<RotationDesc>,
+        scale: [f64; 3],
+    },
+    /// The rows of a 3x4 matrix: `p' = M · (x, y, z, 1)`.
+    Matrix([[f64; 4]; 3]),
+}
+
+impl TransformDesc {
+    pub const IDENTITY: TransformDesc = TransformDesc::Trs {
+        translate: [0.0; 3],
+        rotate: None,
+        scale: [1.0; 3],
+    };
 }
 
 /// A clip plane: what lies on the side its normal points to is cut away.
@@ -809,6 +877,9 @@ pub struct AnimationDesc {
     pub materials: Vec<MaterialTracks>,
     /// Keyed objects (by their `name`), at most one entry per object.
     pub objects: Vec<ObjectTracks>,
+    /// Keyed instances: written in `objects:` by the instance's `name`; here `object` is the
+    /// index in `SceneDesc::instances`.
+    pub instances: Vec<ObjectTracks>,
 }
 
 /// How long the shutter stays open (in frames, from 0 to 2) and where that interval sits

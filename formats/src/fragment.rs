@@ -306,8 +306,11 @@ fn only(kind: &Kind, part: Part, at: Origin) -> Result<(), SceneError> {
         outputs,
         plugin_path,
         animation,
+        prototypes,
+        instances,
         light_names: _,
         object_names: _,
+        instance_names: _,
         render_clock: _,
     } = part;
     let extra = [
@@ -326,6 +329,8 @@ fn only(kind: &Kind, part: Part, at: Origin) -> Result<(), SceneError> {
         ("outputs", !outputs.is_empty()),
         ("plugin_path", !plugin_path.is_empty()),
         ("animation", animation.is_some()),
+        ("prototypes", !prototypes.is_empty()),
+        ("instances", !instances.is_empty()),
     ];
     match extra.iter().find(|(_, set)| *set) {
         Some((field, _)) => Err(SceneError::at(

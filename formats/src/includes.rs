@@ -4,8 +4,8 @@
 //!
 //! - A file's includes are merged before the file's own content, in list order, each with its
 //!   own includes before it (a depth-first walk, each file merged after what it includes).
-//!   Lists (lights, objects, volumes, meshes, plugin paths) are concatenated; named maps
-//!   (textures, materials, clip groups) let a later definition replace an earlier one of the
+//!   Lists (lights, objects, instances, volumes, meshes, plugin paths) are concatenated;
+//!   named maps (textures, materials, clip groups, prototypes) let a later definition replace an earlier one of the
 //!   same name in its place; single settings (camera, background, fog, ambient occlusion,
 //!   render, animation) are taken from the last file that gives them. Outputs belong to the file that
 //!   renders: an including file that names any replaces those of its includes.
@@ -53,6 +53,7 @@ struct Accumulator {
     textures: Names,
     materials: Names,
     clip_groups: Names,
+    prototypes: Names,
 }
 
 /// Name to its place in a list of named definitions.
@@ -265,6 +266,11 @@ impl Accumulator {
         let shift = |names: ItemNames, by: usize| names.into_iter().map(move |(i, n)| (i + by, n));
         part.light_names.extend(shift(later.light_names, lights));
         part.object_names.extend(shift(later.object_names, objects));
+        let instances = part.instances.len();
+        part.instance_names
+            .extend(shift(later.instance_names, instances));
+        part.instances.extend(later.instances);
+        upsert(&mut part.prototypes, &mut self.prototypes, later.prototypes);
         part.lights.extend(later.lights);
         part.objects.extend(later.objects);
         part.volumes.extend(later.volumes);

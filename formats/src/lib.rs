@@ -20,7 +20,7 @@
 //! | input       | `input`, `print`                                 |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
-//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation` |
+//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation`, `instances` |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
 //! | includes    | `includes`                                       |
 //! | formats     | `ron_scene`, `spd`                               |
@@ -38,6 +38,7 @@ pub mod fragment;
 pub mod geometry;
 mod includes;
 pub mod input;
+mod instances;
 mod load;
 pub mod nff;
 pub mod obj;

@@ -732,6 +732,8 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneE
             ..RenderDesc::default()
         },
         animation: None,
+        prototypes: Vec::new(),
+        instances: Vec::new(),
         plugin_path: Vec::new(),
         warnings: import.warnings,
     })

@@ -42,6 +42,10 @@ pub(crate) struct Scene {
     pub render: Option<Render>,
     #[serde(default)]
     pub animation: Option<Animation>,
+    #[serde(default)]
+    pub prototypes: Named<Prototype>,
+    #[serde(default)]
+    pub instances: Vec<Instance>,
 }
 
 #[derive(Deserialize)]
@@ -334,6 +338,47 @@ pub(crate) struct Object {
     pub clip: Option<String>,
     #[serde(default)]
     pub shadows: Option<bool>,
+}
+
+/// A named group of objects and mesh files placed by `instances:`. Lights, volumes and other
+/// instances have no place in it (serde rejects them by name).
+#[derive(Deserialize)]
+#[serde(rename = "Prototype", deny_unknown_fields)]
+pub(crate) struct Prototype {
+    #[serde(default)]
+    pub objects: Vec<Object>,
+    #[serde(default)]
+    pub meshes: Vec<Mesh>,
+}
+
+/// A copy of a prototype, placed by `world_from_object` (the identity when absent).
+#[derive(Deserialize)]
+#[serde(rename = "Instance", deny_unknown_fields)]
+pub(crate) struct Instance {
+    pub prototype: String,
+    /// Names the instance for `animation: (objects: ...)`.
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub world_from_object: Option<Transform>,
+    /// Replaces the material of every object of the prototype.
+    #[serde(default)]
+    pub material: Option<String>,
+}
+
+/// `(translate: ..., rotate: (axis: ..., degrees: ...), scale: ...)` (scaled, then rotated,
+/// then moved) or `(matrix: ((..4..), (..4..), (..4..)))`, the rows of a 3x4 matrix.
+#[derive(Deserialize)]
+#[serde(rename = "Transform", deny_unknown_fields)]
+pub(crate) struct Transform {
+    #[serde(default)]
+    pub translate: Option<Vec3>,
+    #[serde(default)]
+    pub rotate: Option<Rotation>,
+    #[serde(default)]
+    pub scale: Option<Vec3>,
+    #[serde(default)]
+    pub matrix: Option<[[f64; 4]; 3]>,
 }
 
 /// Keeps the side of the plane its normal points away from; cuts away the other.

@@ -4,12 +4,12 @@
 use std::path::Path;
 
 use crate::animation::resolve_animation;
-use crate::convert::MeshRef;
-use crate::desc::SceneDesc;
+use crate::desc::{MeshFile, SceneDesc};
 use crate::error::{quoted_list, unknown_name, SceneError};
 use crate::geometry::InlineGeometry;
 use crate::includes::{resolve, upsert, Names};
 use crate::input::{file_error, DiskSource, LoadOptions, Source};
+use crate::instances::resolve_instances;
 use crate::obj::{is_obj_path, load_obj_with};
 use crate::spans::SourceMap;
 use crate::validate::references;
@@ -79,19 +79,27 @@ fn load_root(
         plugin_path: part.plugin_path,
         warnings: merged.warnings,
         animation: part.animation,
+        prototypes: part.prototypes,
+        instances: part.instances,
     };
     references(&scene)?;
-    resolve_animation(&mut scene, &part.light_names, &part.object_names)?;
+    resolve_instances(&scene, &part.object_names, &part.instance_names)?;
+    resolve_animation(
+        &mut scene,
+        &part.light_names,
+        &part.object_names,
+        &part.instance_names,
+    )?;
     add_meshes(&mut scene, meshes, options)?;
     Ok(scene)
 }
 
 /// Reads the `meshes:` files into `inline` geometry (and their materials, unless the entry
-/// names one), in file order, and their warnings into the scene's. All of them together within
-/// `options.max_geometry`.
+/// names one), in file order, then the prototypes' into theirs, and their warnings into the
+/// scene's. All of them together within `options.max_geometry`.
 fn add_meshes(
     scene: &mut SceneDesc,
-    meshes: Vec<MeshRef>,
+    meshes: Vec<MeshFile>,
     options: &LoadOptions,
 ) -> Result<(), SceneError> {
     let mut names: Names = scene
@@ -110,36 +118,59 @@ fn add_meshes(
         }
     }
     for mesh in meshes {
-        if !is_obj_path(&mesh.file.value) {
-            return Err(SceneError::at(
-                mesh.file.at,
-                format!(
-                    "unsupported mesh file `{}`; expected a Wavefront `.obj` file",
-                    mesh.file.value.display()
-                ),
-            ));
-        }
-        let held: u64 = scene.inline.iter().map(InlineGeometry::bytes).sum();
-        let left = LoadOptions {
-            max_geometry: options.max_geometry.saturating_sub(held),
-            ..options.clone()
-        };
-        let import = load_obj_with(&mesh.file.value, Some(mesh.file.at.clone()), &left)?;
-        scene.warnings.extend(import.warnings);
-        match mesh.material {
-            Some(material) => {
-                for mut g in import.geometry {
-                    g.material = Some(material.clone());
-                    scene.inline.push(g);
-                }
-            }
-            None => {
-                upsert(&mut scene.materials, &mut names, import.materials);
-                scene.inline.extend(import.geometry);
-            }
+        let groups = read_mesh(scene, &mut names, mesh, options)?;
+        scene.inline.extend(groups);
+    }
+    // Then the prototypes' meshes, in the prototypes' own coordinates.
+    for p in 0..scene.prototypes.len() {
+        let files = std::mem::take(&mut scene.prototypes[p].1.value.mesh_files);
+        for mesh in files {
+            let groups = read_mesh(scene, &mut names, mesh, options)?;
+            scene.prototypes[p].1.value.inline.extend(groups);
         }
     }
     Ok(())
+}
+
+/// Reads one mesh file: its groups, each with the entry's material, else with the file's own
+/// (added to the scene's materials, `names` indexing them).
+fn read_mesh(
+    scene: &mut SceneDesc,
+    names: &mut Names,
+    mesh: MeshFile,
+    options: &LoadOptions,
+) -> Result<Vec<InlineGeometry>, SceneError> {
+    if !is_obj_path(&mesh.file.value) {
+        return Err(SceneError::at(
+            mesh.file.at,
+            format!(
+                "unsupported mesh file `{}`; expected a Wavefront `.obj` file",
+                mesh.file.value.display()
+            ),
+        ));
+    }
+    let prototypes = scene.prototypes.iter().flat_map(|(_, p)| &p.value.inline);
+    let held: u64 = scene
+        .inline
+        .iter()
+        .chain(prototypes)
+        .map(InlineGeometry::bytes)
+        .sum();
+    let left = LoadOptions {
+        max_geometry: options.max_geometry.saturating_sub(held),
+        ..options.clone()
+    };
+    let mut import = load_obj_with(&mesh.file.value, Some(mesh.file.at.clone()), &left)?;
+    scene.warnings.extend(import.warnings);
+    match mesh.material {
+        Some(material) => {
+            for g in &mut import.geometry {
+                g.material = Some(material.clone());
+            }
+        }
+        None => upsert(&mut scene.materials, names, import.materials),
+    }
+    Ok(import.geometry)
 }
 
 /// Extensions this crate reads, for messages.

@@ -244,6 +244,8 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
         plugin_path,
         warnings,
         animation,
+        prototypes,
+        instances,
     } = desc;
     let anim = animation.as_ref().map(|a| &a.value);
     // The names the animation uses, by index in `lights` / `objects`.
@@ -337,26 +339,13 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     if !all.is_empty() {
         w.extend_from_slice(b"    objects: [\n");
         for (i, o) in all.iter().enumerate() {
-            let o = &o.value;
-            let _ = write!(w, "        (plugin: {}", string(&o.call.plugin.value));
             // Only the scene's own objects can be named (imported ones come after them).
-            if let Some(name) = object_name(i).filter(|_| i < objects.len()) {
-                let _ = write!(w, ", name: {}", string(name));
-            }
-            let _ = write!(w, ", params: {}", o.call.params);
-            if let Some(m) = &o.material {
-                let _ = write!(w, ", material: {}", string(&m.value));
-            }
-            if let Some(c) = &o.clip {
-                let _ = write!(w, ", clip: {}", string(&c.value));
-            }
-            if !o.shadows {
-                w.extend_from_slice(b", shadows: false");
-            }
-            w.extend_from_slice(b"),\n");
+            let name = object_name(i).filter(|_| i < objects.len());
+            let _ = writeln!(w, "        {},", object(&o.value, name));
         }
         w.extend_from_slice(b"    ],\n");
     }
+    write_instances(&mut w, prototypes, instances);
     if let Some(a) = anim {
         write_animation(&mut w, a);
     }
@@ -364,6 +353,106 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     write_render(&mut w, render, base, anim.is_none());
     w.extend_from_slice(b")\n");
     String::from_utf8(w).map_err(|e| e.to_string())
+}
+
+/// `(plugin: ..., name: ..., params: ..., material: ..., clip: ..., shadows: false)`.
+fn object(o: &ObjectDesc, name: Option<&str>) -> String {
+    let mut w = Vec::new();
+    let _ = write!(w, "(plugin: {}", string(&o.call.plugin.value));
+    if let Some(name) = name {
+        let _ = write!(w, ", name: {}", string(name));
+    }
+    let _ = write!(w, ", params: {}", o.call.params);
+    if let Some(m) = &o.material {
+        let _ = write!(w, ", material: {}", string(&m.value));
+    }
+    if let Some(c) = &o.clip {
+        let _ = write!(w, ", clip: {}", string(&c.value));
+    }
+    if !o.shadows {
+        w.extend_from_slice(b", shadows: false");
+    }
+    w.push(b')');
+    String::from_utf8(w).unwrap_or_default()
+}
+
+/// `prototypes: { ... }` and `instances: [ ... ]`, each when not empty.
+fn write_instances(
+    w: &mut Vec<u8>,
+    prototypes: &[(String, Spanned<PrototypeDesc>)],
+    instances: &[Spanned<InstanceDesc>],
+) {
+    if !prototypes.is_empty() {
+        w.extend_from_slice(b"    prototypes: {\n");
+        for (name, p) in prototypes {
+            let _ = writeln!(w, "        {}: (objects: [", string(name));
+            // Its meshes as objects after its own, as for the scene's (see the module docs).
+            let meshes = p
+                .value
+                .inline
+                .iter()
+                .flat_map(|g| inline_as_objects(g, &p.at));
+            for o in p.value.objects.iter().cloned().chain(meshes) {
+                let _ = writeln!(w, "            {},", object(&o.value, None));
+            }
+            w.extend_from_slice(b"        ]),\n");
+        }
+        w.extend_from_slice(b"    },\n");
+    }
+    if !instances.is_empty() {
+        w.extend_from_slice(b"    instances: [\n");
+        for i in instances {
+            let i = &i.value;
+            let _ = write!(w, "        (prototype: {}", string(&i.prototype.value));
+            if let Some(n) = &i.name {
+                let _ = write!(w, ", name: {}", string(&n.value));
+            }
+            if i.world_from_object.value != TransformDesc::IDENTITY {
+                let _ = write!(
+                    w,
+                    ", world_from_object: {}",
+                    transform(&i.world_from_object.value)
+                );
+            }
+            if let Some(m) = &i.material {
+                let _ = write!(w, ", material: {}", string(&m.value));
+            }
+            w.extend_from_slice(b"),\n");
+        }
+        w.extend_from_slice(b"    ],\n");
+    }
+}
+
+/// `(translate: ..., rotate: ..., scale: ...)` (the fields that are not the identity's) or
+/// `(matrix: (...))`.
+pub(crate) fn transform(t: &TransformDesc) -> String {
+    match t {
+        TransformDesc::Trs {
+            translate,
+            rotate,
+            scale,
+        } => {
+            let mut f = Vec::new();
+            if *translate != [0.0; 3] {
+                f.push(format!("translate: {}", v3(translate)));
+            }
+            if let Some(r) = rotate {
+                f.push(format!(
+                    "rotate: (axis: {}, degrees: {})",
+                    v3(&r.axis),
+                    num(r.degrees)
+                ));
+            }
+            if *scale != [1.0; 3] {
+                f.push(format!("scale: {}", v3(scale)));
+            }
+            format!("({})", f.join(", "))
+        }
+        TransformDesc::Matrix(m) => {
+            let rows: Vec<String> = m.iter().map(|r| v3(r)).collect();
+            format!("(matrix: ({}))", rows.join(", "))
+        }
+    }
 }
 
 fn write_camera(w: &mut Vec<u8>, c: &CameraDesc) {
@@ -774,6 +863,7 @@ fn write_animation(w: &mut Vec<u8>, a: &AnimationDesc) {
         lights,
         materials,
         objects,
+        instances,
     } = a;
     let _ = writeln!(w, "    animation: (");
     let _ = writeln!(
@@ -827,7 +917,7 @@ fn write_animation(w: &mut Vec<u8>, a: &AnimationDesc) {
     }
     write_keyed(w, "materials", entries);
     let mut entries = Vec::new();
-    for o in objects {
+    for o in objects.iter().chain(instances) {
         let fields = [
             track("translate", &o.translate, point, KEYED),
             track("rotate", &o.rotate, rotation, KEYED),

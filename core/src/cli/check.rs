@@ -69,6 +69,9 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
         scene.discs.len(),
         scene.customs.len()
     );
+    for p in &scene.prototypes {
+        println!("prototype  {}", prototype(p));
+    }
     if let Some(a) = &scene.animation {
         let m = &scene.moving;
         println!(
@@ -152,6 +155,33 @@ fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) 
     }
 }
 
+/// One line about a prototype: its size, its instances and how they were realised.
+fn prototype(p: &luxon::scene::PrototypeUse) -> String {
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    let mut how = Vec::new();
+    if p.baked > 0 {
+        how.push(format!("{} baked (flat copies)", p.baked));
+    }
+    if p.keyed > 0 {
+        how.push(format!("{} keyed (placed anew each frame)", p.keyed));
+    }
+    let mut size = plural(p.objects, "object", "objects");
+    if p.meshes > 0 {
+        size.push_str(&format!(
+            ", {}",
+            plural(p.meshes, "mesh group", "mesh groups")
+        ));
+    }
+    format!(
+        "`{}`: {size}, {} per copy; {}: {}",
+        p.name,
+        plural(p.primitives, "primitive", "primitives"),
+        plural(p.baked + p.keyed, "instance", "instances"),
+        how.join(", ")
+    )
+}
+
 /// One line about an animation: its frames, its shutter and what is keyed.
 fn animation(a: &luxon_formats::AnimationDesc) -> String {
     use luxon_formats::{Interpolate, Track};
@@ -212,7 +242,8 @@ fn animation(a: &luxon_formats::AnimationDesc) -> String {
             keyed.push(format!("material `{}` {c}", m.material.value));
         }
     }
-    for o in &a.objects {
+    let objects = a.objects.iter().map(|o| ("object", o));
+    for (what, o) in objects.chain(a.instances.iter().map(|o| ("instance", o))) {
         let p: Vec<String> = [
             track("translate", &o.translate),
             track("rotate", &o.rotate),
@@ -221,7 +252,7 @@ fn animation(a: &luxon_formats::AnimationDesc) -> String {
         .into_iter()
         .flatten()
         .collect();
-        keyed.push(format!("object `{}` {}", o.name.value, p.join(", ")));
+        keyed.push(format!("{what} `{}` {}", o.name.value, p.join(", ")));
     }
     if keyed.is_empty() {
         line.push_str("; nothing keyed");

@@ -509,7 +509,7 @@ fn prepare<'r>(
     let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
     let budget = Arc::new(budget);
     let plan = plan(&desc.render, outputs, job, registry, &scene_dir, &budget)?;
-    let had_objects = !desc.objects.is_empty();
+    let had_objects = !(desc.objects.is_empty() && desc.instances.is_empty());
     let scene = match cached {
         Some(c) => {
             let cache::Cached {

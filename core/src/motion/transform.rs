@@ -2,9 +2,9 @@
 //! keyed tracks (a missing track is the identity), in f64, and what it does to the records a
 //! primitive plugin gives (points, normals, radii).
 
-use super::keys::{rotation, value};
+use super::keys::{quaternion, rotation, value};
 use glam::{DAffine3, DMat3, DQuat, DVec3};
-use luxon_formats::ObjectTracks;
+use luxon_formats::{ObjectTracks, TransformDesc};
 
 /// A transform ready to apply.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +26,43 @@ impl Placement {
             world_from_object: m,
             normal_matrix: m.matrix3.inverse().transpose(),
             uniform: (a[0] == a[1] && a[1] == a[2]).then_some(a[0]),
+        }
+    }
+
+    /// Any invertible affine map. Its scale counts as uniform when its columns have one
+    /// length and are perpendicular, both to 1e-12 relative (a matrix written in decimals is
+    /// seldom an exact similarity).
+    pub fn from_affine(m: DAffine3) -> Placement {
+        let c = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
+        let len = c.map(DVec3::length);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.max(b);
+        let similar = close(len[0], len[1])
+            && close(len[1], len[2])
+            && [(0, 1), (1, 2), (0, 2)]
+                .iter()
+                .all(|&(i, j)| c[i].dot(c[j]).abs() <= 1e-12 * len[i] * len[j]);
+        Placement {
+            world_from_object: m,
+            normal_matrix: m.matrix3.inverse().transpose(),
+            uniform: similar.then_some(len[0]),
+        }
+    }
+
+    /// A static transform of the scene description.
+    pub fn from_desc(t: &TransformDesc) -> Placement {
+        match t {
+            TransformDesc::Trs {
+                translate,
+                rotate,
+                scale,
+            } => {
+                let r = rotate.as_ref().map_or(DQuat::IDENTITY, quaternion);
+                Placement::new(*scale, r, *translate)
+            }
+            TransformDesc::Matrix(rows) => {
+                let col = |j: usize| DVec3::new(rows[0][j], rows[1][j], rows[2][j]);
+                Placement::from_affine(DAffine3::from_cols(col(0), col(1), col(2), col(3)))
+            }
         }
     }
 
@@ -73,6 +110,28 @@ mod tests {
             Placement::new([-2.0, 2.0, 2.0], r, [0.0; 3]).uniform_scale(),
             Some(2.0)
         );
+    }
+
+    #[test]
+    fn matrices_are_rows_and_similarities_scale_uniformly() {
+        let m = TransformDesc::Matrix([
+            [0.0, -2.0, 0.0, 1.0],
+            [2.0, 0.0, 0.0, 2.0],
+            [0.0, 0.0, 2.0, 3.0],
+        ]);
+        let p = Placement::from_desc(&m);
+        assert_eq!(p.point([1.0, 0.0, 0.0]), [1.0, 4.0, 3.0]);
+        assert_eq!(p.uniform_scale(), Some(2.0));
+        let shear = TransformDesc::Matrix([
+            [1.0, 0.5, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ]);
+        assert_eq!(Placement::from_desc(&shear).uniform_scale(), None);
+        // The identity description is the identity, bit for bit.
+        let id = Placement::from_desc(&TransformDesc::IDENTITY);
+        let q = [0.1, -3.7e5, 1e-300];
+        assert_eq!(id.point(q).map(f64::to_bits), q.map(f64::to_bits));
     }
 
     #[test]

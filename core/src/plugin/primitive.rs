@@ -32,7 +32,8 @@ pub struct GeometryBuilder<'a> {
     /// Degenerate triangles dropped.
     pub dropped: u64,
     /// When set, the geometry is recorded here as the plugin gives it instead of stored in the
-    /// sets (an object that moves is stored anew for every frame, see `scene::frame`).
+    /// sets (an object that moves is stored anew for every frame, see `scene::frame`; a
+    /// prototype is stored once per instance, see `scene::instances`).
     pub record: Option<&'a mut Recorded>,
     /// Charged for what is stored (or recorded), before it is stored.
     pub budget: &'a Budget,
@@ -379,8 +380,9 @@ unsafe extern "C" fn add_custom(
             unsafe { CustomObject::new(g.object, vtable, b.plugin.clone(), g.count, made_by) };
         if b.record.is_some() {
             return Err(
-                "custom geometry (drawn by its plugin) cannot be moved by animation keys; \
-                 Luxon moves spheres, planes, cones, discs and meshes"
+                "custom geometry (drawn by its plugin) cannot be moved by animation keys or \
+                 copied into instances; Luxon moves and copies spheres, planes, cones, discs and \
+                 meshes"
                     .into(),
             );
         }

@@ -1,11 +1,13 @@
 //! Building a [`Scene`] from its description, in the stages [`Scene::build_from`] runs in order:
 //! textures, volumes, materials, clip groups, render volumes, objects (plugins, then imported
-//! geometry, then a cache's prebuilt geometry), BVHs, lights, and the effects the scene calls
-//! for; an animated scene then goes to its first frame (keyed objects are recorded by the
-//! objects stage, not stored, see `frame`). A new kind of scene content gets a stage of its own
-//! here.
+//! geometry, then baked instances, then a cache's prebuilt geometry), BVHs, lights, and the
+//! effects the scene calls for; an animated scene then goes to its first frame (keyed objects
+//! and instances are recorded, not stored, see `frame`). A new kind of scene content gets a
+//! stage of its own here.
 
 use super::frame::{self, Animation, Keyed};
+use super::instances::{self, PrototypeUse};
+use super::place::Sets;
 use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
@@ -149,6 +151,7 @@ impl Scene {
         let mut stored = Stored::new(b.world_offset, palette.materials.len());
         b.objects(&palette, &mut stored)?;
         b.imported(inline, &palette, &mut stored)?;
+        let prototypes = b.instances(&palette, &mut stored)?;
         let Palette {
             materials,
             names: material_names,
@@ -220,6 +223,7 @@ impl Scene {
             bvh_time,
             plugin_time,
             moving: Default::default(),
+            prototypes,
             animation: None,
             budget: b.budget,
         };
@@ -245,10 +249,12 @@ pub(super) struct Build<'a> {
     budget: Arc<Budget>,
 }
 
-/// The materials of the imported geometry groups that cast no shadow.
+/// The materials of the imported geometry groups, then of the instanced objects, that cast no
+/// shadow.
 fn shadowless_groups(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
     let groups = desc.inline.iter().filter(|g| g.shadowless);
-    groups.map(|g| g.material.clone()).collect()
+    let groups = groups.map(|g| g.material.clone());
+    groups.chain(instances::shadowless(desc)).collect()
 }
 
 /// The materials (index 0: the default; then the scene's, by name; then copies of those that
@@ -626,6 +632,33 @@ impl<'a> Build<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Stage: the instances of prototypes, baked after everything else (see `instances`).
+    fn instances(
+        &self,
+        palette: &Palette,
+        stored: &mut Stored,
+    ) -> Result<Vec<PrototypeUse>, Error> {
+        let cx = instances::Context {
+            desc: self.desc,
+            registry: self.registry,
+            scene_dir: &self.scene_dir,
+            world_offset: self.world_offset,
+            budget: &self.budget,
+        };
+        let sets = Sets {
+            spheres: &mut stored.spheres,
+            triangles: &mut stored.triangles,
+            planes: &mut stored.planes,
+            cones: &mut stored.cones,
+            discs: &mut stored.discs,
+        };
+        let material = |name: &Option<Spanned<String>>, shadows| palette.index(name, shadows);
+        let baked = instances::bake(&cx, &material, sets, &mut stored.used)?;
+        stored.dropped += baked.dropped;
+        stored.keyed.extend(baked.keyed);
+        Ok(baked.prototypes)
     }
 
     /// Stage: the lights, in render space.

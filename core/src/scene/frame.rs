@@ -15,11 +15,11 @@
 //! each frame's camera is placed relative to it.
 
 use super::build::{shadow_filter, Build};
+use super::place::place;
 use super::{Light, Scene};
 use crate::budget::{Budget, Use};
 use crate::error::Error;
 use crate::geometry::group::Group;
-use crate::geometry::triangle::MeshInput;
 use crate::math::{DVec3, Vec3A};
 use crate::motion::keys::value;
 use crate::motion::Placement;
@@ -295,9 +295,10 @@ impl Animation {
                 &p,
                 world_offset,
                 o.material,
-                &mut group,
+                group.sets(),
                 budget,
             )
+            .map(|_| ())
             .map_err(|m| {
                 Error::at(
                     &o.at,
@@ -313,96 +314,6 @@ impl Animation {
             .map_err(|e| Error::Render(format!("frame {k}: the keyed objects: {}", e.0)))?;
         Ok(group)
     }
-}
-
-/// Stores `g` moved by `p` into `group` (through the sets' own checks), charging its arrays
-/// to `budget` before they grow.
-fn place(
-    g: &Recorded,
-    p: &Placement,
-    offset: DVec3,
-    material: u32,
-    group: &mut Group,
-    budget: &Arc<Budget>,
-) -> Result<(), String> {
-    let m = p.world_from_object.matrix3;
-    let det = m.determinant();
-    if !(det.is_finite() && det != 0.0) {
-        return Err("its transform is singular at this frame (a scale of 0?)".into());
-    }
-    let round = !(g.spheres.is_empty() && g.cones.is_empty() && g.discs.is_empty());
-    let s = match (p.uniform_scale(), round) {
-        (Some(s), _) => s,
-        (None, false) => 1.0,
-        (None, true) => {
-            let s = m.x_axis.length();
-            return Err(format!(
-                "its scale is not the same on every axis at this frame (x is {s}), and it holds \
-                 spheres, cones or discs, which keep their shape only under a uniform scale"
-            ));
-        }
-    };
-    let xyz = |r: &[f64], i: usize| p.point([r[i], r[i + 1], r[i + 2]]);
-    let normal = |r: &[f64], i: usize| p.normal([r[i], r[i + 1], r[i + 2]]);
-    let count = |n: usize, kind: &'static str| move || format!("{n} {kind}");
-    let (ns, np, nc, nd) = (
-        g.spheres.len(),
-        g.planes.len(),
-        g.cones.len(),
-        g.discs.len(),
-    );
-    group.spheres.reserve(ns, budget, &count(ns, "spheres"))?;
-    group.planes.reserve(np, budget, &count(np, "planes"))?;
-    group.cones.reserve(nc, budget, &count(nc, "cones"))?;
-    group.discs.reserve(nd, budget, &count(nd, "discs"))?;
-    for (i, r) in g.spheres.iter().enumerate() {
-        let c = xyz(r, 0);
-        group
-            .spheres
-            .push_world(i, [c[0], c[1], c[2], r[3] * s], offset, material)?;
-    }
-    for (i, r) in g.planes.iter().enumerate() {
-        let (q, n) = (xyz(r, 0), normal(r, 3));
-        group
-            .planes
-            .push_world(i, [q[0], q[1], q[2], n[0], n[1], n[2]], offset, material)?;
-    }
-    for (i, r) in g.cones.iter().enumerate() {
-        let (b, a) = (xyz(r, 0), xyz(r, 4));
-        let cone = [b[0], b[1], b[2], r[3] * s, a[0], a[1], a[2], r[7] * s];
-        group.cones.push_world(i, cone, offset, material)?;
-    }
-    for (i, r) in g.discs.iter().enumerate() {
-        let (c, n) = (xyz(r, 0), normal(r, 3));
-        let disc = [c[0], c[1], c[2], n[0], n[1], n[2], r[6] * s, r[7] * s];
-        group.discs.push_world(i, disc, offset, material)?;
-    }
-    for mesh in &g.meshes {
-        let triangles = mesh.indices.len() / 3;
-        let what = count(triangles, "triangles");
-        let attrs = !(mesh.normals.is_empty() && mesh.colors.is_empty() && mesh.uvs.is_empty());
-        let vertices = mesh.positions.len() / 3;
-        group
-            .triangles
-            .reserve_mesh(triangles, vertices, attrs, budget, &what)?;
-        // The moved positions and normals, charged while they are stored.
-        let moved = |from: &[f64], f: &dyn Fn(&[f64], usize) -> [f64; 3]| {
-            let (mut to, charge) = budget.alloc_vec(Use::Geometry, from.len(), 0.0, what)?;
-            for (a, b) in to.chunks_exact_mut(3).zip(from.chunks_exact(3)) {
-                a.copy_from_slice(&f(b, 0));
-            }
-            Ok::<_, String>((to, charge))
-        };
-        let (positions, _p) = moved(&mesh.positions, &xyz)?;
-        let (normals, _n) = moved(&mesh.normals, &normal)?;
-        let input = MeshInput {
-            positions: &positions,
-            normals: &normals,
-            ..mesh.input()
-        };
-        group.triangles.push_mesh(&input, offset, material)?;
-    }
-    Ok(())
 }
 
 impl Scene {

@@ -3,14 +3,18 @@
 //! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`;
 //! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`;
 //! what a retained scene ([`crate::api::Scene`]) changes without a build (settings, size,
-//! camera, background) in `update`.
+//! camera, background) in `update`; instances of prototypes, baked into flat copies, in
+//! `instances`; moving recorded geometry by a transform (for both) in `place`.
 
 mod build;
 mod frame;
+mod instances;
+mod place;
 mod update;
 
 pub use build::Prebuilt;
 pub use frame::Animation;
+pub use instances::PrototypeUse;
 
 use crate::budget::Budget;
 use crate::camera::Camera;
@@ -344,6 +348,8 @@ pub struct Scene {
     pub plugin_time: Duration,
     /// Keyed objects placed at the current frame (empty in a still scene).
     pub moving: Group,
+    /// The prototypes with instances, and how each was realised.
+    pub prototypes: Vec<PrototypeUse>,
     /// How the scene changes from frame to frame; `None`: a still scene.
     pub animation: Option<Box<Animation>>,
     /// The memory budget the build charged (geometry, BVHs, volumes, texture cache) and the

@@ -579,6 +579,8 @@ impl<'o> Assembler<'o> {
                 ..RenderDesc::default()
             },
             animation: None,
+            prototypes: Vec::new(),
+            instances: Vec::new(),
             plugin_path: Vec::new(),
             warnings: self
                 .warnings

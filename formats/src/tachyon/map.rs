@@ -583,6 +583,8 @@ impl Mapper {
                 ..RenderDesc::default()
             },
             animation: None,
+            prototypes: Vec::new(),
+            instances: Vec::new(),
             plugin_path: Vec::new(),
             warnings: warnings
                 .into_iter()
