@@ -6,7 +6,7 @@
 //! here.
 
 use super::frame::{self, Animation, Keyed};
-use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
+use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings, Sky};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
@@ -25,8 +25,8 @@ use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
 use luxon_formats::{
-    HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned, SpotFade,
-    TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
+    BackgroundDesc, HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned,
+    SpotFade, TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
 };
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -151,7 +151,14 @@ impl Scene {
             camera: camera.clone(),
             primary_width: camera.footprint().0,
             pixel_spread: camera.footprint().1,
-            background: v3(desc.background),
+            background: match desc.background {
+                BackgroundDesc::Color(c) => v3(c),
+                BackgroundDesc::Gradient(g) => v3(g.bottom_color),
+            },
+            sky: match &desc.background {
+                BackgroundDesc::Color(_) => None,
+                BackgroundDesc::Gradient(g) => Some(Sky::new(g, b.world_offset)),
+            },
             lights,
             fog,
             ao,
@@ -551,7 +558,12 @@ impl<'a> Build<'a> {
                     positions: g.mesh.positions.as_flattened(),
                     indices: g.mesh.indices.as_flattened(),
                     normals: g.mesh.normals.as_flattened(),
-                    colors: &[],
+                    colors: &g
+                        .mesh
+                        .colors
+                        .iter()
+                        .flat_map(|c| c.map(|x| x as f32))
+                        .collect::<Vec<_>>(),
                     uvs: &g
                         .mesh
                         .uvs
@@ -756,7 +768,7 @@ impl Stored {
         self.discs.reserve(d, budget, &n(d, "discs"))?;
         self.planes.reserve(p, budget, &n(p, "planes"))?;
         let m = &g.mesh;
-        let attrs = !(m.normals.is_empty() && m.uvs.is_empty());
+        let attrs = !(m.normals.is_empty() && m.uvs.is_empty() && m.colors.is_empty());
         let t = m.indices.len();
         let describe = n(t, "triangles");
         self.triangles
