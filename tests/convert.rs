@@ -320,6 +320,8 @@ const TACHYON: &[&str] = &[
      CAMERA PROJECTION ORTHOGRAPHIC ZOOM 0.25 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 3 \
      CENTER 0 0 -5 VIEWDIR 0 0 1 UPDIR 0 1 0 FRUSTUM -2 2 -1.5 2.5 END_CAMERA\n\
      SKY_LIGHT NUMSAMPLES 4 COLOR 0.5 0.5 0.5\n\
+     BACKGROUND_GRADIENT SKY_ORTHO_PLANE UPDIR 0 1 0.2 TOPVAL 2 BOTTOMVAL -1 \
+     TOPCOLOR 0.9 0.8 0.2 BOTTOMCOLOR 0.1 0.1 0.5\n\
      LIGHT CENTER 0 5 -5 RAD 0 COLOR 1 1 1\n\
      SCAPE RES 8 8 SCALE 4 4 CENTER 0 -1 0 TEXTURE AMBIENT 0.2 DIFFUSE 0.8 SPECULAR 0 \
      OPACITY 1 COLOR 0.5 0.7 0.3 TEXFUNC 0\n\
@@ -335,6 +337,22 @@ const TACHYON: &[&str] = &[
      LIGHT CENTER 0 5 -5 RAD 0 COLOR 1 1 1\n\
      SPHERE CENTER 0 0 0 RAD 1 TEXTURE AMBIENT 0.2 DIFFUSE 0.8 SPECULAR 0 OPACITY 1 \
      COLOR 1 0.5 0 TEXFUNC 0\n\
+     END_SCENE\n",
+    // Vertex colours and a gradient sky.
+    "BEGIN_SCENE RESOLUTION 32 24\n\
+     CAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 3 CENTER 0 0.5 -4 VIEWDIR 0 -0.1 1 \
+     UPDIR 0 1 0 END_CAMERA\n\
+     BACKGROUND_GRADIENT SKY_SPHERE UPDIR 0.1 1 0 TOPVAL 0.5 BOTTOMVAL -0.2 \
+     TOPCOLOR 1 0.6 0.1 BOTTOMCOLOR 0.1 0.2 0.7\n\
+     LIGHT CENTER -2 4 -5 RAD 0 COLOR 1 1 1\n\
+     VCSTRI V0 -2 0 1 V1 0 2 1 V2 0 0 1 N0 0 0 -1 N1 0 0 -1 N2 0.1 0 -1 \
+     C0 1 0 0 C1 0 1 0 C2 0 0 1 AMBIENT 0.2 DIFFUSE 0.7 SPECULAR 0.3 OPACITY 1 \
+     PHONG METAL 0.4 PHONG_SIZE 8 VCST\n\
+     VERTEXARRAY NUMVERTS 4 COORDS 0 -1 0 2 -1 0 2 1 0 0 1 0 \
+     NORMALS 0 0 -1 0 0 -1 0 0 -1 0 0 -1 \
+     TEXTURE AMBIENT 0.2 DIFFUSE 0.6 SPECULAR 0 OPACITY 1 COLOR 0.2 1 0.2 TEXFUNC 0 \
+     TRIMESH 1 0 2 1 COLORS 1 1 0 0 1 1 1 0 1 1 1 1 TRIMESH 1 0 3 2 \
+     TRISTRIP 4 0 1 3 2 END_VERTEXARRAY\n\
      END_SCENE\n",
 ];
 
@@ -377,6 +395,14 @@ fn tachyon_scenes_convert_to_the_same_scene() {
     // The CLI writes what the library writes.
     let source = luxon_formats::load(&dir.join("s0.dat")).unwrap();
     assert_eq!(ron, to_ron(&source, &dir).unwrap());
+    // A gradient and vertex colours are written in the scene format's own syntax.
+    let sky = to_ron(&luxon_formats::load(&dir.join("s3.dat")).unwrap(), &dir).unwrap();
+    assert!(
+        sky.contains("background: Gradient(kind: Sphere, up: (0.1, 1.0, -0.0), top: 0.5"),
+        "{sky}"
+    );
+    assert!(sky.contains("\n            colors: [\n"), "{sky}");
+    assert!(!sky.contains("not rendered"), "{sky}");
 }
 
 #[test]

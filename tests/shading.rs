@@ -56,6 +56,42 @@ fn miss_shows_the_background() {
     assert!(close(centre("miss", &scene), [0.2, 0.3, 0.4]));
 }
 
+/// A gradient background, by direction (`Sphere`) and by where rays start (`OrthoPlane`):
+/// the camera looks along +z, so its centre ray sees x = 0 (a quarter of the way from bottom
+/// to top here), a mirror facing up-and-back sends it up (the top colour).
+#[test]
+fn gradient_backgrounds_follow_the_ray() {
+    let scene = |bg: &str, objects: &str| {
+        format!(
+            r#"Scene(
+    camera: (position: (0, 0, 0), look_at: (0, 0, 1), fov: 30),
+    background: {bg},
+    materials: {{ "mirror": (color: (1, 1, 1), ambient: 0, diffuse: 0, reflect: 1) }},
+    objects: [{objects}],
+)"#
+        )
+    };
+    let sky = "Gradient(kind: Sphere, up: (0, 2, 0), top: 1.5, bottom: -0.5, \
+               top_color: (1, 0, 0), bottom_color: (0, 0, 1))";
+    let c = centre("gradient", &scene(sky, ""));
+    assert!(close(c, [0.25, 0.0, 0.75]), "{c:?}");
+    let mirror = r#"(plugin: "plane", params: (point: (0, 0, 3), normal: (0, 1, -1)),
+                     material: "mirror")"#;
+    let c = centre("gradient-mirror", &scene(sky, mirror));
+    assert!(close(c, [1.0, 0.0, 0.0]), "{c:?}");
+    // By origin: the camera at y = 0 sees x = 0 whatever its direction; moved up by 0.5,
+    // x = 1: half way.
+    let plane = sky.replace("Sphere", "OrthoPlane");
+    let c = centre("gradient-plane", &scene(&plane, ""));
+    assert!(close(c, [0.25, 0.0, 0.75]), "{c:?}");
+    let raised = scene(&plane, "").replace(
+        "position: (0, 0, 0), look_at: (0, 0, 1)",
+        "position: (0, 0.5, 0), look_at: (0, 0.5, 1)",
+    );
+    let c = centre("gradient-plane-up", &raised);
+    assert!(close(c, [0.75, 0.0, 0.25]), "{c:?}");
+}
+
 /// Two parallel mirrors with the camera between them: each bounce adds the ambient term and
 /// halves the rest; at the depth limit a ray sees the background.
 fn mirrors(depth: u32, background: f32) -> [f32; 3] {

@@ -921,3 +921,149 @@ const VOLUME_IMAGE_PIXELS: [((usize, usize), [u8; 3]); 6] = [
     ((33, 8), [166, 212, 71]),
     ((38, 44), [43, 90, 125]),
 ];
+
+/// Luxon's picture of `text` against Tachyon's: each `(row, column)` pixel of `tachyons`
+/// within 2 codes (always), and, with `tachyon-nox` installed, all but `edges` pixels of the
+/// whole picture within 2 codes (pixels on silhouettes may see the other side in f32).
+fn assert_like_tachyon(
+    name: &str,
+    text: &str,
+    tachyons: &[((usize, usize), [u8; 3])],
+    edges: usize,
+) {
+    let dir = temp_dir(&format!("tachyon-{name}"));
+    let (w, h, ours) = luxon_pixels(&dir, text);
+    assert_pixels_near(&ours, w, tachyons);
+    let Some(diff) = differences_from_tachyon(&dir, text, (w, h, &ours)) else {
+        return;
+    };
+    let far: Vec<(usize, u8)> = diff
+        .iter()
+        .enumerate()
+        .filter(|&(_, &d)| d > 2)
+        .map(|(i, &d)| (i, d))
+        .collect();
+    assert!(
+        far.len() <= edges,
+        "{name}: {} of {} pixels differ from Tachyon's by more than 2, e.g. (index, codes) {:?}",
+        far.len(),
+        w * h,
+        &far[..far.len().min(8)]
+    );
+}
+
+/// BACKGROUND_GRADIENT SKY_SPHERE (UPDIR not normalised): seen directly, in a mirror sphere,
+/// through a transparent sphere and in a mirror floor, with a ray depth that runs out (the
+/// mirror then shows the incident ray's background). A BACKGROUND after it changes nothing.
+fn sky_sphere_scene() -> String {
+    String::from(
+        "BEGIN_SCENE\nRESOLUTION 48 36\nCAMERA ZOOM 0.9 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 3\n\
+         CENTER 0 0.5 -1 VIEWDIR 0.1 -0.05 1 UPDIR 0 1 0 END_CAMERA\n\
+         BACKGROUND_GRADIENT SKY_SPHERE UPDIR 0.2 1.5 0.1 TOPVAL 0.8 BOTTOMVAL -0.4 \
+         TOPCOLOR 1 0.5 0 BOTTOMCOLOR 0 0.2 0.8\nBACKGROUND 0 1 0\n\
+         SPHERE CENTER -0.9 0 5 RAD 1 TEXTURE AMBIENT 0.1 DIFFUSE 0 SPECULAR 0.8 OPACITY 1 \
+         COLOR 1 1 1 TEXFUNC 0\n\
+         SPHERE CENTER 1.2 0.4 6 RAD 0.9 TEXTURE AMBIENT 0.2 DIFFUSE 0 SPECULAR 0 OPACITY 0.5 \
+         COLOR 1 0 0 TEXFUNC 0\n\
+         PLANE CENTER 0 -1.2 0 NORMAL 0 1 -0.1 TEXTURE AMBIENT 0 DIFFUSE 0 SPECULAR 0.7 \
+         OPACITY 1 COLOR 1 1 1 TEXFUNC 0\nEND_SCENE\n",
+    )
+}
+
+#[test]
+fn sky_sphere_gradient_gives_tachyons_pixels() {
+    assert_like_tachyon("sky-sphere", &sky_sphere_scene(), &SKY_SPHERE_PIXELS, 3);
+}
+
+/// (row, column) → Tachyon's colour, read from its picture of `sky_sphere_scene`.
+const SKY_SPHERE_PIXELS: [((usize, usize), [u8; 3]); 8] = [
+    ((0, 0), [202, 111, 41]),
+    ((10, 35), [179, 104, 60]),
+    ((15, 14), [229, 127, 25]),
+    ((20, 14), [58, 64, 112]),
+    ((25, 14), [17, 46, 132]),
+    ((25, 28), [142, 44, 0]),
+    ((15, 28), [108, 22, 25]),
+    ((35, 21), [178, 89, 0]),
+];
+
+/// BACKGROUND_GRADIENT SKY_ORTHO_PLANE under an orthographic camera: the gradient runs across
+/// the picture by where camera rays start; a tilted mirror shows it by where its reflected
+/// rays start (its hit points), the mirror at the depth limit by the camera ray's start.
+fn sky_plane_scene() -> String {
+    String::from(
+        "BEGIN_SCENE\nRESOLUTION 40 40\n\
+         CAMERA PROJECTION ORTHOGRAPHIC ZOOM 0.25 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 2\n\
+         CENTER 0.3 0.2 -3 VIEWDIR 0 0 1 UPDIR 0.1 1 0 END_CAMERA\n\
+         BACKGROUND_GRADIENT SKY_ORTHO_PLANE UPDIR 0.3 0.8 0.2 TOPVAL 1.5 BOTTOMVAL -1 \
+         TOPCOLOR 0.9 0.9 0.2 BOTTOMCOLOR 0.1 0 0.6\n\
+         TEXDEF mirror AMBIENT 0 DIFFUSE 0 SPECULAR 1 OPACITY 1 COLOR 1 1 1 TEXFUNC 0\n\
+         RING CENTER -0.8 0.8 2 NORMAL 0.2 0.6 -1 INNER 0 OUTER 0.9 mirror\n\
+         SPHERE CENTER 0.9 -0.7 3 RAD 0.8 mirror\n\
+         RING CENTER 0.9 -0.7 0 NORMAL 0 0 -1 INNER 0.5 OUTER 0.6 mirror\nEND_SCENE\n",
+    )
+}
+
+#[test]
+fn sky_ortho_plane_gradient_gives_tachyons_pixels() {
+    assert_like_tachyon("sky-plane", &sky_plane_scene(), &SKY_PLANE_PIXELS, 3);
+}
+
+/// (row, column) → Tachyon's colour, read from its picture of `sky_plane_scene`.
+const SKY_PLANE_PIXELS: [((usize, usize), [u8; 3]); 8] = [
+    ((0, 0), [179, 173, 76]),
+    ((8, 5), [222, 221, 54]),
+    ((12, 10), [201, 198, 64]),
+    ((16, 20), [107, 92, 112]),
+    ((24, 20), [145, 135, 92]),
+    ((28, 25), [120, 106, 105]),
+    ((32, 30), [66, 45, 132]),
+    ((36, 25), [75, 56, 127]),
+];
+
+/// Vertex colours: two VCSTRIs (PLASTIC and METAL highlights) and a VERTEXARRAY whose first
+/// mesh takes its TEXTURE's checker, and whose later TRIMESH and TRISTRIP take the COLORS in
+/// its place, lit by a light (diffuse and highlights) over an ambient term.
+fn vertex_colour_scene() -> String {
+    String::from(
+        "BEGIN_SCENE\nRESOLUTION 48 40\nCAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 4\n\
+         CENTER 0 0 0.5 VIEWDIR 0 0 1 UPDIR 0 1 0 END_CAMERA\nBACKGROUND 0.1 0.1 0.1\n\
+         LIGHT CENTER -2 3 -3 RAD 0 COLOR 1 1 1\n\
+         VCSTRI V0 -2.2 -0.2 4 V1 -0.2 1.8 3.6 V2 -0.4 -0.4 4 N0 -0.3 0 -1 N1 0 0.3 -1 \
+         N2 0.2 0 -1 C0 1 0 0 C1 0 1 0 C2 0 0 1 AMBIENT 0.2 DIFFUSE 0.7 SPECULAR 0 OPACITY 1 \
+         PHONG PLASTIC 0.4 PHONG_SIZE 8 VCST\n\
+         VCSTRI V0 0.2 0.2 4 V1 2.2 1.8 4.4 V2 2 -0.2 4 N0 0 0 -1 N1 0 0 -1 N2 0 0 -1 \
+         C0 1 1 0 C1 0 1 1 C2 1 0 1 AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0 OPACITY 1 \
+         PHONG METAL 0.5 PHONG_SIZE 4 VCST\n\
+         VERTEXARRAY NUMVERTS 6\n\
+         COORDS -2 -2 4  -1 -0.6 4.2  0 -2 4.4  1 -0.6 4.2  2 -2 4  2.4 -0.8 4.2\n\
+         NORMALS 0 0.2 -1  0 0 -1  0.1 0.1 -1  0 0 -1  0.2 0 -1  0 0 -1\n\
+         TEXTURE AMBIENT 0.2 DIFFUSE 0.6 SPECULAR 0 OPACITY 1 COLOR 0.5 0.5 0.5 TEXFUNC 1 \
+         CENTER 0 0 0 ROTATE 0 0 0 SCALE 1 1 1\n\
+         TRIMESH 1 0 1 2\n\
+         COLORS 1 0 0  1 1 0  0 1 0  0 1 1  0 0 1  1 0 1\n\
+         TRIMESH 1 1 3 2\nTRISTRIP 4 4 2 5 3\nEND_VERTEXARRAY\nEND_SCENE\n",
+    )
+}
+
+#[test]
+fn vertex_colours_give_tachyons_pixels() {
+    assert_like_tachyon(
+        "vertex-colours",
+        &vertex_colour_scene(),
+        &VERTEX_COLOUR_PIXELS,
+        3,
+    );
+}
+
+/// (row, column) → Tachyon's colour, read from its picture of `vertex_colour_scene`.
+const VERTEX_COLOUR_PIXELS: [((usize, usize), [u8; 3]); 8] = [
+    ((21, 0), [214, 39, 36]),
+    ((15, 10), [184, 164, 144]),
+    ((18, 30), [234, 195, 55]),
+    ((12, 45), [111, 102, 199]),
+    ((33, 15), [184, 36, 0]),
+    ((30, 25), [51, 181, 85]),
+    ((36, 40), [72, 50, 117]),
+    ((6, 40), [66, 223, 157]),
+];

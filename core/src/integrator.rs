@@ -12,7 +12,7 @@ use crate::geometry::{Counters, Hit, Surface};
 use crate::math::{gamma, reflect, refract, Vec3A};
 use crate::ray::{spawn, spawn_to, Ray};
 use crate::sampler::{mix, pixel_sample};
-use crate::scene::{AngleRule, Ao, Light, Material, Scene};
+use crate::scene::{AngleRule, Ao, Light, Material, Scene, Sky};
 use luxon_formats::{BeyondMax, Highlight, TransparencyMode};
 use luxon_plugin::abi::TexQuery;
 
@@ -75,8 +75,10 @@ pub struct Whitted<'a> {
     /// Some light or occlusion draws random numbers (more than one sample; `square` ignores
     /// the seed for one): only then is a shading point's seed worth hashing.
     draws: bool,
-    /// What rays that hit nothing show: camera rays, other rays.
+    /// What rays that hit nothing show: camera rays, other rays...
     miss: [Vec3A; 2],
+    /// ...or, where they show the background and it is a gradient, the gradient.
+    sky: [Option<Sky>; 2],
     /// Mirror and transmission coefficients at or below this are ignored.
     floor: f32,
     /// What a light's term is scaled by before Tachyon's threshold: the light scale, times
@@ -112,6 +114,10 @@ impl<'a> Whitted<'a> {
             Some(f) if f.misses => [f.color, if f.every_ray { f.color } else { bg }],
             _ => [bg, bg],
         };
+        let sky = match &scene.fog {
+            Some(f) if f.misses => [None, if f.every_ray { None } else { scene.sky }],
+            _ => [scene.sky; 2],
+        };
         let settings = &scene.settings;
         let t = settings.transparency;
         let filtered = matches!(
@@ -127,6 +133,7 @@ impl<'a> Whitted<'a> {
             scene,
             draws,
             miss,
+            sky,
             floor: if settings.tachyon.light_threshold {
                 TACHYON_FLOOR
             } else {
@@ -185,11 +192,10 @@ impl Whitted<'_> {
     ) -> Vec3A {
         let scene = self.scene;
         let hit = scene.intersect(ray, f32::INFINITY, c);
-        let miss = self.miss[(depth > 0) as usize];
         if !scene.features.volumes {
             return match hit {
                 Some(hit) => self.shade(ray, &hit, depth, weight, media, width, c),
-                None => miss,
+                None => self.missed(ray, depth),
             };
         }
         // Volumes in front of the first surface (or the background), composited over it.
@@ -202,9 +208,29 @@ impl Whitted<'_> {
         }
         let behind = match hit {
             Some(hit) => self.shade(ray, &hit, depth, weight * through, media, width, c),
-            None => miss,
+            None => self.missed(ray, depth),
         };
         color + through * behind
+    }
+
+    /// What `ray` (of generation `depth`) shows when it hits nothing.
+    #[inline]
+    fn missed(&self, ray: &Ray, depth: u32) -> Vec3A {
+        let k = (depth > 0) as usize;
+        match &self.sky[k] {
+            Some(sky) => sky.toward(ray.origin, ray.dir),
+            None => self.miss[k],
+        }
+    }
+
+    /// The background a ray from `origin` along `dir()` would show, for rays that are not
+    /// traced (past the depth limit); `dir` is only worked out for a gradient.
+    #[inline]
+    fn background(&self, origin: Vec3A, dir: impl FnOnce() -> Vec3A) -> Vec3A {
+        match &self.scene.sky {
+            Some(sky) => sky.toward(origin, dir()),
+            None => self.scene.background,
+        }
     }
 
     /// The colour a surface hit shows along `ray`: the material at the hit, its lighting, fog,
@@ -301,7 +327,8 @@ impl Whitted<'_> {
     ) -> Vec3A {
         let next = depth + 1;
         if next > self.scene.settings.max_depth {
-            return self.scene.background;
+            // Tachyon's: the background of the ray that reached the surface.
+            return self.background(ray.origin, || ray.dir);
         }
         c.refraction += 1;
         let r = spawn(s.p, s.p_error, side.ng, ray.dir, ray.time);
@@ -456,10 +483,12 @@ impl Whitted<'_> {
     ) {
         let settings = &self.scene.settings;
         if bounce.depth > settings.max_depth {
+            // Tachyon's: the background of the ray that reached the surface, unscaled; else
+            // the background the mirror would show.
             *color += if settings.tachyon.depth_limit_background {
-                self.scene.background
+                self.background(ray.origin, || ray.dir)
             } else {
-                kr * self.scene.background
+                kr * self.background(s.p, || reflect(ray.dir, side.n))
             };
         } else if bounce.weight >= settings.min_weight {
             c.reflection += 1;
@@ -486,10 +515,11 @@ impl Whitted<'_> {
     ) {
         let settings = &self.scene.settings;
         if bounce.depth > settings.max_depth {
+            // As for reflections; the background straight on through the surface.
             *color += if settings.tachyon.depth_limit_background {
-                self.scene.background
+                self.background(ray.origin, || ray.dir)
             } else {
-                filter * self.scene.background
+                filter * self.background(s.p, || ray.dir)
             };
         } else if bounce.weight >= settings.min_weight {
             // Which media are on each side of the surface.

@@ -13,7 +13,7 @@ use crate::validate::Checker;
 #[derive(Default)]
 pub(crate) struct Part {
     pub camera: Option<Spanned<CameraDesc>>,
-    pub background: Option<[f64; 3]>,
+    pub background: Option<BackgroundDesc>,
     pub lights: Vec<Spanned<LightDesc>>,
     pub fog: Option<FogDesc>,
     pub ambient_occlusion: Option<AoDesc>,
@@ -67,7 +67,7 @@ impl Checker<'_> {
             part.camera = Some(self.camera(camera, field("camera"))?);
         }
         if let Some(background) = scene.background {
-            part.background = Some(self.colour(field("background"), "background", background)?);
+            part.background = Some(self.background(background, field("background"))?);
         }
         if let Some(fog) = scene.fog {
             part.fog = Some(self.fog(fog, field("fog"))?);

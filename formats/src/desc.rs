@@ -26,8 +26,7 @@ pub struct SceneDesc {
     /// The file the scene was loaded from (the first of `include`s).
     pub source: PathBuf,
     pub camera: Spanned<CameraDesc>,
-    /// Linear RGB.
-    pub background: [f64; 3],
+    pub background: BackgroundDesc,
     pub lights: Vec<Spanned<LightDesc>>,
     pub fog: Option<FogDesc>,
     pub ambient_occlusion: Option<AoDesc>,
@@ -56,6 +55,45 @@ pub struct SceneDesc {
     /// Copies of prototypes, in file order (includes first); stored after `objects` and
     /// `inline`.
     pub instances: Vec<Spanned<InstanceDesc>>,
+}
+
+/// What a ray that hits nothing shows (`background:`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BackgroundDesc {
+    /// One colour, linear RGB: `background: (r, g, b)`.
+    Color([f64; 3]),
+    /// `background: Gradient(...)`: Tachyon's BACKGROUND_GRADIENT.
+    Gradient(GradientDesc),
+}
+
+impl Default for BackgroundDesc {
+    fn default() -> Self {
+        BackgroundDesc::Color([0.0; 3])
+    }
+}
+
+/// A background that blends two colours along `up`: with x = `up`·(the missed ray's direction)
+/// (`Sphere`) or `up`·(its origin) (`OrthoPlane`), the mix (x − bottom) / (top − bottom),
+/// clamped to 0..1, runs from `bottom_color` to `top_color` (`top` = `bottom`: a sharp
+/// horizon).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GradientDesc {
+    pub kind: GradientKind,
+    /// Not normalised: its length scales x.
+    pub up: [f64; 3],
+    pub top: f64,
+    pub bottom: f64,
+    pub top_color: [f64; 3],
+    pub bottom_color: [f64; 3],
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GradientKind {
+    /// By the ray's direction: a sky around the scene, the same from everywhere.
+    Sphere,
+    /// By where the ray starts: camera rays of an orthographic view sweep the gradient across
+    /// the picture (a perspective camera's all start at its position: one colour).
+    OrthoPlane,
 }
 
 #[derive(Clone, Debug, PartialEq)]

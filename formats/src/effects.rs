@@ -120,6 +120,54 @@ impl Checker<'_> {
         Ok(self.spanned(light, node))
     }
 
+    /// `background:` a colour, or a gradient (named `Gradient`, with an `up` that is not
+    /// zero).
+    pub(crate) fn background(&self, b: raw::Background, node: &Node) -> Result<BackgroundDesc> {
+        let g = match b {
+            raw::Background::Color(rgb) => {
+                return Ok(BackgroundDesc::Color(self.colour(
+                    node,
+                    "background",
+                    rgb,
+                )?));
+            }
+            raw::Background::Gradient(g) => g,
+        };
+        // RON gives the struct without its name: a gradient is `Gradient(...)` or `(...)`.
+        let text = self.src.slice(node);
+        let name = text[..text.find('(').unwrap_or(0)].trim();
+        if !(name.is_empty() || name == "Gradient") {
+            return Err(self.error(
+                node,
+                format!(
+                    "`background: {}(...)`: expected a colour `(r, g, b)` or `Gradient(kind: \
+                     Sphere, up: (0, 1, 0), top: 1, bottom: -1, top_color: (..), bottom_color: \
+                     (..))`",
+                    crate::error::shown(name)
+                ),
+            ));
+        }
+        let field = |name| node.field(name).unwrap_or(node);
+        let up = g.up.unwrap_or([0.0, 1.0, 0.0]);
+        if up == [0.0; 3] {
+            return Err(self.error(
+                field("up"),
+                "gradient `up` is (0, 0, 0); expected a direction",
+            ));
+        }
+        Ok(BackgroundDesc::Gradient(GradientDesc {
+            kind: match g.kind {
+                raw::GradientKind::Sphere => GradientKind::Sphere,
+                raw::GradientKind::OrthoPlane => GradientKind::OrthoPlane,
+            },
+            up,
+            top: g.top,
+            bottom: g.bottom,
+            top_color: self.colour(field("top_color"), "top_color", g.top_color)?,
+            bottom_color: self.colour(field("bottom_color"), "bottom_color", g.bottom_color)?,
+        }))
+    }
+
     pub(crate) fn fog(&self, fog: raw::Fog, node: &Node) -> Result<FogDesc> {
         let field = |name| node.field(name).unwrap_or(node);
         let mode_node = field("mode");

@@ -29,8 +29,8 @@ pub struct InlineGeometry {
     pub mesh: InlineMesh,
 }
 
-/// Triangles indexing shared vertices; `normals` and `uvs` are empty or have one entry per
-/// position.
+/// Triangles indexing shared vertices; `normals`, `uvs` and `colors` are empty or have one
+/// entry per position.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct InlineMesh {
     pub positions: Vec<[f64; 3]>,
@@ -38,6 +38,9 @@ pub struct InlineMesh {
     pub indices: Vec<[u64; 3]>,
     /// Texture coordinates (u, v).
     pub uvs: Vec<[f64; 2]>,
+    /// Vertex colours (linear RGB, 0 or more): they multiply the material's colour, and are
+    /// interpolated across each triangle.
+    pub colors: Vec<[f64; 3]>,
 }
 
 impl InlineGeometry {
@@ -63,6 +66,7 @@ impl InlineGeometry {
             + held(&m.normals)
             + held(&m.indices)
             + held(&m.uvs)
+            + held(&m.colors)
     }
 
     pub fn primitive_count(&self) -> usize {

@@ -7,6 +7,8 @@
 //!   files are, by the format's convention, convex); negative (relative) indices are resolved.
 //! - Positions, normals and texture coordinates are unified per vertex (a vertex is a distinct
 //!   `v/vt/vn` triple), so `normals` and `uvs` are empty or have one entry per position.
+//! - Vertex colours (`v x y z r g b`, as MeshLab and others write them) become the mesh's
+//!   `colors`, which multiply the material's colour (negative components are taken as 0).
 //! - A mesh without (complete) normals gets smooth vertex normals: the area-weighted mean of the
 //!   normals of the faces around each position (per mesh; vertices split by a texture seam
 //!   share their normal). Faces are counter-clockwise seen from the front, as OBJ expects.
@@ -33,7 +35,8 @@ use std::sync::Arc;
 use luxon_plugin::files::{open_regular, TextReader};
 
 use crate::desc::{
-    CameraDesc, LightDesc, MaterialDesc, Origin, Projection, RenderDesc, SceneDesc, Spanned,
+    BackgroundDesc, CameraDesc, LightDesc, MaterialDesc, Origin, Projection, RenderDesc, SceneDesc,
+    Spanned,
 };
 use crate::error::{shown, SceneError, Warning};
 use crate::geometry::{InlineGeometry, InlineMesh};
@@ -552,6 +555,15 @@ fn mesh_of_model(
     } else {
         Vec::new()
     };
+    // `v x y z r g b`: colours of all vertices or none (tobj keeps them only then).
+    let colors = if m.vertex_color.len() == m.positions.len() {
+        m.vertex_color
+            .chunks_exact(3)
+            .map(|c| [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)])
+            .collect()
+    } else {
+        Vec::new()
+    };
     let material = m.material_id.and_then(|i| names.get(i)).map(|n| Spanned {
         value: n.clone(),
         at: origin.clone(),
@@ -564,6 +576,7 @@ fn mesh_of_model(
             normals,
             indices,
             uvs,
+            colors,
         },
         ..InlineGeometry::default()
     })
@@ -707,7 +720,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneE
             },
             at: at.clone(),
         },
-        background: [0.0; 3],
+        background: BackgroundDesc::default(),
         lights: vec![Spanned {
             value: LightDesc::Point {
                 position: light,

@@ -4,7 +4,7 @@
 use std::fmt;
 use std::marker::PhantomData;
 
-use serde::de::{IgnoredAny, MapAccess, Visitor};
+use serde::de::{IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
 pub(crate) type Vec3 = [f64; 3];
@@ -19,7 +19,7 @@ pub(crate) struct Scene {
     #[serde(default)]
     pub camera: Option<Camera>,
     #[serde(default)]
-    pub background: Option<Vec3>,
+    pub background: Option<Background>,
     #[serde(default)]
     pub lights: Vec<Light>,
     #[serde(default)]
@@ -227,6 +227,59 @@ impl Light {
 pub(crate) enum SpotFade {
     Smooth,
     Linear,
+}
+
+/// `background: (r, g, b)` or `background: Gradient(...)`.
+pub(crate) enum Background {
+    Color(Vec3),
+    Gradient(Gradient),
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Gradient", deny_unknown_fields)]
+pub(crate) struct Gradient {
+    pub kind: GradientKind,
+    #[serde(default)]
+    pub up: Option<Vec3>,
+    pub top: f64,
+    pub bottom: f64,
+    pub top_color: Vec3,
+    pub bottom_color: Vec3,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "GradientKind")]
+pub(crate) enum GradientKind {
+    Sphere,
+    OrthoPlane,
+}
+
+impl<'de> Deserialize<'de> for Background {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct BackgroundVisitor;
+
+        impl<'de> Visitor<'de> for BackgroundVisitor {
+            type Value = Background;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a colour `(r, g, b)` or `Gradient(kind: ..., ...)`")
+            }
+
+            // A tuple is a colour; a struct (its name is checked against the span tree) a
+            // gradient: RON hands both to `deserialize_any` without their names.
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+                let rgb = Vec3::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))?;
+                Ok(Background::Color(rgb))
+            }
+
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+                let g = Gradient::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(Background::Gradient(g))
+            }
+        }
+
+        deserializer.deserialize_any(BackgroundVisitor)
+    }
 }
 
 #[derive(Deserialize)]

@@ -36,7 +36,10 @@ pub(crate) fn ron_error(e: &SpannedError, src: &SourceMap) -> SceneError {
 
 /// What ron found wrong, saying what was expected.
 fn ron_message(code: &ron::Error) -> String {
-    let within = |outer: &Option<String>| match outer {
+    // A gradient background is read without its name (see `raw::Background`): ron then
+    // names the scene around it; its fields say whose they are.
+    let within = |outer: &Option<String>, field: &str| match outer.as_deref() {
+        Some("Scene") if GRADIENT_FIELDS.contains(&field) => " in `Gradient`".to_string(),
         Some(o) => format!(" in `{o}`"),
         None => String::new(),
     };
@@ -63,22 +66,30 @@ fn ron_message(code: &ron::Error) -> String {
             expected,
             found,
             outer,
-        } => unknown_name("field", found, &within(outer), expected.iter().copied()),
+        } => {
+            let whose = within(outer, expected.first().copied().unwrap_or_default());
+            unknown_name("field", found, &whose, expected.iter().copied())
+        }
         E::NoSuchEnumVariant {
             expected,
             found,
             outer,
-        } => unknown_name("variant", found, &within(outer), expected.iter().copied()),
+        } => unknown_name(
+            "variant",
+            found,
+            &within(outer, ""),
+            expected.iter().copied(),
+        ),
         E::MissingStructField { field, outer } => {
             format!(
                 "missing field `{field}`{}; expected `{field}: ...`",
-                within(outer)
+                within(outer, field)
             )
         }
         E::DuplicateStructField { field, outer } => {
             format!(
                 "field `{field}` is given twice{}; expected it once",
-                within(outer)
+                within(outer, field)
             )
         }
         E::ExpectedDifferentStructName { expected, found } => {
@@ -124,6 +135,9 @@ fn lower_first(s: &str) -> String {
         None => String::new(),
     }
 }
+
+/// The fields of `background: Gradient(...)`, none of them a field of `Scene`.
+const GRADIENT_FIELDS: [&str; 6] = ["kind", "up", "top", "bottom", "top_color", "bottom_color"];
 
 /// Whose properties a keyed struct of `animation:` holds, for "… cannot be animated".
 fn keyed(outer: &str) -> Option<&'static str> {

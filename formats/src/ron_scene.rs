@@ -65,7 +65,7 @@ fn load_root(
     let mut scene = SceneDesc {
         source: path.to_path_buf(),
         camera,
-        background: part.background.unwrap_or([0.0; 3]),
+        background: part.background.unwrap_or_default(),
         lights: part.lights,
         fog: part.fog,
         ambient_occlusion: part.ambient_occlusion,

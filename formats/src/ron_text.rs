@@ -6,7 +6,7 @@
 //! Imported geometry (`inline`) has no RON form of its own: [`inline_as_objects`] turns each
 //! group into the `luxon-shapes` objects that store the same primitives — `sphere` /
 //! `spheres`, `cylinder` / `cone` (open), `ring`, `plane`, and one `mesh` of inline arrays
-//! (positions, normals, uvs, indices) per group — in the order the core stores them.
+//! (positions, normals, uvs, colors, indices) per group — in the order the core stores them.
 //!
 //! What the source says that the description does not hold — each warning of the load (a
 //! Tachyon feature Luxon does not render yet, an OBJ statement it does not draw, a missing
@@ -213,6 +213,9 @@ pub fn inline_as_objects(g: &InlineGeometry, fallback: &Origin) -> Vec<Spanned<O
                 items(o, m.uvs.len(), 4, ITEM, |o, k| tuple(o, &m.uvs[k], exact));
                 let _ = write!(o, "\n{FIELD}],");
             }
+            if !m.colors.is_empty() {
+                vector_field(o, "colors", &m.colors, exact);
+            }
             index_field(o, &m.indices);
         });
         out.push(object("mesh", text));
@@ -281,7 +284,7 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
         let _ = writeln!(w, "    plugin_path: [{}],", dirs.join(", "));
     }
     write_camera(&mut w, &camera.value);
-    let _ = writeln!(w, "    background: {},", v3(background));
+    let _ = writeln!(w, "    background: {},", background_text(background));
     if !lights.is_empty() {
         w.extend_from_slice(b"    lights: [\n");
         for (i, l) in lights.iter().enumerate() {
@@ -528,6 +531,22 @@ pub(crate) fn camera_fields(c: &CameraDesc) -> Vec<String> {
         ));
     }
     f
+}
+
+/// The background's RON text: `(r, g, b)` or `Gradient(...)`.
+pub(crate) fn background_text(b: &BackgroundDesc) -> String {
+    match b {
+        BackgroundDesc::Color(c) => v3(c),
+        BackgroundDesc::Gradient(g) => format!(
+            "Gradient(kind: {:?}, up: {}, top: {}, bottom: {}, top_color: {}, bottom_color: {})",
+            g.kind,
+            v3(&g.up),
+            num(g.top),
+            num(g.bottom),
+            v3(&g.top_color),
+            v3(&g.bottom_color)
+        ),
+    }
 }
 
 /// Fog's RON text, `(mode: ..., ...)`.

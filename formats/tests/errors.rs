@@ -634,3 +634,49 @@ fn a_memory_size_without_a_unit_is_an_error_at_its_value() {
     );
     assert_eq!(desc.render.texture_cache, Some(1 << 30));
 }
+
+// ---- Background ----
+
+#[test]
+fn gradient_background_errors_are_at_the_value() {
+    // An unknown field, a misspelt kind, a missing field, a zero `up`, a negative colour, a
+    // struct that is not a `Gradient`, a colour of two components.
+    let g = "kind: Sphere, top: 1, bottom: -1, top_color: (1, 1, 1), bottom_color: (0, 0, 0)";
+    let found = scene_error(&format!(
+        "    background: Gradient({g}, colour: (1, 0, 0)),"
+    ));
+    check(
+        found,
+        3,
+        107,
+        &["unknown field `colour` in `Gradient`", "`top_color`"],
+    );
+    let found = scene_error(
+        "    background: Gradient(kind: Sphre, top: 1, bottom: 0, top_color: (1, 1, 1), \
+         bottom_color: (0, 0, 0)),",
+    );
+    check(
+        found,
+        3,
+        32,
+        &["Sphre", "did you mean `Sphere`?", "`OrthoPlane`"],
+    );
+    let found = scene_error("    background: Gradient(kind: OrthoPlane, top: 1, bottom: 0),");
+    check(found, 3, 17, &["missing field `top_color` in `Gradient`"]);
+    let found = scene_error(&format!("    background: Gradient({g}, up: (0, 0, 0)),"));
+    check(
+        found,
+        3,
+        111,
+        &["`up` is (0, 0, 0)", "expected a direction"],
+    );
+    let found = scene_error(
+        "    background: Gradient(kind: Sphere, top: 1, bottom: 0, top_color: (1, -1, 1), \
+         bottom_color: (0, 0, 0)),",
+    );
+    check(found, 3, 74, &["`top_color` has a negative component -1"]);
+    let found = scene_error(&format!("    background: Sky({g}),"));
+    check(found, 3, 17, &["`background: Sky(...)`", "Gradient(kind:"]);
+    let found = scene_error("    background: (1, 0),");
+    check(found, 3, 17, &["found 2 numbers; expected 3"]);
+}

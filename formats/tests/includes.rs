@@ -136,7 +136,7 @@ fn includes_merge_in_order() {
 
     // Singles: from the including file when it gives them, else from the last include that does.
     assert_eq!(*scene.camera.at.file, d.join("a.ron"));
-    assert_eq!(scene.background, [1.0, 0.0, 0.0]);
+    assert_eq!(scene.background, BackgroundDesc::Color([1.0, 0.0, 0.0]));
     assert_eq!(scene.render.width, 20);
     assert_eq!(scene.source, main);
 }

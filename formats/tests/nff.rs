@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use luxon_formats::nff::{self, Imported};
-use luxon_formats::{InlineGeometry, LightDesc, Projection, SceneDesc};
+use luxon_formats::{BackgroundDesc, InlineGeometry, LightDesc, Projection, SceneDesc};
 
 const VIEW: &str = "v\nfrom 0 -10 0\nat 0 0 0\nup 0 0 1\nangle 45\nhither 1\nresolution 64 48\n";
 
@@ -78,7 +78,7 @@ fn view_maps_to_the_camera_and_render_settings() {
     assert_eq!(d.render.samples, 1);
     assert_eq!(d.render.max_depth, 5);
     // No background: black.
-    assert_eq!(d.background, [0.0; 3]);
+    assert_eq!(d.background, BackgroundDesc::Color([0.0; 3]));
 }
 
 #[test]
@@ -92,7 +92,9 @@ fn view_lines_in_any_order_hither_and_resolution_optional() {
 #[test]
 fn background_is_linear() {
     let i = parse(&format!("{VIEW}b 0.078 0.361 0.753\n"));
-    let b = i.desc.background;
+    let BackgroundDesc::Color(b) = i.desc.background else {
+        panic!("not a colour: {:?}", i.desc.background);
+    };
     // sRGB 0.361 is linear 0.1070...
     assert!((b[1] - 0.107156).abs() < 1e-6, "{b:?}");
     assert!((b[0] - 0.0069413).abs() < 1e-6, "{b:?}");

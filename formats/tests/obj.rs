@@ -43,6 +43,28 @@ fn a_quad_becomes_two_triangles() {
 }
 
 #[test]
+fn vertex_colours_are_kept_per_vertex() {
+    let dir = temp_dir("colours");
+    let text = "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1\nv 0 1 0 0.5 -0.5 1\nf 1 2 3 4\n";
+    let obj = load_obj(&write(&dir, "c.obj", text), None).unwrap();
+    let g = only(&obj.geometry);
+    assert_eq!(g.mesh.colors.len(), g.mesh.positions.len());
+    // Each position keeps its colour (a negative component taken as 0).
+    for (p, c) in g.mesh.positions.iter().zip(&g.mesh.colors) {
+        let want = match [p[0], p[1]] {
+            [0.0, 0.0] => [1.0, 0.0, 0.0],
+            [1.0, 0.0] => [0.0, 1.0, 0.0],
+            [1.0, 1.0] => [0.0, 0.0, 1.0],
+            _ => [0.5, 0.0, 1.0],
+        };
+        assert_eq!(*c, want, "at {p:?}");
+    }
+    // Without colours, none.
+    let plain = load_obj(&write(&dir, "q.obj", QUAD), None).unwrap();
+    assert!(only(&plain.geometry).mesh.colors.is_empty());
+}
+
+#[test]
 fn negative_indices_count_back_from_the_last_vertex() {
     let dir = temp_dir("neg");
     let text = "v 5 5 5\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n";

@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 
 use luxon_formats::tachyon::{parse_file, syntax, Highlights, Options, ShadeLevel, Skylight};
 use luxon_formats::{
-    load, BeyondMax, FogMode, Highlight, HighlightColor, InlineGeometry, LightDesc, MaterialDesc,
-    Origin, Projection, SceneDesc, TransparencyAngle, TransparencyMode, TransparentShadows,
+    load, BackgroundDesc, BeyondMax, FogMode, GradientDesc, GradientKind, Highlight,
+    HighlightColor, InlineGeometry, LightDesc, MaterialDesc, Origin, Projection, SceneDesc,
+    TransparencyAngle, TransparencyMode, TransparentShadows,
 };
 
 struct TempDir(PathBuf);
@@ -96,7 +97,7 @@ fn a_minimal_scene_has_tachyons_default_camera() {
     assert!(close(f.left, -1.0 + 1.0 / 64.0) && close(f.right, 1.0 + 1.0 / 64.0));
     assert!(close(f.bottom, -0.5 + 0.5 / 32.0) && close(f.top, 0.5 + 0.5 / 32.0));
     assert!(d.inline.is_empty() && d.lights.is_empty() && d.warnings.is_empty());
-    assert_eq!(d.background, [0.0; 3]);
+    assert_eq!(d.background, BackgroundDesc::Color([0.0; 3]));
 }
 
 #[test]
@@ -451,7 +452,7 @@ fn shader_modes_set_transparency_fog_and_levels() {
         (m.color, m.ambient, m.diffuse, m.transmit),
         ([1.0; 3], 1.0, 0.0, 0.0)
     );
-    assert_eq!(d.background, [0.0; 3]);
+    assert_eq!(d.background, BackgroundDesc::Color([0.0; 3]));
 }
 
 #[test]
@@ -509,8 +510,49 @@ fn background_and_gradient() {
         "BACKGROUND 0.1 0.2 0.3\nBACKGROUND_GRADIENT SKY_SPHERE UPDIR 0 1 0 TOPVAL 1 \
          BOTTOMVAL -1 TOPCOLOR 1 1 1 BOTTOMCOLOR 0 0 0",
     );
-    assert_eq!(d.background, [0.1, 0.2, 0.3]);
-    assert!(warned(&d, "BACKGROUND_GRADIENT"));
+    // The gradient is shown whatever BACKGROUND says (measured), its UPDIR mirrored.
+    assert_eq!(
+        d.background,
+        BackgroundDesc::Gradient(GradientDesc {
+            kind: GradientKind::Sphere,
+            up: [0.0, 1.0, -0.0],
+            top: 1.0,
+            bottom: -1.0,
+            top_color: [1.0; 3],
+            bottom_color: [0.0; 3],
+        })
+    );
+    assert!(!warned(&d, "BACKGROUND_GRADIENT"));
+    let after = scene(
+        "bg2",
+        "BACKGROUND_GRADIENT SKY_ORTHO_PLANE UPDIR 0.5 1 2 TOPVAL 1 BOTTOMVAL -1 \
+         TOPCOLOR 1 1 1 BOTTOMCOLOR 0 0 0\nBACKGROUND 0.1 0.2 0.3",
+    );
+    match after.background {
+        BackgroundDesc::Gradient(g) => {
+            assert_eq!((g.kind, g.up), (GradientKind::OrthoPlane, [0.5, 1.0, -2.0]));
+        }
+        other => panic!("{other:?}"),
+    }
+    // UPDIR 0 0 0: every ray mixes at x = 0, a plain colour (here a quarter of the way).
+    let flat = scene(
+        "bg3",
+        "BACKGROUND_GRADIENT SKY_SPHERE UPDIR 0 0 0 TOPVAL 3 BOTTOMVAL -1 \
+         TOPCOLOR 1 1 1 BOTTOMCOLOR 0 0 0",
+    );
+    assert_eq!(flat.background, BackgroundDesc::Color([0.25; 3]));
+    // A negative colour is an error, as everywhere.
+    let e = error(
+        "bg4",
+        &format!(
+            "{HEAD}BACKGROUND_GRADIENT SKY_SPHERE UPDIR 0 1 0 TOPVAL 1 BOTTOMVAL -1 \
+             TOPCOLOR 1 -1 1 BOTTOMCOLOR 0 0 0\nEND_SCENE\n"
+        ),
+    );
+    assert!(
+        e.starts_with("s.dat:3:1: COLOR [1.0, -1.0, 1.0] has a negative"),
+        "{e}"
+    );
     let tree = {
         let dir = TempDir::new("bgtree");
         let p = dir.write(
@@ -892,7 +934,7 @@ fn vertex_arrays_meshes_strips_and_textures() {
          NORMALS 0 0 -1 0 0 -1 0 0 -1 0 0 -1\n\
          TRIMESH 1 0 1 2\n\
          TEXTURE AMBIENT 0 DIFFUSE 1 SPECULAR 0 OPACITY 1 COLOR 0 1 0 TEXFUNC 0\n\
-         COLORS 1 0 0 1 0 0 1 0 0 1 0 0\n\
+         COLORS 1 0 0 0 1 0 0 0 1 1 1 0\n\
          TRISTRIP 4 0 1 2 3\n\
          END_VERTEXARRAY",
     );
@@ -900,16 +942,38 @@ fn vertex_arrays_meshes_strips_and_textures() {
     // Before any TEXTURE: Tachyon's default texture.
     let first = material(&d, &d.inline[0].material.as_ref().unwrap().value);
     assert_eq!((first.ambient, first.diffuse), (0.1, 0.9));
+    assert!(first.texture.is_none() && d.inline[0].mesh.colors.is_empty());
+    // After COLORS: the TEXTURE's material in white, untextured; the colours per vertex.
     let second = &d.inline[1];
-    assert_eq!(
-        material(&d, &second.material.as_ref().unwrap().value).color,
-        [0.0, 1.0, 0.0]
-    );
-    // The strip's two triangles over the four vertices, each stored once.
+    let m = material(&d, &second.material.as_ref().unwrap().value);
+    assert_eq!((m.color, m.ambient, m.diffuse), ([1.0; 3], 0.0, 1.0));
+    assert!(m.texture.is_none());
+    // The strip's two triangles over the four vertices, each stored once with its colour (in
+    // order of first use: the mirrored winding takes vertices 0, 2, 1, then 3).
     assert_eq!(second.mesh.indices.len(), 2);
     assert_eq!(second.mesh.positions.len(), 4);
     assert_eq!(second.mesh.normals[0], [0.0, 0.0, 1.0]);
-    assert!(warned(&d, "VERTEXARRAY COLORS"));
+    assert_eq!(
+        second.mesh.colors,
+        vec![
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0]
+        ]
+    );
+    assert!(!warned(&d, "COLORS"));
+    let e = error(
+        "va-neg",
+        &format!(
+            "{HEAD}VERTEXARRAY NUMVERTS 3\nCOORDS 0 0 0 1 0 0 0 1 0\nNORMALS 0 0 -1 0 0 -1 0 0 -1\n\
+             COLORS 1 0 0 0 -1 0 0 0 1\nTRIMESH 1 0 1 2\nEND_VERTEXARRAY\nEND_SCENE\n"
+        ),
+    );
+    assert!(
+        e.starts_with("s.dat:6:1: COLORS: colour 1 [0.0, -1.0, 0.0] has a negative"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -923,7 +987,12 @@ fn vcstri_keeps_its_surface_with_a_white_colour() {
     let g = only(&d);
     let m = material(&d, &g.material.as_ref().unwrap().value);
     assert_eq!((m.color, m.ambient, m.specular), ([1.0; 3], 0.2, 0.5));
-    assert!(warned(&d, "VCSTRI vertex colours"));
+    // The colours ride on the vertices (v1 and v2 swap with the mirrored winding).
+    assert_eq!(
+        g.mesh.colors,
+        vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+    );
+    assert!(!warned(&d, "VCSTRI"));
     // METAL: the highlight in the surface's colour.
     assert_eq!(m.highlight_color, HighlightColor::Surface);
 }

@@ -60,7 +60,7 @@ fn camera_background_and_lights() {
     assert_eq!(camera.up, [0.0, 1.0, 0.0]);
     assert_eq!(camera.projection, Projection::Perspective { fov_deg: 40.0 });
     assert_eq!(camera.aspect, Some(1.5));
-    assert_eq!(scene.background, [0.05, 0.05, 0.1]);
+    assert_eq!(scene.background, BackgroundDesc::Color([0.05, 0.05, 0.1]));
 
     assert_eq!(scene.lights.len(), 2);
     assert_eq!(at(&scene.lights[0].at), (12, 9));
@@ -174,7 +174,7 @@ fn defaults_fill_what_is_left_out() {
         Projection::PerspectiveZoom { zoom: 2.0 }
     );
     assert_eq!(scene.camera.value.aspect, None);
-    assert_eq!(scene.background, [0.0; 3]);
+    assert_eq!(scene.background, BackgroundDesc::Color([0.0; 3]));
     assert_eq!(scene.render, RenderDesc::default());
     assert!(scene.lights.is_empty() && scene.objects.is_empty());
 
@@ -251,5 +251,46 @@ fn adaptive_supersampling_settings() {
             threshold: 0.0,
             max_depth: 3
         })
+    );
+}
+
+#[test]
+fn gradient_backgrounds() {
+    let load = |bg: &str| {
+        let text =
+            format!("(camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n background: {bg})");
+        load_ron_str(&text, Path::new("g.ron"))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .background
+    };
+    assert_eq!(
+        load(
+            "Gradient(kind: OrthoPlane, up: (0, 0, 2), top: 3, bottom: -1, top_color: (1, 1, 1), \
+             bottom_color: (0, 0, 0.5))"
+        ),
+        BackgroundDesc::Gradient(GradientDesc {
+            kind: GradientKind::OrthoPlane,
+            up: [0.0, 0.0, 2.0],
+            top: 3.0,
+            bottom: -1.0,
+            top_color: [1.0; 3],
+            bottom_color: [0.0, 0.0, 0.5],
+        })
+    );
+    // `up` defaults to +y; the name may be left out, as for any RON struct; top = bottom is
+    // a sharp horizon.
+    let BackgroundDesc::Gradient(g) =
+        load("(kind: Sphere, top: 0, bottom: 0, top_color: (1, 0, 0), bottom_color: (0, 0, 1))")
+    else {
+        panic!("not a gradient");
+    };
+    assert_eq!(
+        (g.kind, g.up, g.top),
+        (GradientKind::Sphere, [0.0, 1.0, 0.0], 0.0)
+    );
+    // The colour keeps its syntax.
+    assert_eq!(
+        load("(0.5, 0.25, 1)"),
+        BackgroundDesc::Color([0.5, 0.25, 1.0])
     );
 }

@@ -7,7 +7,7 @@ use crate::error::Error;
 use crate::math::DVec3;
 use crate::plugin::Registry;
 use crate::scene::{Prebuilt, Scene as Built};
-use luxon_formats::{fragment, CameraDesc, RenderDesc, SceneDesc};
+use luxon_formats::{fragment, BackgroundDesc, CameraDesc, RenderDesc, SceneDesc};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -200,7 +200,7 @@ impl Scene {
                 "background {rgb:?}: expected finite components ≥ 0"
             )));
         }
-        self.desc.background = rgb;
+        self.desc.background = BackgroundDesc::Color(rgb);
         Ok(())
     }
 

@@ -8,7 +8,7 @@
 use super::frame::{self, Animation, Keyed};
 use super::instances::{self, PrototypeUse};
 use super::place::Sets;
-use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings};
+use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings, Sky};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
@@ -27,8 +27,8 @@ use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
 use luxon_formats::{
-    HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned, SpotFade,
-    TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
+    BackgroundDesc, HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned,
+    SpotFade, TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
 };
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -196,7 +196,8 @@ impl Scene {
             camera: camera.clone(),
             primary_width: camera.footprint().0,
             pixel_spread: camera.footprint().1,
-            background: v3(desc.background),
+            background: background(&desc.background),
+            sky: sky(&desc.background, b.world_offset),
             lights,
             fog,
             ao,
@@ -617,7 +618,12 @@ impl<'a> Build<'a> {
                     positions: g.mesh.positions.as_flattened(),
                     indices: g.mesh.indices.as_flattened(),
                     normals: g.mesh.normals.as_flattened(),
-                    colors: &[],
+                    colors: &g
+                        .mesh
+                        .colors
+                        .iter()
+                        .flat_map(|c| c.map(|x| x as f32))
+                        .collect::<Vec<_>>(),
                     uvs: &g
                         .mesh
                         .uvs
@@ -849,7 +855,7 @@ impl Stored {
         self.discs.reserve(d, budget, &n(d, "discs"))?;
         self.planes.reserve(p, budget, &n(p, "planes"))?;
         let m = &g.mesh;
-        let attrs = !(m.normals.is_empty() && m.uvs.is_empty());
+        let attrs = !(m.normals.is_empty() && m.uvs.is_empty() && m.colors.is_empty());
         let t = m.indices.len();
         let describe = n(t, "triangles");
         self.triangles
@@ -1082,5 +1088,21 @@ fn material(
         outline: m.outline as f32,
         outline_power: 32.0 * (1.0 - m.outline_width as f32),
         fog: m.fog,
+    }
+}
+
+/// The colour of rays that miss when there is no gradient (a gradient's bottom colour otherwise).
+pub(super) fn background(b: &BackgroundDesc) -> Vec3A {
+    match b {
+        BackgroundDesc::Color(c) => v3(*c),
+        BackgroundDesc::Gradient(g) => v3(g.bottom_color),
+    }
+}
+
+/// A gradient background in render space (its ortho plane is placed relative to the origin).
+pub(super) fn sky(b: &BackgroundDesc, world_offset: DVec3) -> Option<Sky> {
+    match b {
+        BackgroundDesc::Color(_) => None,
+        BackgroundDesc::Gradient(g) => Some(Sky::new(g, world_offset)),
     }
 }

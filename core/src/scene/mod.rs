@@ -10,11 +10,13 @@ mod build;
 mod frame;
 mod instances;
 mod place;
+mod sky;
 mod update;
 
 pub use build::Prebuilt;
 pub use frame::Animation;
 pub use instances::PrototypeUse;
+pub use sky::Sky;
 
 use crate::budget::Budget;
 use crate::camera::Camera;
@@ -307,7 +309,9 @@ pub struct Settings {
 pub struct Scene {
     pub source: PathBuf,
     pub camera: Camera,
+    /// What rays that hit nothing show: this colour, or the gradient `sky`.
     pub background: Vec3A,
+    pub sky: Option<Sky>,
     pub lights: Vec<Light>,
     pub fog: Option<Fog>,
     pub ao: Option<Ao>,

@@ -2,7 +2,7 @@
 //! it again: the render settings that touch no geometry, the image size, the background and the
 //! camera. The rest of a change is a build (`build`).
 
-use super::build::{settings, v3};
+use super::build::{self, settings};
 use super::Scene;
 use crate::error::Error;
 use luxon_formats::SceneDesc;
@@ -27,7 +27,8 @@ impl Scene {
         self.settings.width = width;
         self.settings.height = height;
         self.outputs = r.outputs.clone();
-        self.background = v3(desc.background);
+        self.background = build::background(&desc.background);
+        self.sky = build::sky(&desc.background, self.world_offset);
         self.features.antialiasing = r.samples > 1 || r.adaptive.is_some();
         self.features.tachyon_lights =
             (r.tachyon.light_threshold || r.tachyon.plain_highlights) && !self.lights.is_empty();

@@ -76,8 +76,8 @@ use std::sync::Arc;
 use luxon_plugin::files::{open_regular, TextReader};
 
 use crate::desc::{
-    CameraDesc, Highlight, LightDesc, MaterialDesc, Origin, Projection, RenderDesc, SceneDesc,
-    Spanned,
+    BackgroundDesc, CameraDesc, Highlight, LightDesc, MaterialDesc, Origin, Projection, RenderDesc,
+    SceneDesc, Spanned,
 };
 use crate::error::{SceneError, Warning};
 use crate::geometry::{InlineGeometry, InlineMesh};
@@ -440,6 +440,7 @@ impl<'o> Assembler<'o> {
                     normals: b.normals,
                     indices: b.indices,
                     uvs: Vec::new(),
+                    colors: Vec::new(),
                 },
             });
         }
@@ -560,7 +561,7 @@ impl<'o> Assembler<'o> {
         let desc = SceneDesc {
             source: self.file.as_ref().clone(),
             camera,
-            background: linear_rgb(self.background.unwrap_or([0.0; 3])),
+            background: BackgroundDesc::Color(linear_rgb(self.background.unwrap_or([0.0; 3]))),
             lights,
             fog: None,
             ambient_occlusion: None,

@@ -12,10 +12,10 @@ use super::syntax::*;
 use super::terrain::scape;
 use super::{mirror, Warnings};
 use crate::desc::{
-    AoDesc, Attenuation, BeyondMax, CameraDesc, DepthOfField, FogDesc, FogMode as LuxFog, Frustum,
-    Highlight, LightDesc, MaterialDesc, Projection as LuxProjection, RenderDesc, SceneDesc,
-    SpotFade, TachyonDesc, TransparencyAngle, TransparencyDesc, TransparencyMode,
-    TransparentShadows,
+    AoDesc, Attenuation, BackgroundDesc, BeyondMax, CameraDesc, DepthOfField, FogDesc,
+    FogMode as LuxFog, Frustum, GradientDesc, GradientKind, Highlight, LightDesc, MaterialDesc,
+    Projection as LuxProjection, RenderDesc, SceneDesc, SpotFade, TachyonDesc, TransparencyAngle,
+    TransparencyDesc, TransparencyMode, TransparentShadows,
 };
 use crate::error::SceneError;
 use crate::origin::{Origin, Spanned};
@@ -40,6 +40,8 @@ struct Shading {
 struct Mapper {
     camera: Option<(Origin, Camera)>,
     background: V3,
+    /// The last BACKGROUND_GRADIENT: once given, it is shown whatever BACKGROUND says.
+    gradient: Option<BackgroundDesc>,
     fog: Option<(Origin, Fog)>,
     ao: Option<AoDesc>,
     /// Tachyon's direct light scale (RESCALE_DIRECT): it outlives the occlusion that set it.
@@ -66,6 +68,7 @@ pub(super) fn to_desc(scene: Scene, options: &Options) -> Result<SceneDesc> {
     let mut m = Mapper {
         camera: None,
         background: [0.0; 3],
+        gradient: None,
         fog: None,
         ao: None,
         light_scale: 1.0,
@@ -99,6 +102,48 @@ fn light_color(c: V3, at: &Origin) -> Result<V3> {
         ));
     }
     Ok(c)
+}
+
+/// BACKGROUND_GRADIENT: Tachyon blends by UPDIR·D (SKY_SPHERE, D the missed ray's direction)
+/// or UPDIR·O (SKY_ORTHO_PLANE, O its origin), UPDIR as written (not normalised), mirrored
+/// like every direction. A zero UPDIR gives every ray the same mix: a plain colour.
+fn gradient(g: &Gradient, at: &Origin) -> Result<BackgroundDesc> {
+    let top_color = light_color(g.topcolor, at)?;
+    let bottom_color = light_color(g.bottomcolor, at)?;
+    if g.updir == [0.0; 3] {
+        let t = (0.0 - g.bottomval) / (g.topval - g.bottomval);
+        // (0 / 0, a sharp horizon at 0: the bottom colour, as the core mixes there.)
+        let t = if t >= 0.0 { t.min(1.0) } else { 0.0 };
+        return Ok(BackgroundDesc::Color(
+            [0, 1, 2].map(|k| t * top_color[k] + (1.0 - t) * bottom_color[k]),
+        ));
+    }
+    Ok(BackgroundDesc::Gradient(GradientDesc {
+        kind: match g.kind.value {
+            SkyKind::Sphere => GradientKind::Sphere,
+            SkyKind::OrthoPlane => GradientKind::OrthoPlane,
+        },
+        up: mirror(g.updir),
+        top: g.topval,
+        bottom: g.bottomval,
+        top_color,
+        bottom_color,
+    }))
+}
+
+/// Vertex colours as written (display values, like every Tachyon colour), none negative.
+fn vertex_colors(c: &[V3], what: &str, at: &Origin) -> Result<Vec<V3>> {
+    if let Some(i) = c.iter().position(|c| c.iter().any(|&x| x < 0.0)) {
+        return Err(SceneError::at(
+            at.clone(),
+            format!(
+                "{what}: colour {i} {:?} has a negative component; expected components of 0 or \
+                 more",
+                c[i]
+            ),
+        ));
+    }
+    Ok(c.to_vec())
 }
 
 fn attenuation(a: &Option<Spanned<V3>>) -> Attenuation {
@@ -135,11 +180,7 @@ impl Mapper {
             Kind::ShaderMode(mode) => self.shader_mode(mode),
             Kind::Camera(c) => self.camera = Some((at.clone(), c.clone())),
             Kind::Background(c) => self.background = light_color(*c, at)?,
-            Kind::BackgroundGradient(_) => self.notes.add(
-                "BACKGROUND_GRADIENT",
-                "is not rendered yet; the solid BACKGROUND colour is shown",
-                at,
-            ),
+            Kind::BackgroundGradient(g) => self.gradient = Some(gradient(g, at)?),
             Kind::Fog(f) => self.fog = Some((at.clone(), f.clone())),
             Kind::Light(l) => {
                 let color = light_color(l.color, at)?;
@@ -187,22 +228,20 @@ impl Mapper {
             }
             Kind::Tri { v, tex } => {
                 let m = self.material(tex)?;
-                self.shapes.triangle(&m, *v, None, at);
+                self.shapes.triangle(&m, *v, None, None, at);
             }
             Kind::Stri { v, n, tex } => {
                 let m = self.material(tex)?;
-                self.shapes.triangle(&m, *v, Some(*n), at);
+                self.shapes.triangle(&m, *v, Some(*n), None, at);
             }
-            Kind::Vcstri { v, n, surface, .. } => {
-                self.notes.add(
-                    "VCSTRI vertex colours",
-                    "are not rendered yet: the triangles are white",
-                    at,
-                );
+            Kind::Vcstri { v, n, c, surface } => {
+                // The surface's material in white: the vertex colours are the surface colour.
                 let m = self
                     .materials
                     .surface_material(surface, at, &mut self.notes)?;
-                self.shapes.triangle(&m, *v, Some(*n), at);
+                let c = vertex_colors(c, "VCSTRI C0 C1 C2", at)?;
+                self.shapes
+                    .triangle(&m, *v, Some(*n), Some([c[0], c[1], c[2]]), at);
             }
             Kind::VertexArray(va) => self.vertex_array(va, at)?,
             Kind::Fcylinder {
@@ -259,7 +298,7 @@ impl Mapper {
             } => {
                 let m = self.material(tex)?;
                 let (v, n, t) = scape(*res, *scale, *center);
-                self.shapes.mesh(&m, &v, &n, &t, at);
+                self.shapes.mesh(&m, &v, &n, None, &t, at);
             }
             Kind::ScalarVol {
                 min,
@@ -317,7 +356,7 @@ impl Mapper {
                 for t in triangles {
                     // Each record becomes TRI (v1, v0, v2).
                     let v = [t[1], t[0], t[2]].map(|p| tpoly_vertex(p, *scale, *rot, *center));
-                    self.shapes.triangle(&m, v, None, at);
+                    self.shapes.triangle(&m, v, None, None, at);
                 }
             }
             Kind::StartClipGroup { planes } => self.shapes.start_clip(planes, at)?,
@@ -471,19 +510,17 @@ impl Mapper {
         Ok(())
     }
 
-    /// A VERTEXARRAY's meshes, each with the texture (and colours) in effect before it.
+    /// A VERTEXARRAY's meshes, each with the texture and colours in effect before it. With
+    /// COLORS, the texture's colour (and TEXFUNC) gives way to the vertex colours, as in
+    /// Tachyon: its material in white, without texture.
     fn vertex_array(&mut self, va: &VertexArray, at: &Origin) -> Result<()> {
         let mut material = None;
+        let mut colors = None;
         for block in &va.blocks {
             let b_at = &block.at;
             let triangles = match &block.value {
-                VertexBlock::Colors(_) => {
-                    self.notes.add(
-                        "VERTEXARRAY COLORS",
-                        "(vertex colours) are not rendered yet: the meshes take their \
-                         TEXTURE's colour",
-                        b_at,
-                    );
+                VertexBlock::Colors(c) => {
+                    colors = Some(vertex_colors(c, "COLORS", b_at)?);
                     continue;
                 }
                 VertexBlock::Texture(body) => {
@@ -493,12 +530,21 @@ impl Mapper {
                 VertexBlock::TriMesh(t) => t.clone(),
                 VertexBlock::TriStrip(s) => strip(s),
             };
-            let m = match &material {
+            let mut m = match &material {
                 Some(m) => m.clone(),
                 None => self.materials.default_material(b_at),
             };
-            self.shapes
-                .mesh(&m, &va.coords, &va.normals, &triangles, at);
+            if colors.is_some() {
+                m = self.materials.vertex_colored(&m, b_at);
+            }
+            self.shapes.mesh(
+                &m,
+                &va.coords,
+                &va.normals,
+                colors.as_deref(),
+                &triangles,
+                at,
+            );
         }
         Ok(())
     }
@@ -532,7 +578,9 @@ impl Mapper {
                 }
             }
         }
-        let mut background = self.background;
+        let mut background = self
+            .gradient
+            .unwrap_or(BackgroundDesc::Color(self.background));
         let mut materials = std::mem::take(&mut self.materials.materials);
         let mut textures = std::mem::take(&mut self.materials.textures);
         // LOW: the texture colour, unlit; LOWEST: white on black.
@@ -548,7 +596,7 @@ impl Mapper {
                 }
             }
             if level == ShadeLevel::Lowest {
-                background = [0.0; 3];
+                background = BackgroundDesc::Color([0.0; 3]);
                 textures.clear();
             }
         }

@@ -136,8 +136,8 @@ impl Materials {
         name
     }
 
-    /// A VCSTRI's material: its surface with a white colour (the vertex colours are not
-    /// rendered yet).
+    /// A VCSTRI's material: its surface with a white colour (the vertex colours are the
+    /// surface's colour).
     pub fn surface_material(
         &mut self,
         surface: &Surface,
@@ -155,6 +155,25 @@ impl Materials {
         let name = self.shared_material(m, None, at);
         self.bodies.insert(key, name.clone());
         Ok(name)
+    }
+
+    /// `material` with vertex colours in place of its colour and texture (VERTEXARRAY COLORS):
+    /// white, untextured, the rest as it is.
+    pub fn vertex_colored(&mut self, material: &str, at: &Origin) -> String {
+        let Some(m) = self
+            .materials
+            .iter()
+            .find(|(n, _)| n == material)
+            .map(|(_, m)| m.value.clone())
+        else {
+            return material.to_string();
+        };
+        let m = MaterialDesc {
+            color: [1.0; 3],
+            texture: None,
+            ..m
+        };
+        self.shared_material(m, None, at)
     }
 
     /// `material`'s colour, unlit (ambient 1, nothing else): what Tachyon draws for a volume

@@ -100,7 +100,19 @@
 //! | `FOG EXP` / `EXP2 START s DENSITY d` | `Exp` / `Exp2 { density, start }` (a negative START is taken as 0, with a warning) |
 //! | fog (any mode) | `every_ray: true` (every ray fogged over its own segment, reflections and transmissions included, as Tachyon shades), `misses: true` (rays that miss show the fog colour) |
 //! | `FOG_VMD` | `planar: true` (camera rays' depth along the view direction), `misses: false` (the background stays) |
-//! | `BACKGROUND c` | `background` |
+//! | `BACKGROUND c` | `background: (r, g, b)` |
+//! | `BACKGROUND_GRADIENT SKY_SPHERE UPDIR u TOPVAL t BOTTOMVAL b TOPCOLOR ct BOTTOMCOLOR cb` | `background: Gradient(kind: Sphere, up: u, top: t, bottom: b, top_color: ct, bottom_color: cb)`, u mirrored and not normalised (Tachyon's isn't): a missed ray of direction D shows the mix s·ct + (1 − s)·cb, s = (u·D − b) / (t − b) clamped to 0..1 |
+//! | `... SKY_ORTHO_PLANE ...` | `kind: OrthoPlane`: s from u·O, O where the ray starts (an orthographic camera's rays start across its window: the gradient sweeps the picture; a perspective camera's all start at CENTER: one colour; a reflected ray starts at its mirror) |
+//!
+//! Tachyon evaluates its background for every ray that misses (camera, reflected and
+//! transmitted rays alike) and, past the ray depth, for the ray that reached the last surface
+//! (the mirror shows the background of the incident ray, not of the reflection), and so does
+//! Luxon (`depth_limit_background`). Radial fog turns every miss into the fog colour, so no
+//! gradient is seen; with FOG_VMD misses keep the gradient (and reflected rays' fog applies over
+//! their segments as for hits). Once a BACKGROUND_GRADIENT is given it is shown, whatever
+//! BACKGROUND says before or after it (measured); the last one wins. TOPVAL = BOTTOMVAL is a
+//! sharp horizon; UPDIR 0 0 0 gives every ray the same mix, a plain colour. `SHADER_MODE
+//! LOWEST` shows black instead.
 //!
 //! Three rules of Tachyon's shading are render settings the importer turns on
 //! (`render.tachyon`): a light counts only where its term N·L × attenuation × spot fade ×
@@ -155,6 +167,7 @@
 //! |---|---|
 //! | `SPHERE` | inline sphere |
 //! | `TRI`, `STRI` | inline triangles (flat; with vertex normals); triangles without area are left out, as Tachyon does |
+//! | `VCSTRI ... C0 C1 C2 surface VCST` | an inline triangle with vertex normals and vertex `colors`, in the surface's material in white: the colours interpolated barycentrically are the surface colour, lit as any other (ambient, diffuse, highlights, mirror, transparency; METAL highlights take the vertex colour), as Tachyon does (measured) |
 //! | `FCYLINDER BASE APEX RAD` | inline open cylinder (a cone with equal radii) |
 //! | `POLYCYLINDER` | a sphere at every point and an open cylinder between neighbours (as Tachyon builds it) |
 //! | `RING` | inline disc with a hole |
@@ -162,6 +175,7 @@
 //! | `BOX` | the `box` plugin |
 //! | `CYLINDER` (infinite) | the `infinite_cylinder` plugin |
 //! | `VERTEXARRAY` with `TRIMESH` / `TRISTRIP` | inline meshes with vertex normals, each in the TEXTURE before it (Tachyon's default texture before the first); strips alternate their first two indices |
+//! | `VERTEXARRAY ... COLORS` | the meshes after it take those vertex `colors`, interpolated as VCSTRI's, in their TEXTURE's material in white and without its TEXFUNC: Tachyon's vertex colours replace the texture's colour and pattern (measured) |
 //! | `SCAPE` | Tachyon's terrain generator reproduced (its random sequence and midpoint subdivision), an inline mesh with its normals |
 //! | `TPOLYFILE` | the `.tpoly` file's triangles through Tachyon's SCALE/ROT/CENTER transform (its "rotation" matrix included, which mirrors when ROT.y ≠ 0), as TRI (v1, v0, v2) |
 //! | `SCALARVOL` | a `raw` u8 volume, voxel 0 at MIN and the last at MAX, nearest-voxel samples every \|MAX − MIN\| / \|DIM\|, emitting Tachyon's red-yellow-white ramp with extinction OPACITY·s / \|MAX − MIN\| (s the voxel / 255); a file with extra whole slices is read and cropped to the box (Tachyon reads the first DIM voxels) |
@@ -170,10 +184,8 @@
 //! ## Not yet
 //!
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
-//! renders them: BACKGROUND_GRADIENT; vertex colours (VCSTRI,
-//! VERTEXARRAY COLORS); image maps whose
-//! placement the image texture cannot express (skewed planar axes, a SCALE that mirrors);
-//! Tachyon's two-pass volume compositing. Also different in
+//! renders them: image maps whose placement the image texture cannot express (skewed planar
+//! axes, a SCALE that mirrors); Tachyon's two-pass volume compositing. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
 //! windows blur more sideways in Tachyon), image texel centres (Tachyon puts u = 0 and 1 on
 //! the first and last texel centres), MIP level choice, and the noise of antialiasing, depth of

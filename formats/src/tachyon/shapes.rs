@@ -43,8 +43,8 @@ fn has_area(v: &[V3; 3]) -> bool {
 #[derive(Default)]
 pub(super) struct Shapes {
     pub groups: Vec<InlineGeometry>,
-    /// (material, clip group, smooth, shadowless) → index into `groups`.
-    index: HashMap<(String, Option<usize>, bool, bool), usize>,
+    /// (material, clip group, smooth, colored, shadowless) → index into `groups`.
+    index: HashMap<(String, Option<usize>, bool, bool, bool), usize>,
     pub objects: Vec<Spanned<ObjectDesc>>,
     pub volumes: Vec<Spanned<VolumeDescEntry>>,
     pub clip_groups: Vec<(String, Spanned<Vec<ClipPlaneDesc>>)>,
@@ -54,21 +54,27 @@ pub(super) struct Shapes {
 
 impl Shapes {
     /// The inline group for `material` in the clip group in effect: `smooth` meshes (with
-    /// vertex normals) and everything else are kept apart, since a mesh has normals for all
-    /// of its vertices or none.
-    fn group(&mut self, material: &str, smooth: bool, at: &Origin) -> &mut InlineGeometry {
-        self.group_of(material, smooth, false, at)
+    /// vertex normals), `colored` ones (with vertex colours) and the rest are kept apart, since
+    /// a mesh has normals (colours) for all of its vertices or none.
+    fn group(
+        &mut self,
+        material: &str,
+        smooth: bool,
+        colored: bool,
+        at: &Origin,
+    ) -> &mut InlineGeometry {
+        self.group_of(material, (smooth, colored), false, at)
     }
 
     /// The inline group for `material`, casting shadows or not (`shadowless`).
     fn group_of(
         &mut self,
         material: &str,
-        smooth: bool,
+        (smooth, colored): (bool, bool),
         shadowless: bool,
         at: &Origin,
     ) -> &mut InlineGeometry {
-        let key = (material.to_string(), self.clip, smooth, shadowless);
+        let key = (material.to_string(), self.clip, smooth, colored, shadowless);
         let i = match self.index.get(&key) {
             Some(&i) => i,
             None => {
@@ -137,7 +143,7 @@ impl Shapes {
     pub fn sphere(&mut self, material: &str, center: V3, rad: f64, at: &Origin) {
         if rad != 0.0 {
             let c = mirror(center);
-            self.group(material, false, at)
+            self.group(material, false, false, at)
                 .spheres
                 .push([c[0], c[1], c[2], rad.abs()]);
         }
@@ -147,7 +153,7 @@ impl Shapes {
     /// any other is blocked by it (`material`: the light's colour, unlit and unfogged).
     pub fn light_sphere(&mut self, material: &str, center: V3, rad: f64, at: &Origin) {
         let c = mirror(center);
-        self.group_of(material, false, true, at)
+        self.group_of(material, (false, false), true, at)
             .spheres
             .push([c[0], c[1], c[2], rad]);
     }
@@ -156,7 +162,7 @@ impl Shapes {
     pub fn cylinder(&mut self, material: &str, base: V3, apex: V3, rad: f64, at: &Origin) {
         if rad != 0.0 && base != apex {
             let (b, a, r) = (mirror(base), mirror(apex), rad.abs());
-            self.group(material, false, at)
+            self.group(material, false, false, at)
                 .cones
                 .push([b[0], b[1], b[2], r, a[0], a[1], a[2], r]);
         }
@@ -190,7 +196,7 @@ impl Shapes {
         let (inner, outer) = (radii[0].abs(), radii[1].abs());
         if outer > inner {
             let (c, n) = (mirror(c), mirror(n));
-            self.group(material, false, at)
+            self.group(material, false, false, at)
                 .discs
                 .push([c[0], c[1], c[2], n[0], n[1], n[2], inner, outer]);
         }
@@ -205,19 +211,27 @@ impl Shapes {
             ));
         }
         let (c, n) = (mirror(c), mirror(n));
-        self.group(material, false, at)
+        self.group(material, false, false, at)
             .planes
             .push([c[0], c[1], c[2], n[0], n[1], n[2]]);
         Ok(())
     }
 
-    /// A triangle, flat or with vertex normals. Mirroring reverses the winding, so v1 and v2
-    /// (and their normals) swap places: the normals keep their side of the winding.
-    pub fn triangle(&mut self, material: &str, v: [V3; 3], n: Option<[V3; 3]>, at: &Origin) {
+    /// A triangle, flat or with vertex normals, and with vertex colours or not. Mirroring
+    /// reverses the winding, so v1 and v2 (and their normals and colours) swap places: the
+    /// normals keep their side of the winding.
+    pub fn triangle(
+        &mut self,
+        material: &str,
+        v: [V3; 3],
+        n: Option<[V3; 3]>,
+        c: Option<[V3; 3]>,
+        at: &Origin,
+    ) {
         if !has_area(&v) {
             return;
         }
-        let g = self.group(material, n.is_some(), at);
+        let g = self.group(material, n.is_some(), c.is_some(), at);
         let mesh = &mut g.mesh;
         let base = mesh.positions.len() as u64;
         for k in [0, 2, 1] {
@@ -225,21 +239,25 @@ impl Shapes {
             if let Some(n) = n {
                 mesh.normals.push(mirror(n[k]));
             }
+            if let Some(c) = c {
+                mesh.colors.push(c[k]);
+            }
         }
         mesh.indices.push([base, base + 1, base + 2]);
     }
 
-    /// Smooth triangles indexing `positions` and `normals` (Tachyon coordinates): only the
-    /// vertices used are stored, once each.
+    /// Smooth triangles indexing `positions`, `normals` and, when given, `colors` (Tachyon
+    /// coordinates): only the vertices used are stored, once each.
     pub fn mesh(
         &mut self,
         material: &str,
         positions: &[V3],
         normals: &[V3],
+        colors: Option<&[V3]>,
         triangles: &[[u32; 3]],
         at: &Origin,
     ) {
-        let g = self.group(material, true, at);
+        let g = self.group(material, true, colors.is_some(), at);
         let mesh = &mut g.mesh;
         let mut stored: HashMap<u32, u64> = HashMap::new();
         for t in triangles {
@@ -251,6 +269,9 @@ impl Shapes {
                 *stored.entry(i).or_insert_with(|| {
                     mesh.positions.push(mirror(positions[i as usize]));
                     mesh.normals.push(mirror(normals[i as usize]));
+                    if let Some(c) = colors {
+                        mesh.colors.push(c[i as usize]);
+                    }
                     mesh.positions.len() as u64 - 1
                 })
             };
