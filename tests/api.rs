@@ -188,7 +188,7 @@ fn a_settings_only_commit_builds_no_bvh() {
         parallel: fresh.render.parallel,
         ..settings
     };
-    fresh.background = [0.5, 0.1, 0.1];
+    fresh.background = luxon_formats::BackgroundDesc::Color([0.5, 0.1, 0.1]);
     let mut fresh = Scene::from_desc(&ctx, fresh).unwrap();
     assert!(bits(&got) == bits(&render(&r, &mut fresh, w, h).unwrap()));
 
