@@ -48,19 +48,37 @@ impl BoxRay {
         }
     }
 
-    /// For axis `k`, the row of the plane the ray meets first (min or max, by the sign of its
-    /// direction) and the row of the other.
-    #[inline(always)]
-    fn rows(&self, k: usize) -> (usize, usize) {
-        let n = (self.neg >> k) as usize & 1;
-        (k + 3 * n, k + 3 - 3 * n)
-    }
-
     #[inline(always)]
     pub(super) fn finite(&self) -> bool {
         self.finite
     }
 
+    /// The box tests' operands, made at the start of each traversal.
+    #[inline(always)]
+    pub(super) fn slabs(&self) -> Slabs {
+        let n = [0, 1, 2].map(|k| (self.neg >> k) as usize & 1);
+        Slabs {
+            origin: self.origin.into(),
+            inv: self.inv.into(),
+            inv_far: self.inv_far.into(),
+            near: [3 * n[0], 1 + 3 * n[1], 2 + 3 * n[2]],
+            far: [3 - 3 * n[0], 4 - 3 * n[1], 5 - 3 * n[2]],
+        }
+    }
+}
+
+/// A [`BoxRay`] as one traversal's box tests read it: per axis the row of the plane the ray
+/// meets first (min or max, by the sign of its direction) and the row of the other, resolved
+/// once, not at every node.
+pub(super) struct Slabs {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    inv_far: [f32; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl Slabs {
     /// Which of the node's boxes the ray meets in [0, t_max] (bit l for lane l), and the entry
     /// distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
     /// which is inside that slab for every t) are NaN and are skipped: max(t, acc) and
@@ -79,12 +97,11 @@ impl BoxRay {
                 let mut near = _mm_setzero_ps();
                 let mut far = _mm_set1_ps(t_max * WIDEN);
                 for k in 0..3 {
-                    let (near_row, far_row) = self.rows(k);
                     let o = _mm_set1_ps(self.origin[k]);
                     let inv = _mm_set1_ps(self.inv[k]);
                     let inv_far = _mm_set1_ps(self.inv_far[k]);
-                    let t0 = _mm_mul_ps(_mm_sub_ps(row(near_row), o), inv);
-                    let t1 = _mm_mul_ps(_mm_sub_ps(row(far_row), o), inv_far);
+                    let t0 = _mm_mul_ps(_mm_sub_ps(row(self.near[k]), o), inv);
+                    let t1 = _mm_mul_ps(_mm_sub_ps(row(self.far[k]), o), inv_far);
                     near = _mm_max_ps(t0, near);
                     far = _mm_min_ps(t1, far);
                 }
@@ -110,12 +127,11 @@ impl BoxRay {
         let mut near = _mm256_setzero_ps();
         let mut far = _mm256_set1_ps(t_max * WIDEN);
         for k in 0..3 {
-            let (near_row, far_row) = self.rows(k);
             let o = _mm256_set1_ps(self.origin[k]);
             let inv = _mm256_set1_ps(self.inv[k]);
             let inv_far = _mm256_set1_ps(self.inv_far[k]);
-            let t0 = _mm256_mul_ps(_mm256_sub_ps(row(near_row), o), inv);
-            let t1 = _mm256_mul_ps(_mm256_sub_ps(row(far_row), o), inv_far);
+            let t0 = _mm256_mul_ps(_mm256_sub_ps(row(self.near[k]), o), inv);
+            let t1 = _mm256_mul_ps(_mm256_sub_ps(row(self.far[k]), o), inv_far);
             near = _mm256_max_ps(t0, near);
             far = _mm256_min_ps(t1, far);
         }
@@ -151,8 +167,7 @@ impl BoxRay {
         let mut near = [0.0f32; LANES];
         let mut far = [t_max * WIDEN; LANES];
         for k in 0..3 {
-            let (near_row, far_row) = self.rows(k);
-            let (lo, hi) = (&node.b[near_row], &node.b[far_row]);
+            let (lo, hi) = (&node.b[self.near[k]], &node.b[self.far[k]]);
             for l in 0..LANES {
                 let t0 = (lo[l] - self.origin[k]) * self.inv[k];
                 let t1 = (hi[l] - self.origin[k]) * self.inv_far[k];

@@ -90,12 +90,13 @@ impl Bvh {
         mut t_max: f32,
         mut test: F,
     ) -> f32 {
+        let slabs = ray.slabs();
         let mut space = stack_space::<(u64, f32), STACK>();
         let mut stack = Stack::new(&mut space);
         let mut i = 0usize;
         loop {
             let node = self.node(i);
-            let (mut mask, t) = ray.enter_with::<AVX>(node, t_max);
+            let (mut mask, t) = slabs.enter_with::<AVX>(node, t_max);
             if mask.is_power_of_two() {
                 // One child hit: enter or test it without going through the stack.
                 let link = node.link[first_lane(mask)];
@@ -152,8 +153,9 @@ impl Bvh {
         mut t_max: f32,
         mut test: F,
     ) -> f32 {
+        let slabs = ray.slabs();
         let node = self.node(0);
-        let (mut mask, t) = ray.enter_with::<AVX>(node, t_max);
+        let (mut mask, t) = slabs.enter_with::<AVX>(node, t_max);
         let mut leaf = |link: u64, t_max: &mut f32| {
             let start = offset_of(link);
             for p in start..start + count_of(link) {
@@ -232,6 +234,7 @@ impl Bvh {
         t_max: f32,
         mut test: F,
     ) -> bool {
+        let slabs = ray.slabs();
         let mut space = stack_space::<u64, STACK>();
         let mut stack = Stack::new(&mut space);
         // The root (an inner node, or the wide node holding a lone leaf).
@@ -247,7 +250,7 @@ impl Bvh {
                 }
             } else {
                 let node = self.node(offset_of(link));
-                let (mut mask, _) = ray.enter_with::<AVX>(node, t_max);
+                let (mut mask, _) = slabs.enter_with::<AVX>(node, t_max);
                 if mask != 0 {
                     // The last child hit is taken now, the others pushed (so the order is
                     // the stack's, whatever the count). It is found by a loop of branches,
@@ -283,8 +286,9 @@ impl Bvh {
         t_max: f32,
         mut test: F,
     ) -> bool {
+        let slabs = ray.slabs();
         let node = self.node(0);
-        let (mut mask, _) = ray.enter_with::<AVX>(node, t_max);
+        let (mut mask, _) = slabs.enter_with::<AVX>(node, t_max);
         while mask != 0 {
             let l = last_lane(mask);
             mask &= !(1 << l);
