@@ -26,6 +26,7 @@ use build::{build_node, BuildPrim, PARALLEL_CUTOFF};
 use wide::Wide;
 
 pub use refit::REBUILD_RATIO;
+pub use simd::BoxRay;
 
 /// Leaves hold at most this many primitives.
 const MAX_LEAF: usize = 8;

@@ -6,15 +6,19 @@ use super::wide::Wide;
 use super::{Bvh, LANES};
 use crate::math::{gamma, Vec3A};
 
-/// What a ray precomputes for the box tests: for each axis the row of the plane it meets
-/// first (min or max, by the sign of its direction) and the row of the other.
-pub(super) struct BoxRay {
-    origin: [f32; 3],
-    inv: [f32; 3],
+/// What a ray precomputes for the box tests, once for every tree it is traced through (a few
+/// vector instructions, stored in three vectors and a mask).
+pub struct BoxRay {
+    origin: Vec3A,
+    inv: Vec3A,
     /// `inv` times [`WIDEN`], for the far planes.
-    inv_far: [f32; 3],
-    near: [usize; 3],
-    far: [usize; 3],
+    inv_far: Vec3A,
+    /// Bit k: the direction is negative along axis k (it meets the box's max plane first).
+    neg: u32,
+    /// All coordinates finite. Other rays meet nothing: a NaN (from a zero-length direction,
+    /// say) or an infinity makes the box tests enter empty lanes too, whose link is the
+    /// root's, so their traversal would never end (and would overrun its stack).
+    finite: bool,
 }
 
 /// Far-plane distances and `t_max` are widened by 2·gamma(3) so rounding never culls a box the
@@ -22,20 +26,59 @@ pub(super) struct BoxRay {
 /// roundings as widening each result, and a multiply less on the path from one node to the next.
 const WIDEN: f32 = 1.0 + 2.0 * gamma(3);
 
+/// Whether a ray's coordinates are all finite.
+#[inline(always)]
+#[allow(clippy::eq_op)] // x - x on purpose (below)
+fn finite(origin: Vec3A, dir: Vec3A) -> bool {
+    // x - x is 0 for finite x and NaN for the others (fewer instructions than glam's
+    // `is_finite`, which masks the sign bits and compares with infinity).
+    ((origin - origin) + (dir - dir)).cmpeq(Vec3A::ZERO).all()
+}
+
 impl BoxRay {
     #[inline(always)]
-    pub(super) fn new(origin: Vec3A, dir: Vec3A) -> BoxRay {
-        let inv: [f32; 3] = dir.recip().into();
-        let neg = inv.map(|x| usize::from(x < 0.0) * 3);
+    pub fn new(origin: Vec3A, dir: Vec3A) -> BoxRay {
+        let inv = dir.recip();
         BoxRay {
-            origin: origin.into(),
+            origin,
             inv,
-            inv_far: inv.map(|x| x * WIDEN),
-            near: [neg[0], 1 + neg[1], 2 + neg[2]],
-            far: [3 - neg[0], 4 - neg[1], 5 - neg[2]],
+            inv_far: inv * WIDEN,
+            neg: inv.cmplt(Vec3A::ZERO).bitmask(),
+            finite: finite(origin, dir),
         }
     }
 
+    #[inline(always)]
+    pub(super) fn finite(&self) -> bool {
+        self.finite
+    }
+
+    /// The box tests' operands, made at the start of each traversal.
+    #[inline(always)]
+    pub(super) fn slabs(&self) -> Slabs {
+        let n = [0, 1, 2].map(|k| (self.neg >> k) as usize & 1);
+        Slabs {
+            origin: self.origin.into(),
+            inv: self.inv.into(),
+            inv_far: self.inv_far.into(),
+            near: [3 * n[0], 1 + 3 * n[1], 2 + 3 * n[2]],
+            far: [3 - 3 * n[0], 4 - 3 * n[1], 5 - 3 * n[2]],
+        }
+    }
+}
+
+/// A [`BoxRay`] as one traversal's box tests read it: per axis the row of the plane the ray
+/// meets first (min or max, by the sign of its direction) and the row of the other, resolved
+/// once, not at every node.
+pub(super) struct Slabs {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    inv_far: [f32; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl Slabs {
     /// Which of the node's boxes the ray meets in [0, t_max] (bit l for lane l), and the entry
     /// distances. Slab distances 0 · ∞ (a ray parallel to a face and lying in its plane,
     /// which is inside that slab for every t) are NaN and are skipped: max(t, acc) and
@@ -109,9 +152,9 @@ impl BoxRay {
         #[cfg(target_arch = "x86_64")]
         if AVX {
             debug_assert!(avx());
-            // SAFETY: the CPU has AVX: `AVX` is true only in the loops `intersect_avx` and
-            // `any_avx` instantiate, which run only after `avx()` said so (the `_dispatch`
-            // functions below); nothing else in `bvh` passes `true`.
+            // SAFETY: the CPU has AVX: `AVX` is true only in the loops the `_avx` functions
+            // below instantiate, which run only after `avx()` said so (the `_dispatch`
+            // functions); nothing else in `bvh` passes `true`.
             return unsafe { self.enter_avx(node, t_max) };
         }
         self.enter(node, t_max)
@@ -174,64 +217,112 @@ pub(super) fn clamped_index(v: Vec3A, max: u8) -> [usize; 3] {
     x.map(|x| x.max(0.0).min(f32::from(max)) as usize)
 }
 
-/// The traversal loops (`Bvh::closest` and `Bvh::first`) compiled for AVX where the CPU has it,
-/// else for the baseline.
+/// The traversal loops (`Bvh::closest` and `Bvh::first`, or their one-node forms) compiled
+/// for AVX where the CPU has it, else for the baseline. Each loop is a function of its own, so
+/// only the deep ones reserve the deep stack.
 impl Bvh {
     #[inline(always)]
     pub(super) fn intersect_dispatch<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
-        origin: Vec3A,
-        dir: Vec3A,
+        ray: &BoxRay,
         t_max: f32,
         test: F,
     ) -> f32 {
+        let flat = self.is_flat();
         #[cfg(target_arch = "x86_64")]
         if avx() {
-            // SAFETY: the CPU has AVX (just checked), the feature `intersect_avx` is built for.
-            return unsafe { self.intersect_avx(origin, dir, t_max, test) };
+            // SAFETY: the CPU has AVX (just checked), the feature these loops are built for.
+            return unsafe {
+                if flat {
+                    self.closest_flat_avx(ray, t_max, test)
+                } else {
+                    self.closest_avx(ray, t_max, test)
+                }
+            };
         }
-        self.intersect_base(origin, dir, t_max, test)
+        if flat {
+            self.closest_flat::<false, F>(ray, t_max, test)
+        } else {
+            self.closest_base(ray, t_max, test)
+        }
+    }
+
+    #[inline(never)]
+    fn closest_base<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        ray: &BoxRay,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        self.closest::<false, F>(ray, t_max, test)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[inline(never)]
-    fn intersect_avx<F: FnMut(usize, f32) -> Option<f32>>(
+    fn closest_avx<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
-        origin: Vec3A,
-        dir: Vec3A,
+        ray: &BoxRay,
         t_max: f32,
         test: F,
     ) -> f32 {
-        self.closest::<true, F>(origin, dir, t_max, test)
+        self.closest::<true, F>(ray, t_max, test)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline(never)]
+    fn closest_flat_avx<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        ray: &BoxRay,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        self.closest_flat::<true, F>(ray, t_max, test)
     }
 
     #[inline(always)]
     pub(super) fn any_dispatch<F: FnMut(usize) -> bool>(
         &self,
-        origin: Vec3A,
-        dir: Vec3A,
+        ray: &BoxRay,
         t_max: f32,
         test: F,
     ) -> bool {
+        let flat = self.is_flat();
         #[cfg(target_arch = "x86_64")]
         if avx() {
-            // SAFETY: the CPU has AVX (just checked), the feature `any_avx` is built for.
-            return unsafe { self.any_avx(origin, dir, t_max, test) };
+            // SAFETY: the CPU has AVX (just checked), the feature these loops are built for.
+            return unsafe {
+                if flat {
+                    self.first_flat_avx(ray, t_max, test)
+                } else {
+                    self.first_avx(ray, t_max, test)
+                }
+            };
         }
-        self.any_base(origin, dir, t_max, test)
+        if flat {
+            self.first_flat::<false, F>(ray, t_max, test)
+        } else {
+            self.first_base(ray, t_max, test)
+        }
+    }
+
+    #[inline(never)]
+    fn first_base<F: FnMut(usize) -> bool>(&self, ray: &BoxRay, t_max: f32, test: F) -> bool {
+        self.first::<false, F>(ray, t_max, test)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[inline(never)]
-    fn any_avx<F: FnMut(usize) -> bool>(
-        &self,
-        origin: Vec3A,
-        dir: Vec3A,
-        t_max: f32,
-        test: F,
-    ) -> bool {
-        self.first::<true, F>(origin, dir, t_max, test)
+    fn first_avx<F: FnMut(usize) -> bool>(&self, ray: &BoxRay, t_max: f32, test: F) -> bool {
+        self.first::<true, F>(ray, t_max, test)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[inline(never)]
+    fn first_flat_avx<F: FnMut(usize) -> bool>(&self, ray: &BoxRay, t_max: f32, test: F) -> bool {
+        self.first_flat::<true, F>(ray, t_max, test)
     }
 }

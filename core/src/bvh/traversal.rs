@@ -1,8 +1,11 @@
 //! Traversal: closest hit (children visited nearest first, pruned by the closest hit so far)
-//! and any hit (stops at the first), each a loop generic over the primitive test.
+//! and any hit (stops at the first), each a loop generic over the primitive test. A tree of
+//! one node (at most eight leaves: a kind with a few primitives) has loops of its own that
+//! take the same steps without the deep loops' 14 KB stack; and a ray prepared once
+//! ([`BoxRay`]) serves every tree it is traced through.
 
 use super::simd::BoxRay;
-use super::stack::{stack_space, Stack};
+use super::stack::{stack_space, Stack, STACK};
 use super::{count_of, offset_of, Bvh, LANES};
 use crate::math::Vec3A;
 
@@ -13,27 +16,16 @@ fn first_lane(mask: u32) -> usize {
     mask.trailing_zeros() as usize & (LANES - 1)
 }
 
-/// Whether a ray's coordinates are all finite. Others meet nothing: a NaN (from a zero-length
-/// direction, say) or an infinity makes the box tests enter empty lanes too, whose link is the
-/// root's, so their traversal would never end (and would overrun its stack). Checked in the
-/// loops, after the check for an empty tree, not in `Bvh::intersect` and `Bvh::any`, which are
-/// inlined into every caller (one call per primitive kind).
+/// The highest lane set in a non-empty hit mask.
 #[inline(always)]
-#[allow(clippy::eq_op)] // x - x on purpose (below)
-fn finite(origin: Vec3A, dir: Vec3A) -> bool {
-    // x - x is 0 for finite x and NaN for the others (fewer instructions than glam's
-    // `is_finite`, which masks the sign bits and compares with infinity).
-    ((origin - origin) + (dir - dir)).cmpeq(Vec3A::ZERO).all()
+fn last_lane(mask: u32) -> usize {
+    (31 - mask.leading_zeros()) as usize & (LANES - 1)
 }
 
 impl Bvh {
     /// Closest-hit traversal. `test(prim, t_max)` returns `Some(t)` for a hit closer than
     /// `t_max` (and records whatever it needs). Returns the final `t_max`. A ray with a NaN or
     /// infinite coordinate meets nothing.
-    // Only this dispatch is inlined; the loops (`intersect_avx`, `intersect_base`) are not, or
-    // their 14 KB stack would sit in every frame of the recursive integrator, and deep
-    // reflections (max_depth in the hundreds) would overflow the thread's stack. The primitive
-    // test is inlined into the loops.
     #[inline]
     pub fn intersect<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
@@ -42,10 +34,30 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
-        self.intersect_dispatch(origin, dir, t_max, test)
+        self.intersect_ray(&BoxRay::new(origin, dir), t_max, test)
     }
 
-    #[inline(never)]
+    /// [`Bvh::intersect`] for a ray prepared once for all the trees it meets.
+    // Only this dispatch is inlined; the loops (`closest_avx`, `closest_base`...) are not, or
+    // their 14 KB stack would sit in every frame of the recursive integrator, and deep
+    // reflections (max_depth in the hundreds) would overflow the thread's stack. The primitive
+    // test is inlined into the loops. The checks for an empty tree and a ray that is not
+    // finite are made here, before any call.
+    #[inline]
+    pub fn intersect_ray<F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        ray: &BoxRay,
+        t_max: f32,
+        test: F,
+    ) -> f32 {
+        if self.nodes.is_empty() || !ray.finite() {
+            return t_max;
+        }
+        self.intersect_dispatch(ray, t_max, test)
+    }
+
+    /// The baseline loops (no AVX), dispatched as `intersect_ray` does (for the tests).
+    #[cfg(test)]
     pub(super) fn intersect_base<F: FnMut(usize, f32) -> Option<f32>>(
         &self,
         origin: Vec3A,
@@ -53,27 +65,38 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> f32 {
-        self.closest::<false, F>(origin, dir, t_max, test)
+        let ray = BoxRay::new(origin, dir);
+        if self.nodes.is_empty() || !ray.finite() {
+            return t_max;
+        }
+        if self.is_flat() {
+            self.closest_flat::<false, F>(&ray, t_max, test)
+        } else {
+            self.closest::<false, F>(&ray, t_max, test)
+        }
     }
 
+    /// A tree of one node: its links are all leaves (or empty).
+    #[inline(always)]
+    pub(super) fn is_flat(&self) -> bool {
+        self.nodes.len() == 1
+    }
+
+    /// The closest-hit loop over a non-empty tree, for a finite ray.
     #[inline(always)]
     pub(super) fn closest<const AVX: bool, F: FnMut(usize, f32) -> Option<f32>>(
         &self,
-        origin: Vec3A,
-        dir: Vec3A,
+        ray: &BoxRay,
         mut t_max: f32,
         mut test: F,
     ) -> f32 {
-        if self.nodes.is_empty() || !finite(origin, dir) {
-            return t_max;
-        }
-        let ray = BoxRay::new(origin, dir);
-        let mut space = stack_space::<(u64, f32)>();
+        let slabs = ray.slabs();
+        let mut space = stack_space::<(u64, f32), STACK>();
         let mut stack = Stack::new(&mut space);
         let mut i = 0usize;
         loop {
             let node = self.node(i);
-            let (mut mask, t) = ray.enter_with::<AVX>(node, t_max);
+            let (mut mask, t) = slabs.enter_with::<AVX>(node, t_max);
             if mask.is_power_of_two() {
                 // One child hit: enter or test it without going through the stack.
                 let link = node.link[first_lane(mask)];
@@ -121,6 +144,46 @@ impl Bvh {
         }
     }
 
+    /// [`Bvh::closest`] on a tree of one node: the same box test, the same leaves in the same
+    /// order (so the same hit on exact ties), with a stack of one entry per lane.
+    #[inline(always)]
+    pub(super) fn closest_flat<const AVX: bool, F: FnMut(usize, f32) -> Option<f32>>(
+        &self,
+        ray: &BoxRay,
+        mut t_max: f32,
+        mut test: F,
+    ) -> f32 {
+        let slabs = ray.slabs();
+        let node = self.node(0);
+        let (mut mask, t) = slabs.enter_with::<AVX>(node, t_max);
+        let mut leaf = |link: u64, t_max: &mut f32| {
+            let start = offset_of(link);
+            for p in start..start + count_of(link) {
+                if let Some(t) = test(p, *t_max) {
+                    *t_max = t;
+                }
+            }
+        };
+        if mask.is_power_of_two() {
+            leaf(node.link[first_lane(mask)], &mut t_max);
+            return t_max;
+        }
+        let mut space = stack_space::<(u64, f32), LANES>();
+        let mut stack = Stack::new(&mut space);
+        while mask != 0 {
+            let l = first_lane(mask);
+            mask &= mask - 1;
+            stack.insert_sorted(0, node.link[l], t[l]);
+        }
+        while let Some((link, t)) = stack.pop() {
+            if t > t_max {
+                continue;
+            }
+            leaf(link, &mut t_max);
+        }
+        t_max
+    }
+
     /// Any-hit traversal: stops as soon as `test(prim)` returns true. A ray with a NaN or
     /// infinite coordinate meets nothing.
     #[inline]
@@ -131,10 +194,20 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
-        self.any_dispatch(origin, dir, t_max, test)
+        self.any_ray(&BoxRay::new(origin, dir), t_max, test)
     }
 
-    #[inline(never)]
+    /// [`Bvh::any`] for a ray prepared once for all the trees it meets.
+    #[inline]
+    pub fn any_ray<F: FnMut(usize) -> bool>(&self, ray: &BoxRay, t_max: f32, test: F) -> bool {
+        if self.nodes.is_empty() || !ray.finite() {
+            return false;
+        }
+        self.any_dispatch(ray, t_max, test)
+    }
+
+    /// The baseline loops (no AVX), dispatched as `any_ray` does (for the tests).
+    #[cfg(test)]
     pub(super) fn any_base<F: FnMut(usize) -> bool>(
         &self,
         origin: Vec3A,
@@ -142,22 +215,27 @@ impl Bvh {
         t_max: f32,
         test: F,
     ) -> bool {
-        self.first::<false, F>(origin, dir, t_max, test)
+        let ray = BoxRay::new(origin, dir);
+        if self.nodes.is_empty() || !ray.finite() {
+            return false;
+        }
+        if self.is_flat() {
+            self.first_flat::<false, F>(&ray, t_max, test)
+        } else {
+            self.first::<false, F>(&ray, t_max, test)
+        }
     }
 
+    /// The any-hit loop over a non-empty tree, for a finite ray.
     #[inline(always)]
     pub(super) fn first<const AVX: bool, F: FnMut(usize) -> bool>(
         &self,
-        origin: Vec3A,
-        dir: Vec3A,
+        ray: &BoxRay,
         t_max: f32,
         mut test: F,
     ) -> bool {
-        if self.nodes.is_empty() || !finite(origin, dir) {
-            return false;
-        }
-        let ray = BoxRay::new(origin, dir);
-        let mut space = stack_space::<u64>();
+        let slabs = ray.slabs();
+        let mut space = stack_space::<u64, STACK>();
         let mut stack = Stack::new(&mut space);
         // The root (an inner node, or the wide node holding a lone leaf).
         let mut link = 0u64;
@@ -172,7 +250,7 @@ impl Bvh {
                 }
             } else {
                 let node = self.node(offset_of(link));
-                let (mut mask, _) = ray.enter_with::<AVX>(node, t_max);
+                let (mut mask, _) = slabs.enter_with::<AVX>(node, t_max);
                 if mask != 0 {
                     // The last child hit is taken now, the others pushed (so the order is
                     // the stack's, whatever the count). It is found by a loop of branches,
@@ -197,6 +275,32 @@ impl Bvh {
                 None => return false,
             }
         }
+    }
+
+    /// [`Bvh::first`] on a tree of one node: its leaves hit, from the last lane to the first
+    /// (the order `first` takes them in: the last now, the others off the stack), no stack.
+    #[inline(always)]
+    pub(super) fn first_flat<const AVX: bool, F: FnMut(usize) -> bool>(
+        &self,
+        ray: &BoxRay,
+        t_max: f32,
+        mut test: F,
+    ) -> bool {
+        let slabs = ray.slabs();
+        let node = self.node(0);
+        let (mut mask, _) = slabs.enter_with::<AVX>(node, t_max);
+        while mask != 0 {
+            let l = last_lane(mask);
+            mask &= !(1 << l);
+            let link = node.link[l];
+            let start = offset_of(link);
+            for p in start..start + count_of(link) {
+                if test(p) {
+                    return true;
+                }
+            }
+        }
+        false
     }
 }
 
@@ -370,6 +474,93 @@ mod tests {
         }
         // The same tree meets a finite ray along that line.
         assert!(bvh.any(o, Vec3A::X, inf, |_| true));
+    }
+
+    /// Trees of one node (a kind with a few primitives) have loops of their own: they test
+    /// the same leaves in the same order as the deep loops (the same closest hit on exact
+    /// ties, the same order of shadow filters), AVX and baseline alike, rays parallel to the
+    /// axes included.
+    #[test]
+    fn one_node_trees_visit_what_the_deep_loops_visit() {
+        let mut seed = 11u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        let (mut flat_trees, mut visits) = (0, 0);
+        for n in 1..=64 {
+            // Boxes packed close together, so rays meet several at once, some identical (ties).
+            let b: Vec<_> = boxes(n)
+                .iter()
+                .enumerate()
+                .map(|(i, bx)| {
+                    let c = if i % 5 == 4 {
+                        Vec3A::splat(5.0)
+                    } else {
+                        bx.centroid() * 0.1
+                    };
+                    Aabb::new(c - 1.0, c + 1.0)
+                })
+                .collect();
+            let (bvh, _) = Bvh::build(&b);
+            if !bvh.is_flat() {
+                continue;
+            }
+            flat_trees += 1;
+            for k in 0..200 {
+                // From around the boxes toward a point among them.
+                let o = Vec3A::new(next(), next(), next()) * 30.0 - 10.0;
+                let mut d = Vec3A::new(next(), next(), next()) * 10.0 - o;
+                if k % 3 == 0 {
+                    d[k % 2] = 0.0;
+                }
+                let d = d.normalize_or(Vec3A::Z);
+                let ray = BoxRay::new(o, d);
+                // Closest hit: each test "hits" at a distance that makes some ties.
+                let closest = |avx: bool, flat: bool| {
+                    let mut seen = Vec::new();
+                    let test = |p: usize, tm: f32| {
+                        seen.push(p);
+                        let t = (p % 3) as f32 + 2.0;
+                        (t < tm).then_some(t)
+                    };
+                    let t = match (avx, flat) {
+                        (false, true) => bvh.closest_flat::<false, _>(&ray, 1e3, test),
+                        (false, false) => bvh.closest::<false, _>(&ray, 1e3, test),
+                        // The dispatched loop (AVX where the CPU has it).
+                        (true, _) => bvh.intersect_ray(&ray, 1e3, test),
+                    };
+                    (t, seen)
+                };
+                let deep = closest(false, false);
+                visits += deep.1.len();
+                assert_eq!(closest(false, true), deep, "{n} boxes, ray {k}");
+                assert_eq!(closest(true, true), deep, "{n} boxes, ray {k}");
+                let any = |avx: bool, flat: bool, stop: usize| {
+                    let mut seen = Vec::new();
+                    let test = |p: usize| {
+                        seen.push(p);
+                        seen.len() == stop
+                    };
+                    let r = match (avx, flat) {
+                        (false, true) => bvh.first_flat::<false, _>(&ray, 1e3, test),
+                        (false, false) => bvh.first::<false, _>(&ray, 1e3, test),
+                        (true, _) => bvh.any_ray(&ray, 1e3, test),
+                    };
+                    (r, seen)
+                };
+                for stop in [0, 2] {
+                    let deep = any(false, false, stop);
+                    assert_eq!(any(false, true, stop), deep, "{n} boxes, ray {k}");
+                    assert_eq!(any(true, true, stop), deep, "{n} boxes, ray {k}");
+                }
+            }
+        }
+        assert!(flat_trees >= 8, "only {flat_trees} one-node trees");
+        assert!(
+            visits > 1000,
+            "the rays should meet many boxes, met {visits}"
+        );
     }
 
     #[test]

@@ -143,7 +143,8 @@ impl Set<Cone> {
         Ok(())
     }
 
-    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+    /// The surface at a hit; its texture coordinates only when `uv` asks.
+    pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
         let c = &self.data[hit.index as usize];
         let (b, a) = (Vec3A::from(c.base), Vec3A::from(c.apex));
         let h = (a - b).length();
@@ -157,13 +158,18 @@ impl Set<Cone> {
         let n = (q - k * w).normalize();
         let r_max = c.base_radius.max(c.apex_radius);
         let p_error = gamma(16) * (p.abs() + b.abs().max(a.abs()) + Vec3A::splat(r_max));
-        let u = 0.5 + q.dot(w.cross(ortho)).atan2(q.dot(ortho)) / std::f32::consts::TAU;
+        let uv = if uv {
+            let u = 0.5 + q.dot(w.cross(ortho)).atan2(q.dot(ortho)) / std::f32::consts::TAU;
+            [u, (s / h).clamp(0.0, 1.0)]
+        } else {
+            [0.0; 2]
+        };
         Surface {
             p,
             p_error,
             ng: n,
             ns: n,
-            uv: [u, (s / h).clamp(0.0, 1.0)],
+            uv,
             material: material_of(self.material[hit.index as usize]),
             color: None,
             lift: Vec3A::ZERO,
@@ -258,7 +264,7 @@ mod tests {
             .push_world(0, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0], DVec3::ZERO, 0)
             .unwrap();
         let ray = Ray::new(Vec3A::new(-5.0, 0.0, 0.5), Vec3A::X, 0.0);
-        let s = cones.surface(&Hit::new(4.5, Kind::Cone, 0), &ray);
+        let s = cones.surface(&Hit::new(4.5, Kind::Cone, 0), &ray, true);
         let want = Vec3A::new(-1.0, 0.0, 1.0).normalize();
         assert!((s.ng - want).length() < 1e-5, "{:?}", s.ng);
     }

@@ -82,24 +82,30 @@ impl Set<Disc> {
         Ok(())
     }
 
-    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+    /// The surface at a hit; its texture coordinates only when `uv` asks.
+    pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
         let d = &self.data[hit.index as usize];
         let c = Vec3A::from(d.center);
         let n = Vec3A::from(d.normal);
         let p0 = ray.at(hit.t);
         let p = p0 - n.dot(p0 - c) * n;
-        let r = p - c;
-        let t = crate::math::orthogonal(n);
-        let angle = r.dot(n.cross(t)).atan2(r.dot(t));
+        let uv = if uv {
+            let r = p - c;
+            let t = crate::math::orthogonal(n);
+            let angle = r.dot(n.cross(t)).atan2(r.dot(t));
+            [
+                (r.length() - d.inner) / (d.outer - d.inner),
+                0.5 + angle / std::f32::consts::TAU,
+            ]
+        } else {
+            [0.0; 2]
+        };
         Surface {
             p,
             p_error: gamma(5) * (p.abs() + c.abs()),
             ng: n,
             ns: n,
-            uv: [
-                (r.length() - d.inner) / (d.outer - d.inner),
-                0.5 + angle / std::f32::consts::TAU,
-            ],
+            uv,
             material: material_of(self.material[hit.index as usize]),
             color: None,
             lift: Vec3A::ZERO,

@@ -106,12 +106,12 @@ impl Group {
 
     pub fn surface(&self, hit: &Hit, ray: &Ray, textured: bool) -> Surface {
         match hit.kind {
-            Kind::Sphere => self.spheres.surface(hit, ray),
+            Kind::Sphere => self.spheres.surface(hit, ray, textured),
             Kind::Triangle => self.triangles.surface(hit, textured),
-            Kind::Plane => self.planes.surface(hit, ray),
-            Kind::Cone => self.cones.surface(hit, ray),
+            Kind::Plane => self.planes.surface(hit, ray, textured),
+            Kind::Cone => self.cones.surface(hit, ray, textured),
             // The group holds no custom geometry: a hit can only be on a disc here.
-            Kind::Disc | Kind::Custom => self.discs.surface(hit, ray),
+            Kind::Disc | Kind::Custom => self.discs.surface(hit, ray, textured),
         }
     }
 }

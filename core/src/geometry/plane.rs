@@ -105,20 +105,26 @@ impl Planes {
         })
     }
 
-    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+    /// The surface at a hit; its texture coordinates only when `uv` asks.
+    pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
         let pl = &self.planes[hit.index as usize];
         // Project the parametric point back onto the plane.
         let p0 = ray.at(hit.t);
         let p = p0 - pl.normal.dot(p0 - pl.point) * pl.normal;
         let p_error = gamma(5) * (p.abs() + pl.point.abs());
-        let t = crate::math::orthogonal(pl.normal);
-        let b = pl.normal.cross(t);
+        let uv = if uv {
+            let t = crate::math::orthogonal(pl.normal);
+            let b = pl.normal.cross(t);
+            [(p - pl.point).dot(t), (p - pl.point).dot(b)]
+        } else {
+            [0.0; 2]
+        };
         Surface {
             p,
             p_error,
             ng: pl.normal,
             ns: pl.normal,
-            uv: [(p - pl.point).dot(t), (p - pl.point).dot(b)],
+            uv,
             material: material_of(pl.material),
             color: None,
             lift: Vec3A::ZERO,

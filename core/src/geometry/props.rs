@@ -153,7 +153,7 @@ proptest! {
         set.build();
         let ray = ray_at(pos, scale, from * (r + 1.0), jitter * k * r);
         let (c, rd) = (pos.as_dvec3(), radius as f64);
-        check_hit(&set, &ray, |h, r| set.surface(h, r), |p| ((p - c).length() - rd).abs(),
+        check_hit(&set, &ray, |h, r| set.surface(h, r, true), |p| ((p - c).length() - rd).abs(),
                   rd + c.abs().max_element(), true, leave, k < 0.9 && resolved(scale, pos))?;
     }
 
@@ -216,7 +216,7 @@ proptest! {
             (radial - r).abs() * h / (h * h + (rad - rbd).powi(2)).sqrt()
         };
         let size = (rbd.max(rad) + b.abs().max_element()).max(a.abs().max_element());
-        check_hit(&set, &ray, |h, r| set.surface(h, r), distance, size, true, leave, false)?;
+        check_hit(&set, &ray, |h, r| set.surface(h, r, true), distance, size, true, leave, false)?;
     }
 
     #[test]
@@ -232,7 +232,7 @@ proptest! {
         let ray = ray_at(pos, scale, from, jitter * (inner + width));
         let c = pos.as_dvec3();
         let nd = Vec3::from(n).as_dvec3();
-        check_hit(&set, &ray, |h, r| set.surface(h, r), |p| (p - c).dot(nd).abs(),
+        check_hit(&set, &ray, |h, r| set.surface(h, r, true), |p| (p - c).dot(nd).abs(),
                   c.abs().max_element() + (disc.outer as f64), false, leave, false)?;
     }
 
@@ -250,7 +250,7 @@ proptest! {
             hit
         };
         let Some(hit) = hit_of(&ray) else { return Ok(()); };
-        let s = planes.surface(&hit, &ray);
+        let s = planes.surface(&hit, &ray, true);
         check_normals(&s)?;
         let pn = planes.planes[0].normal.as_dvec3();
         let point = planes.planes[0].point.as_dvec3();

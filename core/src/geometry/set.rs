@@ -4,7 +4,7 @@
 
 use super::{clip_of, material_of, Clips, Counters, Hit, Kind};
 use crate::budget::{Budget, Use};
-use crate::bvh::Bvh;
+use crate::bvh::{BoxRay, Bvh};
 use crate::math::Aabb;
 use crate::ray::Ray;
 use rayon::prelude::*;
@@ -163,15 +163,22 @@ impl<S: Shape> Set<S> {
         clips: &Clips,
         c: &mut Counters,
     ) {
-        self.intersect_noting(ray, t_max, hit, clips, c, |_| {});
+        if self.data.is_empty() {
+            return;
+        }
+        let boxes = BoxRay::new(ray.origin, ray.dir);
+        self.intersect_noting(ray, &boxes, t_max, hit, clips, c, |_| {});
     }
 
-    /// [`Set::intersect`], calling `noted(prim)` for every closer hit found on the way (for
-    /// prefetching what shading that primitive will read).
+    /// [`Set::intersect`] for a ray whose box tests are prepared (`boxes`, once for every
+    /// kind), calling `noted(prim)` for every closer hit found on the way (for prefetching
+    /// what shading that primitive will read).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn intersect_noting(
         &self,
         ray: &Ray,
+        boxes: &BoxRay,
         t_max: &mut f32,
         hit: &mut Option<Hit>,
         clips: &Clips,
@@ -182,9 +189,8 @@ impl<S: Shape> Set<S> {
             return;
         }
         let prep = S::prep(ray);
-        *t_max = self.bvh.intersect(
-            ray.origin,
-            ray.dir,
+        *t_max = self.bvh.intersect_ray(
+            boxes,
             *t_max,
             #[inline(always)]
             |i, tm| {
@@ -211,28 +217,51 @@ impl<S: Shape> Set<S> {
         c: &mut Counters,
         on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
-        self.any_with::<false>(ray, t_max, clips, c, |_| false, on_hit)
+        if self.data.is_empty() {
+            return false;
+        }
+        let boxes = BoxRay::new(ray.origin, ray.dir);
+        self.any_with::<false>(ray, &boxes, t_max, clips, c, |_| false, on_hit)
     }
 
-    /// [`Set::any`] passing over, untested, the primitives whose material `skip` names (those
-    /// a shadow ray crosses unchanged: testing them cannot change what it carries).
+    /// [`Set::any`] for a ray whose box tests are prepared (`boxes`, once for every kind).
     #[inline]
+    pub fn any_prepared(
+        &self,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: f32,
+        clips: &Clips,
+        c: &mut Counters,
+        on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        self.any_with::<false>(ray, boxes, t_max, clips, c, |_| false, on_hit)
+    }
+
+    /// [`Set::any_prepared`] passing over, untested, the primitives whose material `skip`
+    /// names (those a shadow ray crosses unchanged: testing them cannot change what it
+    /// carries).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn any_skipping(
         &self,
         ray: &Ray,
+        boxes: &BoxRay,
         t_max: f32,
         clips: &Clips,
         c: &mut Counters,
         skip: impl Fn(u32) -> bool,
         on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
-        self.any_with::<true>(ray, t_max, clips, c, skip, on_hit)
+        self.any_with::<true>(ray, boxes, t_max, clips, c, skip, on_hit)
     }
 
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn any_with<const SKIP: bool>(
         &self,
         ray: &Ray,
+        boxes: &BoxRay,
         t_max: f32,
         clips: &Clips,
         c: &mut Counters,
@@ -243,9 +272,8 @@ impl<S: Shape> Set<S> {
             return false;
         }
         let prep = S::prep(ray);
-        self.bvh.any(
-            ray.origin,
-            ray.dir,
+        self.bvh.any_ray(
+            boxes,
             t_max,
             #[inline(always)]
             |i| {

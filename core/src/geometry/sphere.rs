@@ -119,7 +119,9 @@ impl Set<Sphere> {
         Ok(())
     }
 
-    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+    /// The surface at a hit; its texture coordinates only when `uv` asks (an `atan2` and an
+    /// `acos`: no texture reads them on most spheres).
+    pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
         let s = self.data[hit.index as usize];
         let c = Vec3A::from(s.center);
         // Re-project onto the sphere: the error is then a few ulps of the coordinates. The
@@ -148,14 +150,19 @@ impl Set<Sphere> {
                 (p_proj, e_proj)
             }
         };
-        let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
-        let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
+        let uv = if uv {
+            let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
+            let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
+            [u, v]
+        } else {
+            [0.0; 2]
+        };
         Surface {
             p,
             p_error,
             ng: n,
             ns: n,
-            uv: [u, v],
+            uv,
             material: material_of(self.material[hit.index as usize]),
             color: None,
             lift: Vec3A::ZERO,

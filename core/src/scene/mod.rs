@@ -19,6 +19,7 @@ pub use instances::PrototypeUse;
 pub use sky::Sky;
 
 use crate::budget::Budget;
+use crate::bvh::BoxRay;
 use crate::camera::Camera;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
@@ -27,7 +28,7 @@ use crate::geometry::group::Group;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
-use crate::geometry::{Clips, Counters, Hit, Kind, Surface};
+use crate::geometry::{material_of, Clips, Counters, Hit, Kind, Surface};
 use crate::math::{DVec3, Vec3A};
 use crate::plugin::texture::TextureInstance;
 use crate::ray::Ray;
@@ -77,6 +78,13 @@ pub enum AngleRule {
 }
 
 impl Material {
+    /// Whether shading reads the texture coordinates at this material's points (a texture
+    /// of any kind: the texture query carries them).
+    #[inline]
+    pub fn reads_uv(&self) -> bool {
+        self.texture.is_some() || self.reflect_texture.is_some() || self.transmit_texture.is_some()
+    }
+
     /// The outline factor on the diffuse light where the view direction makes cosine `cos`
     /// with the normal: 1 facing the viewer, darker toward the silhouette.
     #[inline]
@@ -410,19 +418,16 @@ impl Scene {
     #[inline]
     pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
         let mut hit = None;
-        self.spheres
-            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
-        self.triangles
-            .set
-            .intersect_noting(ray, &mut t_max, &mut hit, &self.clips, c, |i| {
-                self.triangles.prefetch_shading(i)
-            });
-        self.planes
-            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
-        self.cones
-            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
-        self.discs
-            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        // The box tests' set-up, once for every kind.
+        let boxes = BoxRay::new(ray.origin, ray.dir);
+        let (t, h, clips) = (&mut t_max, &mut hit, &self.clips);
+        (self.spheres).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
+        (self.triangles.set).intersect_noting(ray, &boxes, t, h, clips, c, |i| {
+            self.triangles.prefetch_shading(i)
+        });
+        self.planes.intersect(ray, t, h, clips, c);
+        (self.cones).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
+        (self.discs).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
         self.customs
             .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         if !self.moving.is_empty() {
@@ -436,12 +441,17 @@ impl Scene {
         if hit.moving {
             return self.moving.surface(hit, ray, self.features.textures);
         }
+        // Texture coordinates only for a material with a texture (the only reader of uv).
+        let uv = |packed: u32| {
+            self.features.textures && self.materials[material_of(packed) as usize].reads_uv()
+        };
+        let i = hit.index as usize;
         match hit.kind {
-            Kind::Sphere => self.spheres.surface(hit, ray),
+            Kind::Sphere => (self.spheres).surface(hit, ray, uv(self.spheres.material[i])),
             Kind::Triangle => self.triangles.surface(hit, self.features.textures),
-            Kind::Plane => self.planes.surface(hit, ray),
-            Kind::Cone => self.cones.surface(hit, ray),
-            Kind::Disc => self.discs.surface(hit, ray),
+            Kind::Plane => (self.planes).surface(hit, ray, uv(self.planes.planes[i].material)),
+            Kind::Cone => self.cones.surface(hit, ray, uv(self.cones.material[i])),
+            Kind::Disc => self.discs.surface(hit, ray, uv(self.discs.material[i])),
             Kind::Custom => self.customs.surface(hit, ray),
         }
     }
@@ -450,17 +460,24 @@ impl Scene {
     /// the product of the filters (`Material::shadow`) of the surfaces it crosses.
     #[inline]
     pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
+        // The box tests' set-up, once for every kind.
+        let boxes = BoxRay::new(ray.origin, ray.dir);
+        let b = &boxes;
         if !self.features.shadow_filters {
             // Opaque world: the first hit anywhere ends the query.
-            let blocked = self.spheres.any(ray, t_max, &self.clips, c, |_, _| true)
+            let clips = &self.clips;
+            let blocked = self
+                .spheres
+                .any_prepared(ray, b, t_max, clips, c, |_, _| true)
+                || (self.triangles.set).any_prepared(ray, b, t_max, clips, c, |_, _| true)
+                || self.planes.any(ray, t_max, clips, c, |_, _| true)
                 || self
-                    .triangles
-                    .set
-                    .any(ray, t_max, &self.clips, c, |_, _| true)
-                || self.planes.any(ray, t_max, &self.clips, c, |_, _| true)
-                || self.cones.any(ray, t_max, &self.clips, c, |_, _| true)
-                || self.discs.any(ray, t_max, &self.clips, c, |_, _| true)
-                || self.customs.any(ray, t_max, &self.clips, c, |_, _| true)
+                    .cones
+                    .any_prepared(ray, b, t_max, clips, c, |_, _| true)
+                || self
+                    .discs
+                    .any_prepared(ray, b, t_max, clips, c, |_, _| true)
+                || self.customs.any(ray, t_max, clips, c, |_, _| true)
                 || (!self.moving.is_empty()
                     && self
                         .moving
@@ -484,25 +501,19 @@ impl Scene {
         let blocked = if self.features.see_through && min_weight <= 1.0 {
             let skip = |m: u32| self.materials[m as usize].shadow == Some(Vec3A::ONE);
             let clips = &self.clips;
-            self.spheres
-                .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
-                || (self.triangles.set).any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
-                || self.planes.any(ray, t_max, clips, c, &mut on_hit)
-                || self
-                    .cones
-                    .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
-                || self
-                    .discs
-                    .any_skipping(ray, t_max, clips, c, skip, &mut on_hit)
+            let f = &mut on_hit;
+            (self.spheres).any_skipping(ray, b, t_max, clips, c, skip, &mut *f)
+                || (self.triangles.set).any_skipping(ray, b, t_max, clips, c, skip, &mut *f)
+                || self.planes.any(ray, t_max, clips, c, &mut *f)
+                || (self.cones).any_skipping(ray, b, t_max, clips, c, skip, &mut *f)
+                || (self.discs).any_skipping(ray, b, t_max, clips, c, skip, &mut *f)
         } else {
-            self.spheres.any(ray, t_max, &self.clips, c, &mut on_hit)
-                || self
-                    .triangles
-                    .set
-                    .any(ray, t_max, &self.clips, c, &mut on_hit)
-                || self.planes.any(ray, t_max, &self.clips, c, &mut on_hit)
-                || self.cones.any(ray, t_max, &self.clips, c, &mut on_hit)
-                || self.discs.any(ray, t_max, &self.clips, c, &mut on_hit)
+            let (clips, f) = (&self.clips, &mut on_hit);
+            self.spheres.any_prepared(ray, b, t_max, clips, c, &mut *f)
+                || (self.triangles.set).any_prepared(ray, b, t_max, clips, c, &mut *f)
+                || self.planes.any(ray, t_max, clips, c, &mut *f)
+                || self.cones.any_prepared(ray, b, t_max, clips, c, &mut *f)
+                || self.discs.any_prepared(ray, b, t_max, clips, c, &mut *f)
         };
         if blocked
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
