@@ -16,7 +16,7 @@
 use crate::geometry::Clips;
 use crate::math::{DVec3, Vec3A};
 use crate::ray::Ray;
-use crate::volume::{Brick, Volume, BRICK_SIZE};
+use crate::volume::{Brick, Volume, BRICK_SIZE, BRICK_VOXELS};
 use luxon_formats::{Interpolation, VolumeRenderDesc};
 
 /// The most rendered volumes a scene may have (a ray keeps them on the stack).
@@ -134,13 +134,46 @@ pub struct RenderVolume {
     cells: Vec<f32>,
     cell_min: [i64; 3],
     cell_dims: [i64; 3],
+    /// Colour and extinction of every u8 code (the transfer function at its value), so that
+    /// nearest-voxel samples of u8 bricks need no search.
+    u8_rgba: Box<[[f32; 4]; 256]>,
+    /// Whether every index of the box has a magnitude below 2^22 (nearest samples then find
+    /// their voxel in f32).
+    small_index: bool,
+}
+
+/// What a ray's samples of one volume keep from one sample to the next: the brick they last
+/// read (nearest-voxel samples only).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Reader<'a> {
+    /// Brick coordinates, offset by a constant (`u32::MAX`: none read yet; no brick has it).
+    key: [u32; 3],
+    voxels: Voxels<'a>,
+}
+
+impl Default for Reader<'_> {
+    fn default() -> Self {
+        Reader {
+            key: [u32::MAX; 3],
+            voxels: Voxels::Rgba([0.0; 4]),
+        }
+    }
+}
+
+/// A brick as nearest-voxel samples read it.
+#[derive(Clone, Copy, Debug)]
+enum Voxels<'a> {
+    /// Every voxel classifies as this (a constant brick, or none: the background).
+    Rgba([f32; 4]),
+    /// Codes classified through `RenderVolume::u8_rgba`.
+    U8(&'a [u8; BRICK_VOXELS]),
+    /// Values classified one by one.
+    Values(&'a Brick),
 }
 
 /// A volume a ray crosses: its index-space ray and parameter interval.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Crossing {
-    /// Index into `Scene::render_volumes`.
-    pub(crate) v: usize,
     pub(crate) o: Vec3A,
     pub(crate) d: Vec3A,
     pub(crate) t0: f32,
@@ -224,7 +257,14 @@ impl RenderVolume {
             cells: Vec::new(),
             cell_min: [0; 3],
             cell_dims: [0; 3],
+            u8_rgba: Box::new([[0.0; 4]; 256]),
+            small_index: (0..3).all(|a| {
+                let limit = 1 << 22;
+                volume.index_min[a] > -limit && volume.index_max[a] < limit
+            }),
         };
+        let codes = volume.codes();
+        *rv.u8_rgba = std::array::from_fn(|c| rv.transfer.eval(codes.u8(c as u8)));
         rv.build_cells(volume);
         Ok(rv)
     }
@@ -300,13 +340,7 @@ impl RenderVolume {
 
     /// Where `ray` is inside the volume (its box, crop box and clip group) within `[0, t_end)`.
     #[inline]
-    pub(crate) fn crossing(
-        &self,
-        v: usize,
-        ray: &Ray,
-        t_end: f32,
-        clips: &Clips,
-    ) -> Option<Crossing> {
+    pub(crate) fn crossing(&self, ray: &Ray, t_end: f32, clips: &Clips) -> Option<Crossing> {
         let o = self.to_index(ray.origin);
         let d = self.dir_to_index(ray.dir);
         let (mut t0, mut t1) = (0.0f32, t_end);
@@ -335,7 +369,7 @@ impl RenderVolume {
                 }
             }
         }
-        (t0 < t1).then_some(Crossing { v, o, d, t0, t1 })
+        (t0 < t1).then_some(Crossing { o, d, t0, t1 })
     }
 
     /// The scalar at index-space point `p` (clamped into the voxel-centre box).
@@ -402,6 +436,46 @@ impl RenderVolume {
         a + (b - a) * f.z
     }
 
+    /// Colour and extinction of the sample at index-space point `p`: the transfer function at
+    /// [`Self::sample`]'s value, the same bits; nearest-voxel samples read through `reader`.
+    #[inline(always)]
+    pub(crate) fn classify<'a>(
+        &self,
+        vol: &'a Volume,
+        p: Vec3A,
+        reader: &mut Reader<'a>,
+    ) -> [f32; 4] {
+        if !self.nearest || !self.small_index {
+            return self.transfer.eval(self.sample(vol, p));
+        }
+        // The voxel `sample` picks. Every index here is a whole number of magnitude below 2^22,
+        // so each step is exact (the integer arithmetic's result), and the index plus
+        // 1.5 · 2^23 is an f32 whose low 23 bits are the index plus 2^22 (ulp 1 there): those
+        // bits give the brick (above the low 3, offset by a constant) and the voxel in it.
+        let p = p.clamp(self.lo, self.hi);
+        let q = floor(p + Vec3A::splat(0.5)).min(self.hi);
+        let bits = (q + Vec3A::splat(12_582_912.0))
+            .to_array()
+            .map(f32::to_bits);
+        let key = bits.map(|b| b >> 3);
+        if key != reader.key {
+            reader.key = key;
+            let brick = bits.map(|b| (i64::from(b & 0x7f_ffff) - (1 << 22)) >> 3);
+            reader.voxels = match vol.brick(brick) {
+                None => Voxels::Rgba(self.transfer.eval(vol.background)),
+                Some(Brick::Constant(v)) => Voxels::Rgba(self.transfer.eval(*v)),
+                Some(Brick::U8(codes)) => Voxels::U8(codes),
+                Some(b) => Voxels::Values(b),
+            };
+        }
+        let at = || (bits[0] & 7 | (bits[1] & 7) << 3 | (bits[2] & 7) << 6) as usize;
+        match reader.voxels {
+            Voxels::Rgba(rgba) => rgba,
+            Voxels::U8(codes) => self.u8_rgba[usize::from(codes[at()])],
+            Voxels::Values(b) => self.transfer.eval(b.value(at(), vol.codes())),
+        }
+    }
+
     /// Render-space gradient of the field at index-space point `p` (central differences one
     /// voxel apart).
     #[inline]
@@ -415,16 +489,27 @@ impl RenderVolume {
         self.rows[0] * g.x + self.rows[1] * g.y + self.rows[2] * g.z
     }
 
-    /// The cell's largest extinction and the ray parameter where the index-space ray leaves
-    /// it; `None` when the point is outside the table (never skipped).
+    /// Whether the volume has a skipping table (without one nothing is skipped).
     #[inline]
-    pub(crate) fn cell(&self, c: &Crossing, t: f32) -> Option<(f32, f32)> {
+    pub(crate) fn has_cells(&self) -> bool {
+        !self.cells.is_empty()
+    }
+
+    /// The skipping cell of index-space point `p`, as whole-valued floats (`cell_at` takes
+    /// them).
+    #[inline]
+    pub(crate) fn cell_key(p: Vec3A) -> Vec3A {
+        floor(p * (1.0 / BRICK_SIZE as f32))
+    }
+
+    /// Cell `key`'s largest extinction and the ray parameter where the index-space ray `c`
+    /// leaves it; `None` when the cell is outside the table (never skipped).
+    #[inline]
+    pub(crate) fn cell_at(&self, c: &Crossing, key: Vec3A) -> Option<(f32, f32)> {
         if self.cells.is_empty() {
             return None;
         }
-        let p = c.o + t * c.d;
-        let k = (p * (1.0 / BRICK_SIZE as f32)).floor();
-        let k = [k.x as i64, k.y as i64, k.z as i64];
+        let k = [key.x as i64, key.y as i64, key.z as i64];
         let r = [0, 1, 2].map(|a| k[a] - self.cell_min[a]);
         if (0..3).any(|a| r[a] < 0 || r[a] >= self.cell_dims[a]) {
             return None;
@@ -443,6 +528,13 @@ impl RenderVolume {
         }
         Some((max, exit))
     }
+}
+
+/// `v.floor()` lane by lane in one instruction each (glam's emulates it for SSE2), except that
+/// `-0.0` stays `-0.0`: the same whole numbers wherever it is used.
+#[inline(always)]
+fn floor(v: Vec3A) -> Vec3A {
+    Vec3A::new(v.x.floor(), v.y.floor(), v.z.floor())
 }
 
 /// Narrows `[t0, t1]` to where `o + t d` is inside the box `[lo, hi]`.
