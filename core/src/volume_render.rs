@@ -137,9 +137,9 @@ pub struct RenderVolume {
     /// Colour and extinction of every u8 code (the transfer function at its value), so that
     /// nearest-voxel samples of u8 bricks need no search.
     u8_rgba: Box<[[f32; 4]; 256]>,
-    /// Whether every index of the box has a magnitude below 2^22 (nearest samples then find
-    /// their voxel in f32).
-    small_index: bool,
+    /// Nearest-voxel samples, every index of the box of a magnitude below 2^22: samples then
+    /// find their voxel in f32 ([`Self::classify`]).
+    nearest_small: bool,
 }
 
 /// What a ray's samples of one volume keep from one sample to the next: the brick they last
@@ -258,10 +258,11 @@ impl RenderVolume {
             cell_min: [0; 3],
             cell_dims: [0; 3],
             u8_rgba: Box::new([[0.0; 4]; 256]),
-            small_index: (0..3).all(|a| {
-                let limit = 1 << 22;
-                volume.index_min[a] > -limit && volume.index_max[a] < limit
-            }),
+            nearest_small: desc.interpolation == Interpolation::Nearest
+                && (0..3).all(|a| {
+                    let limit = 1 << 22;
+                    volume.index_min[a] > -limit && volume.index_max[a] < limit
+                }),
         };
         let codes = volume.codes();
         *rv.u8_rgba = std::array::from_fn(|c| rv.transfer.eval(codes.u8(c as u8)));
@@ -445,7 +446,7 @@ impl RenderVolume {
         p: Vec3A,
         reader: &mut Reader<'a>,
     ) -> [f32; 4] {
-        if !self.nearest || !self.small_index {
+        if !self.nearest_small {
             return self.transfer.eval(self.sample(vol, p));
         }
         // The voxel `sample` picks. Every index here is a whole number of magnitude below 2^22,

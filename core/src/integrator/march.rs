@@ -9,6 +9,7 @@ use crate::ray::Ray;
 use crate::scene::{Light, Scene};
 use crate::volume::Volume;
 use crate::volume_render::{Crossing, Reader, RenderVolume, Shading, MAX_RENDERED_VOLUMES};
+use std::cell::Cell;
 
 /// One rendered volume a ray crosses, and what its samples keep from step to step.
 #[derive(Clone, Copy, Debug)]
@@ -43,6 +44,12 @@ impl<'a> Track<'a> {
         self.cell
     }
 
+    /// Moves the current sample to `t`.
+    #[inline(always)]
+    fn at(&mut self, t: f32) {
+        self.p = self.x.o + t * self.x.d;
+    }
+
     /// Colour and extinction of the current sample.
     #[inline(always)]
     fn classify(&mut self) -> [f32; 4] {
@@ -53,21 +60,15 @@ impl<'a> Track<'a> {
 /// What a walk does with each sample (a trait rather than a closure so that it is inlined
 /// into both of the walk's loops).
 trait Visit<'a> {
-    /// Takes the sample at `t` covering `dt` of the ray (its point set in each [`active`]
-    /// track); `false` ends the walk.
-    fn visit(
-        &mut self,
-        t: f32,
-        dt: f32,
-        tracks: &mut [Option<Track<'a>>],
-        c: &mut Counters,
-    ) -> bool;
+    /// Takes the sample at `t` covering `dt` of the ray (in each [`active`] track); `false`
+    /// ends the walk.
+    fn visit(&mut self, t: f32, dt: f32, tracks: &mut [Track<'a>], c: &mut Counters) -> bool;
 }
 
-/// The tracks of `slots` the current sample is in.
+/// The tracks the current sample is in.
 #[inline(always)]
-fn active<'s, 'a>(slots: &'s mut [Option<Track<'a>>]) -> impl Iterator<Item = &'s mut Track<'a>> {
-    slots.iter_mut().flatten().filter(|tr| tr.active)
+fn active<'s, 'a>(tracks: &'s mut [Track<'a>]) -> impl Iterator<Item = &'s mut Track<'a>> {
+    tracks.iter_mut().filter(|tr| tr.active)
 }
 
 /// Steps along `ray` through every rendered volume it crosses before `t_end`, calling
@@ -75,27 +76,35 @@ fn active<'s, 'a>(slots: &'s mut [Option<Track<'a>>]) -> impl Iterator<Item = &'
 /// long from the first entry (the last one shorter).
 #[inline(always)]
 fn walk<'a>(scene: &'a Scene, ray: &Ray, t_end: f32, c: &mut Counters, visit: &mut impl Visit<'a>) {
-    let mut slots = [None; MAX_RENDERED_VOLUMES];
-    let mut n = 0;
+    let mut crossed = scene.render_volumes.iter().filter_map(|rv| {
+        let x = rv.crossing(ray, t_end, &scene.clips)?;
+        Some(Track {
+            rv,
+            vol: &scene.volumes[rv.volume],
+            x,
+            active: false,
+            p: Vec3A::ZERO,
+            cell_key: Vec3A::NAN,
+            cell: None,
+            reader: Reader::default(),
+        })
+    });
+    let Some(first) = crossed.next() else {
+        return;
+    };
+    // (The unused slots hold copies of the first.)
+    let mut tracks = [first; MAX_RENDERED_VOLUMES];
+    let mut n = 1;
+    for tr in crossed {
+        tracks[n] = tr;
+        n += 1;
+    }
     let mut step = f32::INFINITY;
     let (mut start, mut stop) = (f32::INFINITY, f32::NEG_INFINITY);
-    for rv in &scene.render_volumes {
-        if let Some(x) = rv.crossing(ray, t_end, &scene.clips) {
-            slots[n] = Some(Track {
-                rv,
-                vol: &scene.volumes[rv.volume],
-                x,
-                active: false,
-                p: Vec3A::ZERO,
-                cell_key: Vec3A::NAN,
-                cell: None,
-                reader: Reader::default(),
-            });
-            n += 1;
-            step = step.min(rv.step);
-            start = start.min(x.t0);
-            stop = stop.max(x.t1);
-        }
+    for tr in &tracks[..n] {
+        step = step.min(tr.rv.step);
+        start = start.min(tr.x.t0);
+        stop = stop.max(tr.x.t1);
     }
     let steps = Steps {
         skip: scene.settings.volume_skip,
@@ -104,10 +113,10 @@ fn walk<'a>(scene: &'a Scene, ray: &Ray, t_end: f32, c: &mut Counters, visit: &m
         step,
     };
     // One volume is the common case: its loops compiled for exactly one track.
-    match n {
-        0 => {}
-        1 => steps.run(&mut slots[..1], c, visit),
-        _ => steps.run(&mut slots[..n], c, visit),
+    if n == 1 {
+        steps.run(&mut tracks[..1], c, visit);
+    } else {
+        steps.run(&mut tracks[..n], c, visit);
     }
 }
 
@@ -121,12 +130,7 @@ struct Steps {
 
 impl Steps {
     #[inline(always)]
-    fn run<'a>(
-        &self,
-        tracks: &mut [Option<Track<'a>>],
-        c: &mut Counters,
-        visit: &mut impl Visit<'a>,
-    ) {
+    fn run<'a>(&self, tracks: &mut [Track<'a>], c: &mut Counters, visit: &mut impl Visit<'a>) {
         let Steps {
             skip,
             start,
@@ -152,7 +156,7 @@ impl Steps {
                 any_active = false;
                 next_entry = f32::INFINITY;
                 next_event = f32::INFINITY;
-                for tr in tracks.iter_mut().flatten() {
+                for tr in tracks.iter_mut() {
                     let x = &tr.x;
                     tr.active = t >= x.t0 && t < x.t1;
                     any_active |= tr.active;
@@ -165,15 +169,13 @@ impl Steps {
                     }
                 }
             }
-            for tr in active(tracks) {
-                tr.p = tr.x.o + t * tr.x.d;
-            }
             if skip {
                 // Skip when every volume here is transparent in its whole cell: up to the first
                 // cell exit or the next volume's entry, whichever comes first.
                 let mut target = next_entry;
                 let mut empty = true;
                 for tr in active(tracks) {
+                    tr.at(t);
                     match tr.cell() {
                         Some((max, exit)) if max <= 0.0 => target = target.min(exit),
                         _ => {
@@ -266,16 +268,44 @@ fn toward(light: &Light, p: Vec3A) -> Option<(Vec3A, f32, Vec3A)> {
 /// What the volumes add along `ray` before `t_end` and what they let through:
 /// (colour, transmittance). Marching stops once the transmittance is below `cutoff`.
 pub fn march(scene: &Scene, ray: &Ray, t_end: f32, cutoff: f32, c: &mut Counters) -> (Vec3A, f32) {
-    let mut m = Composite {
-        scene,
-        ray,
-        cutoff,
-        color: Vec3A::ZERO,
-        trans: 1.0,
-        last: (f32::NAN, f32::NAN, 0.0),
-    };
-    walk(scene, ray, t_end, c, &mut m);
-    (m.color, m.trans)
+    ALPHAS.with(|alphas| {
+        let mut m = Composite {
+            scene,
+            ray,
+            cutoff,
+            color: Vec3A::ZERO,
+            trans: 1.0,
+            alphas,
+        };
+        walk(scene, ray, t_end, c, &mut m);
+        (m.color, m.trans)
+    })
+}
+
+/// Slots of the alpha cache (a power of two).
+const ALPHA_SLOTS: usize = 1024;
+
+std::thread_local! {
+    /// Alphas computed on this thread: (extinction, segment length, alpha), in a slot chosen
+    /// by the first two (NaN: empty). A ray's samples take few distinct pairs (a u8 volume's
+    /// 256 extinctions, and segment lengths that differ only by rounding), so most samples
+    /// find theirs here instead of calling `exp`; a hit is the same bits by construction.
+    static ALPHAS: [Cell<(f32, f32, f32)>; ALPHA_SLOTS] =
+        const { [const { Cell::new((f32::NAN, f32::NAN, 0.0)) }; ALPHA_SLOTS] };
+}
+
+/// `1 - exp(-sigma dt)`, through the thread's cache.
+#[inline(always)]
+fn alpha(alphas: &[Cell<(f32, f32, f32)>; ALPHA_SLOTS], sigma: f32, dt: f32) -> f32 {
+    let h = sigma.to_bits().wrapping_mul(0x9e37_79b9) ^ dt.to_bits().wrapping_mul(0x85eb_ca6b);
+    let slot = &alphas[(h >> 22) as usize % ALPHA_SLOTS];
+    let (s, d, a) = slot.get();
+    if s == sigma && d == dt {
+        return a;
+    }
+    let a = 1.0 - (-sigma * dt).exp();
+    slot.set((sigma, dt, a));
+    a
 }
 
 /// Front-to-back compositing along a ray.
@@ -285,23 +315,17 @@ struct Composite<'r, 'a> {
     cutoff: f32,
     color: Vec3A,
     trans: f32,
-    /// The last (extinction, segment length, alpha) computed (NaN: none).
-    last: (f32, f32, f32),
+    alphas: &'r [Cell<(f32, f32, f32)>; ALPHA_SLOTS],
 }
 
 impl<'a> Visit<'a> for Composite<'_, 'a> {
     #[inline(always)]
-    fn visit(
-        &mut self,
-        t: f32,
-        dt: f32,
-        tracks: &mut [Option<Track<'a>>],
-        c: &mut Counters,
-    ) -> bool {
+    fn visit(&mut self, t: f32, dt: f32, tracks: &mut [Track<'a>], c: &mut Counters) -> bool {
         let mut sigma = 0.0f32;
         let mut weighted = Vec3A::ZERO;
         for tr in active(tracks) {
             c.volume_samples += 1;
+            tr.at(t);
             let [r, g, b, s] = tr.classify();
             if s <= 0.0 {
                 continue;
@@ -314,15 +338,7 @@ impl<'a> Visit<'a> for Composite<'_, 'a> {
             weighted += s * col;
         }
         if sigma > 0.0 {
-            // Neighbouring samples often read the same voxel: its alpha is kept.
-            let last = self.last;
-            let alpha = if sigma == last.0 && dt == last.1 {
-                last.2
-            } else {
-                let alpha = 1.0 - (-sigma * dt).exp();
-                self.last = (sigma, dt, alpha);
-                alpha
-            };
+            let alpha = alpha(self.alphas, sigma, dt);
             self.color += (self.trans * alpha / sigma) * weighted;
             self.trans *= 1.0 - alpha;
         }
@@ -394,15 +410,10 @@ struct Depth(f32);
 
 impl<'a> Visit<'a> for Depth {
     #[inline(always)]
-    fn visit(
-        &mut self,
-        _: f32,
-        dt: f32,
-        tracks: &mut [Option<Track<'a>>],
-        c: &mut Counters,
-    ) -> bool {
+    fn visit(&mut self, t: f32, dt: f32, tracks: &mut [Track<'a>], c: &mut Counters) -> bool {
         for tr in active(tracks) {
             c.volume_samples += 1;
+            tr.at(t);
             self.0 += tr.classify()[3] * dt;
         }
         // exp(-30) is below anything a pixel can show.
