@@ -134,6 +134,9 @@ pub struct RenderVolume {
     cells: Vec<f32>,
     cell_min: [i64; 3],
     cell_dims: [i64; 3],
+    /// The same as floats when every cell coordinate and table index is a whole f32 below
+    /// 2^21 (then `cell_at` works in f32, exactly).
+    cells_f32: Option<(Vec3A, Vec3A)>,
     /// Colour and extinction of every u8 code (the transfer function at its value), so that
     /// nearest-voxel samples of u8 bricks need no search.
     u8_rgba: Box<[[f32; 4]; 256]>,
@@ -257,6 +260,7 @@ impl RenderVolume {
             cells: Vec::new(),
             cell_min: [0; 3],
             cell_dims: [0; 3],
+            cells_f32: None,
             u8_rgba: Box::new([[0.0; 4]; 256]),
             nearest_small: desc.interpolation == Interpolation::Nearest
                 && (0..3).all(|a| {
@@ -319,6 +323,13 @@ impl RenderVolume {
         self.cells = cells;
         self.cell_min = kmin;
         self.cell_dims = dims;
+        let limit = 1 << 21;
+        if (0..3).all(|a| kmin[a].abs() < limit && (kmin[a] + dims[a]).abs() < limit)
+            && (self.cells.len() as i64) < limit
+        {
+            let f = |a: [i64; 3]| Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32);
+            self.cells_f32 = Some((f(kmin), f(dims)));
+        }
     }
 
     #[inline]
@@ -510,6 +521,19 @@ impl RenderVolume {
         if self.cells.is_empty() {
             return None;
         }
+        let size = BRICK_SIZE as f32;
+        if let Some((min, dims)) = self.cells_f32 {
+            // As below, in f32: every whole number here is exact.
+            let r = key - min;
+            if !(r.cmpge(Vec3A::ZERO) & r.cmplt(dims)).all() {
+                return None;
+            }
+            let max = self.cells[((r.z * dims.y + r.y) * dims.x + r.x) as usize];
+            let face = key + Vec3A::select(c.d.cmpgt(Vec3A::ZERO), Vec3A::ONE, Vec3A::ZERO);
+            let t = (face * size - c.o) / c.d;
+            let exit = Vec3A::select(c.d.cmpne(Vec3A::ZERO), t, Vec3A::INFINITY).min_element();
+            return Some((max, exit));
+        }
         let k = [key.x as i64, key.y as i64, key.z as i64];
         let r = [0, 1, 2].map(|a| k[a] - self.cell_min[a]);
         if (0..3).any(|a| r[a] < 0 || r[a] >= self.cell_dims[a]) {
@@ -517,7 +541,6 @@ impl RenderVolume {
         }
         let d = self.cell_dims;
         let max = self.cells[((r[2] * d[1] + r[1]) * d[0] + r[0]) as usize];
-        let size = BRICK_SIZE as f32;
         let mut exit = f32::INFINITY;
         for (a, &ka) in k.iter().enumerate() {
             let (o, dir) = (c.o[a], c.d[a]);
