@@ -605,6 +605,104 @@ mod tests {
         assert_eq!(t.max_extinction(17.5, 20.0), 2.5);
     }
 
+    /// A volume over index box [-13, -5, -9] to [20, 14, 11] with u8 and f32 blocks, a
+    /// constant tile and background elsewhere, drawn with `interpolation`.
+    fn mixed(interpolation: Interpolation) -> (Volume, RenderVolume) {
+        let mut b = crate::volume::VolumeBuilder::new("v", "test");
+        let identity = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
+        b.begin(identity, 0.25, [-13, -5, -9], [20, 14, 11], "grid")
+            .unwrap();
+        let bytes: Vec<u8> = (0..17 * 9 * 10).map(|i| (i * 37 % 256) as u8).collect();
+        b.add_dense_u8([-13, -5, -9], [17, 9, 10], &bytes, 255.0)
+            .unwrap();
+        let floats: Vec<f32> = (0..9 * 11 * 12).map(|i| (i % 23) as f32 / 22.0).collect();
+        b.add_dense([5, 0, 0], [9, 11, 12], &floats).unwrap();
+        b.add_tile([-8, 8, 0], [8, 6, 8], 0.75).unwrap();
+        let vol = b.finish().unwrap();
+        let point = |x: f64, opacity: f64| luxon_formats::TransferPoint {
+            x,
+            color: [x, 1.0 - x, 0.5],
+            opacity,
+        };
+        let desc = VolumeRenderDesc {
+            transfer: luxon_formats::TransferDesc {
+                preset: None,
+                points: vec![
+                    point(0.0, 0.0),
+                    point(0.3, 2.0),
+                    point(0.7, 0.5),
+                    point(1.0, 3.0),
+                ],
+                range: Some([0.0, 1.0]),
+                opacity: 1.0,
+            },
+            step: None,
+            interpolation,
+            shading: None,
+            clip: None,
+            bounds: None,
+        };
+        let rv = RenderVolume::new(&desc, &vol, 0, 1.0, DVec3::ZERO, 0).unwrap();
+        (vol, rv)
+    }
+
+    /// Points along lines through (and past) the box, as a ray's samples come.
+    fn walks() -> Vec<Vec3A> {
+        let mut seed = 12345u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        let mut out = Vec::new();
+        for _ in 0..200 {
+            let o = Vec3A::new(next(), next(), next()) * 50.0 - Vec3A::splat(20.0);
+            let d = (Vec3A::new(next(), next(), next()) - Vec3A::splat(0.5)) * 1.5;
+            out.extend((0..60).map(|i| o + i as f32 * d));
+        }
+        out
+    }
+
+    #[test]
+    fn classify_gives_the_transfer_function_of_the_sample() {
+        for interpolation in [Interpolation::Nearest, Interpolation::Trilinear] {
+            let (vol, rv) = mixed(interpolation);
+            assert_eq!(rv.nearest_small, interpolation == Interpolation::Nearest);
+            let mut reader = Reader::default();
+            for p in walks() {
+                let want = rv.transfer.eval(rv.sample(&vol, p)).map(f32::to_bits);
+                let got = rv.classify(&vol, p, &mut reader).map(f32::to_bits);
+                assert_eq!(got, want, "{p}");
+            }
+        }
+    }
+
+    #[test]
+    fn cells_in_f32_are_the_integer_cells() {
+        let (_, rv) = mixed(Interpolation::Nearest);
+        assert!(rv.cells_f32.is_some() && rv.has_cells());
+        let mut wide = rv.clone();
+        wide.cells_f32 = None;
+        let points = walks();
+        let mut some = 0;
+        for w in points.chunks(60) {
+            let c = Crossing {
+                o: w[0],
+                d: w[1] - w[0],
+                t0: 0.0,
+                t1: 60.0,
+            };
+            for (i, p) in w.iter().enumerate() {
+                for p in [*p, c.o + (i as f32 + 0.5) * c.d] {
+                    let key = RenderVolume::cell_key(p);
+                    let got = rv.cell_at(&c, key);
+                    assert_eq!(got, wide.cell_at(&c, key), "{p}");
+                    some += usize::from(got.is_some());
+                }
+            }
+        }
+        assert!(some > 1000, "{some}");
+    }
+
     #[test]
     fn slab_clips_to_the_box() {
         let (mut t0, mut t1) = (0.0, f32::INFINITY);
