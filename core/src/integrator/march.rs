@@ -151,8 +151,9 @@ impl Steps {
                 break;
             }
             let t = 0.5 * (a + b);
-            // (Also taken for a NaN t: then nothing is active, as the comparisons say.)
-            if !(t < next_event) {
+            // (Also taken for a NaN t: then nothing is active, as the comparisons say.
+            // `next_event` is never NaN.)
+            if t >= next_event || t.is_nan() {
                 any_active = false;
                 next_entry = f32::INFINITY;
                 next_event = f32::INFINITY;
