@@ -16,7 +16,7 @@
 use crate::geometry::Clips;
 use crate::math::{DVec3, Vec3A};
 use crate::ray::Ray;
-use crate::volume::{Brick, Volume, BRICK_SIZE};
+use crate::volume::{Brick, Volume, BRICK_SIZE, BRICK_VOXELS};
 use luxon_formats::{Interpolation, VolumeRenderDesc};
 
 /// The most rendered volumes a scene may have (a ray keeps them on the stack).
@@ -134,13 +134,49 @@ pub struct RenderVolume {
     cells: Vec<f32>,
     cell_min: [i64; 3],
     cell_dims: [i64; 3],
+    /// The same as floats when every cell coordinate and table index is a whole f32 below
+    /// 2^21 (then `cell_at` works in f32, exactly).
+    cells_f32: Option<(Vec3A, Vec3A)>,
+    /// Colour and extinction of every u8 code (the transfer function at its value), so that
+    /// nearest-voxel samples of u8 bricks need no search.
+    u8_rgba: Box<[[f32; 4]; 256]>,
+    /// Nearest-voxel samples, every index of the box of a magnitude below 2^22: samples then
+    /// find their voxel in f32 ([`Self::classify`]).
+    nearest_small: bool,
+}
+
+/// What a ray's samples of one volume keep from one sample to the next: the brick they last
+/// read (nearest-voxel samples only).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Reader<'a> {
+    /// Brick coordinates, offset by a constant (`u32::MAX`: none read yet; no brick has it).
+    key: [u32; 3],
+    voxels: Voxels<'a>,
+}
+
+impl Default for Reader<'_> {
+    fn default() -> Self {
+        Reader {
+            key: [u32::MAX; 3],
+            voxels: Voxels::Rgba([0.0; 4]),
+        }
+    }
+}
+
+/// A brick as nearest-voxel samples read it.
+#[derive(Clone, Copy, Debug)]
+enum Voxels<'a> {
+    /// Every voxel classifies as this (a constant brick, or none: the background).
+    Rgba([f32; 4]),
+    /// Codes classified through `RenderVolume::u8_rgba`.
+    U8(&'a [u8; BRICK_VOXELS]),
+    /// Values classified one by one.
+    Values(&'a Brick),
 }
 
 /// A volume a ray crosses: its index-space ray and parameter interval.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Crossing {
-    /// Index into `Scene::render_volumes`.
-    pub(crate) v: usize,
     pub(crate) o: Vec3A,
     pub(crate) d: Vec3A,
     pub(crate) t0: f32,
@@ -224,7 +260,16 @@ impl RenderVolume {
             cells: Vec::new(),
             cell_min: [0; 3],
             cell_dims: [0; 3],
+            cells_f32: None,
+            u8_rgba: Box::new([[0.0; 4]; 256]),
+            nearest_small: desc.interpolation == Interpolation::Nearest
+                && (0..3).all(|a| {
+                    let limit = 1 << 22;
+                    volume.index_min[a] > -limit && volume.index_max[a] < limit
+                }),
         };
+        let codes = volume.codes();
+        *rv.u8_rgba = std::array::from_fn(|c| rv.transfer.eval(codes.u8(c as u8)));
         rv.build_cells(volume);
         Ok(rv)
     }
@@ -278,6 +323,13 @@ impl RenderVolume {
         self.cells = cells;
         self.cell_min = kmin;
         self.cell_dims = dims;
+        let limit = 1 << 21;
+        if (0..3).all(|a| kmin[a].abs() < limit && (kmin[a] + dims[a]).abs() < limit)
+            && (self.cells.len() as i64) < limit
+        {
+            let f = |a: [i64; 3]| Vec3A::new(a[0] as f32, a[1] as f32, a[2] as f32);
+            self.cells_f32 = Some((f(kmin), f(dims)));
+        }
     }
 
     #[inline]
@@ -300,13 +352,7 @@ impl RenderVolume {
 
     /// Where `ray` is inside the volume (its box, crop box and clip group) within `[0, t_end)`.
     #[inline]
-    pub(crate) fn crossing(
-        &self,
-        v: usize,
-        ray: &Ray,
-        t_end: f32,
-        clips: &Clips,
-    ) -> Option<Crossing> {
+    pub(crate) fn crossing(&self, ray: &Ray, t_end: f32, clips: &Clips) -> Option<Crossing> {
         let o = self.to_index(ray.origin);
         let d = self.dir_to_index(ray.dir);
         let (mut t0, mut t1) = (0.0f32, t_end);
@@ -335,7 +381,7 @@ impl RenderVolume {
                 }
             }
         }
-        (t0 < t1).then_some(Crossing { v, o, d, t0, t1 })
+        (t0 < t1).then_some(Crossing { o, d, t0, t1 })
     }
 
     /// The scalar at index-space point `p` (clamped into the voxel-centre box).
@@ -402,6 +448,46 @@ impl RenderVolume {
         a + (b - a) * f.z
     }
 
+    /// Colour and extinction of the sample at index-space point `p`: the transfer function at
+    /// [`Self::sample`]'s value, the same bits; nearest-voxel samples read through `reader`.
+    #[inline(always)]
+    pub(crate) fn classify<'a>(
+        &self,
+        vol: &'a Volume,
+        p: Vec3A,
+        reader: &mut Reader<'a>,
+    ) -> [f32; 4] {
+        if !self.nearest_small {
+            return self.transfer.eval(self.sample(vol, p));
+        }
+        // The voxel `sample` picks. Every index here is a whole number of magnitude below 2^22,
+        // so each step is exact (the integer arithmetic's result), and the index plus
+        // 1.5 · 2^23 is an f32 whose low 23 bits are the index plus 2^22 (ulp 1 there): those
+        // bits give the brick (above the low 3, offset by a constant) and the voxel in it.
+        let p = p.clamp(self.lo, self.hi);
+        let q = floor(p + Vec3A::splat(0.5)).min(self.hi);
+        let bits = (q + Vec3A::splat(12_582_912.0))
+            .to_array()
+            .map(f32::to_bits);
+        let key = bits.map(|b| b >> 3);
+        if key != reader.key {
+            reader.key = key;
+            let brick = bits.map(|b| (i64::from(b & 0x7f_ffff) - (1 << 22)) >> 3);
+            reader.voxels = match vol.brick(brick) {
+                None => Voxels::Rgba(self.transfer.eval(vol.background)),
+                Some(Brick::Constant(v)) => Voxels::Rgba(self.transfer.eval(*v)),
+                Some(Brick::U8(codes)) => Voxels::U8(codes),
+                Some(b) => Voxels::Values(b),
+            };
+        }
+        let at = || (bits[0] & 7 | (bits[1] & 7) << 3 | (bits[2] & 7) << 6) as usize;
+        match reader.voxels {
+            Voxels::Rgba(rgba) => rgba,
+            Voxels::U8(codes) => self.u8_rgba[usize::from(codes[at()])],
+            Voxels::Values(b) => self.transfer.eval(b.value(at(), vol.codes())),
+        }
+    }
+
     /// Render-space gradient of the field at index-space point `p` (central differences one
     /// voxel apart).
     #[inline]
@@ -415,23 +501,46 @@ impl RenderVolume {
         self.rows[0] * g.x + self.rows[1] * g.y + self.rows[2] * g.z
     }
 
-    /// The cell's largest extinction and the ray parameter where the index-space ray leaves
-    /// it; `None` when the point is outside the table (never skipped).
+    /// Whether the volume has a skipping table (without one nothing is skipped).
     #[inline]
-    pub(crate) fn cell(&self, c: &Crossing, t: f32) -> Option<(f32, f32)> {
+    pub(crate) fn has_cells(&self) -> bool {
+        !self.cells.is_empty()
+    }
+
+    /// The skipping cell of index-space point `p`, as whole-valued floats (`cell_at` takes
+    /// them).
+    #[inline]
+    pub(crate) fn cell_key(p: Vec3A) -> Vec3A {
+        floor(p * (1.0 / BRICK_SIZE as f32))
+    }
+
+    /// Cell `key`'s largest extinction and the ray parameter where the index-space ray `c`
+    /// leaves it; `None` when the cell is outside the table (never skipped).
+    #[inline]
+    pub(crate) fn cell_at(&self, c: &Crossing, key: Vec3A) -> Option<(f32, f32)> {
         if self.cells.is_empty() {
             return None;
         }
-        let p = c.o + t * c.d;
-        let k = (p * (1.0 / BRICK_SIZE as f32)).floor();
-        let k = [k.x as i64, k.y as i64, k.z as i64];
+        let size = BRICK_SIZE as f32;
+        if let Some((min, dims)) = self.cells_f32 {
+            // As below, in f32: every whole number here is exact.
+            let r = key - min;
+            if !(r.cmpge(Vec3A::ZERO) & r.cmplt(dims)).all() {
+                return None;
+            }
+            let max = self.cells[((r.z * dims.y + r.y) * dims.x + r.x) as usize];
+            let face = key + Vec3A::select(c.d.cmpgt(Vec3A::ZERO), Vec3A::ONE, Vec3A::ZERO);
+            let t = (face * size - c.o) / c.d;
+            let exit = Vec3A::select(c.d.cmpne(Vec3A::ZERO), t, Vec3A::INFINITY).min_element();
+            return Some((max, exit));
+        }
+        let k = [key.x as i64, key.y as i64, key.z as i64];
         let r = [0, 1, 2].map(|a| k[a] - self.cell_min[a]);
         if (0..3).any(|a| r[a] < 0 || r[a] >= self.cell_dims[a]) {
             return None;
         }
         let d = self.cell_dims;
         let max = self.cells[((r[2] * d[1] + r[1]) * d[0] + r[0]) as usize];
-        let size = BRICK_SIZE as f32;
         let mut exit = f32::INFINITY;
         for (a, &ka) in k.iter().enumerate() {
             let (o, dir) = (c.o[a], c.d[a]);
@@ -443,6 +552,13 @@ impl RenderVolume {
         }
         Some((max, exit))
     }
+}
+
+/// `v.floor()` lane by lane in one instruction each (glam's emulates it for SSE2), except that
+/// `-0.0` stays `-0.0`: the same whole numbers wherever it is used.
+#[inline(always)]
+fn floor(v: Vec3A) -> Vec3A {
+    Vec3A::new(v.x.floor(), v.y.floor(), v.z.floor())
 }
 
 /// Narrows `[t0, t1]` to where `o + t d` is inside the box `[lo, hi]`.
@@ -487,6 +603,104 @@ mod tests {
         assert_eq!(t.max_extinction(11.0, 19.0), 4.0);
         assert_eq!(t.max_extinction(0.0, 10.0), 0.0);
         assert_eq!(t.max_extinction(17.5, 20.0), 2.5);
+    }
+
+    /// A volume over index box [-13, -5, -9] to [20, 14, 11] with u8 and f32 blocks, a
+    /// constant tile and background elsewhere, drawn with `interpolation`.
+    fn mixed(interpolation: Interpolation) -> (Volume, RenderVolume) {
+        let mut b = crate::volume::VolumeBuilder::new("v", "test");
+        let identity = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
+        b.begin(identity, 0.25, [-13, -5, -9], [20, 14, 11], "grid")
+            .unwrap();
+        let bytes: Vec<u8> = (0..17 * 9 * 10).map(|i| (i * 37 % 256) as u8).collect();
+        b.add_dense_u8([-13, -5, -9], [17, 9, 10], &bytes, 255.0)
+            .unwrap();
+        let floats: Vec<f32> = (0..9 * 11 * 12).map(|i| (i % 23) as f32 / 22.0).collect();
+        b.add_dense([5, 0, 0], [9, 11, 12], &floats).unwrap();
+        b.add_tile([-8, 8, 0], [8, 6, 8], 0.75).unwrap();
+        let vol = b.finish().unwrap();
+        let point = |x: f64, opacity: f64| luxon_formats::TransferPoint {
+            x,
+            color: [x, 1.0 - x, 0.5],
+            opacity,
+        };
+        let desc = VolumeRenderDesc {
+            transfer: luxon_formats::TransferDesc {
+                preset: None,
+                points: vec![
+                    point(0.0, 0.0),
+                    point(0.3, 2.0),
+                    point(0.7, 0.5),
+                    point(1.0, 3.0),
+                ],
+                range: Some([0.0, 1.0]),
+                opacity: 1.0,
+            },
+            step: None,
+            interpolation,
+            shading: None,
+            clip: None,
+            bounds: None,
+        };
+        let rv = RenderVolume::new(&desc, &vol, 0, 1.0, DVec3::ZERO, 0).unwrap();
+        (vol, rv)
+    }
+
+    /// Points along lines through (and past) the box, as a ray's samples come.
+    fn walks() -> Vec<Vec3A> {
+        let mut seed = 12345u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        let mut out = Vec::new();
+        for _ in 0..200 {
+            let o = Vec3A::new(next(), next(), next()) * 50.0 - Vec3A::splat(20.0);
+            let d = (Vec3A::new(next(), next(), next()) - Vec3A::splat(0.5)) * 1.5;
+            out.extend((0..60).map(|i| o + i as f32 * d));
+        }
+        out
+    }
+
+    #[test]
+    fn classify_gives_the_transfer_function_of_the_sample() {
+        for interpolation in [Interpolation::Nearest, Interpolation::Trilinear] {
+            let (vol, rv) = mixed(interpolation);
+            assert_eq!(rv.nearest_small, interpolation == Interpolation::Nearest);
+            let mut reader = Reader::default();
+            for p in walks() {
+                let want = rv.transfer.eval(rv.sample(&vol, p)).map(f32::to_bits);
+                let got = rv.classify(&vol, p, &mut reader).map(f32::to_bits);
+                assert_eq!(got, want, "{p}");
+            }
+        }
+    }
+
+    #[test]
+    fn cells_in_f32_are_the_integer_cells() {
+        let (_, rv) = mixed(Interpolation::Nearest);
+        assert!(rv.cells_f32.is_some() && rv.has_cells());
+        let mut wide = rv.clone();
+        wide.cells_f32 = None;
+        let points = walks();
+        let mut some = 0;
+        for w in points.chunks(60) {
+            let c = Crossing {
+                o: w[0],
+                d: w[1] - w[0],
+                t0: 0.0,
+                t1: 60.0,
+            };
+            for (i, p) in w.iter().enumerate() {
+                for p in [*p, c.o + (i as f32 + 0.5) * c.d] {
+                    let key = RenderVolume::cell_key(p);
+                    let got = rv.cell_at(&c, key);
+                    assert_eq!(got, wide.cell_at(&c, key), "{p}");
+                    some += usize::from(got.is_some());
+                }
+            }
+        }
+        assert!(some > 1000, "{some}");
     }
 
     #[test]
