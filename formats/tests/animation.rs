@@ -1,6 +1,8 @@
 //! `animation:`: what it reads (frames, fps, shutter, tracks of the camera, lights, materials
 //! and named objects), how it merges with `include`, and every error at its `line:col`.
 
+mod common;
+
 use std::path::Path;
 
 use luxon_formats::*;
@@ -23,34 +25,12 @@ fn animation(body: &str) -> AnimationDesc {
     scene.animation.expect("the scene is animated").value
 }
 
-/// The error's line, column and message (without the position).
-fn error(body: &str) -> (u32, u32, String) {
-    let e = load(body).expect_err("the scene is invalid");
-    let at = e.origin().expect("a position").clone();
-    let message = e.to_string();
-    let prefix = format!("a.ron:{}:{}: ", at.line, at.col);
-    assert!(message.starts_with(&prefix), "{message}");
-    (at.line, at.col, message[prefix.len()..].to_string())
-}
-
 /// Checks that the error is at the first `needle` on line `line` of the scene text and that
 /// its message holds `words`.
 #[track_caller]
 fn check(body: &str, line: u32, needle: &str, words: &[&str]) {
-    let text = format!("{HEAD}{body}");
-    let on = text
-        .lines()
-        .nth(line as usize - 1)
-        .expect("the line exists");
-    let col = on
-        .find(needle)
-        .unwrap_or_else(|| panic!("`{needle}` is not on line {line}"))
-        + 1;
-    let (l, c, message) = error(body);
-    assert_eq!((l, c), (line, col as u32), "wrong position for: {message}");
-    for w in words {
-        assert!(message.contains(w), "`{w}` missing from: {message}");
-    }
+    let e = load(body).expect_err("the scene is invalid");
+    common::assert_error_at(&format!("{HEAD}{body}"), &e, line, needle, words);
 }
 
 #[test]

@@ -1,6 +1,8 @@
 //! `prototypes:` and `instances:`: what they read (objects, transforms, material overrides,
 //! names), how they merge with `include`, and every error at its `line:col`.
 
+mod common;
+
 use std::path::Path;
 
 use luxon_formats::*;
@@ -29,26 +31,8 @@ fn scene(body: &str) -> SceneDesc {
 /// its message holds `words`.
 #[track_caller]
 fn check(body: &str, line: u32, needle: &str, words: &[&str]) {
-    let text = format!("{HEAD}{body}");
-    let on = text
-        .lines()
-        .nth(line as usize - 1)
-        .expect("the line exists");
-    let col = on
-        .find(needle)
-        .unwrap_or_else(|| panic!("`{needle}` is not on line {line}"))
-        + 1;
     let e = load(body).expect_err("the scene is invalid");
-    let at = e.origin().expect("a position").clone();
-    let message = e.to_string();
-    assert_eq!(
-        (at.line, at.col),
-        (line, col as u32),
-        "wrong position for: {message}"
-    );
-    for w in words {
-        assert!(message.contains(w), "`{w}` missing from: {message}");
-    }
+    common::assert_error_at(&format!("{HEAD}{body}"), &e, line, needle, words);
 }
 
 #[test]
