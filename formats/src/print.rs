@@ -10,10 +10,16 @@
 use std::path::Path;
 
 use crate::desc::{
-    AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, RenderDesc,
+    AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, RenderDesc, SceneDesc,
     VolumeRenderDesc,
 };
 use crate::ron_text;
+
+/// A whole scene, as `luxon convert` writes it ([`crate::to_ron`]) to be read from directory
+/// `base`: a retained scene's dump (`luxon::api::Scene::to_ron`).
+pub fn scene(desc: &SceneDesc, base: &Path) -> Result<String, String> {
+    ron_text::to_ron(desc, base)
+}
 
 /// `(position: (..), look_at: (..), up: (..), fov: ..)`, on one line.
 pub fn camera(c: &CameraDesc) -> String {

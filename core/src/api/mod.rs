@@ -8,10 +8,12 @@
 //!   program asks for (`threads: 0`: every CPU this process may use). Nothing Luxon does runs
 //!   on rayon's global pool, and the pool's threads sleep between renders.
 //! - [`Scene`] (this module's; [`crate::scene::Scene`] is the built form it keeps): a scene
-//!   file or description, changed in place ([`Scene::set_camera`], [`Scene::set_render`],
-//!   [`Scene::set_background`], [`Scene::set_origin`]) and brought up to date by
-//!   [`Scene::commit`], which redoes only what the changes need: a new camera or sample count
-//!   costs microseconds, no BVH is built again ([`CommitReport`] says what was done).
+//!   file or description, or an empty scene ([`Scene::new`]), changed in place
+//!   ([`Scene::set_camera`], [`Scene::set_render`], [`Scene::set_background`],
+//!   [`Scene::set_origin`]; lights, materials, fog, ambient occlusion and plugin objects by
+//!   id, below) and brought up to date by [`Scene::commit`], which redoes only what the
+//!   changes need: a new camera, sample count, light or material costs microseconds, no BVH
+//!   is built again ([`CommitReport`] says what was done).
 //! - [`Renderer`]: renders a scene on its context's pool or on one of its own, into the
 //!   caller's memory ([`Target`]: RGBA8 sRGB, RGBA f32 linear, depth; any row stride). Every
 //!   render commits the scene first. [`Renderer::cancel_handle`] stops a render from another
@@ -56,8 +58,75 @@
 //!
 //! The built scene's render-space origin is fixed at the first commit (see [`Scene`]), and a
 //! render that fails because a plugin panicked makes the next commit build the scene again.
+//!
+//! ## Editing by id
+//!
+//! Lights and objects get ids when they are added ([`Scene::add_light`],
+//! [`Scene::add_plugin_object`]; a loaded scene's are [`Scene::lights`] and
+//! [`Scene::objects`], in file order); materials and clip groups are named ([`Scene::material`],
+//! [`Scene::set_material`], [`Scene::clip_group`]) and never removed. Every typed value is
+//! checked by the scene files' rules, and each setter has a `_ron` form whose errors point
+//! into its text (`<light>:1:7: unknown field ...`). A removed part's id is refused, as is
+//! another scene's. Lights, materials, fog and ambient occlusion change without touching the
+//! geometry; adding or removing objects builds the scene again at the next commit, once:
+//! plugin objects are for what does not change every step. [`Scene::to_ron`] writes the
+//! scene as a scene file (for a bug report, or to render it with the command line).
+//!
+//! ```
+//! use luxon::api::{Context, ContextOptions, Renderer, RendererOptions, Scene};
+//! # let dir = std::env::temp_dir().join(format!("luxon-api-edit-{}", std::process::id()));
+//! # std::fs::create_dir_all(&dir)?;
+//! # let path = dir.join("ball.nff");
+//! # std::fs::write(&path, "v\nfrom 0 -6 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\n\
+//! #     resolution 64 48\nb 0.2 0.3 0.6\nl 4 -4 6\nf 0.9 0.2 0.2 0.6 0.4 30 0 0\ns 0 0 1 1\n")?;
+//! let ctx = Context::new(ContextOptions { threads: 2, ..Default::default() })?;
+//! let renderer = Renderer::new(&ctx, RendererOptions::default())?;
+//! let mut scene = Scene::load(&ctx, &path)?;
+//! assert_eq!(scene.commit(&renderer)?.rebuilt, 1);
+//!
+//! // The file's light moves, another is added, and fog rolls in: nothing is built again.
+//! let lamp = scene.lights()[0];
+//! scene.set_light_ron(lamp, "Point(position: (-4, -4, 6), intensity: 0.8)")?;
+//! let fill = scene.add_light_ron("Directional(direction: (0, 1, -1), intensity: 0.3)")?;
+//! scene.set_fog_ron("(mode: Exp(density: 0.05), color: (0.2, 0.3, 0.6))")?;
+//! let report = scene.commit(&renderer)?;
+//! assert_eq!((report.rebuilt, report.shading), (0, true));
+//!
+//! // A removed light's id is refused from then on.
+//! scene.remove_light(fill)?;
+//! let e = scene.remove_light(fill).unwrap_err();
+//! assert_eq!(e.to_string(), "light 1 was removed from this scene");
+//! // Text is checked as in a scene file, and errors point into it.
+//! let e = scene.add_light_ron("Point(positon: (0, 0, 5))").unwrap_err();
+//! assert!(e.to_string().starts_with("<light>:1:7: unknown field `positon`"));
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! A scene made in code, with the primitive plugins of `luxon-shapes`:
+//!
+//! ```no_run
+//! # use luxon::api::{Context, Renderer, Scene};
+//! # let ctx = Context::new(Default::default())?;
+//! # let renderer = Renderer::new(&ctx, Default::default())?;
+//! let mut scene = Scene::new(&ctx);
+//! scene.set_camera_ron("(position: (0, 1, -5), look_at: (0, 0.5, 0))")?;
+//! scene.add_light_ron("Point(position: (-4, 6, -5))")?;
+//! let red = scene.set_material_ron("red", "(color: (0.8, 0.1, 0.1), specular: 0.5)")?;
+//! let ball = scene.add_plugin_object("sphere", "(center: (0, 0.8, 0), radius: 0.8)", Some(red), None)?;
+//! scene.add_plugin_object("plane", "(point: (0, 0, 0), normal: (0, 1, 0))", None, None)?;
+//! assert_eq!(scene.commit(&renderer)?.rebuilt, 1);
+//! // A material changes in place; removing the ball builds the scene again.
+//! scene.set_material_ron("red", "(color: (0.1, 0.3, 0.9))")?;
+//! assert_eq!(scene.commit(&renderer)?.rebuilt, 0);
+//! scene.remove(ball)?;
+//! assert_eq!(scene.commit(&renderer)?.rebuilt, 1);
+//! std::fs::write("dump.ron", scene.to_ron()?)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 mod context;
+pub mod ids;
 mod image;
 mod renderer;
 mod scene;
@@ -66,6 +135,7 @@ pub use crate::error::Error;
 pub use crate::framebuffer::{Color, Plane, Target};
 pub use crate::render::{Progress, RenderStats};
 pub use context::{Context, ContextOptions};
+pub use ids::{ClipId, LightId, MaterialId, ObjectId};
 pub use image::write_image;
 pub use renderer::{Cancel, Renderer, RendererOptions};
 pub use scene::{CommitReport, Scene};

@@ -1,14 +1,18 @@
 //! [`Scene`]: a retained scene, its description kept and its built form redone at each commit
 //! only as far as the changes since the last one need.
 
+use super::ids::{self, scene_serial, ClipId, LightId, MaterialId, ObjectId, Slots};
 use super::{Context, Renderer};
 use crate::budget::Budget;
 use crate::error::Error;
 use crate::math::DVec3;
-use crate::plugin::Registry;
-use crate::scene::{Prebuilt, Scene as Built};
-use luxon_formats::{fragment, BackgroundDesc, CameraDesc, RenderDesc, SceneDesc};
-use std::path::Path;
+use crate::plugin::{PluginKind, Registry};
+use crate::scene::{shadowless_groups, Prebuilt, Scene as Built};
+use luxon_formats::{
+    fragment, AoDesc, BackgroundDesc, CameraDesc, FogDesc, LightDesc, MaterialDesc, ObjectDesc,
+    Origin, PluginCall, Projection, RenderDesc, SceneDesc, Spanned,
+};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -16,8 +20,12 @@ use std::time::{Duration, Instant};
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CommitReport {
     /// Geometry builds (all of the scene's objects stored and their BVHs built): 1 when the
-    /// commit built the scene, 0 when it only took new settings, camera or background.
+    /// commit built the scene, 0 when it only took new settings, camera, background, lights,
+    /// materials, fog or ambient occlusion.
     pub rebuilt: u32,
+    /// The commit took new lights, materials, fog or ambient occlusion into the built scene
+    /// without building it again (no geometry touched).
+    pub shading: bool,
     /// Time spent building BVHs.
     pub bvh_time: Duration,
     /// Time the whole commit took.
@@ -26,10 +34,20 @@ pub struct CommitReport {
 
 /// A scene kept between renders: its description (what it was loaded or built from, with the
 /// changes made since) and its built form, redone by [`Scene::commit`] (which every render
-/// runs) only where the changes need it. Changing the camera, the background or the render
-/// settings that touch no geometry costs microseconds; changing render space's origin, or the
-/// settings the build reads (`transparency`, `light_scale`, `volume_step`, `memory`,
-/// `texture_cache`), builds the scene again.
+/// runs) only where the changes need it. Changing the camera, the background, the render
+/// settings that touch no geometry, the lights, fog or ambient occlusion, or a material costs
+/// microseconds; adding or removing an object, changing render space's origin, or the settings
+/// the build reads (`transparency`, `light_scale`, `volume_step`, `memory`, `texture_cache`),
+/// builds the scene again — once per commit, however many changes it takes. (A new material
+/// name in a scene where some objects cast no shadow builds it again too: the materials of
+/// those objects' copies are renumbered.) In an animated scene, whose animation holds the
+/// lights and materials it keys, a change of lights or materials builds it again and puts it
+/// back at its frame.
+///
+/// Lights and objects have ids ([`LightId`], [`ObjectId`]): a scene loaded from a file gives
+/// them to its own in file order ([`Scene::lights`], [`Scene::objects`]). A removed part's id,
+/// or another scene's, is refused with an error that says so. Materials and clip groups are
+/// named and never removed ([`MaterialId`], [`ClipId`]).
 ///
 /// Render space's origin (the world point coordinates are stored relative to, in f32) is fixed
 /// at the first commit: [`Scene::set_origin`]'s point when given, else the camera's position
@@ -58,10 +76,41 @@ pub struct Scene {
     origin: Option<DVec3>,
     /// The image size of the next render.
     size: (u32, u32),
-    /// The build is out of date (origin, budget or a setting the build reads changed; a fault).
-    stale: bool,
+    /// What the next commit must redo.
+    dirty: Dirty,
     /// An animated scene's frame to put it at, at the next commit.
     frame: Option<u32>,
+    /// The frame the built scene was last put at (put back after a build).
+    at_frame: Option<u32>,
+    /// This scene's serial, in its ids.
+    serial: u32,
+    lights: Slots<ids::Light>,
+    objects: Slots<ids::Object>,
+    /// The materials of the imported groups that cast no shadow (the build's copies of them
+    /// depend on it), taken before a frozen scene's groups are consumed.
+    shadowless: Vec<Option<Spanned<String>>>,
+    /// [`Scene::new`]'s scene has no camera until one is set.
+    has_camera: bool,
+}
+
+/// What the next commit must redo besides the camera and settings.
+#[derive(Clone, Copy, Debug, Default)]
+struct Dirty {
+    /// Everything (origin, budget or a setting the build reads changed; objects; a fault).
+    build: bool,
+    lights: bool,
+    materials: bool,
+    /// Fog and ambient occlusion.
+    effects: bool,
+}
+
+/// Where a part added from code is "written": `<kind>:1:1`, as the fragments' messages say.
+fn origin(name: &str) -> Origin {
+    Origin {
+        file: Arc::new(PathBuf::from(name)),
+        line: 1,
+        col: 1,
+    }
 }
 
 const FROZEN: &str = "this scene's imported geometry was consumed at load \
@@ -70,6 +119,50 @@ const PREBUILT: &str = "this scene's geometry came from a geometry cache and was
     (Scene::from_prebuilt); it cannot be built again; load it with Scene::load to change it";
 
 impl Scene {
+    /// An empty scene: no camera (a commit is refused until [`Scene::set_camera`] gives one),
+    /// no lights, objects or materials but the default one, a black background and the
+    /// default render settings. Relative paths in plugin parameters start at the working
+    /// directory.
+    pub fn new(ctx: &Context) -> Scene {
+        // A placeholder, never rendered: `has_camera` is false until one is set.
+        let camera = CameraDesc {
+            position: [0.0; 3],
+            look_at: [0.0, 0.0, -1.0],
+            up: [0.0, 1.0, 0.0],
+            projection: Projection::Perspective { fov_deg: 40.0 },
+            aspect: None,
+            frustum: None,
+            depth_of_field: None,
+            stereo: None,
+        };
+        let desc = SceneDesc {
+            source: PathBuf::from("<scene>"),
+            camera: Spanned {
+                value: camera,
+                at: origin("<camera>"),
+            },
+            background: BackgroundDesc::default(),
+            lights: Vec::new(),
+            fog: None,
+            ambient_occlusion: None,
+            textures: Vec::new(),
+            materials: Vec::new(),
+            clip_groups: Vec::new(),
+            objects: Vec::new(),
+            prototypes: Default::default(),
+            instances: Vec::new(),
+            inline: Vec::new(),
+            volumes: Vec::new(),
+            render: RenderDesc::default(),
+            plugin_path: Vec::new(),
+            warnings: Vec::new(),
+            animation: None,
+        };
+        let mut s = Scene::with_desc(ctx, desc);
+        s.has_camera = false;
+        s
+    }
+
     /// Loads a scene file of any format Luxon reads (on the context's pool). The loader's
     /// warnings go to the log sink ([`crate::error::set_log`]).
     pub fn load(ctx: &Context, path: &Path) -> Result<Scene, Error> {
@@ -83,9 +176,17 @@ impl Scene {
     /// A scene from its description; imported geometry stays in it (so the scene can be built
     /// again after a change).
     pub fn from_desc(ctx: &Context, desc: SceneDesc) -> Result<Scene, Error> {
-        Ok(Scene {
+        Ok(Scene::with_desc(ctx, desc))
+    }
+
+    fn with_desc(ctx: &Context, desc: SceneDesc) -> Scene {
+        let serial = scene_serial();
+        Scene {
             built: None,
             size: (desc.render.width, desc.render.height),
+            lights: Slots::new(serial, desc.lights.len()),
+            objects: Slots::new(serial, desc.objects.len()),
+            shadowless: shadowless_groups(&desc),
             desc,
             registry: ctx.registry.clone(),
             budget: None,
@@ -93,9 +194,15 @@ impl Scene {
             frozen: false,
             consumed: None,
             origin: None,
-            stale: true,
+            dirty: Dirty {
+                build: true,
+                ..Dirty::default()
+            },
             frame: None,
-        })
+            at_frame: None,
+            serial,
+            has_camera: true,
+        }
     }
 
     /// A scene whose imported geometry (NFF, OBJ...) the first commit takes out of the
@@ -133,7 +240,7 @@ impl Scene {
     /// [`Budget::for_render`]). Builds the scene again.
     pub fn set_budget(&mut self, budget: Arc<Budget>) {
         self.budget = Some(budget);
-        self.stale = true;
+        self.dirty.build = true;
     }
 
     /// The camera (checked by the scene files' rules). An animated scene's camera is its
@@ -142,6 +249,7 @@ impl Scene {
         self.camera_not_animated()?;
         fragment::check_camera(&camera).map_err(|m| Error::Api(format!("camera: {m}")))?;
         self.desc.camera.value = camera;
+        self.has_camera = true;
         Ok(())
     }
 
@@ -182,7 +290,7 @@ impl Scene {
             parallel: r.parallel.clone(),
             ..render
         };
-        self.stale |= rebuild;
+        self.dirty.build |= rebuild;
         Ok(())
     }
 
@@ -216,7 +324,7 @@ impl Scene {
         }
         let origin = world.map(DVec3::from);
         if self.built.is_some() && origin != self.origin {
-            self.stale = true;
+            self.dirty.build = true;
         }
         self.origin = origin;
         Ok(())
@@ -235,13 +343,296 @@ impl Scene {
         Ok(())
     }
 
+    /// The scene's lights, in its order (a loaded scene's: file order).
+    pub fn lights(&self) -> Vec<LightId> {
+        self.lights.ids()
+    }
+
+    /// Adds a light (checked by the scene files' rules) after the others.
+    pub fn add_light(&mut self, light: LightDesc) -> Result<LightId, Error> {
+        fragment::check_light(&light).map_err(|m| Error::Api(format!("light: {m}")))?;
+        self.desc.lights.push(Spanned {
+            value: light,
+            at: origin("<light>"),
+        });
+        self.dirty.lights = true;
+        Ok(self.lights.insert())
+    }
+
+    /// Adds a light from RON text, e.g. `Point(position: (1, 2, 3), intensity: 2)`; errors
+    /// point into the text as `<light>:line:col`.
+    pub fn add_light_ron(&mut self, text: &str) -> Result<LightId, Error> {
+        let light = fragment::light(text)?;
+        self.add_light(light)
+    }
+
+    /// Changes a light (checked by the scene files' rules).
+    pub fn set_light(&mut self, id: LightId, light: LightDesc) -> Result<(), Error> {
+        let i = self.lights.position(id)?;
+        fragment::check_light(&light).map_err(|m| Error::Api(format!("light: {m}")))?;
+        self.desc.lights[i] = Spanned {
+            value: light,
+            at: origin("<light>"),
+        };
+        self.dirty.lights = true;
+        Ok(())
+    }
+
+    /// [`Scene::set_light`] from RON text.
+    pub fn set_light_ron(&mut self, id: LightId, text: &str) -> Result<(), Error> {
+        self.lights.position(id)?;
+        let light = fragment::light(text)?;
+        self.set_light(id, light)
+    }
+
+    /// Removes a light; its id is refused from now on. An animated scene's lights cannot be
+    /// removed (its animation refers to them by their place).
+    pub fn remove_light(&mut self, id: LightId) -> Result<(), Error> {
+        self.lights.position(id)?;
+        self.not_animated("lights")?;
+        let i = self.lights.remove(id)?;
+        self.desc.lights.remove(i);
+        self.dirty.lights = true;
+        Ok(())
+    }
+
+    fn not_animated(&self, what: &str) -> Result<(), Error> {
+        match self.desc.animation {
+            Some(_) => Err(Error::Api(format!(
+                "this scene is animated and its animation refers to {what} by their place in \
+                 the scene: they can be added and changed, not removed"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The material named `name` (`default`: the default one), if the scene has it.
+    pub fn material(&self, name: &str) -> Option<MaterialId> {
+        let index = self.material_names().iter().position(|n| *n == name)?;
+        Some(MaterialId {
+            scene: self.serial,
+            index: index as u32,
+        })
+    }
+
+    /// The materials' names by number, as the build numbers them: `default`, then the
+    /// scene's in the order they were first defined.
+    fn material_names(&self) -> Vec<&str> {
+        let mut names = vec!["default"];
+        for (n, _) in &self.desc.materials {
+            if !names.contains(&n.as_str()) {
+                names.push(n);
+            }
+        }
+        names
+    }
+
+    fn material_name(&self, id: MaterialId) -> Result<String, Error> {
+        if id.scene != self.serial {
+            return Err(Error::Api(
+                "this material id belongs to another scene".into(),
+            ));
+        }
+        let names = self.material_names();
+        let name = names
+            .get(id.index as usize)
+            .ok_or_else(|| Error::Api(format!("material {} is not in this scene", id.index)))?;
+        Ok(name.to_string())
+    }
+
+    /// Defines the material `name` (checked by the scene files' rules) or changes it; its
+    /// textures must be the scene's. Materials are never removed. (`default` is the material
+    /// of objects that name none.)
+    pub fn set_material(&mut self, name: &str, m: MaterialDesc) -> Result<MaterialId, Error> {
+        fragment::check_material(&m).map_err(|e| Error::Api(format!("material `{name}`: {e}")))?;
+        for t in [&m.texture, &m.reflect_texture, &m.transmit_texture]
+            .into_iter()
+            .flatten()
+        {
+            if !self.desc.textures.iter().any(|(n, _)| *n == t.value) {
+                return Err(Error::at(&t.at, format!("no texture named `{}`", t.value)));
+            }
+        }
+        let new = self.material(name).is_none();
+        // A new name renumbers the copies that cast no shadow, which a consumed scene's
+        // geometry refers to and cannot be stored again.
+        let copies = self
+            .built
+            .as_ref()
+            .is_some_and(|b| b.materials.len() > b.material_names.len());
+        if let Some(why) = self.consumed.filter(|_| new && copies) {
+            return Err(Error::Api(format!(
+                "material `{name}` is new and would renumber the materials of objects that \
+                 cast no shadow; {why}"
+            )));
+        }
+        let value = Spanned {
+            value: m,
+            at: origin("<material>"),
+        };
+        // Later definitions of a name replace earlier ones: every one becomes the new one.
+        let mut found = false;
+        for (_, d) in self.desc.materials.iter_mut().filter(|(n, _)| n == name) {
+            *d = value.clone();
+            found = true;
+        }
+        if !found {
+            self.desc.materials.push((name.to_string(), value));
+        }
+        self.dirty.materials = true;
+        self.material(name)
+            .ok_or_else(|| Error::Api(format!("material `{name}` was not defined")))
+    }
+
+    /// [`Scene::set_material`] from RON text, e.g. `(color: (0.8, 0.2, 0.2), specular: 0.5)`;
+    /// errors point into the text as `<material>:line:col`.
+    pub fn set_material_ron(&mut self, name: &str, text: &str) -> Result<MaterialId, Error> {
+        let m = fragment::material(text)?;
+        self.set_material(name, m)
+    }
+
+    /// The clip group named `name`, if the scene has it.
+    pub fn clip_group(&self, name: &str) -> Option<ClipId> {
+        let index = self.desc.clip_groups.iter().position(|(n, _)| n == name)?;
+        Some(ClipId {
+            scene: self.serial,
+            index: index as u32,
+        })
+    }
+
+    fn clip_name(&self, id: ClipId) -> Result<String, Error> {
+        if id.scene != self.serial {
+            return Err(Error::Api(
+                "this clip group id belongs to another scene".into(),
+            ));
+        }
+        match self.desc.clip_groups.get(id.index as usize) {
+            Some((n, _)) => Ok(n.clone()),
+            None => Err(Error::Api(format!(
+                "clip group {} is not in this scene",
+                id.index
+            ))),
+        }
+    }
+
+    /// Fog (checked by the scene files' rules); `None`: none.
+    pub fn set_fog(&mut self, fog: Option<FogDesc>) -> Result<(), Error> {
+        if let Some(f) = &fog {
+            fragment::check_fog(f).map_err(|m| Error::Api(format!("fog: {m}")))?;
+        }
+        self.desc.fog = fog;
+        self.dirty.effects = true;
+        Ok(())
+    }
+
+    /// Fog from RON text, e.g. `(mode: Exp(density: 0.1), color: (0.5, 0.5, 0.5))`; errors
+    /// point into the text as `<fog>:line:col`.
+    pub fn set_fog_ron(&mut self, text: &str) -> Result<(), Error> {
+        let fog = fragment::fog(text)?;
+        self.set_fog(Some(fog))
+    }
+
+    /// Ambient occlusion (checked by the scene files' rules); `None`: none.
+    pub fn set_ambient_occlusion(&mut self, ao: Option<AoDesc>) -> Result<(), Error> {
+        if let Some(a) = &ao {
+            fragment::check_ambient_occlusion(a)
+                .map_err(|m| Error::Api(format!("ambient occlusion: {m}")))?;
+        }
+        self.desc.ambient_occlusion = ao;
+        self.dirty.effects = true;
+        Ok(())
+    }
+
+    /// Ambient occlusion from RON text, e.g. `(samples: 16, max_distance: 2)`; errors point
+    /// into the text as `<ambient_occlusion>:line:col`.
+    pub fn set_ambient_occlusion_ron(&mut self, text: &str) -> Result<(), Error> {
+        let ao = fragment::ambient_occlusion(text)?;
+        self.set_ambient_occlusion(Some(ao))
+    }
+
+    /// The scene's objects, in its order (a loaded scene's: file order; imported geometry,
+    /// which has no ids, comes after them).
+    pub fn objects(&self) -> Vec<ObjectId> {
+        self.objects.ids()
+    }
+
+    /// Adds an object made by the primitive plugin `plugin` from its parameters (RON text, as
+    /// after `params:` in a scene file), of `material` (`None`: the default) and cut by `clip`.
+    /// The plugin reads the parameters at the next commit: its errors point into them as
+    /// `<object N>:line:col` (N: the id's number), and the object stays until removed. Every
+    /// commit after objects were added or removed builds the scene again, once: plugin
+    /// objects are for what does not change every step.
+    pub fn add_plugin_object(
+        &mut self,
+        plugin: &str,
+        params_ron: &str,
+        material: Option<MaterialId>,
+        clip: Option<ClipId>,
+    ) -> Result<ObjectId, Error> {
+        self.objects_can_change()?;
+        self.registry
+            .get(plugin, PluginKind::Primitive)
+            .map_err(|e| Error::Api(e.to_string()))?;
+        let material = material.map(|m| self.material_name(m)).transpose()?;
+        let clip = clip.map(|c| self.clip_name(c)).transpose()?;
+        let id = self.objects.insert();
+        let at = origin(&format!("<{id}>"));
+        let named = |value: String| Spanned {
+            value,
+            at: at.clone(),
+        };
+        let object = ObjectDesc {
+            call: PluginCall {
+                plugin: named(plugin.to_string()),
+                params: params_ron.to_string(),
+                params_at: at.clone(),
+            },
+            material: material.map(named),
+            clip: clip.map(named),
+            shadows: true,
+        };
+        self.desc.objects.push(Spanned { value: object, at });
+        self.dirty.build = true;
+        Ok(id)
+    }
+
+    /// Removes an object; its id is refused from now on. The next commit builds the scene
+    /// again. An animated scene's objects cannot be removed (its animation refers to them by
+    /// their place).
+    pub fn remove(&mut self, id: ObjectId) -> Result<(), Error> {
+        self.objects.position(id)?;
+        self.objects_can_change()?;
+        self.not_animated("objects")?;
+        let i = self.objects.remove(id)?;
+        self.desc.objects.remove(i);
+        self.dirty.build = true;
+        Ok(())
+    }
+
+    fn objects_can_change(&self) -> Result<(), Error> {
+        match self.consumed {
+            Some(why) => Err(Error::Api(format!("objects cannot change: {why}"))),
+            None => Ok(()),
+        }
+    }
+
+    /// The description as a RON scene (what `luxon convert` writes), for a bug report or to
+    /// render it with the command line: paths relative to the scene file's directory when it
+    /// has one. A frozen scene's imported geometry is not in it once consumed.
+    pub fn to_ron(&self) -> Result<String, Error> {
+        let base = self.desc.source.parent().unwrap_or(Path::new("."));
+        luxon_formats::print::scene(&self.desc, base).map_err(Error::Api)
+    }
+
     /// The image size of the next commit (a render sets it to its target's).
     pub(super) fn set_size(&mut self, width: u32, height: u32) {
         self.size = (width, height);
     }
 
     /// Brings the built scene up to date with the description, on `on`'s pool: a build when
-    /// there is none yet or it is stale, else only the settings, camera and background.
+    /// there is none yet or it is out of date (objects, origin, the settings a build reads),
+    /// else only what changed among the settings, camera, background, lights, materials, fog
+    /// and ambient occlusion. A scene without a camera ([`Scene::new`]) is refused.
     pub fn commit(&mut self, on: &Renderer) -> Result<CommitReport, Error> {
         let t0 = Instant::now();
         let mut report = on.pool.install(|| self.commit_here())?;
@@ -250,8 +641,27 @@ impl Scene {
     }
 
     fn commit_here(&mut self) -> Result<CommitReport, Error> {
+        if !self.has_camera {
+            return Err(Error::Api(
+                "this scene has no camera; give it one with Scene::set_camera before \
+                 rendering"
+                    .into(),
+            ));
+        }
         let mut report = CommitReport::default();
-        if self.built.is_none() || self.stale {
+        let d = &mut self.dirty;
+        if self.desc.animation.is_some() && (d.lights || d.materials) {
+            // The animation holds the lights and materials it keys: built again with them.
+            d.build = true;
+        }
+        if let (Some(built), false, true) = (self.built.as_mut(), d.build, d.materials) {
+            match built.update_materials(&self.desc, &self.shadowless)? {
+                true => report.shading = true,
+                false => d.build = true,
+            }
+            d.materials = false;
+        }
+        if self.built.is_none() || self.dirty.build {
             if let Some(why) = self.consumed {
                 return Err(Error::Api(why.into()));
             }
@@ -279,15 +689,28 @@ impl Scene {
             report.rebuilt = 1;
             report.bvh_time = built.bvh_time;
             self.built = Some(built);
-            self.stale = false;
+            self.dirty = Dirty::default();
+            // A new build starts at the first frame: back to the frame it was at.
+            self.frame = self.frame.or(self.at_frame);
         }
         let Some(built) = self.built.as_mut() else {
             return Err(Error::Api("the scene is not built".into()));
         };
+        if self.dirty.lights {
+            built.update_lights(&self.desc);
+            self.dirty.lights = false;
+            report.shading = true;
+        }
+        if self.dirty.effects {
+            built.update_effects(&self.desc);
+            self.dirty.effects = false;
+            report.shading = true;
+        }
         let (w, h) = self.size;
         built.update_view(&self.desc, w, h)?;
         if let Some(k) = self.frame.take() {
             built.set_frame(k)?;
+            self.at_frame = Some(k);
         }
         Ok(report)
     }
@@ -308,7 +731,7 @@ impl Scene {
             .is_some_and(|b| b.customs.fault.is_raised())
         {
             self.built = None;
-            self.stale = true;
+            self.dirty.build = true;
         }
     }
 }

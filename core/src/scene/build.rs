@@ -27,8 +27,9 @@ use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
 use luxon_formats::{
-    BackgroundDesc, HighlightColor, InlineGeometry, LightDesc, RenderDesc, SceneDesc, Spanned,
-    SpotFade, TransparencyAngle, TransparencyDesc, TransparencyMode, TransparentShadows,
+    AoDesc, BackgroundDesc, FogDesc, HighlightColor, InlineGeometry, LightDesc, RenderDesc,
+    SceneDesc, Spanned, SpotFade, TransparencyAngle, TransparencyDesc, TransparencyMode,
+    TransparentShadows,
 };
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -145,7 +146,7 @@ impl Scene {
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
-        let palette = b.materials(&texture_names, &shadowless)?;
+        let palette = Build::materials(desc, &texture_names, &shadowless)?;
         let clips = b.clips()?;
         let render_volumes = b.render_volumes(&volumes)?;
         let mut stored = Stored::new(b.world_offset, palette.materials.len());
@@ -172,11 +173,13 @@ impl Scene {
         let bvh_time = t1.elapsed();
 
         let lights = b.lights();
-        let (fog, ao) = b.effects();
+        let (fog, ao) = Build::effects(&desc.fog, &desc.ambient_occlusion);
+        let has_geometry = stored.has_geometry();
         let features = features(
             &desc.render,
             &materials,
-            &stored,
+            &stored.used,
+            has_geometry,
             &lights,
             &fog,
             &ao,
@@ -219,6 +222,7 @@ impl Scene {
             outputs: r.outputs.clone(),
             features,
             used_materials: stored.used,
+            has_geometry,
             object_counts: stored.object_counts,
             degenerate_triangles: stored.dropped,
             bvh_time,
@@ -252,7 +256,7 @@ pub(super) struct Build<'a> {
 
 /// The materials of the imported geometry groups, then of the instanced objects, that cast no
 /// shadow.
-fn shadowless_groups(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
+pub(crate) fn shadowless_groups(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
     let groups = desc.inline.iter().filter(|g| g.shadowless);
     let groups = groups.map(|g| g.material.clone());
     groups.chain(instances::shadowless(desc)).collect()
@@ -260,10 +264,10 @@ fn shadowless_groups(desc: &SceneDesc) -> Vec<Option<Spanned<String>>> {
 
 /// The materials (index 0: the default; then the scene's, by name; then copies of those that
 /// objects casting no shadow use), their names, and each one's copy that casts no shadow.
-struct Palette {
-    materials: Vec<Material>,
-    names: Vec<String>,
-    shadowless: Vec<Option<usize>>,
+pub(super) struct Palette {
+    pub(super) materials: Vec<Material>,
+    pub(super) names: Vec<String>,
+    pub(super) shadowless: Vec<Option<usize>>,
 }
 
 impl Palette {
@@ -393,15 +397,15 @@ impl<'a> Build<'a> {
     /// Stage: the materials (index 0: the default, which the scene may redefine) with their
     /// textures resolved, then a copy casting no shadow of each material that objects casting
     /// none use.
-    fn materials(
-        &self,
+    pub(super) fn materials(
+        desc: &SceneDesc,
         texture_names: &[String],
         shadowless_groups: &[Option<Spanned<String>>],
     ) -> Result<Palette, Error> {
-        let t = &self.desc.render.transparency;
+        let t = &desc.render.transparency;
         let mut material_names = vec!["default".to_string()];
         let mut materials = vec![material(&Default::default(), [None; 3], t)];
-        for (name, m) in &self.desc.materials {
+        for (name, m) in &desc.materials {
             let find = |t: &Option<Spanned<String>>| -> Result<Option<u32>, Error> {
                 match t {
                     Some(t) => texture_names
@@ -426,8 +430,7 @@ impl<'a> Build<'a> {
             }
         }
         let mut shadowless = vec![None; materials.len()];
-        let unshadowed = self
-            .desc
+        let unshadowed = desc
             .objects
             .iter()
             .filter(|o| !o.value.shadows)
@@ -780,15 +783,15 @@ impl<'a> Build<'a> {
     }
 
     /// Stage: fog and ambient occlusion.
-    fn effects(&self) -> (Option<Fog>, Option<Ao>) {
-        let fog = self.desc.fog.as_ref().map(|f| Fog {
+    pub(super) fn effects(fog: &Option<FogDesc>, ao: &Option<AoDesc>) -> (Option<Fog>, Option<Ao>) {
+        let fog = fog.as_ref().map(|f| Fog {
             mode: f.mode,
             color: v3(f.color),
             planar: f.planar,
             every_ray: f.every_ray,
             misses: f.misses,
         });
-        let ao = self.desc.ambient_occlusion.as_ref().map(|a| Ao {
+        let ao = ao.as_ref().map(|a| Ao {
             samples: a.samples,
             max_distance: a.max_distance as f32,
             sky: v3(a.color) * a.intensity as f32,
@@ -965,11 +968,14 @@ impl Stored {
     }
 }
 
-/// Last: the effects the scene calls for, so the integrator skips the others.
-fn features(
+/// Last: the effects the scene calls for, so the integrator skips the others (`used`: per
+/// material, whether any primitive uses it).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn features(
     r: &RenderDesc,
     materials: &[Material],
-    stored: &Stored,
+    used: &[bool],
+    has_geometry: bool,
     lights: &[Light],
     fog: &Option<Fog>,
     ao: &Option<Ao>,
@@ -977,11 +983,10 @@ fn features(
 ) -> Features {
     let used_mats: Vec<&Material> = materials
         .iter()
-        .zip(&stored.used)
+        .zip(used)
         .filter(|(_, u)| **u)
         .map(|(m, _)| m)
         .collect();
-    let has_geometry = stored.has_geometry();
     let transmission = used_mats.iter().any(|m| m.transmit > 0.0);
     let every_ray = fog.as_ref().is_some_and(|f| f.every_ray);
     Features {

@@ -3,8 +3,9 @@
 //! integrator asks of it (closest hit, surface, shadow transmittance). The build is in `build`;
 //! an animated scene's frames (`Scene::set_frame`, the keyed objects' moving group) in `frame`;
 //! what a retained scene ([`crate::api::Scene`]) changes without a build (settings, size,
-//! camera, background) in `update`; instances of prototypes, baked into flat copies, in
-//! `instances`; moving recorded geometry by a transform (for both) in `place`.
+//! camera, background, lights, materials, fog and ambient occlusion) in `update`; instances of
+//! prototypes, baked into flat copies, in `instances`; moving recorded geometry by a transform
+//! (for both) in `place`.
 
 mod build;
 mod frame;
@@ -13,6 +14,7 @@ mod place;
 mod sky;
 mod update;
 
+pub(crate) use build::shadowless_groups;
 pub use build::Prebuilt;
 pub use frame::Animation;
 pub use instances::PrototypeUse;
@@ -351,6 +353,8 @@ pub struct Scene {
     pub features: Features,
     /// Per material: whether any object uses it.
     pub used_materials: Vec<bool>,
+    /// Whether the scene holds any surface (shadows and occlusion need one).
+    pub has_geometry: bool,
     /// Objects per plugin name, in first-use order.
     pub object_counts: Vec<(String, usize)>,
     pub degenerate_triangles: u64,

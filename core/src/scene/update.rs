@@ -1,11 +1,13 @@
 //! What a retained scene ([`crate::api::Scene`]) changes in a built [`Scene`] without building
-//! it again: the render settings that touch no geometry, the image size, the background and the
-//! camera. The rest of a change is a build (`build`).
+//! it again: the render settings that touch no geometry, the image size, the background, the
+//! camera, the lights, the materials (while the geometry's material numbers stay valid), fog
+//! and ambient occlusion. The rest of a change is a build (`build`). Each runs the build's own
+//! stage on the description's part, so the scene is what a build would make of it.
 
-use super::build::{self, settings};
+use super::build::{self, features, settings, Build};
 use super::Scene;
 use crate::error::Error;
-use luxon_formats::SceneDesc;
+use luxon_formats::{RenderDesc, SceneDesc, Spanned};
 
 impl Scene {
     /// Takes `desc`'s render settings (at `width`×`height`, the caller's image), outputs,
@@ -42,5 +44,59 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// Takes `desc`'s lights, in this build's render space. Not for an animated scene (its
+    /// animation holds the lights it moves).
+    pub(crate) fn update_lights(&mut self, desc: &SceneDesc) {
+        let r = &desc.render;
+        self.lights = Build::lights_from(&desc.lights, self.world_offset, r.light_scale);
+        self.update_features(r);
+    }
+
+    /// Takes `desc`'s fog and ambient occlusion.
+    pub(crate) fn update_effects(&mut self, desc: &SceneDesc) {
+        (self.fog, self.ao) = Build::effects(&desc.fog, &desc.ambient_occlusion);
+        self.update_features(&desc.render);
+    }
+
+    /// Takes `desc`'s materials (`shadowless_groups`: the build's, see `shadowless_groups`) if
+    /// the geometry's material numbers stay valid: the same names, or names added while no
+    /// material has a copy that casts no shadow (copies come after the names, so new names
+    /// would move them). `Ok(false)`: they would not; the scene must be built again. Not for an
+    /// animated scene (its animation holds the colours it keys).
+    pub(crate) fn update_materials(
+        &mut self,
+        desc: &SceneDesc,
+        shadowless_groups: &[Option<Spanned<String>>],
+    ) -> Result<bool, Error> {
+        let p = Build::materials(desc, &self.texture_names, shadowless_groups)?;
+        let copies = self.materials.len() - self.material_names.len();
+        let appended = copies == 0
+            && p.materials.len() == p.names.len()
+            && p.names.starts_with(&self.material_names);
+        if p.names != self.material_names && !appended {
+            return Ok(false);
+        }
+        // New materials are used by nothing yet.
+        self.used_materials.resize(p.materials.len(), false);
+        self.materials = p.materials;
+        self.material_names = p.names;
+        self.update_features(&desc.render);
+        Ok(true)
+    }
+
+    /// The features, as the build's last stage finds them.
+    fn update_features(&mut self, r: &RenderDesc) {
+        self.features = features(
+            r,
+            &self.materials,
+            &self.used_materials,
+            self.has_geometry,
+            &self.lights,
+            &self.fog,
+            &self.ao,
+            &self.render_volumes,
+        );
     }
 }
