@@ -242,21 +242,7 @@ fn a_cancelled_render_leaves_the_next_one_complete() {
 /// A scene with a custom object that panics when a ray reaches its box ([-1, 1]³) and a sphere
 /// far from it; `look_at` aims the camera.
 fn faulting_scene(dir: &Path, look_at: &str) -> SceneDesc {
-    ensure_plugins();
-    let exe = std::env::current_exe().unwrap();
-    let lib = |n: &str| {
-        format!(
-            "{}{n}{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_SUFFIX
-        )
-    };
-    let profile_dir = exe.parent().unwrap().parent().unwrap();
-    // Copied once: writing over a loaded library would change the code it runs.
-    let plugin = dir.join(lib("luxon_panics"));
-    if !plugin.exists() {
-        std::fs::copy(profile_dir.join(lib("testplug_panics")), plugin).unwrap();
-    }
+    install_plugin(dir, "testplug_panics", "luxon_panics");
     let text = format!(
         "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: {look_at}),\n    \
          objects: [(plugin: \"panic_intersect\"), (plugin: \"sphere\", params: (center: (0, 0, -12), radius: 1))],\n    \

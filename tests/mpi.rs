@@ -325,21 +325,7 @@ mod with_mpi {
     #[test]
     fn nan_counts_of_every_rank_reach_the_warning() {
         let dir = temp_dir("mpi-nan");
-        let file = |n: &str| {
-            format!(
-                "{}{n}{}",
-                std::env::consts::DLL_PREFIX,
-                std::env::consts::DLL_SUFFIX
-            )
-        };
-        ensure_plugins();
-        let exe = std::env::current_exe().unwrap();
-        let profile = exe.parent().unwrap().parent().unwrap();
-        std::fs::copy(
-            profile.join(file("testplug_nan")),
-            dir.join(file("luxon_nan")),
-        )
-        .unwrap();
+        install_plugin(&dir, "testplug_nan", "luxon_nan");
         let scene = dir.join("nan.ron");
         std::fs::write(
             &scene,

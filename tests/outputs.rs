@@ -14,21 +14,7 @@ use std::time::{Duration, Instant};
 /// `panic_texture`, copied into `dir`). An output error reported instead proves the outputs
 /// were checked before rendering.
 fn failing_scene(dir: &Path, outputs: &str) -> PathBuf {
-    ensure_plugins();
-    let exe = std::env::current_exe().unwrap();
-    let lib = |n: &str| {
-        format!(
-            "{}{n}{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_SUFFIX
-        )
-    };
-    let profile_dir = exe.parent().unwrap().parent().unwrap();
-    std::fs::copy(
-        profile_dir.join(lib("testplug_panics")),
-        dir.join(lib("luxon_panics")),
-    )
-    .unwrap();
+    install_plugin(dir, "testplug_panics", "luxon_panics");
     let scene = dir.join("fails.ron");
     std::fs::write(
         &scene,

@@ -5,24 +5,7 @@ mod common;
 
 use common::*;
 use luxon::Scene;
-use std::path::{Path, PathBuf};
-
-/// Copies a test plugin into `dir` under a name the scanner picks up.
-fn install(dir: &Path, lib: &str, as_name: &str) -> PathBuf {
-    ensure_plugins();
-    let exe = std::env::current_exe().unwrap();
-    let profile_dir = exe.parent().unwrap().parent().unwrap();
-    let file = |n: &str| {
-        format!(
-            "{}{n}{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_SUFFIX
-        )
-    };
-    let dst = dir.join(file(as_name));
-    std::fs::copy(profile_dir.join(file(lib)), &dst).unwrap();
-    dst
-}
+use std::path::Path;
 
 /// Builds a scene with one object line; returns the error message.
 fn build_error(dir: &Path, object: &str) -> String {
@@ -89,7 +72,7 @@ fn bad_parameter_is_reported_at_its_scene_position() {
 #[test]
 fn wrong_abi_version_names_both_versions() {
     let dir = temp_dir("abi");
-    install(&dir, "testplug_bad_abi", "luxon_old");
+    install_plugin(&dir, "testplug_bad_abi", "luxon_old");
     let e = build_error(&dir, r#"(plugin: "old_thing")"#);
     assert!(e.contains("no primitive plugin named `old_thing`"), "{e}");
     // A plugin built for the previous ABI, as every plugin built before the bump to 2 is.
@@ -106,7 +89,7 @@ fn wrong_abi_version_names_both_versions() {
 #[test]
 fn a_library_that_is_not_a_plugin_is_named() {
     let dir = temp_dir("notplugin");
-    install(&dir, "testplug_not_a_plugin", "luxon_imposter");
+    install_plugin(&dir, "testplug_not_a_plugin", "luxon_imposter");
     let e = build_error(&dir, r#"(plugin: "imposter")"#);
     assert!(
         e.contains("libluxon_imposter") && e.contains("not a Luxon plugin"),
@@ -117,7 +100,7 @@ fn a_library_that_is_not_a_plugin_is_named() {
 #[test]
 fn panic_in_create_becomes_an_error_naming_the_plugin() {
     let dir = temp_dir("panic-create");
-    install(&dir, "testplug_panics", "luxon_panics");
+    install_plugin(&dir, "testplug_panics", "luxon_panics");
     let e = build_error(&dir, r#"(plugin: "panic_create")"#);
     assert!(
         e.contains("scene.ron:5:") && e.contains("plugin `panic_create`"),
@@ -149,7 +132,7 @@ fn render_error(dir: &Path, objects: &str, extra: &str) -> String {
 #[test]
 fn panic_while_intersecting_stops_the_render_with_an_error() {
     let dir = temp_dir("panic-intersect");
-    install(&dir, "testplug_panics", "luxon_panics");
+    install_plugin(&dir, "testplug_panics", "luxon_panics");
     let e = render_error(&dir, r#"(plugin: "panic_intersect")"#, "");
     let want = format!(
         "{}:6:15: object 0 (plugin `panic_intersect`) panicked while intersecting a ray: \
@@ -185,7 +168,7 @@ fn line4_at(dir: &Path, line: &str, needle: &str) -> String {
 #[test]
 fn type_errors_in_params_name_the_parameter_what_was_expected_and_found() {
     let dir = temp_dir("param-types");
-    install(&dir, "testplug_nan", "luxon_nan");
+    install_plugin(&dir, "testplug_nan", "luxon_nan");
     let cases = [
         (
             r#"objects: [(plugin: "sphere", params: (center: (0, 0, 0), radius: "big"))],"#,
@@ -260,7 +243,7 @@ fn a_plugins_check_on_a_parameter_points_at_it() {
 #[test]
 fn a_writer_panic_names_the_output_and_carries_its_message() {
     let dir = temp_dir("panic-writer");
-    install(&dir, "testplug_panics", "luxon_panics");
+    install_plugin(&dir, "testplug_panics", "luxon_panics");
     let scene = dir.join("scene.ron");
     let text = format!(
         "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    render: (width: 4, height: 4, outputs: [(path: \"out.panicimg\")]),\n)\n",
@@ -287,7 +270,7 @@ fn a_writer_panic_names_the_output_and_carries_its_message() {
 #[test]
 fn the_search_path_says_what_it_skipped_and_why() {
     let dir = temp_dir("search-notes");
-    let misnamed = install(&dir, "testplug_panics", "zigzag");
+    let misnamed = install_plugin(&dir, "testplug_panics", "zigzag");
     let broken = dir.join(format!(
         "{}luxon_broken{}",
         std::env::consts::DLL_PREFIX,
@@ -353,7 +336,7 @@ fn the_search_path_says_what_it_skipped_and_why() {
 #[test]
 fn panic_in_a_texture_stops_the_render_with_an_error() {
     let dir = temp_dir("panic-texture");
-    install(&dir, "testplug_panics", "luxon_panics");
+    install_plugin(&dir, "testplug_panics", "luxon_panics");
     let e = render_error(
         &dir,
         r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")"#,
@@ -374,7 +357,7 @@ fn panic_in_a_texture_stops_the_render_with_an_error() {
 #[test]
 fn a_failing_texture_stops_the_render_with_its_message() {
     let dir = temp_dir("fail-texture");
-    install(&dir, "testplug_panics", "luxon_panics");
+    install_plugin(&dir, "testplug_panics", "luxon_panics");
     let e = render_error(
         &dir,
         r#"(plugin: "sphere", params: (center: (0, 0, 0), radius: 1), material: "m")"#,
@@ -391,7 +374,7 @@ fn a_failing_texture_stops_the_render_with_its_message() {
 #[test]
 fn a_plugin_file_named_in_plugin_path_is_loaded_whatever_its_name() {
     let dir = temp_dir("explicit");
-    let file = install(&dir, "testplug_panics", "whatever_name");
+    let file = install_plugin(&dir, "testplug_panics", "whatever_name");
     let text = format!(
         "Scene(plugin_path: [\"{}\"], camera: (position: (0, 0, -5), look_at: (0, 0, 0)), objects: [(plugin: \"panic_create\")])",
         file.display()
@@ -409,7 +392,7 @@ fn a_plugin_file_named_in_plugin_path_is_loaded_whatever_its_name() {
 #[test]
 fn plugins_command_lists_every_plugin_and_its_parameters() {
     let dir = temp_dir("list");
-    install(&dir, "testplug_bad_abi", "luxon_old");
+    install_plugin(&dir, "testplug_bad_abi", "luxon_old");
     let out = run(&["plugins", "--plugin-path", dir.to_str().unwrap()]);
     assert!(out.status.success());
     let s = String::from_utf8_lossy(&out.stdout);
@@ -434,7 +417,7 @@ fn plugins_command_lists_every_plugin_and_its_parameters() {
 #[test]
 fn a_truncated_library_on_the_search_path_is_skipped_by_name() {
     let dir = temp_dir("truncated");
-    let lib = install(&dir, "luxon_shapes", "luxon_trunc");
+    let lib = install_plugin(&dir, "luxon_shapes", "luxon_trunc");
     let full = std::fs::read(&lib).unwrap();
     let scene = dir.join("scene.ron");
     std::fs::write(

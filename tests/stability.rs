@@ -416,24 +416,6 @@ fn rays_at_shared_edges_and_vertices_never_leak() {
 // A NaN never aborts a render
 // ------------------------------------------------------------------------------------------------
 
-fn install_nan_plugin(dir: &std::path::Path) {
-    ensure_plugins();
-    let exe = std::env::current_exe().unwrap();
-    let profile = exe.parent().unwrap().parent().unwrap();
-    let file = |n: &str| {
-        format!(
-            "{}{n}{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_SUFFIX
-        )
-    };
-    std::fs::copy(
-        profile.join(file("testplug_nan")),
-        dir.join(file("luxon_nan")),
-    )
-    .unwrap();
-}
-
 fn nan_scene(dir: &std::path::Path) -> String {
     format!(
         r#"Scene(
@@ -453,7 +435,7 @@ fn nan_scene(dir: &std::path::Path) -> String {
 #[test]
 fn a_nan_is_counted_reported_and_clamped() {
     let dir = temp_dir("nan-texture");
-    install_nan_plugin(&dir);
+    install_plugin(&dir, "testplug_nan", "luxon_nan");
     let path = dir.join("scene.ron");
     std::fs::write(&path, nan_scene(&dir)).unwrap();
     let desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
@@ -538,7 +520,7 @@ fn a_nan_is_counted_reported_and_clamped() {
 #[test]
 fn nan_hits_of_custom_geometry_are_counted_per_object() {
     let dir = temp_dir("nan-box");
-    install_nan_plugin(&dir);
+    install_plugin(&dir, "testplug_nan", "luxon_nan");
     let path = dir.join("scene.ron");
     let text = format!(
         "Scene(\n    plugin_path: [\"{}\"],\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    objects: [(plugin: \"sphere\", params: (center: (3, 0, 0), radius: 0.5)), (plugin: \"nan_box\")],\n    render: (width: 8, height: 8, outputs: [(path: \"nan.png\")]),\n)\n",

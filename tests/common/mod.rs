@@ -35,6 +35,27 @@ pub fn ensure_plugins() {
     });
 }
 
+/// Copies the test plugin `lib` (a crate of `tests/plugins`, e.g. `testplug_panics`) into `dir`
+/// as the library of `as_name` (`luxon_panics`: found by the plugin scanner there), unless it
+/// is there already: writing over a loaded library would change the code it runs.
+pub fn install_plugin(dir: &Path, lib: &str, as_name: &str) -> PathBuf {
+    ensure_plugins();
+    let exe = std::env::current_exe().unwrap();
+    let profile_dir = exe.parent().unwrap().parent().unwrap();
+    let file = |n: &str| {
+        format!(
+            "{}{n}{}",
+            std::env::consts::DLL_PREFIX,
+            std::env::consts::DLL_SUFFIX
+        )
+    };
+    let dst = dir.join(file(as_name));
+    if !dst.exists() {
+        std::fs::copy(profile_dir.join(file(lib)), &dst).unwrap();
+    }
+    dst
+}
+
 pub fn registry(desc: &SceneDesc) -> Registry {
     ensure_plugins();
     Registry::discover(&desc.plugin_path)
