@@ -116,13 +116,17 @@ fn one_line_errors() {
     assert!(!std::path::Path::new(f).exists());
 }
 
+/// A scene name, what `luxon spd` reports writing, and whether a linear RGB pixel has the
+/// object's colour.
+type Case = (&'static str, &'static str, fn([f32; 3]) -> bool);
+
 /// The SPD databases added after 1987 (`jacks`, `shells`, `sombrero`): written by `luxon spd` at
 /// their default sizes with the published counts, read back, and rendered small into a picture
 /// that shows the object (not only background) in its own colour.
 #[test]
 fn later_databases_generate_and_render() {
     let dir = temp_dir("spd-later");
-    let cases: [(&str, &str, fn([f32; 3]) -> bool); 3] = [
+    let cases: [Case; 3] = [
         // Pink jacks on dark purple.
         ("jacks", "jacks -s 1: 6 spheres, 3 cones", |p| {
             p[0] > 0.1 && p[0] > 1.2 * p[2]
