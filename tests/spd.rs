@@ -77,7 +77,8 @@ fn lists_the_scenes() {
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8_lossy(&out.stdout);
     for name in [
-        "balls", "gears", "lattice", "mount", "rings", "teapot", "tetra", "tree",
+        "balls", "gears", "jacks", "lattice", "mount", "rings", "shells", "sombrero", "teapot",
+        "tetra", "tree",
     ] {
         assert!(text.contains(name), "{name} missing from\n{text}");
     }
@@ -107,8 +108,79 @@ fn one_line_errors() {
     }
     let e = stderr(&run(&["spd", "teapt", "-o", f]));
     assert!(
-        e.contains("balls, gears, lattice, mount, rings, teapot, tetra, tree"),
+        e.contains(
+            "balls, gears, jacks, lattice, mount, rings, shells, sombrero, teapot, tetra, tree"
+        ),
         "{e}"
     );
     assert!(!std::path::Path::new(f).exists());
+}
+
+/// A scene name, what `luxon spd` reports writing, and whether a linear RGB pixel has the
+/// object's colour.
+type Case = (&'static str, &'static str, fn([f32; 3]) -> bool);
+
+/// The SPD databases added after 1987 (`jacks`, `shells`, `sombrero`): written by `luxon spd` at
+/// their default sizes with the published counts, read back, and rendered small into a picture
+/// that shows the object (not only background) in its own colour.
+#[test]
+fn later_databases_generate_and_render() {
+    let dir = temp_dir("spd-later");
+    let cases: [Case; 3] = [
+        // Pink jacks on dark purple.
+        ("jacks", "jacks -s 1: 6 spheres, 3 cones", |p| {
+            p[0] > 0.1 && p[0] > 1.2 * p[2]
+        }),
+        // Golden spheres on sky blue.
+        ("shells", "shells -s 5: 5761 spheres", |p| {
+            p[0] > 0.1 && p[0] > 1.5 * p[2]
+        }),
+        // A red surface on sky blue.
+        ("sombrero", "sombrero -s 1: 1922 polygons", |p| {
+            p[0] > 0.05 && p[0] > 3.0 * p[1]
+        }),
+    ];
+    for (name, counts, own_colour) in cases {
+        let f = dir.join(format!("{name}.nff"));
+        let out = run(&["spd", name, "-o", f.to_str().unwrap()]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        assert!(stderr(&out).contains(counts), "{name}: {}", stderr(&out));
+        let fb = render_with(&f, |d| {
+            d.render.width = 96;
+            d.render.height = 96;
+        });
+        let pixels: Vec<[f32; 3]> = fb
+            .rgba
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let object = pixels.iter().filter(|p| own_colour(**p)).count();
+        let share = object as f64 / pixels.len() as f64;
+        assert!(
+            (0.02..0.95).contains(&share),
+            "{name}: {:.1} % of the picture in the object's colour",
+            100.0 * share
+        );
+    }
+}
+
+/// Generating twice gives the same bytes.
+#[test]
+fn later_databases_are_deterministic() {
+    let dir = temp_dir("spd-later-det");
+    for name in ["jacks", "shells", "sombrero"] {
+        let (a, b) = (
+            dir.join(format!("{name}-a.nff")),
+            dir.join(format!("{name}-b.nff")),
+        );
+        for f in [&a, &b] {
+            let out = run(&["spd", name, "-s", "2", "-o", f.to_str().unwrap()]);
+            assert!(out.status.success(), "{name}: {}", stderr(&out));
+        }
+        assert_eq!(
+            std::fs::read(&a).unwrap(),
+            std::fs::read(&b).unwrap(),
+            "{name}"
+        );
+    }
 }

@@ -97,7 +97,7 @@ enum Command {
     /// Generate an SPD scene (Eric Haines' Standard Procedural Databases); without a name, list
     /// them.
     Spd {
-        /// balls, gears, lattice, mount, rings, teapot, tetra or tree.
+        /// balls, gears, jacks, lattice, mount, rings, shells, sombrero, teapot, tetra or tree.
         name: Option<String>,
         /// The SPD's size factor (recursion depth or resolution); default: the SPD's default.
         #[arg(short, long)]

@@ -236,10 +236,14 @@ fn mount() {
     assert!(a > 0.5 * b && a < 2.0 * b, "height ranges {a} vs {b}");
 }
 
-/// The defaults are the sizes of the reference files.
+/// The defaults are the sizes of the reference files and, for the databases without one, the
+/// SPD programs' own defaults.
 #[test]
 fn default_sizes() {
     for (name, size) in [
+        ("jacks", 1),
+        ("shells", 5),
+        ("sombrero", 1),
         ("balls", 4),
         ("gears", 4),
         ("tetra", 5),
@@ -272,6 +276,9 @@ fn ron_matches_nff() {
         ("teapot", 3),
         ("balls", 2),
         ("tree", 3),
+        ("jacks", 2),
+        ("shells", 1),
+        ("sombrero", 1),
     ] {
         let mut ron = Vec::new();
         spd::generate_ron(name, size, &mut ron).unwrap();
@@ -320,4 +327,35 @@ fn ron_matches_nff() {
         assert_eq!(plugins("mesh") > 0, c.all_polygons() > 0, "{name}");
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The databases without a reference file start with the SPD programs' settings: background,
+/// view, light and material (the Phong exponent from the highlight's half angle).
+#[test]
+fn later_databases_settings() {
+    for (name, head) in [
+        (
+            "jacks",
+            "b 0.2 0.05 0.2\nv\nfrom 0 0 -8\nat 0 0 0\nup 0 1 0\nangle 25\nhither 0.001\n\
+             resolution 256 256\nl -10 3 -20\nf 0.737 0.561 0.561 0.7 0.7 11.1434 0 1\nc ",
+        ),
+        (
+            "shells",
+            "b 0.078 0.361 0.753\nv\nfrom -6 -60 35\nat 0 8 -15\nup 0 0 1\nangle 45\n\
+             hither 0.5\nresolution 512 512\nl -100 -100 100\nf 1 0.8 0.4 0.8 0.2 45.2776 0 1\ns ",
+        ),
+        (
+            "sombrero",
+            "b 0.078 0.361 0.753\nv\nfrom 0 5 -8\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\n\
+             resolution 512 512\nl 10 10 -10\nf 1 0.1 0.1 0.8 0 2.60078 0 1\np 3\n",
+        ),
+    ] {
+        let size = spd::find(name, None).unwrap().1;
+        let text = generated(name, size);
+        assert!(
+            text.starts_with(head),
+            "{name}:\n{}",
+            &text[..head.len() + 80]
+        );
+    }
 }

@@ -1,6 +1,7 @@
 //! # SPD: Eric Haines' Standard Procedural Databases, generated inside Luxon
 //!
 //! The scenes of "A Proposal for Standard Graphics Environments" (IEEE CG&A, November 1987),
+//! and the three the SPD distribution (3.14) added later (`jacks`, `shells`, `sombrero`),
 //! written from the published descriptions of what each scene holds and how it is built:
 //!
 //! | name | scene | size means | default |
@@ -13,6 +14,9 @@
 //! | `lattice` | a cubic lattice of balls joined by rods | cells per axis | 12 |
 //! | `mount` | fractal mountain (midpoint subdivision) with four glass balls | subdivision depth | 6 |
 //! | `tree` | a branching tree of cones and spheres | branching depth | 11 |
+//! | `jacks` | recursive jacks: three cylinders with balls at the ends, eight half-size children | levels | 1 |
+//! | `shells` | Pickover's seashell: a spiral of overlapping spheres | 180·2^size + 1 spheres | 5 |
+//! | `sombrero` | the height field cos(2πρ)·e^-ρ as triangles | grid 32·2^(size-1) per side | 1 |
 //!
 //! Generators write to a [`Sink`]: [`generate`] streams NFF text exactly as the SPD programs
 //! print it (`%g` numbers, a cone on one line), [`generate_ron`] a Luxon RON scene of the same
@@ -23,15 +27,20 @@
 //! At the sizes of the SPD's reference files the output has the same primitives, in the same
 //! order, as the SPD programs' (see `formats/tests/spd.rs`), except `mount`'s heights: the SPD
 //! draws them from its own random number generator, which is not reproduced (the mountain has
-//! the same structure, counts and statistics; see [`mount`]).
+//! the same structure, counts and statistics; see [`mount`]). No SPD output of `jacks`,
+//! `shells` and `sombrero` is at hand: their counts and geometry are tested against the
+//! construction their modules describe.
 
 pub mod balls;
 pub mod gears;
+pub mod jacks;
 pub mod lattice;
 pub mod mount;
 mod nff_out;
 pub mod rings;
 mod ron_out;
+pub mod shells;
+pub mod sombrero;
 pub mod teapot;
 pub mod tetra;
 pub mod tree;
@@ -96,7 +105,7 @@ impl SpdScene {
     }
 }
 
-/// Every scene, in the order of the SPD's documentation.
+/// Every scene, by name.
 pub const SCENES: &[SpdScene] = &[
     SpdScene {
         name: "balls",
@@ -115,6 +124,15 @@ pub const SCENES: &[SpdScene] = &[
         about: "meshing gears with concave 144-sided faces, some of glass",
         size_means: "gears per axis: size^3 gears of 146 polygons",
         generate: gears::generate,
+    },
+    SpdScene {
+        name: "jacks",
+        default_size: 1,
+        min_size: 1,
+        max_size: 8,
+        about: "recursive jacks: cylinders with balls at their ends, eight half-size copies",
+        size_means: "levels: (8^size - 1) / 7 jacks of 3 cylinders and 6 spheres",
+        generate: jacks::generate,
     },
     SpdScene {
         name: "lattice",
@@ -142,6 +160,24 @@ pub const SCENES: &[SpdScene] = &[
         about: "a pyramid of groups of six interlocked pentagonal rings",
         size_means: "pyramid levels: 30 * (1 + 4 + ... + size^2) cylinders and spheres",
         generate: rings::generate,
+    },
+    SpdScene {
+        name: "shells",
+        default_size: 5,
+        min_size: 1,
+        max_size: 16,
+        about: "Pickover's seashell: a spiral of overlapping spheres",
+        size_means: "angular steps: 180 * 2^size + 1 spheres",
+        generate: shells::generate,
+    },
+    SpdScene {
+        name: "sombrero",
+        default_size: 1,
+        min_size: 1,
+        max_size: 8,
+        about: "height field of a damped ripple (a sombrero) as triangles",
+        size_means: "grid: w = 32 * 2^(size-1) samples per side, 2 (w-1)^2 triangles",
+        generate: sombrero::generate,
     },
     SpdScene {
         name: "teapot",
@@ -507,6 +543,63 @@ pub(crate) fn rotation(axis: V3, angle: f64) -> M3 {
     ]
 }
 
+/// Everything a generator emits, kept for tests that look at the geometry.
+#[cfg(test)]
+#[derive(Default)]
+pub(crate) struct Recorder {
+    pub view: Option<View>,
+    pub lights: Vec<V3>,
+    pub fills: Vec<Fill>,
+    pub spheres: Vec<(V3, f64)>,
+    pub cones: Vec<(V3, f64, V3, f64)>,
+    pub polygons: Vec<Vec<V3>>,
+}
+
+#[cfg(test)]
+impl Recorder {
+    /// Scene `name` at `size`, recorded.
+    pub fn of(name: &str, size: u32) -> Recorder {
+        let mut r = Recorder::default();
+        scene(name).unwrap().generate(size, &mut r).unwrap();
+        r
+    }
+}
+
+#[cfg(test)]
+impl Sink for Recorder {
+    fn background(&mut self, _: [f64; 3]) -> io::Result<()> {
+        Ok(())
+    }
+    fn view(&mut self, v: &View) -> io::Result<()> {
+        self.view = Some(*v);
+        Ok(())
+    }
+    fn light(&mut self, p: [f64; 3]) -> io::Result<()> {
+        self.lights.push(p);
+        Ok(())
+    }
+    fn fill(&mut self, f: &Fill) -> io::Result<()> {
+        self.fills.push(*f);
+        Ok(())
+    }
+    fn sphere(&mut self, c: [f64; 3], r: f64) -> io::Result<()> {
+        self.spheres.push((c, r));
+        Ok(())
+    }
+    fn cone(&mut self, b: [f64; 3], br: f64, a: [f64; 3], ar: f64) -> io::Result<()> {
+        self.cones.push((b, br, a, ar));
+        Ok(())
+    }
+    fn polygon(&mut self, v: &[[f64; 3]]) -> io::Result<()> {
+        self.polygons.push(v.to_vec());
+        Ok(())
+    }
+    fn patch(&mut self, v: &[[f64; 3]], _: &[[f64; 3]]) -> io::Result<()> {
+        self.polygons.push(v.to_vec());
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -526,7 +619,7 @@ mod tests {
     fn unknown_names_and_sizes() {
         let e = find("bals", None).unwrap_err().to_string();
         assert!(e.contains("did you mean `balls`?"), "{e}");
-        assert!(e.contains("balls, gears, lattice"), "{e}");
+        assert!(e.contains("balls, gears, jacks, lattice"), "{e}");
         let e = find("balls", Some(9)).unwrap_err().to_string();
         assert!(e.contains("expected 0..=8"), "{e}");
         assert_eq!(find("teapot", None).unwrap().1, 12);
