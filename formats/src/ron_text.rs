@@ -263,7 +263,7 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
     let mut w = Vec::new();
     let _ = writeln!(
         w,
-        "// Converted by `luxon convert` from {}.",
+        "// Written by Luxon (`luxon convert` or `api::Scene::to_ron`) from {}.",
         one_comment_line(&source.display().to_string())
     );
     if !warnings.is_empty() {
