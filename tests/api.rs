@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use luxon::api::{Color, Context, ContextOptions, Plane, Renderer, RendererOptions, Scene, Target};
+use luxon::api::{Color, Context, Plane, Renderer, RendererOptions, Scene, Target};
 use luxon::Error;
 use luxon_formats::SceneDesc;
 use std::path::Path;
@@ -49,12 +49,7 @@ fn small(d: &mut SceneDesc) {
 }
 
 fn context(desc: &SceneDesc, threads: usize) -> Context {
-    ensure_plugins();
-    Context::new(ContextOptions {
-        plugin_path: desc.plugin_path.clone(),
-        threads,
-    })
-    .unwrap_or_else(|e| panic!("{e}"))
+    api_context(desc, threads)
 }
 
 fn load(name: &str) -> SceneDesc {
@@ -64,21 +59,8 @@ fn load(name: &str) -> SceneDesc {
     desc
 }
 
-/// Renders into a linear RGBA f32 buffer of the scene's size.
 fn render(r: &Renderer, scene: &mut Scene, w: u32, h: u32) -> Result<Vec<[f32; 4]>, Error> {
-    let mut px = vec![[0.0f32; 4]; w as usize * h as usize];
-    let target = Target {
-        width: w,
-        height: h,
-        color: Color::Rgba32fLinear(Plane::new(&mut px, w as usize)),
-        depth: None,
-    };
-    r.render(scene, target)?;
-    Ok(px)
-}
-
-fn bits(px: &[[f32; 4]]) -> Vec<u32> {
-    px.iter().flatten().map(|v| v.to_bits()).collect()
+    api_render(r, scene, w, h)
 }
 
 #[test]

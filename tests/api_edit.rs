@@ -7,9 +7,7 @@
 mod common;
 
 use common::*;
-use luxon::api::{
-    Color, CommitReport, Context, ContextOptions, Plane, Renderer, RendererOptions, Scene, Target,
-};
+use luxon::api::{CommitReport, Context, ContextOptions, Renderer, RendererOptions, Scene};
 use luxon::Error;
 use luxon_formats::{fragment, SceneDesc};
 
@@ -26,24 +24,11 @@ fn spheres() -> SceneDesc {
 }
 
 fn context(desc: &SceneDesc) -> Context {
-    ensure_plugins();
-    let o = ContextOptions {
-        plugin_path: desc.plugin_path.clone(),
-        threads: 2,
-    };
-    Context::new(o).unwrap_or_else(|e| panic!("{e}"))
+    api_context(desc, 2)
 }
 
 fn render(r: &Renderer, scene: &mut Scene, w: u32, h: u32) -> Result<Vec<u32>, Error> {
-    let mut px = vec![[0.0f32; 4]; w as usize * h as usize];
-    let target = Target {
-        width: w,
-        height: h,
-        color: Color::Rgba32fLinear(Plane::new(&mut px, w as usize)),
-        depth: None,
-    };
-    r.render(scene, target)?;
-    Ok(px.iter().flatten().map(|v| v.to_bits()).collect())
+    api_render(r, scene, w, h).map(|px| bits(&px))
 }
 
 /// The edited scene's image, and whether a fresh scene of its description gives the same bits.

@@ -56,6 +56,40 @@ pub fn install_plugin(dir: &Path, lib: &str, as_name: &str) -> PathBuf {
     dst
 }
 
+/// An API context on `threads` threads (0: every CPU) with the scene's plugin path.
+pub fn api_context(desc: &SceneDesc, threads: usize) -> luxon::api::Context {
+    ensure_plugins();
+    luxon::api::Context::new(luxon::api::ContextOptions {
+        plugin_path: desc.plugin_path.clone(),
+        threads,
+    })
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Renders `scene` through the API into a linear RGBA f32 buffer of `w`×`h`.
+pub fn api_render(
+    r: &luxon::api::Renderer,
+    scene: &mut luxon::api::Scene,
+    w: u32,
+    h: u32,
+) -> Result<Vec<[f32; 4]>, luxon::Error> {
+    use luxon::api::{Color, Plane, Target};
+    let mut px = vec![[0.0f32; 4]; w as usize * h as usize];
+    let target = Target {
+        width: w,
+        height: h,
+        color: Color::Rgba32fLinear(Plane::new(&mut px, w as usize)),
+        depth: None,
+    };
+    r.render(scene, target)?;
+    Ok(px)
+}
+
+/// The bits of every channel of every pixel (for bitwise comparisons).
+pub fn bits(px: &[[f32; 4]]) -> Vec<u32> {
+    px.iter().flatten().map(|v| v.to_bits()).collect()
+}
+
 pub fn registry(desc: &SceneDesc) -> Registry {
     ensure_plugins();
     Registry::discover(&desc.plugin_path)
