@@ -166,6 +166,9 @@ fn prototype(p: &luxon::scene::PrototypeUse) -> String {
     if p.keyed > 0 {
         how.push(format!("{} keyed (placed anew each frame)", p.keyed));
     }
+    if p.shared > 0 {
+        how.push(format!("{} shared (one copy, two-level BVH)", p.shared));
+    }
     let mut size = plural(p.objects, "object", "objects");
     if p.meshes > 0 {
         size.push_str(&format!(
@@ -177,7 +180,7 @@ fn prototype(p: &luxon::scene::PrototypeUse) -> String {
         "`{}`: {size}, {} per copy; {}: {}",
         p.name,
         plural(p.primitives, "primitive", "primitives"),
-        plural(p.baked + p.keyed, "instance", "instances"),
+        plural(p.baked + p.keyed + p.shared, "instance", "instances"),
         how.join(", ")
     )
 }
