@@ -482,6 +482,14 @@ fn check_prints_each_prototype_and_how_it_was_realised() {
         text.contains("prototype  `floor`: 1 object, 1 primitive per copy; 1 instance: 1 baked"),
         "{text}"
     );
+    // `--instancing share` on the command line: every copy shared.
+    let out = run(&["check", path.to_str().unwrap(), "--instancing", "share"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("`tetra`: 1 object, 4 primitives per copy; 3 instances: 3 shared (one copy, two-level BVH)"),
+        "{text}"
+    );
 }
 
 #[test]
