@@ -915,3 +915,43 @@ fn a_thousand_shared_copies_of_a_big_mesh_cost_about_one() {
     // One copy is far more than that: baking 1,000 would cost 1,000 times it.
     assert!(o > 1_000_000, "{o} bytes for one copy");
 }
+
+#[test]
+fn keyed_shared_instances_get_a_new_top_level_each_frame() {
+    let dir = temp_dir("inst-keyed-share");
+    let text = |how: &str| {
+        keyed_scene(
+            r#"prototypes: { "bar": (objects: [(plugin: "cylinder", params: (base: (-0.4, 0, 0), apex: (0.4, 0, 0), radius: 0.1), material: "paint")]) },
+    instances: [
+        (prototype: "bar", name: "b", world_from_object: (translate: (5, 5, 5))),
+        (prototype: "bar", world_from_object: (translate: (0, 0.6, 0), scale: (1.5, 1.5, 1.5))),
+    ],
+    animation: (frames: (0, 2), objects: { "b": (translate: (keys: [(0, (-1.2, 0, 0)), (2, (1.2, 0, 0))]),
+        rotate: (keys: [(0, (axis: (0, 0, 1), degrees: 0)), (2, (axis: (0, 0, 1), degrees: 90))])) }),"#,
+        )
+        .replace("height: 32)", &format!("height: 32, instancing: {how})"))
+    };
+    let shared = load(&dir, "shared.ron", &text("Share"));
+    let baked = load(&dir, "baked.ron", &text("Bake"));
+    let (mut s, mut b) = (build(&shared).unwrap(), build(&baked).unwrap());
+    // Both copies share the prototype; nothing is placed in the moving group.
+    assert_eq!((s.instances.list.len(), s.cones.len()), (2, 0));
+    assert!(s.moving.is_empty());
+    assert_eq!((s.prototypes[0].keyed, s.prototypes[0].shared), (1, 1));
+    let mut frames = Vec::new();
+    for k in 0..3 {
+        s.set_frame(k).unwrap();
+        b.set_frame(k).unwrap();
+        let fs = luxon::render::render(&s, &|_, _| {}).unwrap().0;
+        let fb = luxon::render::render(&b, &|_, _| {}).unwrap().0;
+        assert!(fs.rgba.chunks(4).filter(|p| p[0] > 0.5).count() > 20, "frame {k}");
+        within_rounding(&fs, &fb).unwrap_or_else(|e| panic!("frame {k}: {e}"));
+        frames.push(bits(&fs));
+    }
+    assert!(frames[0] != frames[2], "the bar moves");
+    // Frame 1 alone, in a fresh scene, is frame 1 of the sequence.
+    let mut fresh = build(&shared).unwrap();
+    fresh.set_frame(1).unwrap();
+    let f1 = luxon::render::render(&fresh, &|_, _| {}).unwrap().0;
+    assert!(bits(&f1) == frames[1]);
+}

@@ -156,6 +156,18 @@ impl Instances {
         self.list.is_empty()
     }
 
+    /// Moves instances (`(index, world_from_object)`, each invertible) and rebuilds the top
+    /// level over every instance's new bounds (a rebuild, never a refit: the tree is a
+    /// function of the placements alone).
+    pub fn place(&mut self, moved: &[(u32, DAffine3)]) {
+        for &(i, m) in moved {
+            let p = Placement::new(m, self.world_offset);
+            self.list[i as usize].motion = Motion::Fixed(Box::new(p));
+        }
+        let bounds: Vec<Aabb> = self.list.iter().map(|i| self.bounds(i)).collect();
+        self.top = TopLevel::build(&bounds);
+    }
+
     /// An instance's render-space box: its bottom level's box (infinite with a plane) with
     /// its eight corners moved in f64, rounded outward and widened by a few ulps, so rays that
     /// the object-space test could hit after rounding are never culled.

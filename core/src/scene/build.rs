@@ -28,9 +28,9 @@ use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
 use luxon_formats::{
-    AoDesc, BackgroundDesc, FogDesc, HighlightColor, InlineGeometry, LightDesc, RenderDesc,
-    SceneDesc, Spanned, SpotFade, TransparencyAngle, TransparencyDesc, TransparencyMode,
-    TransparentShadows,
+    AoDesc, BackgroundDesc, FogDesc, HighlightColor, InlineGeometry, LightDesc, ObjectTracks,
+    RenderDesc, SceneDesc, Spanned, SpotFade, TransparencyAngle, TransparencyDesc,
+    TransparencyMode, TransparentShadows,
 };
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -237,7 +237,14 @@ impl Scene {
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
-            let animation = Animation::new(desc, &scene.material_names, &shadowless_copies, keyed)?;
+            let shared_keyed = std::mem::take(&mut stored.shared_keyed);
+            let animation = Animation::new(
+                desc,
+                &scene.material_names,
+                &shadowless_copies,
+                keyed,
+                shared_keyed,
+            )?;
             scene.animation = Some(Box::new(animation));
             scene.set_frame(a.value.first)?;
         }
@@ -303,6 +310,8 @@ struct Stored {
     keyed: Vec<Keyed>,
     /// Instances sharing their prototype's one copy, and the geometry bytes charged for them.
     shared: Instances,
+    /// Keyed shared instances: index in `shared.list` and tracks.
+    shared_keyed: Vec<(u32, ObjectTracks)>,
     shared_bytes: u64,
 }
 
@@ -674,6 +683,7 @@ impl<'a> Build<'a> {
         stored.dropped += baked.dropped;
         stored.keyed.extend(baked.keyed);
         stored.shared = baked.shared;
+        stored.shared_keyed = baked.shared_keyed;
         stored.shared_bytes = baked.shared_bytes;
         Ok(baked.prototypes)
     }
@@ -850,6 +860,7 @@ impl Stored {
             dropped: 0,
             keyed: Vec::new(),
             shared: Instances::default(),
+            shared_keyed: Vec::new(),
             shared_bytes: 0,
         }
     }

@@ -83,6 +83,9 @@ pub(super) struct Baked {
     pub prototypes: Vec<PrototypeUse>,
     /// Keyed instances' copies, one per prototype object.
     pub keyed: Vec<Keyed>,
+    /// Keyed instances sharing their prototype (`instancing: Share`): the index in
+    /// `shared.list` and the tracks that place it at each frame.
+    pub shared_keyed: Vec<(u32, ObjectTracks)>,
     /// Zero-area triangles dropped.
     pub dropped: u64,
     /// The shared instances (empty when every instance was baked or keyed).
@@ -108,6 +111,7 @@ pub(super) fn bake(
     let mut baked = Baked {
         prototypes: Vec::new(),
         keyed: Vec::new(),
+        shared_keyed: Vec::new(),
         dropped: 0,
         shared: Instances::default(),
         shared_bytes: 0,
@@ -157,6 +161,17 @@ pub(super) fn bake(
         let what = || describe(k, inst, name);
         if let Some(tracks) = keyed(k) {
             let tracks = with_static(tracks, &inst.value.world_from_object, &what)?;
+            if desc.render.instancing == Instancing::Share {
+                // Shared like a static copy; `set_frame` places it at each frame and rebuilds
+                // the top level (here it stands where the first frame puts it).
+                let first = desc.animation.as_ref().map_or(0, |a| a.value.first);
+                let placement = Placement::at(&tracks, f64::from(first));
+                shared.add(cx, material_of, (inst, p), parts, &placement, used, &what)?;
+                let index = shared.list.len() as u32 - 1;
+                baked.shared_keyed.push((index, tracks));
+                uses[p].keyed += 1;
+                continue;
+            }
             for part in parts {
                 let m = material(material_of, &inst.value, &part.material, part.shadows)?;
                 used[m] = true;
