@@ -944,7 +944,10 @@ fn keyed_shared_instances_get_a_new_top_level_each_frame() {
         b.set_frame(k).unwrap();
         let fs = luxon::render::render(&s, &|_, _| {}).unwrap().0;
         let fb = luxon::render::render(&b, &|_, _| {}).unwrap().0;
-        assert!(fs.rgba.chunks(4).filter(|p| p[0] > 0.5).count() > 20, "frame {k}");
+        assert!(
+            fs.rgba.chunks(4).filter(|p| p[0] > 0.5).count() > 20,
+            "frame {k}"
+        );
         within_rounding(&fs, &fb).unwrap_or_else(|e| panic!("frame {k}: {e}"));
         frames.push(bits(&fs));
     }
