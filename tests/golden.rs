@@ -76,6 +76,11 @@ fn animation_carousel_frames() {
 }
 
 #[test]
+fn shared_instances_field_of_molecules() {
+    check("shared-instances");
+}
+
+#[test]
 fn instances_ring_of_molecules() {
     check("instances");
 }

@@ -2,7 +2,11 @@
 //! the same geometry written out flat (its coordinates computed by `luxon::motion` in f64 and
 //! printed with `{:?}`, which reads back exactly), on any thread count; a thousand instances
 //! render; what baking cannot do is refused naming the instance and its place; keyed
-//! instances move like keyed objects.
+//! instances move like keyed objects. Shared instances (one copy of a prototype traced through
+//! each instance's transform) render within rounding of the flat scene, the same bits on any
+//! threads and tiles, far from the origin too, with shadows, reflections and transparency;
+//! `instancing: Auto` bakes where baking is exact and small and shares otherwise; a thousand
+//! shared copies of a big mesh cost about one copy.
 
 mod common;
 
@@ -267,8 +271,13 @@ fn build(desc: &SceneDesc) -> Result<Scene, luxon::Error> {
 }
 
 fn render(desc: &SceneDesc, threads: u32) -> Framebuffer {
+    render_tiles(desc, threads, desc.render.parallel.tile_size)
+}
+
+fn render_tiles(desc: &SceneDesc, threads: u32, tile: u32) -> Framebuffer {
     let mut desc = desc.clone();
     desc.render.parallel.threads = Some(threads);
+    desc.render.parallel.tile_size = tile;
     let scene = build(&desc).unwrap_or_else(|e| panic!("{e}"));
     luxon::render::render(&scene, &|_, _| {})
         .unwrap_or_else(|e| panic!("{e}"))
@@ -418,7 +427,7 @@ fn a_thousand_instances_render() {
 fn build_error(prototypes: &str, instances: &str) -> String {
     let dir = temp_dir("inst-errors");
     let text = format!(
-        "Scene(\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    prototypes: {{ {prototypes} }},\n    instances: [\n        {instances}\n    ],\n)\n"
+        "Scene(\n    camera: (position: (0, 0, -5), look_at: (0, 0, 0)),\n    prototypes: {{ {prototypes} }},\n    instances: [\n        {instances}\n    ],\n    render: (instancing: Bake),\n)\n"
     );
     let desc = load(&dir, "bad.ron", &text);
     match build(&desc) {
@@ -471,6 +480,14 @@ fn check_prints_each_prototype_and_how_it_was_realised() {
     );
     assert!(
         text.contains("prototype  `floor`: 1 object, 1 primitive per copy; 1 instance: 1 baked"),
+        "{text}"
+    );
+    // `--instancing share` on the command line: every copy shared.
+    let out = run(&["check", path.to_str().unwrap(), "--instancing", "share"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("`tetra`: 1 object, 4 primitives per copy; 3 instances: 3 shared (one copy, two-level BVH)"),
         "{text}"
     );
 }
@@ -678,4 +695,266 @@ fn mesh_files_in_prototypes_bake_like_the_moved_file() {
     let want = render(&flat, 2);
     assert!(want.rgba.chunks(4).filter(|p| p[0] > 0.3).count() > 100);
     assert!(bits(&render(&inst, 2)) == bits(&want));
+}
+
+/// `text` (a scene of `instanced`) with the render setting `instancing: how`.
+fn instancing(text: &str, how: &str) -> String {
+    let t = text.replace("samples: 2)", &format!("samples: 2, instancing: {how})"));
+    assert_ne!(t, text);
+    t
+}
+
+/// Shared instances' tolerance against the flat picture: mean |Δ| ≤ 1e-4 over the channels,
+/// and at most 0.1 % of pixels with a channel off by more than 1/255.
+fn within_rounding(got: &Framebuffer, want: &Framebuffer) -> Result<(), String> {
+    let (a, b) = (&got.rgba, &want.rgba);
+    assert_eq!(a.len(), b.len());
+    let mean = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs() as f64)
+        .sum::<f64>()
+        / a.len() as f64;
+    let pixels = a.len() / 4;
+    let off = (a.chunks(4).zip(b.chunks(4)))
+        .filter(|(p, q)| p.iter().zip(*q).any(|(x, y)| (x - y).abs() > 1.0 / 255.0))
+        .count();
+    if mean <= 1e-4 && off * 1000 <= pixels {
+        Ok(())
+    } else {
+        Err(format!(
+            "mean |Δ| {mean:.3e}, {off} of {pixels} pixels off by more than 1/255"
+        ))
+    }
+}
+
+/// How each prototype was realised: (name, baked, shared).
+fn realised(scene: &Scene) -> Vec<(String, usize, usize)> {
+    (scene.prototypes.iter())
+        .map(|p| (p.name.clone(), p.baked, p.shared))
+        .collect()
+}
+
+#[test]
+fn shared_instances_render_the_flat_scene_within_rounding_on_any_threads() {
+    let dir = temp_dir("inst-share");
+    let inst = load(
+        &dir,
+        "shared.ron",
+        &instancing(&instanced(INSTANCES), "Share"),
+    );
+    let flat = load(&dir, "flat.ron", &flat(&inst, INSTANCES));
+    let scene = build(&inst).unwrap();
+    // Nothing baked: the scene's own sphere alone is in its sets.
+    assert_eq!(scene.instances.list.len(), INSTANCES.len());
+    assert_eq!((scene.spheres.len(), scene.triangles.len()), (1, 0));
+    let want = [("atoms", 0, 5), ("tetra", 0, 3), ("floor", 0, 1)];
+    let want: Vec<(String, usize, usize)> =
+        want.iter().map(|&(n, b, s)| (n.into(), b, s)).collect();
+    assert_eq!(realised(&scene), want);
+    let first = render_tiles(&inst, 1, 16);
+    within_rounding(&first, &render(&flat, 1)).unwrap();
+    for (threads, tile) in [(2, 16), (3, 7), (1, 7)] {
+        assert!(
+            bits(&render_tiles(&inst, threads, tile)) == bits(&first),
+            "{threads} threads, tiles of {tile}: not the bits of 1 thread"
+        );
+    }
+}
+
+#[test]
+fn auto_bakes_where_exact_and_small_and_shares_otherwise() {
+    let dir = temp_dir("inst-auto");
+    // Every instance bakes exactly: Auto bakes them all (the bitwise test above covers them).
+    let scene = build(&load(&dir, "auto.ron", &instanced(INSTANCES))).unwrap();
+    assert!(scene.instances.is_empty());
+    assert!(scene.prototypes.iter().all(|p| p.shared == 0));
+    // An instance stretching the prototype holding spheres: that prototype is shared, the
+    // others still baked.
+    let mut list = INSTANCES.to_vec();
+    list.push(("atoms", "(scale: (1, 2, 1), translate: (0, 0, 3))", None));
+    let desc = load(&dir, "stretched.ron", &instanced(&list));
+    let scene = build(&desc).unwrap();
+    let want = [("atoms", 0, 6), ("tetra", 3, 0), ("floor", 1, 0)];
+    let want: Vec<(String, usize, usize)> =
+        want.iter().map(|&(n, b, s)| (n.into(), b, s)).collect();
+    assert_eq!(realised(&scene), want);
+    assert_eq!(scene.instances.list.len(), 6);
+    // Bake refuses that instance by name.
+    let bake = load(&dir, "bake.ron", &instancing(&instanced(&list), "Bake"));
+    let e = build(&bake).err().expect("an error").to_string();
+    assert!(
+        e.contains("instance 9 of prototype `atoms`") && e.contains("Share"),
+        "{e}"
+    );
+}
+
+#[test]
+fn shared_instances_far_from_the_origin_keep_their_precision() {
+    // The scene moved by 1e6 along x, camera and lights included.
+    const FAR: &[(&str, &str, Option<&str>)] = &[
+        ("floor", "(translate: (1000000, -1.2, 0), rotate: (axis: (1, 0, 0.3), degrees: 4))", None),
+        ("atoms", "(translate: (1000000, 0, 0))", None),
+        ("atoms", "(translate: (1000002.1, 0.3, 0.5))", Some("white")),
+        ("atoms", "(rotate: (axis: (1, 2, 3), degrees: 37), translate: (999998, 0.2, 0))", None),
+        ("atoms", "(scale: (0.5, 0.5, 0.5), rotate: (axis: (0, 1, 0), degrees: -60), translate: (1000000.3, -0.8, -1.5))", None),
+        ("atoms", "(matrix: ((0, 0, -1.5, 1000001.2), (0, 1.5, 0, 1.1), (1.5, 0, 0, 2.0)))", Some("mirror")),
+        ("tetra", "(translate: (999998.9, -0.9, -1.8), scale: (-1, 1, 1))", None),
+        ("tetra", "(matrix: ((1, 0.4, 0, 1000000.9), (0, 1, 0, -1.0), (0.2, 0, 1.3, -1.9)))", None),
+        ("tetra", "(scale: (0.7, 1.4, 0.5), rotate: (axis: (0, 0, 1), degrees: 25), translate: (1000002.2, -1.0, -0.8))", Some("red")),
+    ];
+    let far = |how: &str| {
+        instancing(&instanced(FAR), how)
+            .replace(
+                "position: (0.5, 2.5, -7), look_at: (0, -0.2, 0)",
+                "position: (1000000.5, 2.5, -7), look_at: (1000000, -0.2, 0)",
+            )
+            .replace(
+                "Point(position: (-4, 6, -5)",
+                "Point(position: (999996, 6, -5)",
+            )
+            .replace("center: (0, 1.6, 2.5)", "center: (1000000, 1.6, 2.5)")
+    };
+    let dir = temp_dir("inst-far");
+    let shared = load(&dir, "shared.ron", &far("Share"));
+    let baked = load(&dir, "baked.ron", &far("Bake"));
+    assert_eq!(build(&shared).unwrap().instances.list.len(), FAR.len());
+    let want = render(&baked, 2);
+    // Not an empty view: the copies are in the picture.
+    let lit = want.rgba.chunks(4).filter(|p| p[0] > 0.3).count();
+    assert!(lit > 500, "{lit} lit pixels");
+    within_rounding(&render(&shared, 2), &want).unwrap();
+}
+
+#[test]
+fn shared_instances_cast_shadows_reflect_and_let_light_through() {
+    // Nothing but instances, one material reflecting and transparent.
+    let text = instanced(INSTANCES)
+        .replace(
+            "        (plugin: \"sphere\", params: (center: (0, 1.6, 2.5), radius: 0.6), material: \"mirror\"),\n",
+            "",
+        )
+        .replace("reflect: 0.4, specular: 0.6)", "reflect: 0.4, transmit: 0.5, specular: 0.6)");
+    let dir = temp_dir("inst-effects");
+    let shared = load(&dir, "shared.ron", &instancing(&text, "Share"));
+    let baked = load(&dir, "baked.ron", &instancing(&text, "Bake"));
+    let scene = build(&shared).unwrap();
+    assert_eq!(scene.primitive_count(), 0);
+    let f = scene.features;
+    assert!(
+        f.shadows && f.reflection && f.transmission && f.shadow_filters,
+        "{f:?}"
+    );
+    assert_eq!(build(&baked).unwrap().features, f);
+    within_rounding(&render(&shared, 2), &render(&baked, 2)).unwrap();
+}
+
+#[test]
+fn a_thousand_shared_copies_of_a_big_mesh_cost_about_one() {
+    use luxon::geometry::instance::{Instance, Placement as Placed};
+    let dir = temp_dir("inst-memory");
+    // A 100 × 100 grid of quads: 20,000 triangles.
+    let mut obj = String::new();
+    for j in 0..=100 {
+        for i in 0..=100 {
+            let (x, z) = (i as f64 / 100.0, j as f64 / 100.0);
+            let _ = writeln!(
+                obj,
+                "v {x} {} {z}",
+                0.05 * (x * 9.0).sin() * (z * 7.0).cos()
+            );
+        }
+    }
+    for j in 0..100 {
+        for i in 0..100 {
+            let a = j * 101 + i + 1;
+            let _ = writeln!(
+                obj,
+                "f {a} {} {}\nf {} {} {}",
+                a + 1,
+                a + 102,
+                a,
+                a + 102,
+                a + 101
+            );
+        }
+    }
+    std::fs::write(dir.join("grid.obj"), obj).unwrap();
+    let scene = |copies: usize, how: &str| {
+        let mut s = String::from(
+            "Scene(\n    camera: (position: (0, 30, -40), look_at: (0, 0, 0)),\n    prototypes: { \"grid\": (meshes: [(file: \"grid.obj\")]) },\n    instances: [\n",
+        );
+        for k in 0..copies {
+            let (x, z) = ((k % 40) as f64 * 1.5, (k / 40) as f64 * 1.5);
+            let _ = writeln!(
+                s,
+                "        (prototype: \"grid\", world_from_object: (translate: ({x}, 0, {z}), rotate: (axis: (0, 1, 0), degrees: {}))),",
+                k * 7
+            );
+        }
+        let _ = write!(
+            s,
+            "    ],\n    render: (width: 32, height: 24, instancing: {how}),\n)\n"
+        );
+        build(&load(&dir, &format!("grid{copies}.ron"), &s)).unwrap()
+    };
+    // 1,000 copies of 20,000 triangles are past Auto's baking limit: shared.
+    let many = scene(1000, "Auto");
+    let one = scene(1, "Share");
+    assert_eq!((many.triangles.len(), many.instances.list.len()), (0, 1000));
+    assert_eq!(many.instances.blases[0].triangles.len(), 20_000);
+    let (m, o) = (many.instances.memory_bytes(), one.instances.memory_bytes());
+    let per = std::mem::size_of::<Instance>() + std::mem::size_of::<Placed>();
+    assert!(
+        m as f64 <= 1.1 * (o + 1000 * per as u64) as f64,
+        "{m} bytes for 1,000 copies, {o} for one, {per} per instance"
+    );
+    // About 350 bytes per instance (its placement and its share of the top level).
+    let each = (m - o) / 999;
+    assert!((250..=450).contains(&each), "{each} bytes per instance");
+    // One copy is far more than that: baking 1,000 would cost 1,000 times it.
+    assert!(o > 1_000_000, "{o} bytes for one copy");
+}
+
+#[test]
+fn keyed_shared_instances_get_a_new_top_level_each_frame() {
+    let dir = temp_dir("inst-keyed-share");
+    let text = |how: &str| {
+        keyed_scene(
+            r#"prototypes: { "bar": (objects: [(plugin: "cylinder", params: (base: (-0.4, 0, 0), apex: (0.4, 0, 0), radius: 0.1), material: "paint")]) },
+    instances: [
+        (prototype: "bar", name: "b", world_from_object: (translate: (5, 5, 5))),
+        (prototype: "bar", world_from_object: (translate: (0, 0.6, 0), scale: (1.5, 1.5, 1.5))),
+    ],
+    animation: (frames: (0, 2), objects: { "b": (translate: (keys: [(0, (-1.2, 0, 0)), (2, (1.2, 0, 0))]),
+        rotate: (keys: [(0, (axis: (0, 0, 1), degrees: 0)), (2, (axis: (0, 0, 1), degrees: 90))])) }),"#,
+        )
+        .replace("height: 32)", &format!("height: 32, instancing: {how})"))
+    };
+    let shared = load(&dir, "shared.ron", &text("Share"));
+    let baked = load(&dir, "baked.ron", &text("Bake"));
+    let (mut s, mut b) = (build(&shared).unwrap(), build(&baked).unwrap());
+    // Both copies share the prototype; nothing is placed in the moving group.
+    assert_eq!((s.instances.list.len(), s.cones.len()), (2, 0));
+    assert!(s.moving.is_empty());
+    assert_eq!((s.prototypes[0].keyed, s.prototypes[0].shared), (1, 1));
+    let mut frames = Vec::new();
+    for k in 0..3 {
+        s.set_frame(k).unwrap();
+        b.set_frame(k).unwrap();
+        let fs = luxon::render::render(&s, &|_, _| {}).unwrap().0;
+        let fb = luxon::render::render(&b, &|_, _| {}).unwrap().0;
+        assert!(
+            fs.rgba.chunks(4).filter(|p| p[0] > 0.5).count() > 20,
+            "frame {k}"
+        );
+        within_rounding(&fs, &fb).unwrap_or_else(|e| panic!("frame {k}: {e}"));
+        frames.push(bits(&fs));
+    }
+    assert!(frames[0] != frames[2], "the bar moves");
+    // Frame 1 alone, in a fresh scene, is frame 1 of the sequence.
+    let mut fresh = build(&shared).unwrap();
+    fresh.set_frame(1).unwrap();
+    let f1 = luxon::render::render(&fresh, &|_, _| {}).unwrap().0;
+    assert!(bits(&f1) == frames[1]);
 }

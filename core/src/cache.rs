@@ -167,6 +167,7 @@ pub fn cacheable(scene: &Scene, had_objects: bool) -> bool {
         && scene.planes.planes.is_empty()
         && scene.discs.is_empty()
         && scene.clips.groups.is_empty()
+        && scene.instances.is_empty()
 }
 
 /// Writes the cache of `source` (whose non-geometry lines are `skeleton`) for `scene`, to the

@@ -46,6 +46,9 @@ enum Command {
         /// what the scene holds of it.
         #[arg(long, value_name = "SIZE", value_parser = cli::parse_memory)]
         memory: Option<luxon_formats::MemorySize>,
+        /// How instances are realised (as for `render`); `check` prints each prototype's way.
+        #[arg(long, value_parser = ["auto", "bake", "share"])]
+        instancing: Option<String>,
     },
     /// List every plugin found: file, kind, names, ABI version, parameters.
     Plugins {
@@ -159,7 +162,11 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render { scene, overrides } => cli::render::run(&scene, &overrides),
         Command::Sweep { scene, args } => cli::sweep::run(&scene, &args),
-        Command::Check { scene, memory } => cli::check::run(&scene, memory),
+        Command::Check {
+            scene,
+            memory,
+            instancing,
+        } => cli::check::run(&scene, memory, instancing.as_deref()),
         Command::Plugins { plugin_path } => {
             cli::plugins::run(&plugin_path);
             Ok(())

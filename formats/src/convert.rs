@@ -393,6 +393,12 @@ impl Checker<'_> {
                 None => d.volume_step,
             },
             volume_skip: r.volume_skip.unwrap_or(d.volume_skip),
+            instancing: match r.instancing {
+                Some(raw::Instancing::Auto) => Instancing::Auto,
+                Some(raw::Instancing::Bake) => Instancing::Bake,
+                Some(raw::Instancing::Share) => Instancing::Share,
+                None => d.instancing,
+            },
             memory: match &r.memory {
                 Some(text) => Some(self.memory_size(field("memory"), "memory", text)?),
                 None => None,

@@ -641,6 +641,25 @@ pub struct RenderDesc {
     /// Bytes of decoded texture data kept at once (`texture_cache: "1 GiB"`); `None`: 1 GiB,
     /// or a quarter of the memory budget when that is less.
     pub texture_cache: Option<u64>,
+    /// How instances of prototypes are realised (`instancing: Auto`).
+    pub instancing: Instancing,
+}
+
+/// How instances of prototypes are realised: flat copies of the prototype's geometry in the
+/// scene's own sets (bitwise the same picture as the geometry written out flat), or one copy
+/// per prototype shared by its instances through a two-level BVH (little memory; the picture
+/// within rounding of the flat one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Instancing {
+    /// Bake a prototype's static instances where baking is exact and small (every instance
+    /// a similarity when the prototype holds spheres, cones or discs, and at most
+    /// `2^20` primitives in all its copies); share them otherwise.
+    #[default]
+    Auto,
+    /// Always bake (an error names an instance that cannot be).
+    Bake,
+    /// Always share.
+    Share,
 }
 
 /// Tachyon's shading rules that have no other use: the Tachyon importer turns them on.
@@ -838,6 +857,7 @@ impl Default for RenderDesc {
             tachyon: TachyonDesc::default(),
             memory: None,
             texture_cache: None,
+            instancing: Instancing::Auto,
         }
     }
 }

@@ -551,6 +551,15 @@ pub(crate) struct Render {
     pub tachyon: Option<Tachyon>,
     pub memory: Option<String>,
     pub texture_cache: Option<String>,
+    pub instancing: Option<Instancing>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "Instancing")]
+pub(crate) enum Instancing {
+    Auto,
+    Bake,
+    Share,
 }
 
 #[derive(Deserialize)]

@@ -1046,6 +1046,7 @@ pub(crate) fn render_fields(
         tachyon,
         memory,
         texture_cache,
+        instancing,
     } = r;
     let mut f = vec![
         ("width", format!("width: {width}")),
@@ -1165,6 +1166,12 @@ pub(crate) fn render_fields(
             "texture_cache",
             format!("texture_cache: \"{}\"", MemorySize::Bytes(*n)),
         ));
+    }
+    // Written only when not the default, so scenes without instances read as before.
+    match instancing {
+        Instancing::Auto => {}
+        Instancing::Bake => f.push(("instancing", "instancing: Bake".into())),
+        Instancing::Share => f.push(("instancing", "instancing: Share".into())),
     }
     f
 }

@@ -370,3 +370,30 @@ fn prototype_meshes_are_read_after_merging() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn instancing_is_a_render_setting_written_back_when_not_auto() {
+    assert_eq!(scene("").render.instancing, Instancing::Auto);
+    for (text, want) in [
+        ("Auto", Instancing::Auto),
+        ("Bake", Instancing::Bake),
+        ("Share", Instancing::Share),
+    ] {
+        let s = scene(&format!("    render: (instancing: {text}),"));
+        assert_eq!(s.render.instancing, want);
+        let ron = to_ron(&s, Path::new("")).unwrap();
+        assert_eq!(
+            ron.contains("instancing:"),
+            want != Instancing::Auto,
+            "{ron}"
+        );
+        let back = load_ron_str(&ron, Path::new("b.ron")).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(back.render.instancing, want);
+    }
+    check(
+        "    render: (instancing: Shared),",
+        5,
+        "Shared",
+        &["Auto", "Bake", "Share"],
+    );
+}

@@ -6,7 +6,8 @@
 //!
 //! By concern: `build` (the binned SAH build of the binary tree), `wide` (8-wide nodes: the
 //! collapse, their layout and words), `refit` (new bounds into a built tree, and its SAH cost),
-//! `traversal` (closest- and any-hit loops), `simd` (the box tests of a wide node and the choice
+//! `traversal` (closest- and any-hit loops), `top` (the top level of a two-level BVH: a BVH over
+//! instances), `simd` (the box tests of a wide node and the choice
 //! of AVX at run time) and `stack` (the traversal's stack and node fetches). All unsafe code of
 //! the BVH is in `simd` and `stack`.
 
@@ -18,6 +19,7 @@ mod simd;
 // Unchecked stack and node accesses.
 #[allow(unsafe_code)]
 mod stack;
+pub mod top;
 mod traversal;
 mod wide;
 

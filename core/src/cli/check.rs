@@ -7,8 +7,15 @@ use luxon_formats::{InlineGeometry, MemorySize, SceneDesc};
 use std::path::Path;
 use std::sync::Arc;
 
-pub fn run(path: &Path, memory: Option<MemorySize>) -> Result<(), Error> {
-    let desc = luxon_formats::load_with(path, &Budget::for_load(memory, 1).load_options())?;
+pub fn run(path: &Path, memory: Option<MemorySize>, instancing: Option<&str>) -> Result<(), Error> {
+    let mut desc = luxon_formats::load_with(path, &Budget::for_load(memory, 1).load_options())?;
+    if let Some(how) = instancing {
+        let args = super::shading::ShadingArgs {
+            instancing: Some(how.to_string()),
+            ..Default::default()
+        };
+        args.apply(&mut desc)?;
+    }
     super::warn_scene(&desc);
     // The build runs on every CPU, as a render's would by default.
     let ctx = Context::new(ContextOptions {
@@ -166,6 +173,9 @@ fn prototype(p: &luxon::scene::PrototypeUse) -> String {
     if p.keyed > 0 {
         how.push(format!("{} keyed (placed anew each frame)", p.keyed));
     }
+    if p.shared > 0 {
+        how.push(format!("{} shared (one copy, two-level BVH)", p.shared));
+    }
     let mut size = plural(p.objects, "object", "objects");
     if p.meshes > 0 {
         size.push_str(&format!(
@@ -177,7 +187,7 @@ fn prototype(p: &luxon::scene::PrototypeUse) -> String {
         "`{}`: {size}, {} per copy; {}: {}",
         p.name,
         plural(p.primitives, "primitive", "primitives"),
-        plural(p.baked + p.keyed, "instance", "instances"),
+        plural(p.baked + p.keyed + p.shared, "instance", "instances"),
         how.join(", ")
     )
 }

@@ -1,5 +1,6 @@
 //! Tachyon's shading switches for any scene: `--shade`, `--max-depth`, `--no-shadows`, `--ao`;
-//! and the volume sampling switches `--volume-step`, `--volume-skip`.
+//! the volume sampling switches `--volume-step`, `--volume-skip`; and how instances are
+//! realised, `--instancing`.
 
 use luxon::Error;
 use luxon_formats::{AoDesc, LightDesc, SceneDesc};
@@ -26,6 +27,10 @@ pub struct ShadingArgs {
     /// Empty-space skipping in volumes (render setting `volume_skip`; the image is the same).
     #[arg(long = "volume-skip", value_parser = ["on", "off"])]
     pub volume_skip: Option<String>,
+    /// How instances of prototypes are realised (render setting `instancing`): bake (flat
+    /// copies, bitwise the flat scene), share (one copy per prototype, a two-level BVH), auto.
+    #[arg(long, value_parser = ["auto", "bake", "share"])]
+    pub instancing: Option<String>,
 }
 
 fn no_shadows(desc: &mut SceneDesc) {
@@ -75,6 +80,14 @@ impl ShadingArgs {
         }
         if let Some(s) = &self.volume_skip {
             desc.render.volume_skip = s == "on";
+        }
+        if let Some(s) = &self.instancing {
+            use luxon_formats::Instancing;
+            desc.render.instancing = match s.as_str() {
+                "bake" => Instancing::Bake,
+                "share" => Instancing::Share,
+                _ => Instancing::Auto,
+            };
         }
         if self.no_shadows {
             no_shadows(desc);

@@ -3,6 +3,7 @@
 //! frames before it). It is tested after the scene's still geometry; hits in it are marked
 //! `Hit::moving`. Custom (plugin-intersected) geometry cannot be moved, so it has none. The
 //! group holds the charges of its memory to the budget, given back when it is replaced.
+//! A shared prototype (`instance`) is a group too, in its own object space.
 
 use super::cone::Cones;
 use super::disc::Discs;
@@ -39,6 +40,19 @@ impl Group {
             + self.discs.len()
     }
 
+    /// Bytes of the primitives and BVHs.
+    pub fn memory_bytes(&self) -> u64 {
+        self.spheres.bytes()
+            + self.triangles.bytes()
+            + self.planes.bytes()
+            + self.cones.bytes()
+            + self.discs.bytes()
+            + self.spheres.bvh_bytes()
+            + self.triangles.set.bvh_bytes()
+            + self.cones.bvh_bytes()
+            + self.discs.bvh_bytes()
+    }
+
     /// Builds every set's BVH, charging the build's working memory while it runs and the BVHs'
     /// bytes for the group's life.
     pub fn build(&mut self, budget: &Arc<Budget>) -> Result<(), BudgetError> {
@@ -72,6 +86,22 @@ impl Group {
         clips: &Clips,
         c: &mut Counters,
     ) {
+        if let Some(mut h) = self.closest(ray, t_max, clips, c) {
+            h.moving = true;
+            *hit = Some(h);
+        }
+    }
+
+    /// The closest hit in the group before `t_max` (which it lowers), unmarked: kinds in the
+    /// scene's order. (A shared instance's prototype is a group traced this way.)
+    #[inline]
+    pub fn closest(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        clips: &Clips,
+        c: &mut Counters,
+    ) -> Option<Hit> {
         let mut found = None;
         self.spheres.intersect(ray, t_max, &mut found, clips, c);
         self.triangles
@@ -80,10 +110,7 @@ impl Group {
         self.planes.intersect(ray, t_max, &mut found, clips, c);
         self.cones.intersect(ray, t_max, &mut found, clips, c);
         self.discs.intersect(ray, t_max, &mut found, clips, c);
-        if let Some(mut h) = found {
-            h.moving = true;
-            *hit = Some(h);
-        }
+        found
     }
 
     /// Calls `on_hit(material, crossings)` for what the ray crosses in (0, t_max) until it

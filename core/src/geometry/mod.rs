@@ -7,6 +7,7 @@ pub mod cone;
 pub mod custom;
 pub mod disc;
 pub mod group;
+pub mod instance;
 pub mod plane;
 pub mod set;
 pub mod sphere;
@@ -65,6 +66,9 @@ impl Clips {
     }
 }
 
+/// `Hit::instance` of a hit outside every shared instance.
+pub const NO_INSTANCE: u32 = u32::MAX;
+
 /// The closest hit found so far. Kind-specific extras (`b1`, `b2`: triangle barycentrics;
 /// `n`, `uv`: custom geometry's answer) are filled by the kind that found it.
 #[derive(Clone, Copy, Debug)]
@@ -73,6 +77,9 @@ pub struct Hit {
     pub kind: Kind,
     /// On a keyed object (in the scene's moving group) rather than in the still geometry.
     pub moving: bool,
+    /// The shared instance hit (`NO_INSTANCE`: none; the primitive is in the scene's own
+    /// geometry or its moving group).
+    pub instance: u32,
     /// The primitive within its kind (64-bit: molecular scenes reach billions of atoms).
     pub index: u64,
     pub b1: f32,
@@ -87,6 +94,7 @@ impl Hit {
             t,
             kind,
             moving: false,
+            instance: NO_INSTANCE,
             index: index as u64,
             b1: 0.0,
             b2: 0.0,

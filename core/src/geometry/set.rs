@@ -93,6 +93,11 @@ impl<S: Shape> Set<S> {
         Ok(())
     }
 
+    /// The box around every primitive (once built; empty when the set is).
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
     /// Bytes of the built BVH.
     pub fn bvh_bytes(&self) -> u64 {
         self.bvh.memory_bytes()

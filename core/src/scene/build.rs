@@ -16,6 +16,7 @@ use crate::error::Error;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
+use crate::geometry::instance::Instances;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::{MeshInput, Triangles};
@@ -27,9 +28,9 @@ use crate::plugin::{read_volume, PluginKind, Registry};
 use crate::volume::Volume;
 use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
 use luxon_formats::{
-    AoDesc, BackgroundDesc, FogDesc, HighlightColor, InlineGeometry, LightDesc, RenderDesc,
-    SceneDesc, Spanned, SpotFade, TransparencyAngle, TransparencyDesc, TransparencyMode,
-    TransparentShadows,
+    AoDesc, BackgroundDesc, FogDesc, HighlightColor, InlineGeometry, LightDesc, ObjectTracks,
+    RenderDesc, SceneDesc, Spanned, SpotFade, TransparencyAngle, TransparencyDesc,
+    TransparencyMode, TransparentShadows,
 };
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -194,6 +195,7 @@ impl Scene {
         };
         let camera = Camera::new(&desc.camera.value, eye, r.width, r.height);
         let keyed = std::mem::take(&mut stored.keyed);
+        let shared = std::mem::take(&mut stored.shared);
         let mut scene = Scene {
             source: desc.source.clone(),
             camera: camera.clone(),
@@ -228,13 +230,21 @@ impl Scene {
             bvh_time,
             plugin_time,
             moving: Default::default(),
+            instances: shared,
             prototypes,
             animation: None,
             budget: b.budget,
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
-            let animation = Animation::new(desc, &scene.material_names, &shadowless_copies, keyed)?;
+            let shared_keyed = std::mem::take(&mut stored.shared_keyed);
+            let animation = Animation::new(
+                desc,
+                &scene.material_names,
+                &shadowless_copies,
+                keyed,
+                shared_keyed,
+            )?;
             scene.animation = Some(Box::new(animation));
             scene.set_frame(a.value.first)?;
         }
@@ -298,6 +308,11 @@ struct Stored {
     dropped: u64,
     /// The keyed objects' geometry, recorded to be placed at each frame.
     keyed: Vec<Keyed>,
+    /// Instances sharing their prototype's one copy, and the geometry bytes charged for them.
+    shared: Instances,
+    /// Keyed shared instances: index in `shared.list` and tracks.
+    shared_keyed: Vec<(u32, ObjectTracks)>,
+    shared_bytes: u64,
 }
 
 impl<'a> Build<'a> {
@@ -667,6 +682,9 @@ impl<'a> Build<'a> {
         let baked = instances::bake(&cx, &material, sets, &mut stored.used)?;
         stored.dropped += baked.dropped;
         stored.keyed.extend(baked.keyed);
+        stored.shared = baked.shared;
+        stored.shared_keyed = baked.shared_keyed;
+        stored.shared_bytes = baked.shared_bytes;
         Ok(baked.prototypes)
     }
 
@@ -841,6 +859,9 @@ impl Stored {
             object_counts: Vec::new(),
             dropped: 0,
             keyed: Vec::new(),
+            shared: Instances::default(),
+            shared_keyed: Vec::new(),
+            shared_bytes: 0,
         }
     }
 
@@ -875,6 +896,7 @@ impl Stored {
             + self.discs.bytes()
             + self.customs.bytes()
             + self.keyed.iter().map(|k| k.geometry.bytes()).sum::<u64>()
+            + self.shared_bytes
     }
 
     /// Stage (with a geometry cache): its native sets and BVHs replace the (empty) ones here.
@@ -964,7 +986,8 @@ impl Stored {
             && self.triangles.is_empty()
             && self.planes.planes.is_empty()
             && self.customs.is_empty()
-            && self.keyed.iter().all(|k| k.geometry == Recorded::default()))
+            && self.keyed.iter().all(|k| k.geometry == Recorded::default())
+            && self.shared.is_empty())
     }
 }
 

@@ -24,6 +24,7 @@ use crate::math::{DVec3, Vec3A};
 use crate::motion::keys::value;
 use crate::motion::Placement;
 use crate::plugin::primitive::Recorded;
+use glam::DAffine3;
 use luxon_formats::{
     AnimationDesc, CameraDesc, LightDesc, ObjectTracks, Origin, Projection, SceneDesc, ShutterDesc,
     Spanned, Track, TransparentShadows,
@@ -54,6 +55,8 @@ pub struct Animation {
     /// shadow (if objects use one), and the track.
     materials: Vec<(usize, Option<usize>, Track<[f64; 3]>)>,
     objects: Vec<Keyed>,
+    /// Keyed shared instances (`Scene::instances` index) and their tracks.
+    instances: Vec<(u32, ObjectTracks)>,
     frame: u32,
 }
 
@@ -81,6 +84,7 @@ impl Animation {
         material_names: &[String],
         shadowless: &[Option<usize>],
         objects: Vec<Keyed>,
+        instances: Vec<(u32, ObjectTracks)>,
     ) -> Result<Animation, Error> {
         let a = desc
             .animation
@@ -133,6 +137,7 @@ impl Animation {
             shadows: desc.render.transparency.shadows,
             materials,
             objects,
+            instances,
             frame: a.value.first,
         })
     }
@@ -274,6 +279,27 @@ impl Animation {
         Ok(Build::lights_from(&lights, world_offset, self.light_scale))
     }
 
+    /// The keyed shared instances' transforms at time `t` (each checked invertible).
+    fn instances_at(&self, t: f64, k: u32) -> Result<Vec<(u32, DAffine3)>, Error> {
+        (self.instances.iter())
+            .map(|(i, tracks)| {
+                let m = Placement::at(tracks, t).world_from_object;
+                let det = m.matrix3.determinant();
+                if det.is_finite() && det != 0.0 {
+                    Ok((*i, m))
+                } else {
+                    Err(Error::at(
+                        &tracks.name.at,
+                        format!(
+                            "frame {k}: instance `{}`: its transform is singular (a scale of 0?)",
+                            tracks.name.value
+                        ),
+                    ))
+                }
+            })
+            .collect()
+    }
+
     /// The keyed objects placed at time `t`, in render space, with their BVHs, charged to
     /// `budget` (the group keeps the charges).
     fn group_at(
@@ -333,6 +359,7 @@ impl Scene {
         let camera = anim.camera_at(t, k)?;
         let lights = anim.lights_at(t, k, self.world_offset)?;
         let moving = anim.group_at(t, k, self.world_offset, &self.budget)?;
+        let placed = anim.instances_at(t, k)?;
         let shadows = anim.shadows;
         let colors: Vec<(usize, Option<usize>, Vec3A)> = anim
             .materials
@@ -346,6 +373,9 @@ impl Scene {
         self.lights = lights;
         // The previous frame's group goes, and its charges with it.
         self.moving = moving;
+        if !placed.is_empty() {
+            self.instances.place(&placed);
+        }
         for (i, copy, c) in colors {
             let m = &mut self.materials[i];
             m.color = c;

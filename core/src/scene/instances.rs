@@ -6,10 +6,18 @@
 //! those coordinates would store: same f64 values, same f32 values, same order, same BVHs,
 //! same picture, bit for bit.
 //!
-//! What baking cannot do is refused by name: a prototype holding spheres, cones or discs under
-//! a scale that is not uniform (a sphere cannot become an ellipsoid), and custom
-//! (plugin-intersected) geometry, which the host cannot move. Sharing one copy among
-//! instances (a two-level BVH) is not built yet.
+//! Or by **sharing**: one copy of the prototype in its own object space (a bottom-level BVH)
+//! for all its static instances, a top-level BVH over the instances, and rays moved into
+//! object space per instance (`geometry::instance`): memory for one copy plus a few hundred
+//! bytes per instance, the picture within rounding of the flat one (not bit for bit).
+//!
+//! The render setting `instancing` chooses, per prototype: `Bake` bakes every static instance
+//! (refusing by name what baking cannot do: spheres, cones or discs under a scale that is not
+//! uniform — a sphere cannot become an ellipsoid); `Share` shares them all; `Auto` (the
+//! default) bakes a prototype's static instances when baking is exact — no instance stretches
+//! a prototype holding spheres, cones or discs — and small — at most [`BAKE_LIMIT`] primitives
+//! in all its baked copies — and shares them otherwise. Custom (plugin-intersected) geometry
+//! cannot be copied either way (the host cannot move it).
 //!
 //! An instance the animation keys (by its `name`) is not baked: its copies are recorded as
 //! keyed objects and placed anew at every frame in the scene's moving group (`frame`).
@@ -17,10 +25,13 @@
 use super::frame::Keyed;
 use super::place::{place, Sets};
 use crate::budget::Budget;
+use crate::budget::Use;
 use crate::error::Error;
 use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
+use crate::geometry::group::Group;
+use crate::geometry::instance::{self, Instance, Instances, Motion};
 use crate::geometry::pack;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
@@ -30,7 +41,7 @@ use crate::motion::Placement;
 use crate::plugin::primitive::{create_primitive, GeometryBuilder, Recorded, RecordedMesh};
 use crate::plugin::{PluginKind, Registry};
 use luxon_formats::{
-    InlineGeometry, InstanceDesc, Key, ObjectTracks, Origin, SceneDesc, Spanned, Track,
+    InlineGeometry, InstanceDesc, Instancing, Key, ObjectTracks, Origin, SceneDesc, Spanned, Track,
     TransformDesc,
 };
 use std::path::Path;
@@ -48,6 +59,8 @@ pub struct PrototypeUse {
     pub baked: usize,
     /// Instances keyed by the animation, placed anew at every frame.
     pub keyed: usize,
+    /// Instances sharing one copy of the prototype (a two-level BVH).
+    pub shared: usize,
     /// Primitives (spheres, triangles, planes, cones, discs) in one copy.
     pub primitives: usize,
 }
@@ -70,9 +83,21 @@ pub(super) struct Baked {
     pub prototypes: Vec<PrototypeUse>,
     /// Keyed instances' copies, one per prototype object.
     pub keyed: Vec<Keyed>,
+    /// Keyed instances sharing their prototype (`instancing: Share`): the index in
+    /// `shared.list` and the tracks that place it at each frame.
+    pub shared_keyed: Vec<(u32, ObjectTracks)>,
     /// Zero-area triangles dropped.
     pub dropped: u64,
+    /// The shared instances (empty when every instance was baked or keyed).
+    pub shared: Instances,
+    /// Bytes charged to the budget's geometry for the shared instances (their prototypes'
+    /// copies and the instance table), kept for the scene's life.
+    pub shared_bytes: u64,
 }
+
+/// `Auto` bakes a prototype's static instances only while all its copies hold at most this
+/// many primitives in all; more share one copy.
+pub const BAKE_LIMIT: usize = 1 << 20;
 
 /// The stage: every instance of `cx.desc` stored into `sets` (or, when keyed, recorded into
 /// `Baked::keyed`); `used` marks the materials the copies use.
@@ -86,7 +111,10 @@ pub(super) fn bake(
     let mut baked = Baked {
         prototypes: Vec::new(),
         keyed: Vec::new(),
+        shared_keyed: Vec::new(),
         dropped: 0,
+        shared: Instances::default(),
+        shared_bytes: 0,
     };
     if desc.instances.is_empty() {
         return Ok(baked);
@@ -117,19 +145,33 @@ pub(super) fn bake(
             meshes: p.value.inline.len(),
             baked: 0,
             keyed: 0,
+            shared: 0,
             primitives: r
                 .as_ref()
                 .map_or(0, |r| r.iter().map(|p| primitives(&p.geometry)).sum()),
         })
         .collect();
     let keyed_tracks = desc.animation.as_ref().map(|a| &a.value.instances);
+    let keyed = |k: usize| keyed_tracks.and_then(|t| t.iter().find(|t| t.object == k));
+    let share = realisations(desc, &instance_of, &recorded, &keyed);
+    let mut shared = Shared::default();
     for (k, (inst, &p)) in desc.instances.iter().zip(&instance_of).enumerate() {
         let name = &desc.prototypes[p].0;
         let parts = recorded[p].as_ref().expect("recorded above");
         let what = || describe(k, inst, name);
-        let tracks = keyed_tracks.and_then(|t| t.iter().find(|t| t.object == k));
-        if let Some(tracks) = tracks {
+        if let Some(tracks) = keyed(k) {
             let tracks = with_static(tracks, &inst.value.world_from_object, &what)?;
+            if desc.render.instancing == Instancing::Share {
+                // Shared like a static copy; `set_frame` places it at each frame and rebuilds
+                // the top level (here it stands where the first frame puts it).
+                let first = desc.animation.as_ref().map_or(0, |a| a.value.first);
+                let placement = Placement::at(&tracks, f64::from(first));
+                shared.add(cx, material_of, (inst, p), parts, &placement, used, &what)?;
+                let index = shared.list.len() as u32 - 1;
+                baked.shared_keyed.push((index, tracks));
+                uses[p].keyed += 1;
+                continue;
+            }
             for part in parts {
                 let m = material(material_of, &inst.value, &part.material, part.shadows)?;
                 used[m] = true;
@@ -144,6 +186,11 @@ pub(super) fn bake(
             continue;
         }
         let placement = Placement::from_desc(&inst.value.world_from_object.value);
+        if share[p] {
+            shared.add(cx, material_of, (inst, p), parts, &placement, used, &what)?;
+            uses[p].shared += 1;
+            continue;
+        }
         let round = parts
             .iter()
             .map(|p| &p.geometry)
@@ -155,8 +202,9 @@ pub(super) fn bake(
                     "{}: its `world_from_object` does not scale the same on every axis, and the \
                      prototype holds spheres, cones or discs, which baking cannot stretch (a \
                      sphere does not become an ellipsoid); expected a uniform scale (a rotation, \
-                     one scale factor and a translation) — shared instances, which could, are \
-                     not built yet",
+                     one scale factor and a translation), or `instancing: Share` or `Auto` in the \
+                     render settings, which share the prototype instead (one copy traced \
+                     through each instance's transform stretches fine)",
                     what()
                 ),
             ));
@@ -176,9 +224,141 @@ pub(super) fn bake(
         }
         uses[p].baked += 1;
     }
-    uses.retain(|u| u.baked + u.keyed > 0);
+    uses.retain(|u| u.baked + u.keyed + u.shared > 0);
     baked.prototypes = uses;
+    baked.dropped += shared.dropped;
+    (baked.shared, baked.shared_bytes) = shared.finish(cx)?;
     Ok(baked)
+}
+
+/// Per prototype: whether its static instances are shared (else baked), as the render
+/// setting `instancing` says (see the module's documentation for `Auto`'s rule).
+fn realisations<'d>(
+    desc: &'d SceneDesc,
+    instance_of: &[usize],
+    recorded: &[Option<Vec<Part>>],
+    keyed: &dyn Fn(usize) -> Option<&'d ObjectTracks>,
+) -> Vec<bool> {
+    let n = desc.prototypes.len();
+    match desc.render.instancing {
+        Instancing::Bake => return vec![false; n],
+        Instancing::Share => return vec![true; n],
+        Instancing::Auto => {}
+    }
+    let mut copies = vec![0usize; n];
+    let mut stretched = vec![false; n];
+    for (k, (inst, &p)) in desc.instances.iter().zip(instance_of).enumerate() {
+        if keyed(k).is_some() {
+            continue;
+        }
+        copies[p] += 1;
+        let placement = Placement::from_desc(&inst.value.world_from_object.value);
+        stretched[p] |= placement.uniform_scale().is_none();
+    }
+    (0..n)
+        .map(|p| {
+            let Some(parts) = &recorded[p] else {
+                return false;
+            };
+            let round = parts
+                .iter()
+                .map(|p| &p.geometry)
+                .any(|g| !(g.spheres.is_empty() && g.cones.is_empty() && g.discs.is_empty()));
+            let size: usize = parts.iter().map(|p| primitives(&p.geometry)).sum();
+            (round && stretched[p]) || copies[p].saturating_mul(size) > BAKE_LIMIT
+        })
+        .collect()
+}
+
+/// The shared instances as they are collected: one bottom level per prototype and material
+/// override (an instance's `material` recolours its copy), the instances placing them.
+#[derive(Default)]
+struct Shared {
+    blases: Vec<Group>,
+    /// What each bottom level is: (prototype, the instance's material override).
+    keys: Vec<(usize, Option<String>)>,
+    list: Vec<Instance>,
+    dropped: u64,
+    /// Geometry charged for the bottom levels' arrays.
+    bytes: u64,
+}
+
+impl Shared {
+    /// An instance (of prototype `p`, whose recorded parts are `parts`) placed by `placement`:
+    /// its prototype's bottom level made on first use, in object space.
+    #[allow(clippy::too_many_arguments)]
+    fn add(
+        &mut self,
+        cx: &Context,
+        material_of: &MaterialOf,
+        (inst, p): (&Spanned<InstanceDesc>, usize),
+        parts: &[Part],
+        placement: &Placement,
+        used: &mut [bool],
+        what: &dyn Fn() -> String,
+    ) -> Result<(), Error> {
+        let det = placement.world_from_object.matrix3.determinant();
+        if !(det.is_finite() && det != 0.0) {
+            return Err(Error::at(
+                &inst.value.world_from_object.at,
+                format!("{}: its transform is singular (a scale of 0?)", what()),
+            ));
+        }
+        let key = (p, inst.value.material.as_ref().map(|m| m.value.clone()));
+        let blas = match self.keys.iter().position(|b| *b == key) {
+            Some(b) => b,
+            None => {
+                let before = cx.budget.used(Use::Geometry);
+                let mut group = Group::default();
+                let identity = Placement::from_desc(&TransformDesc::IDENTITY);
+                for part in parts {
+                    let m = material(material_of, &inst.value, &part.material, part.shadows)?;
+                    used[m] = true;
+                    let at = pack(m as u32, 0);
+                    // Object space: no offset (the instances' transforms carry it).
+                    let sets = group.sets();
+                    self.dropped +=
+                        place(&part.geometry, &identity, DVec3::ZERO, at, sets, cx.budget)
+                            .map_err(|e| {
+                                Error::at(&inst.at, format!("{}, {}: {e}", what(), part.label))
+                            })?;
+                }
+                self.bytes += cx.budget.used(Use::Geometry).saturating_sub(before);
+                self.blases.push(group);
+                self.keys.push(key);
+                self.blases.len() - 1
+            }
+        };
+        let placement = instance::Placement::new(placement.world_from_object, cx.world_offset);
+        self.list.push(Instance {
+            blas: blas as u32,
+            motion: Motion::Fixed(Box::new(placement)),
+        });
+        Ok(())
+    }
+
+    /// The bottom levels built, the table charged and the top level built over it; with the
+    /// geometry bytes charged for good.
+    fn finish(mut self, cx: &Context) -> Result<(Instances, u64), Error> {
+        if self.list.is_empty() {
+            return Ok((Instances::default(), 0));
+        }
+        let n = self.list.len();
+        let table = (n
+            * (std::mem::size_of::<Instance>() + std::mem::size_of::<instance::Placement>()))
+            as u64;
+        cx.budget.reserve(Use::Geometry, table, || {
+            format!("the table of {n} shared instances")
+        })?;
+        for g in &mut self.blases {
+            g.build(cx.budget)
+                .map_err(|e| Error::Render(format!("the shared prototypes: {}", e.0)))?;
+        }
+        Ok((
+            Instances::new(self.blases, self.list, cx.world_offset),
+            self.bytes + table,
+        ))
+    }
 }
 
 /// "instance 3 of prototype `gear`" (with its name when it has one).

@@ -27,10 +27,11 @@ use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
 use crate::geometry::group::Group;
+use crate::geometry::instance::Instances;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
-use crate::geometry::{material_of, Clips, Counters, Hit, Kind, Surface};
+use crate::geometry::{material_of, Clips, Counters, Hit, Kind, Surface, NO_INSTANCE};
 use crate::math::{DVec3, Vec3A};
 use crate::plugin::texture::TextureInstance;
 use crate::ray::Ray;
@@ -364,6 +365,9 @@ pub struct Scene {
     pub plugin_time: Duration,
     /// Keyed objects placed at the current frame (empty in a still scene).
     pub moving: Group,
+    /// Instances sharing one copy of their prototype (a two-level BVH; empty unless some
+    /// prototype is shared).
+    pub instances: Instances,
     /// The prototypes with instances, and how each was realised.
     pub prototypes: Vec<PrototypeUse>,
     /// How the scene changes from frame to frame; `None`: a still scene.
@@ -438,12 +442,18 @@ impl Scene {
             self.moving
                 .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         }
+        if !self.instances.is_empty() {
+            (self.instances).intersect(ray, &boxes, &mut t_max, &mut hit, c);
+        }
         hit
     }
 
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         if hit.moving {
             return self.moving.surface(hit, ray, self.features.textures);
+        }
+        if hit.instance != NO_INSTANCE {
+            return self.instances.surface(hit, ray, self.features.textures);
         }
         // Texture coordinates only for a material with a texture (the only reader of uv).
         let uv = |packed: u32| {
@@ -485,7 +495,9 @@ impl Scene {
                 || (!self.moving.is_empty()
                     && self
                         .moving
-                        .any(ray, t_max, &self.clips, c, &mut |_, _| true));
+                        .any(ray, t_max, &self.clips, c, &mut |_, _| true))
+                || (!self.instances.is_empty()
+                    && (self.instances).any(ray, b, t_max, c, &mut |_, _| true));
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
         let mut filter = Vec3A::ONE;
@@ -522,6 +534,7 @@ impl Scene {
         if blocked
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
             || (!self.moving.is_empty() && self.moving.any(ray, t_max, &self.clips, c, &mut on_hit))
+            || (!self.instances.is_empty() && self.instances.any(ray, b, t_max, c, &mut on_hit))
         {
             return Vec3A::ZERO;
         }
