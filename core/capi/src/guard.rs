@@ -54,12 +54,13 @@ fn guarded(name: &'static str, f: impl FnOnce() -> Result<(), Failure>) -> Resul
     HELD.with(|h| h.borrow_mut().clear());
     let outer = GUARDED.with(|g| g.replace(true));
     let run = catch_unwind(AssertUnwindSafe(|| {
-        // Tests make an entry point panic to check the guard (as LUXON_TEST_FAIL_RANK does
-        // for MPI).
+        let result = f();
+        // Tests make an entry point panic (after its work, holding its handles) to check the
+        // guard, as LUXON_TEST_FAIL_RANK makes an MPI rank fail.
         if std::env::var_os("LUXON_TEST_PANIC").is_some_and(|v| v == name) {
             panic!("panic injected by LUXON_TEST_PANIC");
         }
-        f()
+        result
     }));
     GUARDED.with(|g| g.set(outer));
     let held = HELD.with(|h| std::mem::take(&mut *h.borrow_mut()));

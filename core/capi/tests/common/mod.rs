@@ -121,3 +121,4 @@ pub fn render_rgba8(
 pub fn bits(px: &[[f32; 4]]) -> Vec<u32> {
     px.iter().flatten().map(|v| v.to_bits()).collect()
 }
+pub mod capi;
