@@ -172,3 +172,47 @@ fn cpp17_program_on_the_static_library_renders_what_rust_renders() {
     check_pixels(&dir);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_readme_example_compiles_and_runs() {
+    let Some(cc) = compiler("CC", "cc") else {
+        println!("note: no C compiler (cc or $CC) found; skipping the README's C example");
+        return;
+    };
+    ensure_built();
+    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(here.join("README.md")).unwrap();
+    let at = readme
+        .find("<!-- compiled and run by tests/compile.rs -->")
+        .unwrap();
+    let start = readme[at..].find("```c\n").unwrap() + at + "```c\n".len();
+    let end = readme[start..].find("```").unwrap() + start;
+    let dir = temp_dir("readme");
+    std::fs::write(dir.join("app.c"), &readme[start..end]).unwrap();
+    let lib = profile_dir();
+    let exe = dir.join("app");
+    run(Command::new(&cc)
+        .args([
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Wpedantic",
+            "-Werror",
+            "-I",
+        ])
+        .arg(here.join("include"))
+        .arg(dir.join("app.c"))
+        .arg("-o")
+        .arg(&exe)
+        .arg("-L")
+        .arg(&lib)
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .arg("-lluxon"));
+    let o = run(Command::new(&exe).env_remove("LUXON_PLUGIN_PATH"));
+    assert!(
+        o.stdout.is_empty() && o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -358,3 +358,25 @@ fn the_last_error_copy_cuts_at_a_character() {
         );
     }
 }
+
+#[test]
+fn versions_are_the_crates() {
+    let api = capi();
+    let mut v = [u32::MAX; 3];
+    // SAFETY: the version string is static and NUL-terminated; the pointers are writable.
+    unsafe {
+        assert_eq!((api.luxon_api_version)(), 1);
+        let text = std::ffi::CStr::from_ptr((api.luxon_version_string)());
+        assert_eq!(text.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
+        (api.luxon_version)(&mut v[0], &mut v[1], &mut v[2]);
+        (api.luxon_version)(null_mut(), null_mut(), null_mut());
+        assert_eq!((api.luxon_plugin_abi_version)(), luxon_plugin::ABI_VERSION);
+        // With `--features mpi` the library is built with MPI (and says so), else without.
+        assert_eq!((api.luxon_has_mpi)(), cfg!(feature = "mpi"));
+    }
+    let want: Vec<u32> = env!("CARGO_PKG_VERSION")
+        .split('.')
+        .map(|n| n.parse().unwrap())
+        .collect();
+    assert_eq!(v.to_vec(), want);
+}

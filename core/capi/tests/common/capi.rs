@@ -83,6 +83,10 @@ macro_rules! functions {
 
 functions! {
     luxon_api_version() -> u32;
+    luxon_version_string() -> *const c_char;
+    luxon_version(*mut u32, *mut u32, *mut u32) -> ();
+    luxon_plugin_abi_version() -> u32;
+    luxon_has_mpi() -> bool;
     luxon_last_error() -> *const c_char;
     luxon_last_error_copy(*mut c_char, usize) -> usize;
     luxon_context_create(*const ContextOptions, *mut Handle) -> i32;

@@ -30,6 +30,10 @@ pub fn ensure_built() {
         if profile_dir().file_name().is_some_and(|n| n == "release") {
             cmd.arg("--release");
         }
+        // The library the tests load is built as this test was (with MPI or not).
+        if cfg!(feature = "mpi") {
+            cmd.args(["--features", "mpi"]);
+        }
         let status = cmd.status().expect("cannot run cargo to build libluxon");
         assert!(status.success(), "building libluxon and the plugins failed");
     });
