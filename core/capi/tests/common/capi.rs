@@ -43,6 +43,8 @@ pub struct CommitReport {
     pub commit_seconds: f64,
 }
 
+pub type LogFn = Option<unsafe extern "C" fn(i32, *const c_char, *mut c_void)>;
+
 pub type ProgressFn = Option<unsafe extern "C" fn(u64, u64, *mut c_void) -> i32>;
 
 pub const OK: i32 = 0;
@@ -108,6 +110,8 @@ functions! {
     luxon_renderer_set_progress(Handle, ProgressFn, *mut c_void) -> i32;
     luxon_render(Handle, Handle, *const TargetDesc, *mut c_void) -> i32;
     luxon_write_image(Handle, *const c_char, *const f32, u32, u32, usize) -> i32;
+    luxon_scene_save_ron(Handle, *const c_char) -> i32;
+    luxon_set_log(LogFn, *mut c_void, i32) -> i32;
 }
 
 /// The library, loaded once per test process.

@@ -1,0 +1,164 @@
+//! What comes out besides pixels: commit reports, images written through the writer plugins, a
+//! scene saved as RON (which renders the same), and log lines through the callback.
+
+mod common;
+
+use common::bits;
+use common::capi::*;
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::ptr::null_mut;
+use std::sync::Mutex;
+
+fn c(s: &str) -> CString {
+    CString::new(s).unwrap()
+}
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("luxon-capi-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn commit_reports_say_what_was_built() {
+    let api = capi();
+    let ctx = context();
+    let r = renderer(ctx);
+    let scene = scene_ron(ctx, &ball_scene(1));
+    let mut report = CommitReport {
+        size: std::mem::size_of::<CommitReport>() as u32,
+        ..Default::default()
+    };
+    // SAFETY: valid handles and a report whose size is set.
+    unsafe {
+        expect((api.luxon_scene_commit)(scene, r, &mut report), OK, "");
+        assert_eq!((report.rebuilt, report.shading), (1, 0));
+        assert!(report.commit_seconds >= report.bvh_seconds);
+        let light = c("Point(position: (4, 6, -5), intensity: 0.5)");
+        expect(
+            (api.luxon_scene_add_light_ron)(scene, light.as_ptr(), null_mut()),
+            OK,
+            "",
+        );
+        expect((api.luxon_scene_commit)(scene, r, &mut report), OK, "");
+        assert_eq!((report.rebuilt, report.shading), (0, 1));
+        // A report of an older, smaller version gets only its fields.
+        let mut old = CommitReport {
+            size: 8,
+            shading: 77,
+            ..Default::default()
+        };
+        expect((api.luxon_scene_commit)(scene, r, &mut old), OK, "");
+        assert_eq!((old.size, old.rebuilt, old.shading), (8, 0, 77));
+    }
+}
+
+#[test]
+fn a_saved_scene_renders_as_the_scene_did_and_images_are_written() {
+    let api = capi();
+    let ctx = context();
+    let r = renderer(ctx);
+    let scene = scene_ron(ctx, &ball_scene(2));
+    let dir = temp_dir("outputs");
+    let (ron, ppm) = (dir.join("saved.ron"), dir.join("ball.ppm"));
+    let mut first = vec![[0.0f32; 4]; 12 * 8];
+    let mut second = vec![[0.0f32; 4]; 12 * 8];
+    let mut saved = Handle::default();
+    // SAFETY: valid handles, strings, targets over live buffers.
+    unsafe {
+        let light = c("Directional(direction: (1, -1, 1), intensity: 0.3)");
+        expect(
+            (api.luxon_scene_add_light_ron)(scene, light.as_ptr(), null_mut()),
+            OK,
+            "",
+        );
+        expect(
+            (api.luxon_render)(r, scene, &target_f32(&mut first, 12, 8), null_mut()),
+            OK,
+            "",
+        );
+        let path = c(ron.to_str().unwrap());
+        expect((api.luxon_scene_save_ron)(scene, path.as_ptr()), OK, "");
+        expect(
+            (api.luxon_scene_load)(ctx, path.as_ptr(), &mut saved),
+            OK,
+            "",
+        );
+        expect(
+            (api.luxon_render)(r, saved, &target_f32(&mut second, 12, 8), null_mut()),
+            OK,
+            "",
+        );
+        assert_eq!(bits(&first), bits(&second));
+
+        // Rows of 10 pixels (40 floats) in a buffer of 12.
+        let padded: Vec<f32> = first
+            .chunks(12)
+            .flat_map(|row| row[..10].iter().flatten().copied().chain([0.0; 8]))
+            .collect();
+        let path = c(ppm.to_str().unwrap());
+        let s = (api.luxon_write_image)(ctx, path.as_ptr(), padded.as_ptr(), 10, 8, 48);
+        expect(s, OK, "");
+        let bytes = std::fs::read(&ppm).unwrap();
+        assert!(bytes.starts_with(b"P6\n10 8\n255\n"), "{:?}", &bytes[..12]);
+        let bad = c(dir.join("x.nope").to_str().unwrap());
+        let s = (api.luxon_write_image)(ctx, bad.as_ptr(), padded.as_ptr(), 10, 8, 48);
+        assert_ne!(s, OK);
+        assert!(last_error().contains("nope"), "{}", last_error());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+static LINES: Mutex<Vec<(i32, String)>> = Mutex::new(Vec::new());
+
+unsafe extern "C" fn collect(level: i32, message: *const c_char, _: *mut c_void) {
+    // SAFETY: the library passes a NUL-terminated message valid during the call.
+    let text = unsafe { CStr::from_ptr(message) }
+        .to_string_lossy()
+        .into_owned();
+    LINES.lock().unwrap().push((level, text));
+}
+
+#[test]
+fn scene_warnings_reach_the_log_callback() {
+    let api = capi();
+    let ctx = context();
+    let dir = temp_dir("log");
+    let nff = dir.join("ball.nff");
+    std::fs::write(
+        &nff,
+        "v\nfrom 0 -6 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\nresolution 8 8\n\
+         b 0.2 0.3 0.6\nl 4 -4 6\nf 0.9 0.2 0.2 0.6 0.4 30 0 0\ns 0 0 1 -1\n",
+    )
+    .unwrap();
+    let path = c(nff.to_str().unwrap());
+    let mut scene = Handle::default();
+    // SAFETY: a callback callable from any thread (it locks), valid strings and pointers.
+    unsafe {
+        let s = (api.luxon_set_log)(Some(collect), null_mut(), 7);
+        expect(
+            s,
+            INVALID_ARGUMENT,
+            "max_level 7: expected 0 (errors) to 3 (debug)",
+        );
+        expect((api.luxon_set_log)(Some(collect), null_mut(), 1), OK, "");
+        expect(
+            (api.luxon_scene_load)(ctx, path.as_ptr(), &mut scene),
+            OK,
+            "",
+        );
+        expect((api.luxon_set_log)(None, null_mut(), 0), OK, "");
+        expect((api.luxon_scene_release)(scene), OK, "");
+        expect(
+            (api.luxon_scene_load)(ctx, path.as_ptr(), &mut scene),
+            OK,
+            "",
+        );
+    }
+    let lines = LINES.lock().unwrap();
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert_eq!(lines[0].0, 1);
+    assert!(lines[0].1.contains("ball.nff:11:"), "{lines:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
