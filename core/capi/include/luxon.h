@@ -390,7 +390,7 @@ luxon_status luxon_scene_set_render_ron(struct luxon_scene scene, const char *ro
 // `ron` is NULL or a valid string.
 luxon_status luxon_scene_set_fog_ron(struct luxon_scene scene, const char *ron);
 
-// Ambient occlusion from RON text, e.g. `(samples: 16, max_distance: 2)`; NULL: none.
+// Ambient occlusion from RON text, e.g. `(samples: 16, distance: 2)`; NULL: none.
 // Errors point into the text as `<ambient_occlusion>:line:col`.
 //
 // # Safety

@@ -353,7 +353,7 @@ pub unsafe extern "C" fn luxon_scene_set_fog_ron(
     })
 }
 
-/// Ambient occlusion from RON text, e.g. `(samples: 16, max_distance: 2)`; NULL: none.
+/// Ambient occlusion from RON text, e.g. `(samples: 16, distance: 2)`; NULL: none.
 /// Errors point into the text as `<ambient_occlusion>:line:col`.
 ///
 /// # Safety

@@ -162,3 +162,82 @@ fn scene_warnings_reach_the_log_callback() {
     assert!(lines[0].1.contains("ball.nff:11:"), "{lines:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn effects_origin_and_objects_change_the_picture_and_back() {
+    let api = capi();
+    let ctx = context();
+    let r = renderer(ctx);
+    let scene = scene_ron(ctx, &ball_scene(1));
+    let render = |px: &mut Vec<[f32; 4]>| {
+        // SAFETY: valid handles and a target over `px`.
+        let s = unsafe { (api.luxon_render)(r, scene, &target_f32(px, 8, 8), null_mut()) };
+        expect(s, OK, "");
+        bits(px)
+    };
+    let mut px = vec![[0.0f32; 4]; 64];
+    let plain = render(&mut px);
+    let mut objects = [Handle::default(); 4];
+    let mut n = 0;
+    // SAFETY: valid handles, strings, NULL where allowed, arrays of the sizes given.
+    unsafe {
+        let fog = c("(mode: Exp(density: 0.3), color: (0.5, 0.5, 0.5))");
+        expect((api.luxon_scene_set_fog_ron)(scene, fog.as_ptr()), OK, "");
+        assert_ne!(render(&mut px), plain);
+        expect(
+            (api.luxon_scene_set_fog_ron)(scene, std::ptr::null()),
+            OK,
+            "",
+        );
+        let ao = c("(samples: 4, distance: 2)");
+        expect(
+            (api.luxon_scene_set_ambient_occlusion_ron)(scene, ao.as_ptr()),
+            OK,
+            "",
+        );
+        assert_ne!(render(&mut px), plain);
+        expect(
+            (api.luxon_scene_set_ambient_occlusion_ron)(scene, std::ptr::null()),
+            OK,
+            "",
+        );
+        assert_eq!(render(&mut px), plain);
+        // Render space's origin: NULL (the camera's) is where the scene started.
+        expect(
+            (api.luxon_scene_set_origin)(scene, std::ptr::null()),
+            OK,
+            "",
+        );
+        assert_eq!(render(&mut px), plain);
+        let nan = [0.0, f64::NAN, 0.0];
+        let s = (api.luxon_scene_set_origin)(scene, nan.as_ptr());
+        expect(s, INVALID_ARGUMENT, "origin");
+
+        // The file's two objects; without the ball the picture changes.
+        expect(
+            (api.luxon_scene_objects)(scene, objects.as_mut_ptr(), 4, &mut n),
+            OK,
+            "",
+        );
+        assert_eq!(n, 2);
+        let mut again = [Handle::default(); 1];
+        expect(
+            (api.luxon_scene_objects)(scene, again.as_mut_ptr(), 1, &mut n),
+            OK,
+            "",
+        );
+        assert_eq!(
+            (again[0], n),
+            (objects[0], 2),
+            "the same part, the same handle"
+        );
+        expect((api.luxon_scene_remove)(scene, objects[0]), OK, "");
+        assert_ne!(render(&mut px), plain);
+        expect(
+            (api.luxon_scene_objects)(scene, std::ptr::null_mut(), 0, &mut n),
+            OK,
+            "",
+        );
+        assert_eq!(n, 1);
+    }
+}

@@ -111,6 +111,10 @@ functions! {
     luxon_render(Handle, Handle, *const TargetDesc, *mut c_void) -> i32;
     luxon_write_image(Handle, *const c_char, *const f32, u32, u32, usize) -> i32;
     luxon_scene_save_ron(Handle, *const c_char) -> i32;
+    luxon_scene_set_fog_ron(Handle, *const c_char) -> i32;
+    luxon_scene_set_ambient_occlusion_ron(Handle, *const c_char) -> i32;
+    luxon_scene_set_origin(Handle, *const f64) -> i32;
+    luxon_scene_objects(Handle, *mut Handle, usize, *mut usize) -> i32;
     luxon_set_log(LogFn, *mut c_void, i32) -> i32;
 }
 
