@@ -210,6 +210,10 @@ typedef struct luxon_commit_report {
 // The scene is being rendered or committed on another thread; the call did nothing.
 #define LUXON_ERROR_BUSY 8
 
+// This library cannot run here: it was built for x86-64-v3 (AVX2, FMA, BMI2) and this CPU
+// lacks them (rebuild with RUSTFLAGS="-C target-cpu=x86-64").
+#define LUXON_ERROR_UNSUPPORTED 9
+
 // An internal error (a bug in Luxon; please report it). The process goes on; the handles the
 // call used are unusable from then on (they can only be released).
 #define LUXON_ERROR_PANIC 11

@@ -54,6 +54,7 @@ pub unsafe extern "C" fn luxon_context_create(
     guard("luxon_context_create", || {
         // SAFETY: `out` is NULL or writable (caller); cleared first so a failure leaves {0}.
         unsafe { put(out, "out", luxon_context::default()) }?;
+        cpu_supported()?;
         let o = match options.is_null() {
             true => luxon_context_options::default(),
             // SAFETY: a valid struct, as the caller guarantees.
@@ -105,8 +106,34 @@ pub unsafe extern "C" fn luxon_context_threads(
     })
 }
 
+/// A library built for x86-64-v3 (the workspace's default, `.cargo/config.toml`) says so on an
+/// older CPU instead of dying on an illegal instruction in a render (as the `luxon` command).
+fn cpu_supported() -> Result<(), Failure> {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    if !(std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi2"))
+    {
+        return Err(Failure::new(
+            crate::status::LUXON_ERROR_UNSUPPORTED,
+            "this build of Luxon needs an x86-64-v3 CPU (AVX2, FMA, BMI2), which this one is \
+             not; rebuild it for any x86-64 with RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build \
+             --release",
+        ));
+    }
+    Ok(())
+}
+
 /// The directory of the file this code was loaded from (`libluxon.so`, or the program that
 /// linked `libluxon.a`): plugins are installed beside the library.
+#[cfg(not(unix))]
+fn library_dir() -> Option<PathBuf> {
+    None
+}
+
+/// The directory of the file this code was loaded from (`libluxon.so`, or the program that
+/// linked `libluxon.a`): plugins are installed beside the library.
+#[cfg(unix)]
 fn library_dir() -> Option<PathBuf> {
     let mut info = std::mem::MaybeUninit::<libc::Dl_info>::zeroed();
     let here = library_dir as *const c_void;

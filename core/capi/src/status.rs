@@ -29,6 +29,9 @@ pub const LUXON_ERROR_IO: luxon_status = 6;
 pub const LUXON_ERROR_CANCELLED: luxon_status = 7;
 /// The scene is being rendered or committed on another thread; the call did nothing.
 pub const LUXON_ERROR_BUSY: luxon_status = 8;
+/// This library cannot run here: it was built for x86-64-v3 (AVX2, FMA, BMI2) and this CPU
+/// lacks them (rebuild with RUSTFLAGS="-C target-cpu=x86-64").
+pub const LUXON_ERROR_UNSUPPORTED: luxon_status = 9;
 /// An internal error (a bug in Luxon; please report it). The process goes on; the handles the
 /// call used are unusable from then on (they can only be released).
 pub const LUXON_ERROR_PANIC: luxon_status = 11;
