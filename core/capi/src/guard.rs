@@ -51,7 +51,9 @@ pub(crate) fn guard_value<T>(name: &'static str, fallback: T, f: impl FnOnce() -
 
 fn guarded(name: &'static str, f: impl FnOnce() -> Result<(), Failure>) -> Result<(), Failure> {
     install_hook();
-    HELD.with(|h| h.borrow_mut().clear());
+    // A callback may call Luxon from inside a call (a log line during a load): the inner call
+    // holds what it adds after `mark`.
+    let mark = HELD.with(|h| h.borrow().len());
     let outer = GUARDED.with(|g| g.replace(true));
     let run = catch_unwind(AssertUnwindSafe(|| {
         let result = f();
@@ -63,7 +65,7 @@ fn guarded(name: &'static str, f: impl FnOnce() -> Result<(), Failure>) -> Resul
         result
     }));
     GUARDED.with(|g| g.set(outer));
-    let held = HELD.with(|h| std::mem::take(&mut *h.borrow_mut()));
+    let held: Vec<_> = HELD.with(|h| h.borrow_mut().drain(mark..).collect());
     let result = match run {
         Ok(r) => r,
         Err(payload) => {
