@@ -379,6 +379,10 @@ luxon_status luxon_scene_set_origin(struct luxon_scene scene, const double *orig
 // The colour of rays that hit nothing (linear RGB, each finite and ≥ 0).
 luxon_status luxon_scene_set_background(struct luxon_scene scene, double r, double g, double b);
 
+// Puts an animated scene (a scene file with `animation:`) at frame `frame` at the next commit:
+// its camera, lights, keyed objects and colours. A scene without an animation refuses it.
+luxon_status luxon_scene_set_frame(struct luxon_scene scene, uint32_t frame);
+
 // The render settings from RON text, e.g. `(samples: 4, max_depth: 8)` (a scene file's
 // `render:`, without `width`, `height`, `outputs` and `parallel`: the target gives the size,
 // `luxon_write_image` writes files); errors point into the text as `<render_settings>:line:col`.

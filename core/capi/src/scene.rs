@@ -315,6 +315,15 @@ pub extern "C" fn luxon_scene_set_background(
     })
 }
 
+/// Puts an animated scene (a scene file with `animation:`) at frame `frame` at the next commit:
+/// its camera, lights, keyed objects and colours. A scene without an animation refuses it.
+#[unsafe(no_mangle)]
+pub extern "C" fn luxon_scene_set_frame(scene: luxon_scene, frame: u32) -> luxon_status {
+    guard("luxon_scene_set_frame", || {
+        with_scene(scene, |s, _| Ok(s.scene.set_frame(frame)?))
+    })
+}
+
 /// The render settings from RON text, e.g. `(samples: 4, max_depth: 8)` (a scene file's
 /// `render:`, without `width`, `height`, `outputs` and `parallel`: the target gives the size,
 /// `luxon_write_image` writes files); errors point into the text as `<render_settings>:line:col`.

@@ -241,3 +241,46 @@ fn effects_origin_and_objects_change_the_picture_and_back() {
         assert_eq!(n, 1);
     }
 }
+
+#[test]
+fn an_animated_scene_renders_its_frame_as_the_rust_api_does() {
+    let api = capi();
+    let ctx = context();
+    let r = renderer(ctx);
+    let path = common::root().join("scenes/carousel.ron");
+    let text = c(path.to_str().unwrap());
+    let (mut scene, mut px) = (Handle::default(), vec![[0.0f32; 4]; 16 * 12]);
+    // SAFETY: valid handles, strings and a target over `px`.
+    unsafe {
+        expect(
+            (api.luxon_scene_load)(ctx, text.as_ptr(), &mut scene),
+            OK,
+            "",
+        );
+        expect((api.luxon_scene_set_frame)(scene, 5), OK, "");
+        expect(
+            (api.luxon_render)(r, scene, &target_f32(&mut px, 16, 12), null_mut()),
+            OK,
+            "",
+        );
+        let still = scene_ron(ctx, &ball_scene(1));
+        let s = (api.luxon_scene_set_frame)(still, 5);
+        expect(s, INVALID_ARGUMENT, "frame 5: ");
+        assert!(
+            last_error().ends_with("has no `animation:`"),
+            "{}",
+            last_error()
+        );
+    }
+    let (rust_ctx, rust_renderer) = common::rust_api();
+    let mut want = luxon_core::api::Scene::load(&rust_ctx, &path).unwrap_or_else(|e| panic!("{e}"));
+    want.set_frame(5).unwrap_or_else(|e| panic!("{e}"));
+    let want = common::render_f32(&rust_renderer, &mut want, 16, 12);
+    assert_eq!(bits(&px), bits(&want));
+    let mut first =
+        luxon_core::api::Scene::load(&rust_ctx, &path).unwrap_or_else(|e| panic!("{e}"));
+    assert_ne!(
+        bits(&common::render_f32(&rust_renderer, &mut first, 16, 12)),
+        bits(&want)
+    );
+}

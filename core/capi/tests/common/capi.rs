@@ -114,6 +114,7 @@ functions! {
     luxon_scene_set_fog_ron(Handle, *const c_char) -> i32;
     luxon_scene_set_ambient_occlusion_ron(Handle, *const c_char) -> i32;
     luxon_scene_set_origin(Handle, *const f64) -> i32;
+    luxon_scene_set_frame(Handle, u32) -> i32;
     luxon_scene_objects(Handle, *mut Handle, usize, *mut usize) -> i32;
     luxon_set_log(LogFn, *mut c_void, i32) -> i32;
 }
