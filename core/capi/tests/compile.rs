@@ -96,6 +96,22 @@ fn check_pixels(out: &Path) {
     );
 }
 
+/// A static library built with MPI needs the MPI library at link time: what OpenMPI's
+/// `mpicc --showme:link` says (else `-lmpi`).
+fn mpi_libs() -> Vec<String> {
+    if !cfg!(feature = "mpi") {
+        return Vec::new();
+    }
+    let shown = Command::new("mpicc").arg("--showme:link").output();
+    match shown {
+        Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout)
+            .split_whitespace()
+            .map(str::to_string)
+            .collect(),
+        _ => vec!["-lmpi".to_string()],
+    }
+}
+
 #[test]
 fn c99_program_on_the_shared_library_renders_what_rust_renders() {
     let Some(cc) = compiler("CC", "cc") else {
@@ -157,6 +173,7 @@ fn cpp17_program_on_the_static_library_renders_what_rust_renders() {
         .arg(lib.join("libluxon.a"))
         .arg("-o")
         .arg(&exe)
+        .args(mpi_libs())
         // What Rust's standard library needs from the system (`--print native-static-libs`).
         .args([
             "-lgcc_s",
