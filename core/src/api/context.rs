@@ -3,7 +3,7 @@
 use crate::error::Error;
 use crate::plugin::{Problem, Registry};
 use crate::schedule::{available_cpus, thread_pool};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// How a [`Context`] starts.
@@ -27,12 +27,19 @@ pub struct Context {
 impl Context {
     /// Discovers the plugins and starts the pool.
     pub fn new(o: ContextOptions) -> Result<Context, Error> {
+        Context::with_plugin_home(o, None)
+    }
+
+    /// [`Context::new`] for a library that a host program loaded (the C API): its plugins
+    /// are also searched in `home`, the library's directory, after `$LUXON_PLUGIN_PATH` and
+    /// before the executable's (see [`Registry::discover_with_home`]).
+    pub fn with_plugin_home(o: ContextOptions, home: Option<&Path>) -> Result<Context, Error> {
         let threads = match o.threads {
             0 => available_cpus(),
             n => n,
         };
         let pool = Arc::new(thread_pool(threads)?);
-        let registry = Arc::new(Registry::discover(&o.plugin_path));
+        let registry = Arc::new(Registry::discover_with_home(&o.plugin_path, home));
         Ok(Context { pool, registry })
     }
 

@@ -543,7 +543,7 @@ impl Scene {
         Ok(())
     }
 
-    /// Ambient occlusion from RON text, e.g. `(samples: 16, max_distance: 2)`; errors point
+    /// Ambient occlusion from RON text, e.g. `(samples: 16, distance: 2)`; errors point
     /// into the text as `<ambient_occlusion>:line:col`.
     pub fn set_ambient_occlusion_ron(&mut self, text: &str) -> Result<(), Error> {
         let ao = fragment::ambient_occlusion(text)?;

@@ -284,10 +284,21 @@ fn name_note(name: &str) -> Option<String> {
 impl Registry {
     /// Loads every plugin found on `search_path(extra)`.
     pub fn discover(extra: &[PathBuf]) -> Registry {
+        Registry::discover_with_home(extra, None)
+    }
+
+    /// [`discover`](Self::discover), also searching `home` (the directory of the library
+    /// Luxon runs from, when a host program loaded it: its plugins are installed beside it)
+    /// after `$LUXON_PLUGIN_PATH` and before the executable's directory. Like the executable's,
+    /// it is one of Luxon's own places: nothing is noted when it holds no plugins.
+    pub fn discover_with_home(extra: &[PathBuf], home: Option<&Path>) -> Registry {
         let mut r = Registry::default();
         let (named, builtin) = search_places(extra);
         for dir in named {
             r.add_named_path(&dir);
+        }
+        if let Some(dir) = home {
+            r.add_path(dir);
         }
         for dir in builtin {
             r.add_path(&dir);
