@@ -49,7 +49,7 @@ impl BoxRay {
     }
 
     #[inline(always)]
-    pub(super) fn finite(&self) -> bool {
+    pub(crate) fn finite(&self) -> bool {
         self.finite
     }
 
