@@ -49,20 +49,37 @@ impl BoxRay {
     }
 
     #[inline(always)]
-    pub(super) fn finite(&self) -> bool {
+    pub(crate) fn finite(&self) -> bool {
         self.finite
     }
 
     /// The box tests' operands, made at the start of each traversal.
     #[inline(always)]
     pub(super) fn slabs(&self) -> Slabs {
-        let n = [0, 1, 2].map(|k| (self.neg >> k) as usize & 1);
+        // Row k (min) or 3 + k (max) per axis: looked up by the signs, not worked out (a
+        // dozen instructions less per traversal).
+        const ROWS: [([usize; 3], [usize; 3]); 8] = {
+            let mut rows = [([0; 3], [0; 3]); 8];
+            let mut neg = 0;
+            while neg < 8 {
+                let mut k = 0;
+                while k < 3 {
+                    let n = (neg >> k) & 1;
+                    rows[neg].0[k] = k + 3 * n;
+                    rows[neg].1[k] = k + 3 - 3 * n;
+                    k += 1;
+                }
+                neg += 1;
+            }
+            rows
+        };
+        let (near, far) = ROWS[self.neg as usize & 7];
         Slabs {
             origin: self.origin.into(),
             inv: self.inv.into(),
             inv_far: self.inv_far.into(),
-            near: [3 * n[0], 1 + 3 * n[1], 2 + 3 * n[2]],
-            far: [3 - 3 * n[0], 4 - 3 * n[1], 5 - 3 * n[2]],
+            near,
+            far,
         }
     }
 }

@@ -34,6 +34,18 @@ pub trait Shape: Copy + Send + Sync {
     }
 }
 
+/// Up to this many primitives of a kind, an opaque any-hit query tests them one by one,
+/// without the box tests of the tree's node (eight boxes and their set-up): four spheres,
+/// whose test rejects a miss about as cheaply as a box test, or two triangles; cones and discs
+/// cost more than their boxes (measured on Tachyon's scenes).
+const fn tiny(kind: Kind) -> usize {
+    match kind {
+        Kind::Sphere => 4,
+        Kind::Triangle => 2,
+        _ => 0,
+    }
+}
+
 pub struct Set<S> {
     pub data: Vec<S>,
     /// Material and clip group, packed (see `pack`).
@@ -129,6 +141,19 @@ impl<S: Shape> Set<S> {
         }
         self.bvh = bvh;
         self.clipped = self.material.iter().any(|&m| clip_of(m) != 0);
+    }
+
+    /// A copy holding only the primitives whose packed material `keep` accepts, with its own
+    /// BVH.
+    pub fn filtered(&self, keep: impl Fn(u32) -> bool) -> Set<S> {
+        let mut out = Set::default();
+        for (s, &m) in self.data.iter().zip(&self.material) {
+            if keep(m) {
+                out.push(*s, m);
+            }
+        }
+        out.build();
+        out
     }
 
     /// The nearest hit of primitive `i` in (0, t_max) that its clip group keeps.
@@ -243,6 +268,34 @@ impl<S: Shape> Set<S> {
         self.any_with::<false>(ray, boxes, t_max, clips, c, |_| false, on_hit)
     }
 
+    /// Whether the ray crosses a primitive in (0, t_max) (that its clip group keeps): the
+    /// query of a world where every primitive blocks, so the order of the tests does not
+    /// matter. A handful of spheres or triangles are tested one by one, without the box tests
+    /// (which only pass over primitives the ray cannot cross).
+    #[inline]
+    pub fn any_opaque(
+        &self,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: f32,
+        clips: &Clips,
+        c: &mut Counters,
+    ) -> bool {
+        if self.data.len() <= const { tiny(S::KIND) } && !self.clipped {
+            // A ray with a NaN or infinite coordinate, or a NaN length, meets nothing, as in
+            // the trees.
+            if self.data.is_empty() || !boxes.finite() || t_max.is_nan() {
+                return false;
+            }
+            let prep = S::prep(ray);
+            return self.data.iter().any(|s| {
+                c.tests += 1;
+                s.crossings(ray, &prep, t_max) > 0
+            });
+        }
+        self.any_with::<false>(ray, boxes, t_max, clips, c, |_| false, |_, _| true)
+    }
+
     /// [`Set::any_prepared`] passing over, untested, the primitives whose material `skip`
     /// names (those a shadow ray crosses unchanged: testing them cannot change what it
     /// carries).
@@ -305,5 +358,95 @@ impl<S: Shape> Set<S> {
                 n > 0 && on_hit(material_of(packed), n)
             },
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::sphere::Sphere;
+    use crate::geometry::triangle::Triangle;
+    use crate::math::Vec3A;
+    use glam::Vec3;
+
+    /// Rays from a grid of origins toward a grid of targets, with lengths ending before,
+    /// inside and past the primitives, and some with non-finite coordinates.
+    fn rays() -> Vec<(Ray, f32)> {
+        let mut out = Vec::new();
+        for i in 0..9 {
+            for j in 0..9 {
+                let o = Vec3A::new(i as f32 * 0.7 - 3.0, j as f32 * 0.6 - 2.5, -4.0);
+                for k in 0..7 {
+                    let target = Vec3A::new(k as f32 * 0.5 - 1.5, 0.3 * k as f32 - 1.0, 1.0);
+                    let d = (target - o).normalize();
+                    for t_max in [1.0, 4.5, f32::INFINITY] {
+                        out.push((Ray::new(o, d, 0.0), t_max));
+                    }
+                }
+            }
+        }
+        out.push((
+            Ray::new(Vec3A::new(f32::NAN, 0.0, -4.0), Vec3A::Z, 0.0),
+            9.0,
+        ));
+        out.push((
+            Ray::new(Vec3A::new(0.0, 0.0, -4.0), Vec3A::Z, 0.0),
+            f32::NAN,
+        ));
+        out
+    }
+
+    /// The loop over a handful of primitives answers as the tree does, on every ray.
+    fn same_as_tree<S: Shape>(set: &Set<S>) -> usize {
+        let (clips, mut c) = (Clips::default(), Counters::default());
+        let mut blocked = 0;
+        for (ray, t_max) in rays() {
+            let b = BoxRay::new(ray.origin, ray.dir);
+            let tree = set.any_prepared(&ray, &b, t_max, &clips, &mut c, |_, _| true);
+            let one_by_one = set.any_opaque(&ray, &b, t_max, &clips, &mut c);
+            assert_eq!(one_by_one, tree, "{ray:?} {t_max}");
+            blocked += usize::from(tree);
+        }
+        blocked
+    }
+
+    #[test]
+    fn opaque_queries_on_small_sets_match_the_tree() {
+        let mut spheres = Set::default();
+        for (k, (x, r)) in [(-1.0, 0.5), (0.0, 0.3), (1.2, 0.8), (0.5, 0.1)]
+            .iter()
+            .enumerate()
+        {
+            let center = Vec3::new(*x, 0.2 * k as f32, 2.0 + k as f32);
+            spheres.push(Sphere { center, radius: *r }, k as u32);
+        }
+        spheres.build();
+        let mut triangles = Set::default();
+        let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        triangles.push(
+            Triangle {
+                v: [v(-1.0, -1.0, 2.0), v(1.0, -1.0, 2.5), v(0.0, 1.0, 3.0)],
+                attr: 0,
+            },
+            0,
+        );
+        triangles.push(
+            Triangle {
+                v: [v(0.5, 0.5, 1.0), v(2.0, 0.5, 1.0), v(0.5, 2.0, 1.5)],
+                attr: 0,
+            },
+            1,
+        );
+        triangles.build();
+        // Some rays are blocked and some are not, so the comparison means something.
+        let n = rays().len();
+        for blocked in [same_as_tree(&spheres), same_as_tree(&triangles)] {
+            assert!(blocked > n / 20 && blocked < n * 9 / 10, "{blocked} of {n}");
+        }
+        // Below the limit too: one sphere, and none.
+        let one = spheres.filtered(|m| m == 2);
+        assert_eq!((one.len(), one.data[0].radius), (1, 0.8));
+        same_as_tree(&one);
+        assert_eq!(same_as_tree(&spheres.filtered(|_| false)), 0);
     }
 }

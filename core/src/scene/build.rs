@@ -8,7 +8,7 @@
 use super::frame::{self, Animation, Keyed};
 use super::instances::{self, PrototypeUse};
 use super::place::Sets;
-use super::{AngleRule, Ao, Fade, Features, Fog, Light, Material, Scene, Settings, Sky};
+use super::{AngleRule, Ao, Casters, Fade, Features, Fog, Light, Material, Scene, Settings, Sky};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
@@ -234,6 +234,7 @@ impl Scene {
             prototypes,
             animation: None,
             budget: b.budget,
+            casters: None,
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
@@ -248,6 +249,7 @@ impl Scene {
             scene.animation = Some(Box::new(animation));
             scene.set_frame(a.value.first)?;
         }
+        scene.casters = Casters::of(&scene);
         Ok(scene)
     }
 }

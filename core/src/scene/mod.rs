@@ -11,6 +11,7 @@ mod build;
 mod frame;
 mod instances;
 mod place;
+mod shadows;
 mod sky;
 mod update;
 
@@ -18,6 +19,7 @@ pub(crate) use build::shadowless_groups;
 pub use build::Prebuilt;
 pub use frame::Animation;
 pub use instances::PrototypeUse;
+pub use shadows::Casters;
 pub use sky::Sky;
 
 use crate::budget::Budget;
@@ -375,6 +377,9 @@ pub struct Scene {
     /// The memory budget the build charged (geometry, BVHs, volumes, texture cache) and the
     /// render charges (images).
     pub budget: Arc<Budget>,
+    /// What shadow rays test when every surface blocks them or lets them through unchanged
+    /// (refreshed with the features).
+    pub casters: Option<Casters>,
 }
 
 impl Scene {
@@ -477,20 +482,18 @@ impl Scene {
         // The box tests' set-up, once for every kind.
         let boxes = BoxRay::new(ray.origin, ray.dir);
         let b = &boxes;
+        if let (Some(casters), true) = (&self.casters, min_weight <= 1.0) {
+            let blocked = casters.blocked(self, ray, b, t_max, c);
+            return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
+        }
         if !self.features.shadow_filters {
             // Opaque world: the first hit anywhere ends the query.
             let clips = &self.clips;
-            let blocked = self
-                .spheres
-                .any_prepared(ray, b, t_max, clips, c, |_, _| true)
-                || (self.triangles.set).any_prepared(ray, b, t_max, clips, c, |_, _| true)
+            let blocked = self.spheres.any_opaque(ray, b, t_max, clips, c)
+                || (self.triangles.set).any_opaque(ray, b, t_max, clips, c)
                 || self.planes.any(ray, t_max, clips, c, |_, _| true)
-                || self
-                    .cones
-                    .any_prepared(ray, b, t_max, clips, c, |_, _| true)
-                || self
-                    .discs
-                    .any_prepared(ray, b, t_max, clips, c, |_, _| true)
+                || self.cones.any_opaque(ray, b, t_max, clips, c)
+                || self.discs.any_opaque(ray, b, t_max, clips, c)
                 || self.customs.any(ray, t_max, clips, c, |_, _| true)
                 || (!self.moving.is_empty()
                     && self

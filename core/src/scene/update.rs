@@ -5,7 +5,7 @@
 //! stage on the description's part, so the scene is what a build would make of it.
 
 use super::build::{self, features, settings, Build};
-use super::Scene;
+use super::{Casters, Scene};
 use crate::error::Error;
 use luxon_formats::{RenderDesc, SceneDesc, Spanned};
 
@@ -98,5 +98,6 @@ impl Scene {
             &self.ao,
             &self.render_volumes,
         );
+        self.casters = Casters::of(self);
     }
 }

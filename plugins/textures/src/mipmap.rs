@@ -155,8 +155,9 @@ pub enum Wrap {
     Mirror,
 }
 
-/// Texel index `i` on an axis of `n` texels under `wrap`.
-#[inline]
+/// Texel index `i` on an axis of `n` texels under `wrap`. Always inlined: a lookup calls it
+/// four times, mostly for the first branch.
+#[inline(always)]
 pub fn wrap_index(i: i64, n: usize, wrap: Wrap) -> usize {
     // Inside the image every rule keeps the index: no division (most lookups).
     if (i as u64) < n as u64 {

@@ -142,6 +142,9 @@ impl Converter {
 
     /// Converts `row` (at least `out.len()` texels of samples) into `out`.
     pub fn row(&self, row: &[u8], out: &mut [[f32; 4]]) {
+        if self.format.sample == Sample::U8 {
+            return self.row_u8(row, out);
+        }
         let s = self.format.sample.bytes();
         let texel = self.format.bytes_per_texel();
         for (raw, o) in row.chunks_exact(texel).zip(out.iter_mut()) {
@@ -170,11 +173,69 @@ impl Converter {
             };
         }
     }
+
+    /// [`Converter::row`] for 8-bit samples (most image maps), the same values (`colour` and
+    /// `alpha` of one byte) read straight from the table, a loop per layout.
+    fn row_u8(&self, row: &[u8], out: &mut [[f32; 4]]) {
+        let t = &self.table;
+        let a = |x: u8| x as f32 / 255.0;
+        match self.format.channels {
+            1 => {
+                for (&l, o) in row.iter().zip(out.iter_mut()) {
+                    let l = t[l as usize];
+                    *o = [l, l, l, 1.0];
+                }
+            }
+            2 => {
+                for (raw, o) in row.chunks_exact(2).zip(out.iter_mut()) {
+                    let l = t[raw[0] as usize];
+                    *o = [l, l, l, a(raw[1])];
+                }
+            }
+            3 => {
+                for (raw, o) in row.chunks_exact(3).zip(out.iter_mut()) {
+                    let c = |i: usize| t[raw[i] as usize];
+                    *o = [c(0), c(1), c(2), 1.0];
+                }
+            }
+            _ => {
+                let n = self.format.channels;
+                for (raw, o) in row.chunks_exact(n).zip(out.iter_mut()) {
+                    let c = |i: usize| t[raw[i] as usize];
+                    *o = [c(0), c(1), c(2), a(raw[3])];
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// 8-bit rows of every layout give each channel's `colour` (alpha: `alpha`), sRGB or not.
+    #[test]
+    fn eight_bit_rows_read_the_table() {
+        let bytes: Vec<u8> = (0..48u32).map(|i| (i * 53 % 256) as u8).collect();
+        for channels in 1..=4 {
+            for srgb in [false, true] {
+                let sample = Sample::U8;
+                let c = Converter::new(RowFormat { sample, channels }, srgb);
+                let mut out = vec![[0.0; 4]; bytes.len() / channels];
+                c.row(&bytes, &mut out);
+                for (raw, o) in bytes.chunks_exact(channels).zip(&out) {
+                    let v = |i: usize| c.colour(&raw[i..=i]);
+                    let want = match channels {
+                        1 => [v(0), v(0), v(0), 1.0],
+                        2 => [v(0), v(0), v(0), c.alpha(&raw[1..2])],
+                        3 => [v(0), v(1), v(2), 1.0],
+                        _ => [v(0), v(1), v(2), c.alpha(&raw[3..4])],
+                    };
+                    assert_eq!(*o, want, "{channels} channels, sRGB {srgb}: {raw:?}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn samples_of_every_layout() {

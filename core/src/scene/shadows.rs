@@ -1,0 +1,96 @@
+//! Shadow rays in a scene whose surfaces each either block light or let it through unchanged:
+//! Tachyon's scenes, opaque surfaces beside the light spheres Tachyon draws, which cast no
+//! shadow. A shadow ray there is blocked or not, whatever the order it meets surfaces in, so
+//! it is asked of the spheres that block only (the light spheres left out at build time, not
+//! passed over one by one on every ray), and of small sets one primitive after another.
+
+use super::Scene;
+use crate::bvh::BoxRay;
+use crate::geometry::sphere::Spheres;
+use crate::geometry::{material_of, Counters};
+use crate::math::Vec3A;
+use crate::ray::Ray;
+
+/// Most spheres copied into [`Casters`] (a few kilobytes, not charged to the memory budget):
+/// more would take a second BVH build for little (a shadow ray rarely comes near a light's
+/// sphere), so those pass the light spheres over one by one as before.
+const MAX_COPIED: usize = 64;
+
+/// What shadow rays test in such a scene.
+pub struct Casters {
+    /// The spheres that block light, in their own BVH (`None`: too many to copy).
+    spheres: Option<Spheres>,
+    /// Per kind (triangles, cones, discs): every primitive blocks, so the kind is asked
+    /// without looking at materials.
+    all_block: [bool; 3],
+}
+
+impl Casters {
+    /// The casters of `scene` when every used material either blocks shadow rays or lets them
+    /// through unchanged, and some used one does the latter (otherwise the general query
+    /// costs no more). Not for an animated scene, whose frames may change a material's shadow.
+    pub(super) fn of(scene: &Scene) -> Option<Casters> {
+        let used = scene.materials.iter().zip(&scene.used_materials);
+        let mut used = used.filter(|(_, u)| **u).map(|(m, _)| m.shadow);
+        if !scene.features.see_through
+            || scene.animation.is_some()
+            || !used.all(|s| s.is_none() || s == Some(Vec3A::ONE))
+        {
+            return None;
+        }
+        let blocks = |packed: u32| {
+            scene.materials[material_of(packed) as usize]
+                .shadow
+                .is_none()
+        };
+        let all = |m: &[u32]| m.iter().all(|&p| blocks(p));
+        Some(Casters {
+            spheres: (scene.spheres.len() <= MAX_COPIED).then(|| scene.spheres.filtered(blocks)),
+            all_block: [
+                all(&scene.triangles.set.material),
+                all(&scene.cones.material),
+                all(&scene.discs.material),
+            ],
+        })
+    }
+
+    /// Whether something blocks `ray` before `t_max` (`boxes`: its box tests' set-up).
+    #[inline]
+    pub(super) fn blocked(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: f32,
+        c: &mut Counters,
+    ) -> bool {
+        let (b, clips) = (boxes, &scene.clips);
+        let blocks = |m: u32, _: u32| scene.materials[m as usize].shadow.is_none();
+        let [triangles, cones, discs] = self.all_block;
+        let tri = &scene.triangles.set;
+        let passes = |m: u32| scene.materials[m as usize].shadow.is_some();
+        let spheres = match &self.spheres {
+            Some(s) => s.any_opaque(ray, b, t_max, clips, c),
+            None => (scene.spheres).any_skipping(ray, b, t_max, clips, c, passes, |_, _| true),
+        };
+        spheres
+            || if triangles {
+                tri.any_opaque(ray, b, t_max, clips, c)
+            } else {
+                tri.any_prepared(ray, b, t_max, clips, c, blocks)
+            }
+            || scene.planes.any(ray, t_max, clips, c, blocks)
+            || if cones {
+                (scene.cones).any_opaque(ray, b, t_max, clips, c)
+            } else {
+                (scene.cones).any_prepared(ray, b, t_max, clips, c, blocks)
+            }
+            || if discs {
+                (scene.discs).any_opaque(ray, b, t_max, clips, c)
+            } else {
+                (scene.discs).any_prepared(ray, b, t_max, clips, c, blocks)
+            }
+            || scene.customs.any(ray, t_max, clips, c, blocks)
+            || (!scene.moving.is_empty() && scene.moving.any(ray, t_max, clips, c, &mut { blocks }))
+    }
+}
