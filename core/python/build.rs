@@ -34,7 +34,7 @@ fn main() {
     let target_dir = root.join("target/python-plugins");
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     // The plugins are built as the extension is: release for a wheel, dev when maturin is
-    // asked for `--profile dev` (CI, where the dev profile's dependencies are built already).
+    // asked for `--profile dev` (as .ci/run does).
     let profile = std::env::var("PROFILE").expect("set by cargo");
     let mut cmd = Command::new(cargo);
     cmd.current_dir(&root)
