@@ -1,0 +1,274 @@
+"""``luxon.Scene``, ``luxon.Context`` and the handles of a scene's lights and objects."""
+
+import os
+import threading
+
+import numpy as np
+
+from . import _luxon
+from ._image import Image
+from ._ron import text as _text, to_ron
+
+_PLUGINS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "plugins")
+
+
+class Context(_luxon.Context):
+    """The plugins Luxon found and the thread pool its loads, builds and renders run on.
+
+    ``Context(threads=0, plugin_path=())``: ``threads`` is the pool's size (0: every CPU this
+    process may use); plugins are searched in ``plugin_path``, then ``$LUXON_PLUGIN_PATH``,
+    then the plugins installed with this package. Most programs never make one: scenes made
+    without a context share :func:`luxon.default_context`.
+
+    ``plugins()`` lists what was found as ``(kind, name, library)``, ``searched()`` the places
+    looked in, ``problems()`` the files that could not be used and why.
+    """
+
+    def __new__(cls, threads=0, plugin_path=()):
+        if isinstance(plugin_path, (str, os.PathLike)):
+            plugin_path = [plugin_path]
+        path = [os.fspath(p) for p in plugin_path]
+        env = os.environ.get("LUXON_PLUGIN_PATH", "")
+        path += [p for p in env.split(os.pathsep) if p]
+        if os.path.isdir(_PLUGINS):
+            path.append(_PLUGINS)
+        return super().__new__(cls, threads, path)
+
+    def __repr__(self):
+        return f"<luxon.Context: {self.threads} threads, {len(self.plugins())} plugins>"
+
+
+_default = None
+_default_lock = threading.Lock()
+
+
+def default_context():
+    """The context of scenes made without one (made at first use: every CPU, the default
+    plugin path)."""
+    global _default
+    with _default_lock:
+        if _default is None:
+            _default = Context()
+        return _default
+
+
+class Light:
+    """A light of a scene (from :meth:`Scene.add_light` or :attr:`Scene.lights`)."""
+
+    __slots__ = ("scene", "id")
+
+    def __init__(self, scene, id):
+        self.scene = scene
+        self.id = id
+
+    def set(self, kind, /, **params):
+        """Replaces the light, as :meth:`Scene.add_light` describes one."""
+        self.scene._set_light_ron(self.id, _light_text(kind, params))
+
+    def remove(self):
+        """Removes the light from its scene; the handle is refused from then on."""
+        self.scene._remove_light(self.id)
+
+    def __eq__(self, other):
+        return isinstance(other, Light) and self.id == other.id
+
+    def __hash__(self):
+        return hash(self.id)
+
+    def __repr__(self):
+        return f"<luxon.Light {self.id!r}>"
+
+
+class Object:
+    """An object of a scene (from :meth:`Scene.add_object` or :attr:`Scene.objects`)."""
+
+    __slots__ = ("scene", "id")
+
+    def __init__(self, scene, id):
+        self.scene = scene
+        self.id = id
+
+    def remove(self):
+        """Removes the object; the next render builds the scene again."""
+        self.scene._remove_object(self.id)
+
+    def __eq__(self, other):
+        return isinstance(other, Object) and self.id == other.id
+
+    def __hash__(self):
+        return hash(self.id)
+
+    def __repr__(self):
+        return f"<luxon.Object {self.id!r}>"
+
+
+def _light_text(kind, params):
+    if not isinstance(kind, str):
+        raise TypeError(f"light kind: expected a str, not {type(kind).__name__}")
+    if not params and "(" in kind:
+        return kind
+    fields = ", ".join(f"{k}: {to_ron(v)}" for k, v in params.items())
+    return f"{kind[:1].upper()}{kind[1:]}({fields})"
+
+
+_UNSET = object()
+
+
+class Scene(_luxon.Scene):
+    """A scene kept between renders: loaded from a file (:func:`luxon.load`) or built in code,
+    changed in place, and rendered to numpy arrays.
+
+    ``Scene(context=None)`` is an empty scene: no camera until :meth:`set_camera`, no lights
+    or objects, the default material, a black background, the default render settings.
+
+    Every setter takes either RON text, exactly as in a scene file, or keyword arguments that
+    are written as RON for you (tuples are vectors, lists are lists, dicts are structs;
+    :class:`luxon.Variant` and :class:`luxon.Ron` cover enums and raw text)::
+
+        s = luxon.Scene()
+        s.set_camera(position=(0, 1, -5), look_at=(0, 0.5, 0), fov=40)
+        s.set_camera("(position: (0, 1, -5), look_at: (0, 0.5, 0), fov: 40)")  # the same
+
+    Errors in that text raise :class:`luxon.SceneError` pointing into it
+    (``<camera>:1:2: unknown field ...``). A render commits the scene first: changing the
+    camera, lights, materials, background, fog or render settings costs microseconds, adding
+    or removing objects builds the scene again once (see :meth:`commit`).
+    """
+
+    def __new__(cls, context=None, _path=None):
+        if context is None:
+            context = default_context()
+        return super().__new__(cls, context, _path)
+
+    # --- camera and settings ------------------------------------------------------------
+
+    def set_camera(self, ron=None, /, **fields):
+        """The camera: ``position``, ``look_at``, and optionally ``up``, ``fov`` (degrees),
+        ``projection``... as the scene files' ``camera:`` field."""
+        self._set_camera_ron(_text(ron, fields, "camera"))
+
+    def set_render(self, ron=None, /, **fields):
+        """The render settings (``samples``, ``max_depth``, ``transparency``...), as the scene
+        files' ``render:`` field. They replace the scene's: a field not given takes its
+        default. The image size is the render's, and ``outputs`` are ignored (use
+        :meth:`save`)."""
+        self._set_render_ron(_text(ron, fields, "render settings"))
+
+    def set_background(self, r, g=None, b=None):
+        """The colour of rays that hit nothing: ``set_background(0.1, 0.2, 0.4)`` or
+        ``set_background((0.1, 0.2, 0.4))`` (linear RGB)."""
+        rgb = tuple(r) if g is None and b is None else (r, g, b)
+        self._set_background([float(c) for c in rgb])
+
+    def set_origin(self, world=None):
+        """Render space's origin in world coordinates (None: the camera's position at the
+        first build). See the Rust API's ``Scene::set_origin``."""
+        self._set_origin(None if world is None else [float(c) for c in world])
+
+    def set_fog(self, ron=_UNSET, /, **fields):
+        """Fog, as the scene files' ``fog:`` field: ``set_fog(mode=luxon.Variant("Exp",
+        density=0.05), color=(0.2, 0.3, 0.6))``; ``set_fog(None)`` clears it."""
+        if ron is None and not fields:
+            return self._set_fog_ron(None)
+        self._set_fog_ron(_text(None if ron is _UNSET else ron, fields, "fog"))
+
+    def set_ambient_occlusion(self, ron=_UNSET, /, **fields):
+        """Ambient occlusion, as the scene files' ``ambient_occlusion:`` field
+        (``samples``, ``distance``, ``intensity``...); ``set_ambient_occlusion(None)`` turns it
+        off."""
+        if ron is None and not fields:
+            return self._set_ambient_occlusion_ron(None)
+        self._set_ambient_occlusion_ron(
+            _text(None if ron is _UNSET else ron, fields, "ambient occlusion")
+        )
+
+    # --- lights, materials, objects -----------------------------------------------------
+
+    def add_light(self, kind, /, **params):
+        """Adds a light and returns its handle: ``add_light("point", position=(4, -4, 6),
+        intensity=0.8)``, or the RON text ``add_light("Point(position: (4, -4, 6))")``.
+        Kinds are the scene files' (``Point``, ``Directional``, ``Spot``...)."""
+        return Light(self, self._add_light_ron(_light_text(kind, params)))
+
+    @property
+    def lights(self):
+        """The scene's lights, in order (a loaded scene's in file order)."""
+        return [Light(self, i) for i in self._lights()]
+
+    def set_material(self, name, ron=None, /, **fields):
+        """Defines or replaces the material ``name`` (``color``, ``diffuse``, ``specular``,
+        ``transmit``, ``texture``...): ``set_material("red", color=(0.8, 0.1, 0.1))``.
+        Returns ``name``, to pass as an object's ``material``."""
+        self._set_material_ron(name, _text(ron, fields, f"material {name!r}"))
+        return name
+
+    def has_material(self, name):
+        """Whether the scene has a material called ``name`` (``default`` always)."""
+        return self._has_material(name)
+
+    def add_object(self, plugin, params=None, /, *, material=None, clip=None, **fields):
+        """Adds an object made by the primitive plugin ``plugin`` (``sphere``, ``spheres``,
+        ``cylinder``, ``plane``, ``mesh``... or any plugin of your own), from its parameters
+        as RON text (``params``, what follows ``params:`` in a scene file), a dict, or keyword
+        arguments: ``add_object("sphere", center=(0, 0.8, 0), radius=0.8,
+        material="red")``. The plugin reads them at the next render or commit, and its errors
+        point into them (``<object 0>:1:9: ...``). Returns the object's handle."""
+        if isinstance(params, dict):
+            if fields:
+                raise TypeError("add_object: give params or keyword arguments, not both")
+            params, fields = None, params
+        return Object(self, self._add_plugin_object(plugin, _text(params, fields, plugin), material, clip))
+
+    @property
+    def objects(self):
+        """The scene's objects made by plugins, in order (imported geometry has no handle)."""
+        return [Object(self, i) for i in self._objects()]
+
+    # --- building, rendering, saving ----------------------------------------------------
+
+    def commit(self):
+        """Brings the built scene up to date now (a render does it anyway) and says what it
+        did: ``{"rebuilt": 0 or 1, "shading": bool, "bvh_seconds": ..., "commit_seconds":
+        ...}``. Useful to build outside a timed render, or to see a plugin's error early."""
+        return self._commit()
+
+    def render(self, width, height, *, samples=None, threads=None, dtype="uint8", progress=None):
+        """Renders the scene at ``width`` x ``height`` and returns an :class:`luxon.Image`, a
+        numpy array of shape ``(height, width, 4)``: ``dtype="uint8"`` (sRGB, the bytes a PNG
+        holds) or ``"float32"`` (linear RGBA, as an EXR holds).
+
+        ``samples``: samples per pixel for this render (default: the scene's setting).
+        ``threads``: render threads (default: the context's pool; 0: every CPU).
+        ``progress``: called as ``progress(done_pixels, total_pixels)`` on this thread about
+        ten times a second and once at the end; if it raises, the render is cancelled and the
+        exception propagates.
+
+        The GIL is released while rendering (other Python threads run), and Ctrl-C
+        (``KeyboardInterrupt``) stops the render within a tile per thread; the scene stays
+        usable. Same pixels, bit for bit, as ``luxon render`` at that size and for any thread
+        count.
+        """
+        image = self._render(width, height, samples, threads, dtype, progress).view(Image)
+        self._last = image
+        return image
+
+    def save(self, path, image=None):
+        """Writes ``image`` (default: the last render) to ``path`` with the writer plugin the
+        extension names (``.png``, ``.exr``, ``.ppm``...)."""
+        if image is None:
+            image = getattr(self, "_last", None)
+            if image is None:
+                raise ValueError("save: nothing rendered yet; give the image or call render first")
+        from . import write_image
+
+        write_image(path, image, context=self.context)
+
+    def to_ron(self):
+        """The scene as a RON scene file (what ``luxon convert`` writes): for a bug report, or
+        to render it with the command line."""
+        return self._to_ron()
+
+    def __repr__(self):
+        return (
+            f"<luxon.Scene: {len(self._lights())} lights, {len(self._objects())} plugin objects>"
+        )

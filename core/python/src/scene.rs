@@ -1,0 +1,234 @@
+//! `luxon._luxon.Scene`: a retained scene ([`luxon::api::Scene`]) edited through RON text,
+//! its lights and objects named by id tokens. `luxon.Scene` (python/luxon/_scene.py) subclasses
+//! it with keyword arguments and the handles users see.
+
+use crate::context::PyContext;
+use crate::errors::{guard, IntoPy};
+use luxon::api::{self, LightId, ObjectId, Renderer, RendererOptions};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+#[pyclass(module = "luxon._luxon", name = "Scene", subclass)]
+pub struct PyScene {
+    pub(crate) context: Py<PyContext>,
+    pub(crate) scene: api::Scene,
+    /// Renderers by thread count (`None`: the context's pool), made on first use.
+    renderers: Vec<(Option<usize>, Arc<Renderer>)>,
+}
+
+/// A light's id in its scene (compared and hashed; `luxon.Light` holds one).
+#[pyclass(module = "luxon._luxon", name = "LightId", frozen, eq, hash)]
+#[derive(PartialEq, Eq, Hash)]
+pub struct PyLightId(pub LightId);
+
+/// An object's id in its scene (compared and hashed; `luxon.Object` holds one).
+#[pyclass(module = "luxon._luxon", name = "ObjectId", frozen, eq, hash)]
+#[derive(PartialEq, Eq, Hash)]
+pub struct PyObjectId(pub ObjectId);
+
+#[pymethods]
+impl PyLightId {
+    fn __repr__(&self) -> String {
+        format!("<{}>", self.0)
+    }
+}
+
+#[pymethods]
+impl PyObjectId {
+    fn __repr__(&self) -> String {
+        format!("<{}>", self.0)
+    }
+}
+
+#[pymethods]
+impl PyScene {
+    /// An empty scene, or with `_path` the scene file loaded (any format Luxon reads).
+    #[new]
+    #[pyo3(signature = (context, _path = None))]
+    fn new(py: Python<'_>, context: Py<PyContext>, _path: Option<PathBuf>) -> PyResult<Self> {
+        guard(|| {
+            let ctx = context.get().ctx.clone();
+            let scene = match _path {
+                Some(path) => py.detach(|| api::Scene::load(&ctx, &path)).py_err()?,
+                None => api::Scene::new(&ctx),
+            };
+            Ok(PyScene {
+                context,
+                scene,
+                renderers: Vec::new(),
+            })
+        })
+    }
+
+    /// The context the scene was made with.
+    #[getter]
+    fn context(&self, py: Python<'_>) -> Py<PyContext> {
+        self.context.clone_ref(py)
+    }
+
+    fn _set_camera_ron(&mut self, text: &str) -> PyResult<()> {
+        guard(|| self.scene.set_camera_ron(text).py_err())
+    }
+
+    fn _set_render_ron(&mut self, text: &str) -> PyResult<()> {
+        guard(|| self.scene.set_render_ron(text).py_err())
+    }
+
+    fn _set_background(&mut self, rgb: [f64; 3]) -> PyResult<()> {
+        guard(|| self.scene.set_background(rgb).py_err())
+    }
+
+    fn _set_origin(&mut self, world: Option<[f64; 3]>) -> PyResult<()> {
+        guard(|| self.scene.set_origin(world).py_err())
+    }
+
+    /// `None` clears the fog.
+    fn _set_fog_ron(&mut self, text: Option<&str>) -> PyResult<()> {
+        guard(|| match text {
+            Some(t) => self.scene.set_fog_ron(t).py_err(),
+            None => self.scene.set_fog(None).py_err(),
+        })
+    }
+
+    /// `None` turns ambient occlusion off.
+    fn _set_ambient_occlusion_ron(&mut self, text: Option<&str>) -> PyResult<()> {
+        guard(|| match text {
+            Some(t) => self.scene.set_ambient_occlusion_ron(t).py_err(),
+            None => self.scene.set_ambient_occlusion(None).py_err(),
+        })
+    }
+
+    fn _add_light_ron(&mut self, text: &str) -> PyResult<PyLightId> {
+        guard(|| self.scene.add_light_ron(text).py_err().map(PyLightId))
+    }
+
+    fn _set_light_ron(&mut self, id: &PyLightId, text: &str) -> PyResult<()> {
+        guard(|| self.scene.set_light_ron(id.0, text).py_err())
+    }
+
+    fn _remove_light(&mut self, id: &PyLightId) -> PyResult<()> {
+        guard(|| self.scene.remove_light(id.0).py_err())
+    }
+
+    fn _lights(&self) -> Vec<PyLightId> {
+        self.scene.lights().into_iter().map(PyLightId).collect()
+    }
+
+    fn _set_material_ron(&mut self, name: &str, text: &str) -> PyResult<()> {
+        guard(|| self.scene.set_material_ron(name, text).py_err().map(|_| ()))
+    }
+
+    fn _has_material(&self, name: &str) -> bool {
+        self.scene.material(name).is_some()
+    }
+
+    #[pyo3(signature = (plugin, params, material = None, clip = None))]
+    fn _add_plugin_object(
+        &mut self,
+        plugin: &str,
+        params: &str,
+        material: Option<&str>,
+        clip: Option<&str>,
+    ) -> PyResult<PyObjectId> {
+        guard(|| {
+            let material = match material {
+                None => None,
+                Some(name) => Some(self.scene.material(name).ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "no material named `{name}` in this scene; define it first with \
+                         scene.set_material(\"{name}\", ...)"
+                    ))
+                })?),
+            };
+            let clip = match clip {
+                None => None,
+                Some(name) => Some(self.scene.clip_group(name).ok_or_else(|| {
+                    PyValueError::new_err(format!("no clip group named `{name}` in this scene"))
+                })?),
+            };
+            let id = self
+                .scene
+                .add_plugin_object(plugin, params, material, clip)
+                .py_err()?;
+            Ok(PyObjectId(id))
+        })
+    }
+
+    fn _remove_object(&mut self, id: &PyObjectId) -> PyResult<()> {
+        guard(|| self.scene.remove(id.0).py_err())
+    }
+
+    fn _objects(&self) -> Vec<PyObjectId> {
+        self.scene.objects().into_iter().map(PyObjectId).collect()
+    }
+
+    fn _to_ron(&self) -> PyResult<String> {
+        guard(|| self.scene.to_ron().py_err())
+    }
+
+    /// The render settings' sample count now.
+    fn _samples(&self) -> u32 {
+        self.scene.desc().render.samples
+    }
+
+    /// Brings the built scene up to date; what it did as a dict.
+    fn _commit<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        guard(|| {
+            let renderer = self.renderer(None)?;
+            let scene = &mut self.scene;
+            let r = py.detach(|| scene.commit(&renderer)).py_err()?;
+            let d = PyDict::new(py);
+            d.set_item("rebuilt", r.rebuilt)?;
+            d.set_item("shading", r.shading)?;
+            d.set_item("bvh_seconds", r.bvh_time.as_secs_f64())?;
+            d.set_item("commit_seconds", r.commit_time.as_secs_f64())?;
+            Ok(d)
+        })
+    }
+
+    /// Renders into a new `(height, width, 4)` array; see `luxon.Scene.render`.
+    #[pyo3(signature = (width, height, samples = None, threads = None, dtype = "uint8", progress = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn _render<'py>(
+        &mut self,
+        py: Python<'py>,
+        width: u32,
+        height: u32,
+        samples: Option<u32>,
+        threads: Option<usize>,
+        dtype: &str,
+        progress: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let renderer = self.renderer(threads)?;
+            crate::render::render(
+                py,
+                &mut self.scene,
+                &renderer,
+                crate::render::Request {
+                    width,
+                    height,
+                    samples,
+                    dtype,
+                    progress,
+                },
+            )
+        })
+    }
+}
+
+impl PyScene {
+    /// The renderer for `threads` (made once per thread count).
+    fn renderer(&mut self, threads: Option<usize>) -> PyResult<Arc<Renderer>> {
+        if let Some((_, r)) = self.renderers.iter().find(|(t, _)| *t == threads) {
+            return Ok(r.clone());
+        }
+        let ctx = self.context.get().ctx.clone();
+        let r = Arc::new(Renderer::new(&ctx, RendererOptions { threads }).py_err()?);
+        self.renderers.push((threads, r.clone()));
+        Ok(r)
+    }
+}
