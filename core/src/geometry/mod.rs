@@ -1,12 +1,14 @@
 //! Native geometry (intersected inline) and custom plugin geometry (called through its table),
 //! each kind in its own BVH, so every traversal loop is monomorphic.
 
+pub mod array_set;
 pub mod cone;
 // Calls into plugin objects.
 #[allow(unsafe_code)]
 pub mod custom;
 pub mod disc;
 pub mod group;
+pub mod objects;
 pub mod plane;
 pub mod set;
 pub mod sphere;
@@ -16,6 +18,15 @@ pub mod triangle;
 
 #[cfg(test)]
 mod props;
+
+#[cfg(test)]
+mod tests {
+    /// A hit is copied on every closer find: the array objects' number took padding only.
+    #[test]
+    fn a_hit_stays_48_bytes() {
+        assert_eq!(std::mem::size_of::<super::Hit>(), 48);
+    }
+}
 
 use crate::math::Vec3A;
 
@@ -73,6 +84,9 @@ pub struct Hit {
     pub kind: Kind,
     /// On a keyed object (in the scene's moving group) rather than in the still geometry.
     pub moving: bool,
+    /// On array object `object - 1` of the scene's [`objects::Objects`] (0: not on one; 16
+    /// bits fit the padding after `kind` and `moving`, so a hit stays 48 bytes).
+    pub object: u16,
     /// The primitive within its kind (64-bit: molecular scenes reach billions of atoms).
     pub index: u64,
     pub b1: f32,
@@ -87,6 +101,7 @@ impl Hit {
             t,
             kind,
             moving: false,
+            object: 0,
             index: index as u64,
             b1: 0.0,
             b2: 0.0,

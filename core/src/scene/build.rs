@@ -228,6 +228,7 @@ impl Scene {
             bvh_time,
             plugin_time,
             moving: Default::default(),
+            objects: Default::default(),
             prototypes,
             animation: None,
             budget: b.budget,

@@ -27,6 +27,7 @@ use crate::geometry::cone::Cones;
 use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
 use crate::geometry::group::Group;
+use crate::geometry::objects::Objects;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
@@ -364,6 +365,9 @@ pub struct Scene {
     pub plugin_time: Duration,
     /// Keyed objects placed at the current frame (empty in a still scene).
     pub moving: Group,
+    /// A retained scene's array objects (read in place from the caller's arrays; empty
+    /// otherwise).
+    pub objects: Objects,
     /// The prototypes with instances, and how each was realised.
     pub prototypes: Vec<PrototypeUse>,
     /// How the scene changes from frame to frame; `None`: a still scene.
@@ -438,6 +442,9 @@ impl Scene {
             self.moving
                 .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
         }
+        if !self.objects.is_empty() {
+            self.objects.intersect(ray, &boxes, &mut t_max, &mut hit, c);
+        }
         hit
     }
 
@@ -449,6 +456,9 @@ impl Scene {
         let uv = |packed: u32| {
             self.features.textures && self.materials[material_of(packed) as usize].reads_uv()
         };
+        if hit.object != 0 {
+            return self.objects.surface(hit, ray, uv);
+        }
         let i = hit.index as usize;
         match hit.kind {
             Kind::Sphere => (self.spheres).surface(hit, ray, uv(self.spheres.material[i])),
@@ -485,7 +495,9 @@ impl Scene {
                 || (!self.moving.is_empty()
                     && self
                         .moving
-                        .any(ray, t_max, &self.clips, c, &mut |_, _| true));
+                        .any(ray, t_max, &self.clips, c, &mut |_, _| true))
+                || (!self.objects.is_empty()
+                    && self.objects.any(ray, b, t_max, c, &mut |_, _| true));
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
         let mut filter = Vec3A::ONE;
@@ -522,6 +534,7 @@ impl Scene {
         if blocked
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
             || (!self.moving.is_empty() && self.moving.any(ray, t_max, &self.clips, c, &mut on_hit))
+            || (!self.objects.is_empty() && self.objects.any(ray, b, t_max, c, &mut on_hit))
         {
             return Vec3A::ZERO;
         }
@@ -547,5 +560,6 @@ impl Scene {
             + self.cones.len()
             + self.discs.len()
             + self.customs.len()
+            + self.objects.len()
     }
 }

@@ -1,0 +1,56 @@
+//! The array objects a retained scene reads from the caller's arrays ([`crate::arrays`]):
+//! [`Spheres`] for now, each checked for its arrays' element types when added and for its
+//! elements' values at every commit that reads them.
+
+use super::ids::MaterialId;
+use crate::arrays::{Array, Elem};
+use crate::error::Error;
+
+/// The radius of every sphere, or one per sphere.
+#[derive(Clone, Debug)]
+pub enum Radius {
+    Const(f64),
+    /// f32 or f64, one per centre.
+    Each(Array),
+}
+
+/// Spheres read in place: centres (f32x3 or f64x3, world coordinates), radii, optional linear
+/// RGB colours (f32x3 or f64x3, ≥ 0; they replace the material's colour), of `material` (`None`:
+/// the default one). Added by [`super::Scene::add_spheres`].
+#[derive(Clone, Debug)]
+pub struct Spheres {
+    pub centers: Array,
+    pub radius: Radius,
+    pub colors: Option<Array>,
+    pub material: Option<MaterialId>,
+}
+
+impl Spheres {
+    /// Spheres of the default material, without colours.
+    pub fn new(centers: Array, radius: Radius) -> Spheres {
+        Spheres {
+            centers,
+            radius,
+            colors: None,
+            material: None,
+        }
+    }
+}
+
+/// Refuses an array whose elements are not of one of the types `allowed`.
+pub(super) fn expect_elem(what: &str, a: &Array, allowed: &[Elem]) -> Result<(), Error> {
+    if allowed.contains(&a.elem()) {
+        return Ok(());
+    }
+    let names: Vec<&str> = allowed.iter().map(|e| e.name()).collect();
+    Err(Error::Api(format!(
+        "{what}: an array of {} elements; expected {}",
+        a.elem(),
+        names.join(" or ")
+    )))
+}
+
+/// Vectors of three numbers (positions, colours).
+pub(super) const VEC3: &[Elem] = &[Elem::F32x3, Elem::F64x3];
+/// Real numbers (radii).
+pub(super) const REAL: &[Elem] = &[Elem::F32, Elem::F64];

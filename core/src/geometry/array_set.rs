@@ -1,0 +1,316 @@
+//! Primitives read in place from the caller's arrays ([`crate::arrays`]): an [`ArraySet`] is a
+//! BVH over the elements a [`Reader`] finds in pinned arrays, with the element order of its
+//! leaves. Nothing is copied: every test reads the element again through its views (checked
+//! against the arrays' lengths; a read past the end is a miss), re-centred exactly as the
+//! stored sets' `push_world` re-centres (f64 value minus the origin, then f32), and runs the
+//! kind's own `Shape` test and surface function, so an array set and a stored set of the same
+//! primitives give the same tree and the same pixels.
+//!
+//! When the arrays' content changes but not their lengths, [`ArraySet::refit`] puts the new
+//! bounds into the tree (leaves keep their elements) and says how much its cost grew.
+
+use super::set::Shape;
+use super::sphere::{self, Sphere};
+use super::{Counters, Hit, Surface};
+use crate::arrays::Pins;
+use crate::bvh::{BoxRay, Bvh};
+use crate::math::{Aabb, DVec3, Vec3A};
+use crate::ray::Ray;
+use rayon::prelude::*;
+
+/// How a kind of primitive is read from pinned arrays (which arrays: the reader knows their
+/// places among the object's pins).
+pub trait Reader: Send + Sync {
+    type Shape: Shape;
+    /// What the primitives are called in messages (`sphere`).
+    const ELEMENT: &'static str;
+    /// Elements in the arrays.
+    fn len(&self, pins: &Pins) -> usize;
+    /// Element `i` in render space, computed as `push_world` computes it; `None` when an array
+    /// is too short for it.
+    fn get(&self, pins: &Pins, i: usize) -> Option<Self::Shape>;
+    /// Whether element `i` is valid (`push_world`'s rules); the message names it.
+    fn check(&self, pins: &Pins, i: usize) -> Result<(), String>;
+    /// Checks that need every array at once (lengths that must agree).
+    fn check_arrays(&self, pins: &Pins) -> Result<(), String>;
+    /// The surface of element `i` at `hit` (`uv`: texture coordinates wanted).
+    fn surface(
+        &self,
+        pins: &Pins,
+        i: usize,
+        hit: &Hit,
+        ray: &Ray,
+        uv: bool,
+        material: u32,
+    ) -> Option<Surface>;
+}
+
+/// A sphere's radius: one for all, or one per sphere from an array.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RadiusRead {
+    Const(f64),
+    /// The pin holding the radii.
+    Each(usize),
+}
+
+/// Spheres: centres from pin 0 (f32x3 or f64x3), radii (a constant or a pin of scalars) and
+/// optional linear RGB colours (a pin of f32x3 or f64x3).
+#[derive(Clone, Copy, Debug)]
+pub struct SphereReader {
+    pub radius: RadiusRead,
+    /// The pin holding the colours.
+    pub colors: Option<usize>,
+    /// Render space's origin in world coordinates.
+    pub offset: DVec3,
+}
+
+impl SphereReader {
+    /// Centre and radius in world coordinates, as given.
+    #[inline(always)]
+    fn world(&self, pins: &Pins, i: usize) -> Option<[f64; 4]> {
+        let c = pins.view(0).vec3(i)?;
+        let r = match self.radius {
+            RadiusRead::Const(r) => r,
+            RadiusRead::Each(k) => pins.view(k).scalar(i)?,
+        };
+        Some([c.x, c.y, c.z, r])
+    }
+}
+
+impl Reader for SphereReader {
+    type Shape = Sphere;
+    const ELEMENT: &'static str = "sphere";
+
+    fn len(&self, pins: &Pins) -> usize {
+        pins.view(0).len()
+    }
+
+    #[inline(always)]
+    fn get(&self, pins: &Pins, i: usize) -> Option<Sphere> {
+        let s = self.world(pins, i)?;
+        Some(Sphere {
+            center: (DVec3::new(s[0], s[1], s[2]) - self.offset).as_vec3(),
+            radius: s[3] as f32,
+        })
+    }
+
+    fn check(&self, pins: &Pins, i: usize) -> Result<(), String> {
+        let Some(s) = self.world(pins, i) else {
+            return Err(format!("sphere {i} cannot be read"));
+        };
+        // The messages of `Set<Sphere>::push_world`.
+        if s.iter().any(|x| !x.is_finite()) {
+            return Err(format!("sphere {i} has a non-finite value {s:?}"));
+        }
+        if s[3] <= 0.0 {
+            return Err(format!(
+                "sphere {i} has radius {}; expected a radius > 0",
+                s[3]
+            ));
+        }
+        if let Some(k) = self.colors {
+            let c = pins.view(k).vec3(i);
+            if !c.is_some_and(|c| c.is_finite() && c.min_element() >= 0.0) {
+                return Err(format!(
+                    "sphere {i} has colour {c:?}; expected finite components >= 0"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn check_arrays(&self, pins: &Pins) -> Result<(), String> {
+        let n = self.len(pins);
+        let mut others = vec![("colours", self.colors)];
+        if let RadiusRead::Each(k) = self.radius {
+            others.push(("radii", Some(k)));
+        }
+        for (what, k) in others {
+            let Some(k) = k else { continue };
+            let m = pins.view(k).len();
+            if m != n {
+                return Err(format!("{m} {what} for {n} centres; give one per centre"));
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn surface(
+        &self,
+        pins: &Pins,
+        i: usize,
+        hit: &Hit,
+        ray: &Ray,
+        uv: bool,
+        material: u32,
+    ) -> Option<Surface> {
+        let mut s = sphere::surface(self.get(pins, i)?, hit.t, ray, uv, material);
+        if let Some(k) = self.colors {
+            s.color = pins.view(k).vec3(i).map(|c| Vec3A::from(c.as_vec3()));
+        }
+        Some(s)
+    }
+}
+
+/// Primitives read through a [`Reader`], in a BVH of their own, all of one material.
+pub struct ArraySet<R> {
+    pub reader: R,
+    /// Leaf slot → element.
+    order: Vec<u64>,
+    bvh: Bvh,
+    /// Packed material (no clip group).
+    material: u32,
+    /// The tree's normalised SAH cost when built.
+    cost_at_build: f32,
+}
+
+/// The first element (lowest index) that fails `check`, and why.
+fn first_error(n: usize, check: impl Fn(usize) -> Result<(), String> + Sync) -> Result<(), String> {
+    let bad = if crate::bvh::serial(n) {
+        (0..n).find(|&i| check(i).is_err())
+    } else {
+        (0..n).into_par_iter().find_first(|&i| check(i).is_err())
+    };
+    match bad {
+        Some(i) => check(i),
+        None => Ok(()),
+    }
+}
+
+impl<R: Reader> ArraySet<R> {
+    /// Checks every element and builds the tree over them.
+    pub fn build(reader: R, pins: &Pins, material: u32) -> Result<ArraySet<R>, String> {
+        reader.check_arrays(pins)?;
+        let n = reader.len(pins);
+        first_error(n, |i| reader.check(pins, i))?;
+        let bound = |i: usize| reader.get(pins, i).map_or(Aabb::EMPTY, |s| s.bounds());
+        let (bvh, order) = Bvh::build_with(n, bound);
+        let cost_at_build = bvh.sah_cost();
+        Ok(ArraySet {
+            reader,
+            order,
+            bvh,
+            material,
+            cost_at_build,
+        })
+    }
+
+    /// Checks every element and puts their new bounds into the tree (the arrays' lengths must
+    /// be those of the build). Returns the refitted tree's cost over its cost when built.
+    pub fn refit(&mut self, pins: &Pins) -> Result<f32, String> {
+        let reader = &self.reader;
+        reader.check_arrays(pins)?;
+        let n = reader.len(pins);
+        if n != self.order.len() {
+            return Err(format!(
+                "{n} {}s where the tree has {}: a refit needs the same count",
+                R::ELEMENT,
+                self.order.len()
+            ));
+        }
+        first_error(n, |i| reader.check(pins, i))?;
+        let order = &self.order;
+        let cost = self.bvh.refit(|slot| {
+            let i = order[slot] as usize;
+            reader.get(pins, i).map_or(Aabb::EMPTY, |s| s.bounds())
+        });
+        Ok(match self.cost_at_build > 0.0 {
+            true => cost / self.cost_at_build,
+            false => 1.0,
+        })
+    }
+
+    /// Elements in the tree.
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
+    }
+
+    /// The packed material of every element.
+    pub fn material(&self) -> u32 {
+        self.material
+    }
+
+    /// Bytes of the tree and the leaf order.
+    pub fn bytes(&self) -> u64 {
+        self.bvh.memory_bytes() + (self.order.capacity() * 8) as u64
+    }
+
+    /// The closest hit before `t_max`, if closer than `hit` (marked as object `object`).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn intersect(
+        &self,
+        pins: &Pins,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        c: &mut Counters,
+        object: u16,
+    ) {
+        if self.order.is_empty() {
+            return;
+        }
+        let prep = R::Shape::prep(ray);
+        *t_max = self.bvh.intersect_ray(
+            boxes,
+            *t_max,
+            #[inline(always)]
+            |slot, tm| {
+                c.tests += 1;
+                let i = self.order[slot] as usize;
+                let (t, b1, b2) = self.reader.get(pins, i)?.hit(ray, &prep, tm)?;
+                let mut h = Hit::new(t, R::Shape::KIND, i);
+                h.b1 = b1;
+                h.b2 = b2;
+                h.object = object;
+                *hit = Some(h);
+                Some(t)
+            },
+        );
+    }
+
+    /// Calls `on_hit(material, crossings)` for the elements the ray crosses in (0, t_max)
+    /// until it returns true; returns whether it did.
+    #[inline]
+    pub fn any(
+        &self,
+        pins: &Pins,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: f32,
+        c: &mut Counters,
+        on_hit: &mut impl FnMut(u32, u32) -> bool,
+    ) -> bool {
+        if self.order.is_empty() {
+            return false;
+        }
+        let prep = R::Shape::prep(ray);
+        let material = super::material_of(self.material);
+        self.bvh.any_ray(
+            boxes,
+            t_max,
+            #[inline(always)]
+            |slot| {
+                c.tests += 1;
+                let i = self.order[slot] as usize;
+                let n = match self.reader.get(pins, i) {
+                    Some(s) => s.crossings(ray, &prep, t_max),
+                    None => 0,
+                };
+                n > 0 && on_hit(material, n)
+            },
+        )
+    }
+
+    /// The surface at a hit on element `hit.index`.
+    pub fn surface(&self, pins: &Pins, hit: &Hit, ray: &Ray, uv: bool) -> Option<Surface> {
+        let material = super::material_of(self.material);
+        (self.reader).surface(pins, hit.index as usize, hit, ray, uv, material)
+    }
+}
