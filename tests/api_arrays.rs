@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use luxon::api::{Context, Radius, Renderer, RendererOptions, Scene, Spheres};
+use luxon::api::{Context, Mesh, Radius, Renderer, RendererOptions, Scene, Spheres};
 use luxon::arrays::{Array, SharedVec};
 use luxon::Error;
 
@@ -353,4 +353,143 @@ fn arrays_are_free_between_renders() {
     assert!(e.contains("being written by this thread"), "{e}");
     drop(w);
     render(&r, &mut s).unwrap();
+}
+
+/// A wavy `g`×`g` grid in the y = 0 plane: positions, normals, colours, uvs (f32) and the two
+/// triangles of every cell (none of zero area).
+#[allow(clippy::type_complexity)]
+fn grid(
+    g: usize,
+) -> (
+    Vec<[f32; 3]>,
+    Vec<[f32; 3]>,
+    Vec<[f32; 3]>,
+    Vec<[f32; 2]>,
+    Vec<[u32; 3]>,
+) {
+    let (mut p, mut n, mut c, mut uv, mut tri) = (vec![], vec![], vec![], vec![], vec![]);
+    for j in 0..g {
+        for i in 0..g {
+            let (u, v) = (i as f32 / (g - 1) as f32, j as f32 / (g - 1) as f32);
+            let h = 0.3 * (u * 6.0).sin() * (v * 5.0).cos();
+            p.push([u * 4.0 - 2.0, h - 1.0, v * 4.0 - 2.0]);
+            n.push([-0.2 * (u * 6.0).cos(), 1.0, 0.15 * (v * 5.0).sin()]);
+            c.push([u, 0.5, 1.0 - v]);
+            uv.push([u, v]);
+        }
+    }
+    for j in 0..g - 1 {
+        for i in 0..g - 1 {
+            let k = (j * g + i) as u32;
+            let g = g as u32;
+            tri.push([k, k + 1, k + g]);
+            tri.push([k + 1, k + g + 1, k + g]);
+        }
+    }
+    (p, n, c, uv, tri)
+}
+
+fn list<const K: usize, T: Copy + std::fmt::Debug>(
+    v: &[[T; K]],
+    f: impl Fn(T) -> String,
+) -> String {
+    let items: Vec<String> = v
+        .iter()
+        .map(|x| format!("({})", x.map(&f).join(", ")))
+        .collect();
+    format!("[{}]", items.join(", "))
+}
+
+#[test]
+fn a_mesh_from_arrays_renders_as_the_mesh_plugin() {
+    let ctx = context();
+    let r = Renderer::new(&ctx, RendererOptions::default()).unwrap();
+    let (p, n, c, uv, tri) = grid(24);
+    let real = |x: f32| format!("{:?}", x as f64);
+    let params = format!(
+        "(positions: {}, indices: {}, normals: {}, colors: {}, uvs: {})",
+        list(&p, real),
+        list(&tri, |i| i.to_string()),
+        list(&n, real),
+        list(&c, real),
+        list(&uv, real),
+    );
+    let (mut plugin, m) = base(&ctx);
+    plugin
+        .add_plugin_object("mesh", &params, Some(m), None)
+        .unwrap();
+    let want = render(&r, &mut plugin).unwrap();
+    assert!(want != render(&r, &mut base(&ctx).0).unwrap(), "the mesh is seen");
+
+    let packed = Mesh {
+        normals: Some(Array::from_vec(n.clone())),
+        colors: Some(Array::from_vec(c.clone())),
+        uvs: Some(Array::from_vec(uv.clone())),
+        ..Mesh::new(
+            Array::from_vec(p.clone()),
+            Some(Array::from_vec(tri.clone())),
+        )
+    };
+    let wide = Mesh {
+        normals: Some(Array::from_vec(widen(&n))),
+        colors: Some(Array::from_vec(widen(&c))),
+        uvs: Some(Array::from_vec(uv.clone())),
+        ..Mesh::new(
+            Array::from_vec(widen(&p)),
+            Some(Array::from_vec(
+                tri.iter().map(|t| t.map(u64::from)).collect::<Vec<_>>(),
+            )),
+        )
+    };
+    for (name, mesh) in [("f32/u32", packed), ("f64/u64", wide)] {
+        let (mut s, m) = base(&ctx);
+        let material = Some(m);
+        s.add_mesh(Mesh { material, ..mesh }).unwrap();
+        assert!(
+            render(&r, &mut s).unwrap() == want,
+            "{name}: the image differs"
+        );
+    }
+
+    // Without indices: every three positions make a triangle.
+    let soup: Vec<[f32; 3]> = tri.iter().flat_map(|t| t.map(|i| p[i as usize])).collect();
+    let (mut s, _) = base(&ctx);
+    s.add_mesh(Mesh::new(Array::from_vec(soup), None)).unwrap();
+    render(&r, &mut s).unwrap();
+    assert_eq!(s.built().unwrap().primitive_count(), tri.len());
+}
+
+#[test]
+fn mesh_vertices_moved_refit_and_new_indices_rebuild() {
+    let ctx = context();
+    let r = Renderer::new(&ctx, RendererOptions::default()).unwrap();
+    let (p, _, _, _, tri) = grid(16);
+    let positions = SharedVec::new(p);
+    let indices = SharedVec::new(tri);
+    let mut s = base(&ctx).0;
+    let mesh = Mesh::new(Array::shared(&positions), Some(Array::shared(&indices)));
+    s.add_mesh(mesh).unwrap();
+    s.commit(&r).unwrap();
+    for v in positions.write().iter_mut() {
+        v[1] += 0.1;
+    }
+    let report = s.commit(&r).unwrap();
+    assert_eq!((report.refitted, report.rebuilt), (1, 0), "{report:?}");
+    indices.write().swap(0, 1);
+    let report = s.commit(&r).unwrap();
+    assert_eq!((report.refitted, report.rebuilt), (0, 1), "{report:?}");
+
+    // A zero-area triangle is kept (never hit): triangle numbers stay those of the caller.
+    let count = indices.len();
+    indices.write()[3] = [5, 5, 6];
+    render(&r, &mut s).unwrap();
+    assert_eq!(s.built().unwrap().primitive_count(), count);
+
+    // An index past the vertices is refused, naming the object, triangle and vertex.
+    indices.write()[7] = [1, 2, 900];
+    let e = s.commit(&r).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "object 0 (mesh): triangle 7 uses vertex 900, but the mesh has 256 vertices"
+    );
 }

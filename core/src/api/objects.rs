@@ -37,6 +37,37 @@ impl Spheres {
     }
 }
 
+/// A triangle mesh read in place: vertex positions (f32x3 or f64x3, world coordinates),
+/// triangles as vertex index triples (u32x3 or u64x3; `None`: every three positions make
+/// one), and optional per-vertex normals (f32x3 or f64x3, any non-zero length), linear RGB
+/// colours (f32x3 or f64x3; they replace the material's colour) and texture coordinates
+/// (f32x2), of `material` (`None`: the default one). Added by [`super::Scene::add_mesh`].
+/// Triangles of zero area are kept (and never hit): a triangle keeps its number whatever its
+/// vertices do.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub positions: Array,
+    pub indices: Option<Array>,
+    pub normals: Option<Array>,
+    pub colors: Option<Array>,
+    pub uvs: Option<Array>,
+    pub material: Option<MaterialId>,
+}
+
+impl Mesh {
+    /// A mesh of the default material, without vertex attributes.
+    pub fn new(positions: Array, indices: Option<Array>) -> Mesh {
+        Mesh {
+            positions,
+            indices,
+            normals: None,
+            colors: None,
+            uvs: None,
+            material: None,
+        }
+    }
+}
+
 /// Refuses an array whose elements are not of one of the types `allowed`.
 pub(super) fn expect_elem(what: &str, a: &Array, allowed: &[Elem]) -> Result<(), Error> {
     if allowed.contains(&a.elem()) {
@@ -52,5 +83,9 @@ pub(super) fn expect_elem(what: &str, a: &Array, allowed: &[Elem]) -> Result<(),
 
 /// Vectors of three numbers (positions, colours).
 pub(super) const VEC3: &[Elem] = &[Elem::F32x3, Elem::F64x3];
+/// Triangles' vertex indices.
+pub(super) const INDEX3: &[Elem] = &[Elem::U32x3, Elem::U64x3];
+/// Texture coordinates.
+pub(super) const UV: &[Elem] = &[Elem::F32x2];
 /// Real numbers (radii).
 pub(super) const REAL: &[Elem] = &[Elem::F32, Elem::F64];

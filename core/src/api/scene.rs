@@ -2,12 +2,12 @@
 //! only as far as the changes since the last one need.
 
 use super::ids::{self, scene_serial, ClipId, LightId, MaterialId, ObjectId, Slots};
-use super::objects::{expect_elem, Radius, Spheres, REAL, VEC3};
+use super::objects::{expect_elem, Mesh, Radius, Spheres, INDEX3, REAL, UV, VEC3};
 use super::{Context, Renderer};
 use crate::arrays::{Array, Pins};
 use crate::budget::Budget;
 use crate::error::Error;
-use crate::geometry::array_set::{RadiusRead, SphereReader};
+use crate::geometry::array_set::{MeshReader, RadiusRead, SphereReader};
 use crate::geometry::objects::{Object, Objects, Outcome, Spec, MAX_OBJECTS};
 use crate::math::DVec3;
 use crate::plugin::{PluginKind, Registry};
@@ -121,6 +121,9 @@ struct ArrayObject {
     spec: Spec,
     material: u32,
 }
+
+/// An array object's arrays, reader and material.
+type ArrayParts = (Vec<Array>, Spec, u32);
 
 fn array_key() -> u64 {
     static NEXT: AtomicU64 = AtomicU64::new(1);
@@ -659,7 +662,36 @@ impl Scene {
     /// their content changed refits the object's BVH; after their count changed, or
     /// [`Scene::set_spheres`] gave other arrays, it builds it again.
     pub fn add_spheres(&mut self, s: Spheres) -> Result<ObjectId, Error> {
-        let (arrays, spec, material) = self.spheres_parts(s)?;
+        let parts = self.spheres_parts(s)?;
+        self.add_array(parts)
+    }
+
+    /// Gives array object `id` (added by [`Scene::add_spheres`]) new spheres: its BVH is
+    /// built again at the next commit.
+    pub fn set_spheres(&mut self, id: ObjectId, s: Spheres) -> Result<(), Error> {
+        let parts = self.spheres_parts(s)?;
+        self.set_array(id, parts)
+    }
+
+    /// Adds a triangle mesh read from arrays (in place, or Luxon's copy: see
+    /// [`crate::arrays`]). The element types are checked now; the values at every commit that
+    /// reads them (an index past the vertices, a non-finite coordinate, are refused naming the
+    /// object, the triangle and the vertex). A commit after the vertices' content changed
+    /// refits the object's BVH; after the indices changed (content or count), or the vertex
+    /// count, or [`Scene::set_mesh`] gave other arrays, it builds it again.
+    pub fn add_mesh(&mut self, m: Mesh) -> Result<ObjectId, Error> {
+        let parts = self.mesh_parts(m)?;
+        self.add_array(parts)
+    }
+
+    /// Gives array object `id` (added by [`Scene::add_mesh`]) a new mesh: its BVH is built
+    /// again at the next commit.
+    pub fn set_mesh(&mut self, id: ObjectId, m: Mesh) -> Result<(), Error> {
+        let parts = self.mesh_parts(m)?;
+        self.set_array(id, parts)
+    }
+
+    fn add_array(&mut self, (arrays, spec, material): ArrayParts) -> Result<ObjectId, Error> {
         if self.arrays.iter().flatten().count() >= MAX_OBJECTS {
             return Err(Error::Api(format!(
                 "a scene holds at most {MAX_OBJECTS} array objects"
@@ -668,7 +700,7 @@ impl Scene {
         let id = self.objects.insert();
         self.arrays.push(Some(ArrayObject {
             key: array_key(),
-            label: format!("{id} (spheres)"),
+            label: format!("{id} ({})", spec.kind()),
             arrays,
             spec,
             material,
@@ -676,19 +708,19 @@ impl Scene {
         Ok(id)
     }
 
-    /// Gives array object `id` (added by [`Scene::add_spheres`]) new spheres: its BVH is
-    /// built again at the next commit.
-    pub fn set_spheres(&mut self, id: ObjectId, s: Spheres) -> Result<(), Error> {
+    fn set_array(
+        &mut self,
+        id: ObjectId,
+        (arrays, spec, material): ArrayParts,
+    ) -> Result<(), Error> {
         let i = self.objects.position(id)?;
-        if !matches!(&self.arrays[i], Some(a) if matches!(a.spec, Spec::Spheres(_))) {
-            return Err(Error::Api(format!(
-                "{id} is not spheres (Scene::add_spheres)"
-            )));
+        let kind = spec.kind();
+        if !matches!(&self.arrays[i], Some(a) if a.spec.kind() == kind) {
+            return Err(Error::Api(format!("{id} is not an array object of {kind}")));
         }
-        let (arrays, spec, material) = self.spheres_parts(s)?;
         self.arrays[i] = Some(ArrayObject {
             key: array_key(),
-            label: format!("{id} (spheres)"),
+            label: format!("{id} ({kind})"),
             arrays,
             spec,
             material,
@@ -696,7 +728,37 @@ impl Scene {
         Ok(())
     }
 
-    fn spheres_parts(&self, s: Spheres) -> Result<(Vec<Array>, Spec, u32), Error> {
+    fn material_index(&self, m: Option<MaterialId>) -> Result<u32, Error> {
+        match m {
+            Some(m) => {
+                self.material_name(m)?;
+                Ok(m.index)
+            }
+            None => Ok(0),
+        }
+    }
+
+    fn mesh_parts(&self, m: Mesh) -> Result<ArrayParts, Error> {
+        expect_elem("mesh positions", &m.positions, VEC3)?;
+        let mut arrays = vec![m.positions];
+        let mut slot = |what: &str, a: Option<Array>, allowed| -> Result<Option<usize>, Error> {
+            let Some(a) = a else { return Ok(None) };
+            expect_elem(what, &a, allowed)?;
+            arrays.push(a);
+            Ok(Some(arrays.len() - 1))
+        };
+        let reader = MeshReader {
+            indices: slot("mesh indices", m.indices, INDEX3)?,
+            normals: slot("mesh normals", m.normals, VEC3)?,
+            colors: slot("mesh colours", m.colors, VEC3)?,
+            uvs: slot("mesh uvs", m.uvs, UV)?,
+            offset: Default::default(),
+        };
+        let material = self.material_index(m.material)?;
+        Ok((arrays, Spec::Mesh(reader), material))
+    }
+
+    fn spheres_parts(&self, s: Spheres) -> Result<ArrayParts, Error> {
         expect_elem("spheres' centres", &s.centers, VEC3)?;
         let mut arrays = vec![s.centers];
         let radius = match s.radius {
@@ -722,13 +784,7 @@ impl Scene {
             }
             None => None,
         };
-        let material = match s.material {
-            Some(m) => {
-                self.material_name(m)?;
-                m.index
-            }
-            None => 0,
-        };
+        let material = self.material_index(s.material)?;
         let reader = SphereReader {
             radius,
             colors,

@@ -11,11 +11,13 @@
 
 use super::set::Shape;
 use super::sphere::{self, Sphere};
+use super::triangle::{self, Triangle, VertexAttr, NO_ATTR};
 use super::{Counters, Hit, Surface};
 use crate::arrays::Pins;
 use crate::bvh::{BoxRay, Bvh};
 use crate::math::{Aabb, DVec3, Vec3A};
 use crate::ray::Ray;
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// How a kind of primitive is read from pinned arrays (which arrays: the reader knows their
@@ -150,6 +152,160 @@ impl Reader for SphereReader {
             s.color = pins.view(k).vec3(i).map(|c| Vec3A::from(c.as_vec3()));
         }
         Some(s)
+    }
+}
+
+/// A triangle mesh: positions from pin 0 (f32x3 or f64x3), triangles as index triples (a pin
+/// of u32x3 or u64x3) or, without one, consecutive triples of positions; optional per-vertex
+/// normals, linear RGB colours (f32x3 or f64x3) and texture coordinates (f32x2). Triangles of
+/// zero area are kept (never hit), so an element is a triangle index whatever the vertices do.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshReader {
+    pub indices: Option<usize>,
+    pub normals: Option<usize>,
+    pub colors: Option<usize>,
+    pub uvs: Option<usize>,
+    /// Render space's origin in world coordinates.
+    pub offset: DVec3,
+}
+
+impl MeshReader {
+    /// Vertices.
+    fn vertices(&self, pins: &Pins) -> usize {
+        pins.view(0).len()
+    }
+
+    /// The vertex indices of triangle `t`.
+    #[inline(always)]
+    fn corners(&self, pins: &Pins, t: usize) -> Option<[u64; 3]> {
+        match self.indices {
+            Some(k) => pins.view(k).index3(t),
+            None => {
+                let first = t.checked_mul(3)? as u64;
+                Some([first, first + 1, first + 2])
+            }
+        }
+    }
+
+    fn has_attrs(&self) -> bool {
+        self.normals.is_some() || self.colors.is_some() || self.uvs.is_some()
+    }
+
+    /// Vertex `v`'s shading attributes, as `Triangles::push_mesh` stores them.
+    fn attr(&self, pins: &Pins, v: usize) -> Option<VertexAttr> {
+        let n = match self.normals {
+            Some(k) => pins.view(k).vec3(v)?.normalize_or_zero().as_vec3(),
+            None => Vec3::ZERO,
+        };
+        let c = match self.colors {
+            Some(k) => {
+                let c = pins.view(k).vec3(v)?;
+                Vec3::new(c.x as f32, c.y as f32, c.z as f32)
+            }
+            None => Vec3::splat(-1.0),
+        };
+        let uv = match self.uvs {
+            Some(k) => pins.view(k).vec2(v)?.map(|x| x as f32),
+            None => [0.0; 2],
+        };
+        Some(VertexAttr { n, c, uv })
+    }
+}
+
+impl Reader for MeshReader {
+    type Shape = Triangle;
+    const ELEMENT: &'static str = "triangle";
+
+    fn len(&self, pins: &Pins) -> usize {
+        match self.indices {
+            Some(k) => pins.view(k).len(),
+            None => self.vertices(pins) / 3,
+        }
+    }
+
+    #[inline(always)]
+    fn get(&self, pins: &Pins, t: usize) -> Option<Triangle> {
+        let c = self.corners(pins, t)?;
+        let p = pins.view(0);
+        let at = |i: u64| -> Option<Vec3> {
+            let v = p.vec3(usize::try_from(i).ok()?)?;
+            Some((v - self.offset).as_vec3())
+        };
+        Some(Triangle {
+            v: [at(c[0])?, at(c[1])?, at(c[2])?],
+            attr: NO_ATTR,
+        })
+    }
+
+    fn check(&self, pins: &Pins, t: usize) -> Result<(), String> {
+        let nv = self.vertices(pins);
+        let Some(c) = self.corners(pins, t) else {
+            return Err(format!("triangle {t} cannot be read"));
+        };
+        for i in c {
+            // The messages of `Triangles::push_mesh`.
+            if i >= nv as u64 {
+                return Err(format!(
+                    "triangle {t} uses vertex {i}, but the mesh has {nv} vertices"
+                ));
+            }
+            let v = i as usize;
+            if !pins.view(0).vec3(v).is_some_and(|p| p.is_finite()) {
+                return Err(format!("vertex {v} has a non-finite coordinate"));
+            }
+            if self.has_attrs() {
+                let finite = self.attr(pins, v).is_some_and(|a| {
+                    a.n.is_finite() && a.c.is_finite() && a.uv.iter().all(|x| x.is_finite())
+                });
+                if !finite {
+                    return Err(format!("vertex {v} has a non-finite normal, colour or uv"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn check_arrays(&self, pins: &Pins) -> Result<(), String> {
+        let nv = self.vertices(pins);
+        if self.indices.is_none() && !nv.is_multiple_of(3) {
+            return Err(format!(
+                "{nv} positions and no indices: the positions are not whole triangles"
+            ));
+        }
+        for (what, k) in [
+            ("normals", self.normals),
+            ("colours", self.colors),
+            ("uvs", self.uvs),
+        ] {
+            let Some(k) = k else { continue };
+            let m = pins.view(k).len();
+            if m != nv {
+                return Err(format!("mesh has {nv} vertices but {m} {what}"));
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn surface(
+        &self,
+        pins: &Pins,
+        t: usize,
+        hit: &Hit,
+        _: &Ray,
+        uv: bool,
+        material: u32,
+    ) -> Option<Surface> {
+        let tri = self.get(pins, t)?;
+        let va = match self.has_attrs() {
+            true => {
+                let c = self.corners(pins, t)?;
+                let at = |i: u64| self.attr(pins, usize::try_from(i).ok()?);
+                Some([at(c[0])?, at(c[1])?, at(c[2])?])
+            }
+            false => None,
+        };
+        Some(triangle::surface(tri.v, va, hit, uv, material))
     }
 }
 

@@ -5,7 +5,7 @@
 //! pinned (held still, writers waiting) from the commit that reads them to the end of the
 //! render after it, and released between renders ([`Objects::unpin`]).
 
-use super::array_set::{ArraySet, SphereReader};
+use super::array_set::{ArraySet, MeshReader, SphereReader};
 use super::{Counters, Hit, Surface};
 use crate::arrays::{Array, Pins};
 use crate::bvh::{BoxRay, REBUILD_RATIO};
@@ -20,6 +20,7 @@ pub const MAX_OBJECTS: usize = u16::MAX as usize;
 #[derive(Clone, Copy, Debug)]
 pub enum Spec {
     Spheres(SphereReader),
+    Mesh(MeshReader),
 }
 
 impl Spec {
@@ -27,6 +28,15 @@ impl Spec {
     pub fn kind(&self) -> &'static str {
         match self {
             Spec::Spheres(_) => "spheres",
+            Spec::Mesh(_) => "mesh",
+        }
+    }
+
+    /// The pin whose change is a change of topology (a mesh's indices): built again.
+    fn topology(&self) -> Option<usize> {
+        match self {
+            Spec::Spheres(_) => None,
+            Spec::Mesh(m) => m.indices,
         }
     }
 
@@ -34,6 +44,7 @@ impl Spec {
     fn at(self, offset: DVec3) -> Spec {
         match self {
             Spec::Spheres(r) => Spec::Spheres(SphereReader { offset, ..r }),
+            Spec::Mesh(r) => Spec::Mesh(MeshReader { offset, ..r }),
         }
     }
 }
@@ -41,6 +52,7 @@ impl Spec {
 /// A built object's primitives.
 enum Shapes {
     Spheres(ArraySet<SphereReader>),
+    Mesh(ArraySet<MeshReader>),
 }
 
 /// What a commit did to an object.
@@ -92,6 +104,7 @@ impl Object {
         let spec = spec.at(offset);
         let shapes = match spec {
             Spec::Spheres(r) => ArraySet::build(r, &pins, material).map(Shapes::Spheres),
+            Spec::Mesh(r) => ArraySet::build(r, &pins, material).map(Shapes::Mesh),
         };
         let shapes = shapes.map_err(|m| Error::Api(format!("{label}: {m}")))?;
         Ok(Object {
@@ -128,7 +141,9 @@ impl Object {
         let pins = Pins::new(&arrays)?;
         let lens: Vec<usize> = (0..arrays.len()).map(|k| pins.view(k).len()).collect();
         let generations: Vec<u64> = (0..arrays.len()).map(|k| pins.generation(k)).collect();
-        if lens != self.lens {
+        let topology = spec.topology();
+        let retopo = topology.is_some_and(|k| generations[k] != self.generations[k]);
+        if lens != self.lens || retopo {
             drop(pins);
             let o = Object::build(key, label, arrays, spec, material, offset)?;
             return Ok((o, Outcome::Built));
@@ -151,6 +166,7 @@ impl Object {
         }
         let ratio = match &mut object.shapes {
             Shapes::Spheres(s) => s.refit(&pins),
+            Shapes::Mesh(m) => m.refit(&pins),
         };
         let ratio = ratio.map_err(|m| Error::Api(format!("{}: {m}", object.label)))?;
         if ratio > REBUILD_RATIO {
@@ -175,6 +191,7 @@ impl Object {
     pub fn len(&self) -> usize {
         match &self.shapes {
             Shapes::Spheres(s) => s.len(),
+            Shapes::Mesh(m) => m.len(),
         }
     }
 
@@ -195,6 +212,7 @@ impl Object {
     pub fn bytes(&self) -> u64 {
         match &self.shapes {
             Shapes::Spheres(s) => s.bytes(),
+            Shapes::Mesh(m) => m.bytes(),
         }
     }
 }
@@ -253,6 +271,7 @@ impl Objects {
             let object = (k + 1) as u16;
             match &o.shapes {
                 Shapes::Spheres(s) => s.intersect(pins, ray, boxes, t_max, hit, c, object),
+                Shapes::Mesh(m) => m.intersect(pins, ray, boxes, t_max, hit, c, object),
             }
         }
     }
@@ -272,6 +291,7 @@ impl Objects {
             let Some(pins) = &o.pins else { return false };
             match &o.shapes {
                 Shapes::Spheres(s) => s.any(pins, ray, boxes, t_max, c, on_hit),
+                Shapes::Mesh(m) => m.any(pins, ray, boxes, t_max, c, on_hit),
             }
         })
     }
@@ -283,6 +303,7 @@ impl Objects {
         let m = super::material_of(o.material);
         let found = o.pins.as_ref().and_then(|pins| match &o.shapes {
             Shapes::Spheres(s) => s.surface(pins, hit, ray, uv(m)),
+            Shapes::Mesh(t) => t.surface(pins, hit, ray, uv(m)),
         });
         // Only if the arrays were released between the hit and its shading (never in a
         // render): a flat surface facing the ray.

@@ -339,64 +339,78 @@ impl Triangles {
     pub fn surface(&self, hit: &Hit, textured: bool) -> Surface {
         let i = hit.index as usize;
         let Triangle { v, attr: a } = self.set.data[i];
-        let (b1, b2) = (hit.b1, hit.b2);
-        let b0 = 1.0 - b1 - b2;
-        let (p0, p1, p2) = (Vec3A::from(v[0]), Vec3A::from(v[1]), Vec3A::from(v[2]));
-        let p = b0 * p0 + b1 * p1 + b2 * p2;
-        let p_error = gamma(7) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
-        // Normal in f64: thin triangles lose the direction of the cross product in f32.
-        let e1 = DVec3::from(v[1]) - DVec3::from(v[0]);
-        let e2 = DVec3::from(v[2]) - DVec3::from(v[0]);
-        let ng = Vec3A::from(e1.cross(e2).normalize_or_zero().as_vec3());
-        let mut s = Surface {
-            p,
-            p_error,
-            ng,
-            ns: ng,
-            uv: [b1, b2],
-            material: material_of(self.set.material[i]),
-            color: None,
-            uv_scale: 0.0,
-            lift: Vec3A::ZERO,
-        };
-        if a != NO_ATTR {
+        let va = (a != NO_ATTR).then(|| {
             let c = self.corners[a as usize];
-            let va = c.map(|i| self.vertex_attrs[i as usize]);
-            if va[0].n != Vec3::ZERO {
-                let n = b0 * Vec3A::from(va[0].n)
-                    + b1 * Vec3A::from(va[1].n)
-                    + b2 * Vec3A::from(va[2].n);
-                let n = n.normalize_or_zero();
-                if n != Vec3A::ZERO {
-                    let side = if n.dot(ng) < 0.0 { -1.0 } else { 1.0 };
-                    s.ns = side * n;
-                    s.lift = terminator_lift(p, [p0, p1, p2], [b0, b1, b2], &va, side);
-                }
-            }
-            if va[0].c.x >= 0.0 {
-                s.color = Some(
-                    b0 * Vec3A::from(va[0].c)
-                        + b1 * Vec3A::from(va[1].c)
-                        + b2 * Vec3A::from(va[2].c),
-                );
-            }
-            if !textured {
-                return s;
-            }
-            let uv = |k: usize| b0 * va[0].uv[k] + b1 * va[1].uv[k] + b2 * va[2].uv[k];
-            s.uv = [uv(0), uv(1)];
-            let (d1, d2) = (
-                [va[1].uv[0] - va[0].uv[0], va[1].uv[1] - va[0].uv[1]],
-                [va[2].uv[0] - va[0].uv[0], va[2].uv[1] - va[0].uv[1]],
-            );
-            let uv_area = (d1[0] * d2[1] - d1[1] * d2[0]).abs();
-            let world_area = e1.cross(e2).length() as f32;
-            if world_area > 0.0 {
-                s.uv_scale = (uv_area / world_area).sqrt();
+            c.map(|i| self.vertex_attrs[i as usize])
+        });
+        surface(v, va, hit, textured, material_of(self.set.material[i]))
+    }
+}
+
+/// The surface of the triangle with vertices `v` (and vertex attributes `va`, when its mesh
+/// has them) at `hit`, of `material`; `textured`: the scene looks textures up, so the uvs and
+/// their scale are needed. Shared by the stored meshes and those read from the caller's arrays
+/// (`array_set`), so both shade alike.
+#[inline]
+pub fn surface(
+    v: [Vec3; 3],
+    va: Option<[VertexAttr; 3]>,
+    hit: &Hit,
+    textured: bool,
+    material: u32,
+) -> Surface {
+    let (b1, b2) = (hit.b1, hit.b2);
+    let b0 = 1.0 - b1 - b2;
+    let (p0, p1, p2) = (Vec3A::from(v[0]), Vec3A::from(v[1]), Vec3A::from(v[2]));
+    let p = b0 * p0 + b1 * p1 + b2 * p2;
+    let p_error = gamma(7) * ((b0 * p0).abs() + (b1 * p1).abs() + (b2 * p2).abs());
+    // Normal in f64: thin triangles lose the direction of the cross product in f32.
+    let e1 = DVec3::from(v[1]) - DVec3::from(v[0]);
+    let e2 = DVec3::from(v[2]) - DVec3::from(v[0]);
+    let ng = Vec3A::from(e1.cross(e2).normalize_or_zero().as_vec3());
+    let mut s = Surface {
+        p,
+        p_error,
+        ng,
+        ns: ng,
+        uv: [b1, b2],
+        material,
+        color: None,
+        uv_scale: 0.0,
+        lift: Vec3A::ZERO,
+    };
+    if let Some(va) = va {
+        if va[0].n != Vec3::ZERO {
+            let n =
+                b0 * Vec3A::from(va[0].n) + b1 * Vec3A::from(va[1].n) + b2 * Vec3A::from(va[2].n);
+            let n = n.normalize_or_zero();
+            if n != Vec3A::ZERO {
+                let side = if n.dot(ng) < 0.0 { -1.0 } else { 1.0 };
+                s.ns = side * n;
+                s.lift = terminator_lift(p, [p0, p1, p2], [b0, b1, b2], &va, side);
             }
         }
-        s
+        if va[0].c.x >= 0.0 {
+            s.color = Some(
+                b0 * Vec3A::from(va[0].c) + b1 * Vec3A::from(va[1].c) + b2 * Vec3A::from(va[2].c),
+            );
+        }
+        if !textured {
+            return s;
+        }
+        let uv = |k: usize| b0 * va[0].uv[k] + b1 * va[1].uv[k] + b2 * va[2].uv[k];
+        s.uv = [uv(0), uv(1)];
+        let (d1, d2) = (
+            [va[1].uv[0] - va[0].uv[0], va[1].uv[1] - va[0].uv[1]],
+            [va[2].uv[0] - va[0].uv[0], va[2].uv[1] - va[0].uv[1]],
+        );
+        let uv_area = (d1[0] * d2[1] - d1[1] * d2[0]).abs();
+        let world_area = e1.cross(e2).length() as f32;
+        if world_area > 0.0 {
+            s.uv_scale = (uv_area / world_area).sqrt();
+        }
     }
+    s
 }
 
 /// Hanika's shadow-terminator fix ("Hacking the shadow terminator", Ray Tracing Gems II): the
