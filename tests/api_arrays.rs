@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use luxon::api::{Context, Mesh, Radius, Renderer, RendererOptions, Scene, Spheres};
+use luxon::api::{Context, Cylinders, Mesh, Radius, Renderer, RendererOptions, Scene, Spheres};
 use luxon::arrays::{Array, SharedVec};
 use luxon::Error;
 
@@ -419,7 +419,10 @@ fn a_mesh_from_arrays_renders_as_the_mesh_plugin() {
         .add_plugin_object("mesh", &params, Some(m), None)
         .unwrap();
     let want = render(&r, &mut plugin).unwrap();
-    assert!(want != render(&r, &mut base(&ctx).0).unwrap(), "the mesh is seen");
+    assert!(
+        want != render(&r, &mut base(&ctx).0).unwrap(),
+        "the mesh is seen"
+    );
 
     let packed = Mesh {
         normals: Some(Array::from_vec(n.clone())),
@@ -491,5 +494,83 @@ fn mesh_vertices_moved_refit_and_new_indices_rebuild() {
     assert_eq!(
         e,
         "object 0 (mesh): triangle 7 uses vertex 900, but the mesh has 256 vertices"
+    );
+}
+
+#[test]
+fn capped_cylinders_from_arrays_render_as_the_cylinder_plugin() {
+    let ctx = context();
+    let r = Renderer::new(&ctx, RendererOptions::default()).unwrap();
+    let (bases, radii) = cloud(60, 21);
+    let (dirs, _) = cloud(60, 22);
+    let apexes: Vec<[f32; 3]> = bases
+        .iter()
+        .zip(&dirs)
+        .map(|(b, d)| [b[0] + d[0] * 0.3, b[1] + d[1] * 0.3, b[2] + d[2] * 0.3])
+        .collect();
+    let radii: Vec<f32> = radii.iter().map(|r| r * 1.5).collect();
+    let real = |x: f32| format!("{:?}", x as f64);
+    // A stored scene of cones and discs only has no shadows (its build counts neither as
+    // geometry); a ground sphere in both makes the comparison one with shadows.
+    const GROUND: &str = "(center: (0, -30, 0), radius: 27)";
+    let (mut plugin, m) = base(&ctx);
+    plugin
+        .add_plugin_object("sphere", GROUND, None, None)
+        .unwrap();
+    for i in 0..bases.len() {
+        let params = format!(
+            "(base: ({}, {}, {}), apex: ({}, {}, {}), radius: {})",
+            real(bases[i][0]),
+            real(bases[i][1]),
+            real(bases[i][2]),
+            real(apexes[i][0]),
+            real(apexes[i][1]),
+            real(apexes[i][2]),
+            real(radii[i]),
+        );
+        plugin
+            .add_plugin_object("cylinder", &params, Some(m), None)
+            .unwrap();
+    }
+    let want = render(&r, &mut plugin).unwrap();
+    assert!(
+        want != render(&r, &mut base(&ctx).0).unwrap(),
+        "the cylinders are seen"
+    );
+
+    let (mut s, m) = base(&ctx);
+    let cylinders = Cylinders {
+        material: Some(m),
+        ..Cylinders::new(
+            Array::from_vec(widen(&bases)),
+            Array::from_vec(apexes.clone()),
+            Radius::Each(Array::from_vec(radii.clone())),
+        )
+    };
+    s.add_plugin_object("sphere", GROUND, None, None).unwrap();
+    let id = s.add_cylinders(cylinders).unwrap();
+    assert!(render(&r, &mut s).unwrap() == want, "the image differs");
+    assert_eq!(s.built().unwrap().primitive_count(), 1 + 3 * bases.len());
+
+    // Open ones have no caps; a base at its apex is refused.
+    let mut open = Cylinders::new(
+        Array::from_vec(bases.clone()),
+        Array::from_vec(apexes),
+        Radius::Const(0.1),
+    );
+    open.caps = false;
+    s.set_cylinders(id, open).unwrap();
+    render(&r, &mut s).unwrap();
+    assert_eq!(s.built().unwrap().primitive_count(), 1 + bases.len());
+    let same = Cylinders::new(
+        Array::from_vec(bases.clone()),
+        Array::from_vec(bases),
+        Radius::Const(0.1),
+    );
+    s.set_cylinders(id, same).unwrap();
+    let e = s.commit(&r).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "object 1 (cylinders): cylinder 0 has the same base and apex centre; expected a length > 0"
     );
 }

@@ -180,6 +180,6 @@ pub use crate::render::{Progress, RenderStats};
 pub use context::{Context, ContextOptions};
 pub use ids::{ClipId, LightId, MaterialId, ObjectId};
 pub use image::write_image;
-pub use objects::{Mesh, Radius, Spheres};
+pub use objects::{Cylinders, Mesh, Radius, Spheres};
 pub use renderer::{Cancel, Renderer, RendererOptions};
 pub use scene::{CommitReport, Scene};

@@ -37,6 +37,31 @@ impl Spheres {
     }
 }
 
+/// Cylinders read in place: base and apex centres (f32x3 or f64x3, world coordinates), radii,
+/// closed at both ends by discs when `caps` (as the `cylinder` plugin makes them), of
+/// `material` (`None`: the default one). Added by [`super::Scene::add_cylinders`].
+#[derive(Clone, Debug)]
+pub struct Cylinders {
+    pub bases: Array,
+    pub apexes: Array,
+    pub radius: Radius,
+    pub caps: bool,
+    pub material: Option<MaterialId>,
+}
+
+impl Cylinders {
+    /// Capped cylinders of the default material.
+    pub fn new(bases: Array, apexes: Array, radius: Radius) -> Cylinders {
+        Cylinders {
+            bases,
+            apexes,
+            radius,
+            caps: true,
+            material: None,
+        }
+    }
+}
+
 /// A triangle mesh read in place: vertex positions (f32x3 or f64x3, world coordinates),
 /// triangles as vertex index triples (u32x3 or u64x3; `None`: every three positions make
 /// one), and optional per-vertex normals (f32x3 or f64x3, any non-zero length), linear RGB

@@ -2,12 +2,12 @@
 //! only as far as the changes since the last one need.
 
 use super::ids::{self, scene_serial, ClipId, LightId, MaterialId, ObjectId, Slots};
-use super::objects::{expect_elem, Mesh, Radius, Spheres, INDEX3, REAL, UV, VEC3};
+use super::objects::{expect_elem, Cylinders, Mesh, Radius, Spheres, INDEX3, REAL, UV, VEC3};
 use super::{Context, Renderer};
 use crate::arrays::{Array, Pins};
 use crate::budget::Budget;
 use crate::error::Error;
-use crate::geometry::array_set::{MeshReader, RadiusRead, SphereReader};
+use crate::geometry::array_set::{CylinderReader, MeshReader, RadiusRead, SphereReader};
 use crate::geometry::objects::{Object, Objects, Outcome, Spec, MAX_OBJECTS};
 use crate::math::DVec3;
 use crate::plugin::{PluginKind, Registry};
@@ -120,6 +120,25 @@ struct ArrayObject {
     arrays: Vec<Array>,
     spec: Spec,
     material: u32,
+}
+
+/// A radius as a reader takes it (a radius array joins `arrays`); `whose`: `spheres'`.
+fn radius_read(whose: &str, r: Radius, arrays: &mut Vec<Array>) -> Result<RadiusRead, Error> {
+    match r {
+        Radius::Const(r) => {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::Api(format!(
+                    "{whose} radius {r}; expected a radius > 0"
+                )));
+            }
+            Ok(RadiusRead::Const(r))
+        }
+        Radius::Each(a) => {
+            expect_elem(&format!("{whose} radii"), &a, REAL)?;
+            arrays.push(a);
+            Ok(RadiusRead::Each(arrays.len() - 1))
+        }
+    }
 }
 
 /// An array object's arrays, reader and material.
@@ -691,6 +710,44 @@ impl Scene {
         self.set_array(id, parts)
     }
 
+    /// Adds cylinders read from arrays (in place, or Luxon's copy: see [`crate::arrays`]),
+    /// capped as [`Cylinders::caps`] says. The element types are checked now; the values at
+    /// every commit that reads them (a NaN coordinate, a radius ≤ 0 or a base at its apex are
+    /// refused, naming the object and the cylinder). A commit after their content changed
+    /// refits the object's BVHs; after their count changed, or [`Scene::set_cylinders`] gave
+    /// other arrays, it builds them again.
+    pub fn add_cylinders(&mut self, c: Cylinders) -> Result<ObjectId, Error> {
+        let parts = self.cylinders_parts(c)?;
+        self.add_array(parts)
+    }
+
+    /// Gives array object `id` (added by [`Scene::add_cylinders`]) new cylinders: its BVHs
+    /// are built again at the next commit.
+    pub fn set_cylinders(&mut self, id: ObjectId, c: Cylinders) -> Result<(), Error> {
+        let parts = self.cylinders_parts(c)?;
+        self.set_array(id, parts)
+    }
+
+    fn cylinders_parts(&self, c: Cylinders) -> Result<ArrayParts, Error> {
+        expect_elem("cylinders' bases", &c.bases, VEC3)?;
+        expect_elem("cylinders' apexes", &c.apexes, VEC3)?;
+        let mut arrays = vec![c.bases, c.apexes];
+        let radius = radius_read("cylinders'", c.radius, &mut arrays)?;
+        let reader = CylinderReader {
+            radius,
+            offset: Default::default(),
+        };
+        let material = self.material_index(c.material)?;
+        Ok((
+            arrays,
+            Spec::Cylinders {
+                reader,
+                caps: c.caps,
+            },
+            material,
+        ))
+    }
+
     fn add_array(&mut self, (arrays, spec, material): ArrayParts) -> Result<ObjectId, Error> {
         if self.arrays.iter().flatten().count() >= MAX_OBJECTS {
             return Err(Error::Api(format!(
@@ -761,21 +818,7 @@ impl Scene {
     fn spheres_parts(&self, s: Spheres) -> Result<ArrayParts, Error> {
         expect_elem("spheres' centres", &s.centers, VEC3)?;
         let mut arrays = vec![s.centers];
-        let radius = match s.radius {
-            Radius::Const(r) => {
-                if !(r.is_finite() && r > 0.0) {
-                    return Err(Error::Api(format!(
-                        "spheres' radius {r}; expected a radius > 0"
-                    )));
-                }
-                RadiusRead::Const(r)
-            }
-            Radius::Each(a) => {
-                expect_elem("spheres' radii", &a, REAL)?;
-                arrays.push(a);
-                RadiusRead::Each(arrays.len() - 1)
-            }
-        };
+        let radius = radius_read("spheres'", s.radius, &mut arrays)?;
         let colors = match s.colors {
             Some(a) => {
                 expect_elem("spheres' colours", &a, VEC3)?;

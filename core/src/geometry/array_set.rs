@@ -9,6 +9,8 @@
 //! When the arrays' content changes but not their lengths, [`ArraySet::refit`] puts the new
 //! bounds into the tree (leaves keep their elements) and says how much its cost grew.
 
+use super::cone::{self, Cone};
+use super::disc::{self, Disc};
 use super::set::Shape;
 use super::sphere::{self, Sphere};
 use super::triangle::{self, Triangle, VertexAttr, NO_ATTR};
@@ -152,6 +154,166 @@ impl Reader for SphereReader {
             s.color = pins.view(k).vec3(i).map(|c| Vec3A::from(c.as_vec3()));
         }
         Some(s)
+    }
+}
+
+/// Cylinders: base centres from pin 0 and apex centres from pin 1 (f32x3 or f64x3), radii (a
+/// constant or a pin of scalars), as the `cylinder` plugin gives them.
+#[derive(Clone, Copy, Debug)]
+pub struct CylinderReader {
+    pub radius: RadiusRead,
+    /// Render space's origin in world coordinates.
+    pub offset: DVec3,
+}
+
+impl CylinderReader {
+    /// Base, apex and radius of cylinder `i` in world coordinates.
+    #[inline(always)]
+    fn world(&self, pins: &Pins, i: usize) -> Option<(DVec3, DVec3, f64)> {
+        let b = pins.view(0).vec3(i)?;
+        let a = pins.view(1).vec3(i)?;
+        let r = match self.radius {
+            RadiusRead::Const(r) => r,
+            RadiusRead::Each(k) => pins.view(k).scalar(i)?,
+        };
+        Some((b, a, r))
+    }
+
+    fn count(&self, pins: &Pins) -> usize {
+        pins.view(0).len()
+    }
+
+    fn check_cylinder(&self, pins: &Pins, i: usize) -> Result<(), String> {
+        let Some((b, a, r)) = self.world(pins, i) else {
+            return Err(format!("cylinder {i} cannot be read"));
+        };
+        if !(b.is_finite() && a.is_finite() && r.is_finite()) {
+            let v = [b.x, b.y, b.z, a.x, a.y, a.z, r];
+            return Err(format!("cylinder {i} has a non-finite value {v:?}"));
+        }
+        if r <= 0.0 {
+            return Err(format!(
+                "cylinder {i} has radius {r}; expected a radius > 0"
+            ));
+        }
+        if (b - self.offset).as_vec3() == (a - self.offset).as_vec3() || a == b {
+            return Err(format!(
+                "cylinder {i} has the same base and apex centre; expected a length > 0"
+            ));
+        }
+        Ok(())
+    }
+
+    fn check_all(&self, pins: &Pins) -> Result<(), String> {
+        let n = self.count(pins);
+        let mut others = vec![("apexes", Some(1))];
+        if let RadiusRead::Each(k) = self.radius {
+            others.push(("radii", Some(k)));
+        }
+        for (what, k) in others {
+            let Some(k) = k else { continue };
+            let m = pins.view(k).len();
+            if m != n {
+                return Err(format!("{m} {what} for {n} bases; give one per base"));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Reader for CylinderReader {
+    type Shape = Cone;
+    const ELEMENT: &'static str = "cylinder";
+
+    fn len(&self, pins: &Pins) -> usize {
+        self.count(pins)
+    }
+
+    #[inline(always)]
+    fn get(&self, pins: &Pins, i: usize) -> Option<Cone> {
+        let (b, a, r) = self.world(pins, i)?;
+        // `Set<Cone>::push_world`'s conversions.
+        Some(Cone {
+            base: (b - self.offset).as_vec3(),
+            base_radius: r as f32,
+            apex: (a - self.offset).as_vec3(),
+            apex_radius: r as f32,
+        })
+    }
+
+    fn check(&self, pins: &Pins, i: usize) -> Result<(), String> {
+        self.check_cylinder(pins, i)
+    }
+
+    fn check_arrays(&self, pins: &Pins) -> Result<(), String> {
+        self.check_all(pins)
+    }
+
+    #[inline]
+    fn surface(
+        &self,
+        pins: &Pins,
+        i: usize,
+        hit: &Hit,
+        ray: &Ray,
+        uv: bool,
+        material: u32,
+    ) -> Option<Surface> {
+        Some(cone::surface(&self.get(pins, i)?, hit.t, ray, uv, material))
+    }
+}
+
+/// The caps of cylinders (the same arrays as a [`CylinderReader`]'s): element `2i` closes
+/// cylinder `i` at its base, `2i + 1` at its apex, as the `cylinder` plugin gives them.
+#[derive(Clone, Copy, Debug)]
+pub struct CapReader(pub CylinderReader);
+
+impl Reader for CapReader {
+    type Shape = Disc;
+    const ELEMENT: &'static str = "cap";
+
+    fn len(&self, pins: &Pins) -> usize {
+        2 * self.0.count(pins)
+    }
+
+    #[inline(always)]
+    fn get(&self, pins: &Pins, j: usize) -> Option<Disc> {
+        let (b, a, r) = self.0.world(pins, j / 2)?;
+        // The plugin's axis (its own arithmetic, in f64), then `Set<Disc>::push_world`'s.
+        let axis = [a.x - b.x, a.y - b.y, a.z - b.z];
+        let h = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let w = axis.map(|x| x * (1.0 / h));
+        let (center, n) = match j % 2 {
+            0 => (b, DVec3::new(-w[0], -w[1], -w[2])),
+            _ => (a, DVec3::from(w)),
+        };
+        Some(Disc {
+            center: (center - self.0.offset).as_vec3(),
+            normal: n.normalize().as_vec3(),
+            inner: 0.0,
+            outer: r as f32,
+        })
+    }
+
+    fn check(&self, pins: &Pins, j: usize) -> Result<(), String> {
+        self.0.check_cylinder(pins, j / 2)
+    }
+
+    fn check_arrays(&self, pins: &Pins) -> Result<(), String> {
+        self.0.check_all(pins)
+    }
+
+    #[inline]
+    fn surface(
+        &self,
+        pins: &Pins,
+        j: usize,
+        hit: &Hit,
+        ray: &Ray,
+        uv: bool,
+        material: u32,
+    ) -> Option<Surface> {
+        Some(disc::surface(&self.get(pins, j)?, hit.t, ray, uv, material))
     }
 }
 

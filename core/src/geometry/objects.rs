@@ -5,7 +5,8 @@
 //! pinned (held still, writers waiting) from the commit that reads them to the end of the
 //! render after it, and released between renders ([`Objects::unpin`]).
 
-use super::array_set::{ArraySet, MeshReader, SphereReader};
+use super::array_set::{ArraySet, CapReader, CylinderReader, MeshReader, SphereReader};
+use super::Kind;
 use super::{Counters, Hit, Surface};
 use crate::arrays::{Array, Pins};
 use crate::bvh::{BoxRay, REBUILD_RATIO};
@@ -21,6 +22,11 @@ pub const MAX_OBJECTS: usize = u16::MAX as usize;
 pub enum Spec {
     Spheres(SphereReader),
     Mesh(MeshReader),
+    /// Cylinders, capped at both ends when `caps`.
+    Cylinders {
+        reader: CylinderReader,
+        caps: bool,
+    },
 }
 
 impl Spec {
@@ -29,13 +35,14 @@ impl Spec {
         match self {
             Spec::Spheres(_) => "spheres",
             Spec::Mesh(_) => "mesh",
+            Spec::Cylinders { .. } => "cylinders",
         }
     }
 
     /// The pin whose change is a change of topology (a mesh's indices): built again.
     fn topology(&self) -> Option<usize> {
         match self {
-            Spec::Spheres(_) => None,
+            Spec::Spheres(_) | Spec::Cylinders { .. } => None,
             Spec::Mesh(m) => m.indices,
         }
     }
@@ -45,6 +52,10 @@ impl Spec {
         match self {
             Spec::Spheres(r) => Spec::Spheres(SphereReader { offset, ..r }),
             Spec::Mesh(r) => Spec::Mesh(MeshReader { offset, ..r }),
+            Spec::Cylinders { reader, caps } => Spec::Cylinders {
+                reader: CylinderReader { offset, ..reader },
+                caps,
+            },
         }
     }
 }
@@ -53,6 +64,8 @@ impl Spec {
 enum Shapes {
     Spheres(ArraySet<SphereReader>),
     Mesh(ArraySet<MeshReader>),
+    /// The tubes, then their caps (tested in that order, as the stored cones and discs are).
+    Cylinders(ArraySet<CylinderReader>, Option<ArraySet<CapReader>>),
 }
 
 /// What a commit did to an object.
@@ -105,6 +118,14 @@ impl Object {
         let shapes = match spec {
             Spec::Spheres(r) => ArraySet::build(r, &pins, material).map(Shapes::Spheres),
             Spec::Mesh(r) => ArraySet::build(r, &pins, material).map(Shapes::Mesh),
+            Spec::Cylinders { reader, caps } => {
+                ArraySet::build(reader, &pins, material).and_then(|tubes| {
+                    let caps = caps
+                        .then(|| ArraySet::build(CapReader(reader), &pins, material))
+                        .transpose()?;
+                    Ok(Shapes::Cylinders(tubes, caps))
+                })
+            }
         };
         let shapes = shapes.map_err(|m| Error::Api(format!("{label}: {m}")))?;
         Ok(Object {
@@ -167,6 +188,10 @@ impl Object {
         let ratio = match &mut object.shapes {
             Shapes::Spheres(s) => s.refit(&pins),
             Shapes::Mesh(m) => m.refit(&pins),
+            Shapes::Cylinders(tubes, caps) => tubes.refit(&pins).and_then(|a| match caps {
+                Some(c) => Ok(a.max(c.refit(&pins)?)),
+                None => Ok(a),
+            }),
         };
         let ratio = ratio.map_err(|m| Error::Api(format!("{}: {m}", object.label)))?;
         if ratio > REBUILD_RATIO {
@@ -192,6 +217,7 @@ impl Object {
         match &self.shapes {
             Shapes::Spheres(s) => s.len(),
             Shapes::Mesh(m) => m.len(),
+            Shapes::Cylinders(tubes, caps) => tubes.len() + caps.as_ref().map_or(0, |c| c.len()),
         }
     }
 
@@ -213,6 +239,9 @@ impl Object {
         match &self.shapes {
             Shapes::Spheres(s) => s.bytes(),
             Shapes::Mesh(m) => m.bytes(),
+            Shapes::Cylinders(tubes, caps) => {
+                tubes.bytes() + caps.as_ref().map_or(0, |c| c.bytes())
+            }
         }
     }
 }
@@ -272,6 +301,12 @@ impl Objects {
             match &o.shapes {
                 Shapes::Spheres(s) => s.intersect(pins, ray, boxes, t_max, hit, c, object),
                 Shapes::Mesh(m) => m.intersect(pins, ray, boxes, t_max, hit, c, object),
+                Shapes::Cylinders(tubes, caps) => {
+                    tubes.intersect(pins, ray, boxes, t_max, hit, c, object);
+                    if let Some(caps) = caps {
+                        caps.intersect(pins, ray, boxes, t_max, hit, c, object);
+                    }
+                }
             }
         }
     }
@@ -292,6 +327,12 @@ impl Objects {
             match &o.shapes {
                 Shapes::Spheres(s) => s.any(pins, ray, boxes, t_max, c, on_hit),
                 Shapes::Mesh(m) => m.any(pins, ray, boxes, t_max, c, on_hit),
+                Shapes::Cylinders(tubes, caps) => {
+                    tubes.any(pins, ray, boxes, t_max, c, on_hit)
+                        || caps
+                            .as_ref()
+                            .is_some_and(|caps| caps.any(pins, ray, boxes, t_max, c, on_hit))
+                }
             }
         })
     }
@@ -304,6 +345,10 @@ impl Objects {
         let found = o.pins.as_ref().and_then(|pins| match &o.shapes {
             Shapes::Spheres(s) => s.surface(pins, hit, ray, uv(m)),
             Shapes::Mesh(t) => t.surface(pins, hit, ray, uv(m)),
+            Shapes::Cylinders(tubes, caps) => match (hit.kind, caps) {
+                (Kind::Disc, Some(caps)) => caps.surface(pins, hit, ray, uv(m)),
+                _ => tubes.surface(pins, hit, ray, uv(m)),
+            },
         });
         // Only if the arrays were released between the hit and its shading (never in a
         // render): a flat surface facing the ray.
