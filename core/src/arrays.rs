@@ -156,9 +156,10 @@ pub trait Source: Send + Sync + 'static + sealed::Source {
     }
 }
 
-/// A guard kept alive by a [`Pinned`].
-trait Held {}
-impl<T> Held for T {}
+/// A guard kept alive by a [`Pinned`]: sendable, so pins can be held by a scene that moves
+/// between threads (the guards only count readers, see [`GateHold`]).
+trait Held: Send + Sync {}
+impl<T: Send + Sync> Held for T {}
 
 /// An array held still: its memory is neither written nor freed until this drops.
 pub struct Pinned<'a> {
@@ -220,6 +221,63 @@ impl<'a> Pinned<'a> {
     /// The generation of the content held.
     pub fn generation(&self) -> u64 {
         self.generation
+    }
+}
+
+// SAFETY: a pin only reads its memory, which is not written or freed while it lives
+// (`Pinned::new`'s contract), and its guard is `Send + Sync` (`Held`); so it may be moved to and
+// shared by any thread.
+unsafe impl Send for Pinned<'_> {}
+// SAFETY: as for `Send`.
+unsafe impl Sync for Pinned<'_> {}
+
+/// Arrays pinned together, for as long as this lives (a commit and the render after it): it
+/// holds clones of the arrays, so it borrows nothing and can be kept by a built scene.
+pub struct Pins {
+    // Dropped before the arrays whose sources they borrow.
+    pinned: Vec<Pinned<'static>>,
+    arrays: Vec<Array>,
+}
+
+impl Pins {
+    /// Pins every array (fails as [`Array::pin`] does; those pinned already are released).
+    pub fn new(arrays: &[Array]) -> Result<Pins, Error> {
+        let arrays = arrays.to_vec();
+        let mut pinned = Vec::with_capacity(arrays.len());
+        for a in &arrays {
+            let pin = a.pin()?;
+            // SAFETY: the pin borrows `a`'s source, an `Arc` whose clone `arrays` keeps (the
+            // source does not move when `arrays` does) and which outlives `pinned` (declared
+            // first, so dropped first); no `Pinned<'static>` leaves this struct (only views
+            // borrowing `self`).
+            pinned.push(unsafe { std::mem::transmute::<Pinned<'_>, Pinned<'static>>(pin) });
+        }
+        Ok(Pins { pinned, arrays })
+    }
+
+    /// A view of the `k`-th array (an empty one past the last).
+    #[inline]
+    pub fn view(&self, k: usize) -> View<'_> {
+        match self.pinned.get(k) {
+            Some(p) => p.view(),
+            None => View {
+                base: std::ptr::null(),
+                len: 0,
+                stride: 0,
+                elem: Elem::U8,
+                _pin: PhantomData,
+            },
+        }
+    }
+
+    /// The generation of the `k`-th array's content held (0 past the last).
+    pub fn generation(&self, k: usize) -> u64 {
+        self.pinned.get(k).map_or(0, Pinned::generation)
+    }
+
+    /// The arrays pinned, in order.
+    pub fn arrays(&self) -> &[Array] {
+        &self.arrays
     }
 }
 
@@ -493,6 +551,30 @@ impl<T> Drop for SharedRead<'_, T> {
     }
 }
 
+impl<'a, T> SharedRead<'a, T> {
+    /// Keeps the vector read (writers held off) without its lock's guard, which may not
+    /// leave its thread: the gate's reader count alone keeps writers off.
+    fn into_hold(mut self) -> GateHold<'a, T> {
+        self.data = None;
+        let hold = GateHold(self.shared);
+        std::mem::forget(self);
+        hold
+    }
+}
+
+/// A reader counted at a [`Shared`] vector's gate (writers wait until it drops). Its memory
+/// stays put: every writer (and `replace`) passes the gate first.
+struct GateHold<'a, T>(&'a Shared<T>);
+
+impl<T> Drop for GateHold<'_, T> {
+    fn drop(&mut self) {
+        let mut gate = self.0.gate();
+        gate.readers -= 1;
+        drop(gate);
+        self.0.changed.notify_all();
+    }
+}
+
 /// The vector being written: a mutable slice (never the `Vec`, so the buffer cannot move while
 /// pins may know where it is). Dropping it gives the vector a new generation.
 pub struct SharedWrite<'a, T> {
@@ -548,7 +630,7 @@ impl<T: Element> Source for Shared<T> {
                 size_of::<T>(),
                 T::ELEM,
                 generation,
-                Some(Box::new(read)),
+                Some(Box::new(read.into_hold())),
             )
         })
     }
@@ -643,7 +725,7 @@ impl<P: Send + Sync + 'static, F: Element> Source for Field<P, F> {
                 size_of::<P>(),
                 F::ELEM,
                 generation,
-                Some(Box::new(read)),
+                Some(Box::new(read.into_hold())),
             )
         })
     }

@@ -124,10 +124,53 @@
 //! std::fs::write("dump.ron", scene.to_ron()?)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! ## Arrays read in place
+//!
+//! A simulation hands its arrays over once ([`crate::arrays`]: a shared vector, a field of a
+//! vector of structs, Luxon's copy, or memory of its own from C) and Luxon reads them where
+//! they are at every commit and render, holding writers off meanwhile. After the data moved,
+//! a commit refits the object's BVH; when the count changed, or the refitted tree became
+//! more than [`crate::bvh::REBUILD_RATIO`] times as costly as a fresh one, it builds it again
+//! ([`CommitReport`] counts both). Array objects are tested after the scene's other geometry;
+//! [`Scene::to_ron`] does not write them.
+//!
+//! ```
+//! use luxon::api::{Context, ContextOptions, Radius, Renderer, RendererOptions, Scene, Spheres};
+//! use luxon::arrays::{Array, SharedVec};
+//! let ctx = Context::new(ContextOptions { threads: 2, ..Default::default() })?;
+//! let renderer = Renderer::new(&ctx, RendererOptions::default())?;
+//! let mut scene = Scene::new(&ctx);
+//! scene.set_camera_ron("(position: (0, 0, 8), look_at: (0, 0, 0))")?;
+//! scene.add_light_ron("Point(position: (5, 5, 10))")?;
+//!
+//! // The simulation's particles, shared with Luxon: positions read in place.
+//! #[derive(Clone, Copy)]
+//! struct Particle { pos: [f64; 3], vel: [f64; 3] }
+//! let particles = SharedVec::new(
+//!     (0..100)
+//!         .map(|i| Particle { pos: [(i % 10) as f64 - 4.5, (i / 10) as f64 - 4.5, 0.0], vel: [0.0, 0.0, 0.1] })
+//!         .collect::<Vec<_>>(),
+//! );
+//! let centers = Array::field(&particles, |p: &Particle| &p.pos)?;
+//! scene.add_spheres(Spheres::new(centers, Radius::Const(0.3)))?;
+//! assert_eq!(scene.commit(&renderer)?.rebuilt, 2); // the scene, and the spheres' BVH
+//!
+//! // A step of the simulation: the guard marks the array modified when it drops.
+//! for p in particles.write().iter_mut() {
+//!     for k in 0..3 {
+//!         p.pos[k] += p.vel[k];
+//!     }
+//! }
+//! let report = scene.commit(&renderer)?;
+//! assert_eq!((report.refitted, report.rebuilt), (1, 0));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 mod context;
 pub mod ids;
 mod image;
+mod objects;
 mod renderer;
 mod scene;
 
@@ -137,5 +180,6 @@ pub use crate::render::{Progress, RenderStats};
 pub use context::{Context, ContextOptions};
 pub use ids::{ClipId, LightId, MaterialId, ObjectId};
 pub use image::write_image;
+pub use objects::{Cylinders, Mesh, Radius, Spheres};
 pub use renderer::{Cancel, Renderer, RendererOptions};
 pub use scene::{CommitReport, Scene};

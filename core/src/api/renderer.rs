@@ -77,14 +77,16 @@ impl Renderer {
         target.check().map_err(Error::Target)?;
         scene.set_size(target.width, target.height);
         self.start();
-        scene.commit(self)?;
-        let rendered = render_into(
-            scene.committed()?,
-            &self.pool,
-            target,
-            &self.cancel,
-            progress,
-        );
+        let rendered = scene.commit_pinned(self).and_then(|_| {
+            render_into(
+                scene.committed()?,
+                &self.pool,
+                target,
+                &self.cancel,
+                progress,
+            )
+        });
+        scene.unpin();
         if rendered.is_err() {
             scene.after_failure();
         }
@@ -95,12 +97,14 @@ impl Renderer {
     /// process, handing each finished chunk of pixels to `sink` (from the render threads).
     pub fn render_chunks(&self, scene: &mut Scene, sink: Sink) -> Result<RankStats, Error> {
         self.start();
-        scene.commit(self)?;
         let options = RunOptions {
             cancel: &self.cancel,
             depth: false,
         };
-        let rendered = render_local(scene.committed()?, &self.pool, options, sink);
+        let rendered = scene
+            .commit_pinned(self)
+            .and_then(|_| render_local(scene.committed()?, &self.pool, options, sink));
+        scene.unpin();
         if rendered.is_err() {
             scene.after_failure();
         }
@@ -122,9 +126,11 @@ impl Renderer {
         sink: Sink,
     ) -> Result<crate::schedule::cluster::Rendered, Error> {
         self.start();
-        scene.commit(self)?;
-        let built = scene.committed()?;
-        Ok(cluster.render(built, &self.pool, threads, gather, keep, sink))
+        let rendered = scene.commit_pinned(self).and_then(|_| {
+            Ok(cluster.render(scene.committed()?, &self.pool, threads, gather, keep, sink))
+        });
+        scene.unpin();
+        rendered
     }
 
     /// A render starts: a cancel meant for an earlier one is forgotten.

@@ -2,9 +2,13 @@
 //! only as far as the changes since the last one need.
 
 use super::ids::{self, scene_serial, ClipId, LightId, MaterialId, ObjectId, Slots};
+use super::objects::{expect_elem, Cylinders, Mesh, Radius, Spheres, INDEX3, REAL, UV, VEC3};
 use super::{Context, Renderer};
+use crate::arrays::{Array, Pins};
 use crate::budget::Budget;
 use crate::error::Error;
+use crate::geometry::array_set::{CylinderReader, MeshReader, RadiusRead, SphereReader};
+use crate::geometry::objects::{Object, Objects, Outcome, Spec, MAX_OBJECTS};
 use crate::math::DVec3;
 use crate::plugin::{PluginKind, Registry};
 use crate::scene::{shadowless_groups, Prebuilt, Scene as Built};
@@ -12,17 +16,27 @@ use luxon_formats::{
     fragment, AoDesc, BackgroundDesc, CameraDesc, FogDesc, LightDesc, MaterialDesc, ObjectDesc,
     Origin, PluginCall, Projection, RenderDesc, SceneDesc, Spanned,
 };
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// What a commit did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CommitReport {
-    /// Geometry builds (all of the scene's objects stored and their BVHs built): 1 when the
-    /// commit built the scene, 0 when it only took new settings, camera, background, lights,
-    /// materials, fog or ambient occlusion.
+    /// Geometry builds: 1 when the commit built the scene (its plugin objects and imported
+    /// geometry stored and their BVHs built), plus one per array object whose BVH it built
+    /// (new, given new arrays or counts, or degraded); 0 when it only took new settings,
+    /// camera, background, lights, materials, fog or ambient occlusion, or refitted.
     pub rebuilt: u32,
+    /// Array objects whose content changed but not their counts: their BVHs were refitted.
+    pub refitted: u32,
+    /// Array objects refitted whose tree's cost then exceeded [`crate::bvh::REBUILD_RATIO`] times its cost
+    /// when built, so built again (also counted in `rebuilt`).
+    pub degraded: u32,
+    /// The largest ratio of a refitted tree's cost to its cost when built (0: no refit).
+    pub worst_ratio: f32,
     /// The commit took new lights, materials, fog or ambient occlusion into the built scene
     /// without building it again (no geometry touched).
     pub shading: bool,
@@ -86,11 +100,53 @@ pub struct Scene {
     serial: u32,
     lights: Slots<ids::Light>,
     objects: Slots<ids::Object>,
+    /// Per object, in the order of `objects`: an array object's description, `None` for a
+    /// plugin object (the description's `objects`, in the same order).
+    arrays: Vec<Option<ArrayObject>>,
     /// The materials of the imported groups that cast no shadow (the build's copies of them
     /// depend on it), taken before a frozen scene's groups are consumed.
     shadowless: Vec<Option<Spanned<String>>>,
     /// [`Scene::new`]'s scene has no camera until one is set.
     has_camera: bool,
+}
+
+/// An array object as the caller described it.
+#[derive(Clone)]
+struct ArrayObject {
+    /// Changes when the object is given new arrays: its built form is then built again.
+    key: u64,
+    /// `object 2 (spheres)`.
+    label: String,
+    arrays: Vec<Array>,
+    spec: Spec,
+    material: u32,
+}
+
+/// A radius as a reader takes it (a radius array joins `arrays`); `whose`: `spheres'`.
+fn radius_read(whose: &str, r: Radius, arrays: &mut Vec<Array>) -> Result<RadiusRead, Error> {
+    match r {
+        Radius::Const(r) => {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(Error::Api(format!(
+                    "{whose} radius {r}; expected a radius > 0"
+                )));
+            }
+            Ok(RadiusRead::Const(r))
+        }
+        Radius::Each(a) => {
+            expect_elem(&format!("{whose} radii"), &a, REAL)?;
+            arrays.push(a);
+            Ok(RadiusRead::Each(arrays.len() - 1))
+        }
+    }
+}
+
+/// An array object's arrays, reader and material.
+type ArrayParts = (Vec<Array>, Spec, u32);
+
+fn array_key() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 /// What the next commit must redo besides the camera and settings.
@@ -186,6 +242,7 @@ impl Scene {
             size: (desc.render.width, desc.render.height),
             lights: Slots::new(serial, desc.lights.len()),
             objects: Slots::new(serial, desc.objects.len()),
+            arrays: vec![None; desc.objects.len()],
             shadowless: shadowless_groups(&desc),
             desc,
             registry: ctx.registry.clone(),
@@ -592,6 +649,7 @@ impl Scene {
             shadows: true,
         };
         self.desc.objects.push(Spanned { value: object, at });
+        self.arrays.push(None);
         self.dirty.build = true;
         Ok(id)
     }
@@ -600,13 +658,182 @@ impl Scene {
     /// again. An animated scene's objects cannot be removed (its animation refers to them by
     /// their place).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), Error> {
-        self.objects.position(id)?;
+        let i = self.objects.position(id)?;
+        if self.arrays[i].is_some() {
+            // An array object: dropped from the built scene at the next commit, no build.
+            self.objects.remove(id)?;
+            self.arrays.remove(i);
+            return Ok(());
+        }
         self.objects_can_change()?;
         self.not_animated("objects")?;
         let i = self.objects.remove(id)?;
-        self.desc.objects.remove(i);
+        self.arrays.remove(i);
+        let plugin = i - self.arrays[..i].iter().filter(|a| a.is_some()).count();
+        self.desc.objects.remove(plugin);
         self.dirty.build = true;
         Ok(())
+    }
+
+    /// Adds spheres read from arrays (in place, or Luxon's copy: see [`crate::arrays`]). The
+    /// element types are checked now; the values at every commit that reads them (a NaN
+    /// centre or a radius ≤ 0 is refused, naming the object and the sphere). A commit after
+    /// their content changed refits the object's BVH; after their count changed, or
+    /// [`Scene::set_spheres`] gave other arrays, it builds it again.
+    pub fn add_spheres(&mut self, s: Spheres) -> Result<ObjectId, Error> {
+        let parts = self.spheres_parts(s)?;
+        self.add_array(parts)
+    }
+
+    /// Gives array object `id` (added by [`Scene::add_spheres`]) new spheres: its BVH is
+    /// built again at the next commit.
+    pub fn set_spheres(&mut self, id: ObjectId, s: Spheres) -> Result<(), Error> {
+        let parts = self.spheres_parts(s)?;
+        self.set_array(id, parts)
+    }
+
+    /// Adds a triangle mesh read from arrays (in place, or Luxon's copy: see
+    /// [`crate::arrays`]). The element types are checked now; the values at every commit that
+    /// reads them (an index past the vertices, a non-finite coordinate, are refused naming the
+    /// object, the triangle and the vertex). A commit after the vertices' content changed
+    /// refits the object's BVH; after the indices changed (content or count), or the vertex
+    /// count, or [`Scene::set_mesh`] gave other arrays, it builds it again.
+    pub fn add_mesh(&mut self, m: Mesh) -> Result<ObjectId, Error> {
+        let parts = self.mesh_parts(m)?;
+        self.add_array(parts)
+    }
+
+    /// Gives array object `id` (added by [`Scene::add_mesh`]) a new mesh: its BVH is built
+    /// again at the next commit.
+    pub fn set_mesh(&mut self, id: ObjectId, m: Mesh) -> Result<(), Error> {
+        let parts = self.mesh_parts(m)?;
+        self.set_array(id, parts)
+    }
+
+    /// Adds cylinders read from arrays (in place, or Luxon's copy: see [`crate::arrays`]),
+    /// capped as [`Cylinders::caps`] says. The element types are checked now; the values at
+    /// every commit that reads them (a NaN coordinate, a radius ≤ 0 or a base at its apex are
+    /// refused, naming the object and the cylinder). A commit after their content changed
+    /// refits the object's BVHs; after their count changed, or [`Scene::set_cylinders`] gave
+    /// other arrays, it builds them again.
+    pub fn add_cylinders(&mut self, c: Cylinders) -> Result<ObjectId, Error> {
+        let parts = self.cylinders_parts(c)?;
+        self.add_array(parts)
+    }
+
+    /// Gives array object `id` (added by [`Scene::add_cylinders`]) new cylinders: its BVHs
+    /// are built again at the next commit.
+    pub fn set_cylinders(&mut self, id: ObjectId, c: Cylinders) -> Result<(), Error> {
+        let parts = self.cylinders_parts(c)?;
+        self.set_array(id, parts)
+    }
+
+    fn cylinders_parts(&self, c: Cylinders) -> Result<ArrayParts, Error> {
+        expect_elem("cylinders' bases", &c.bases, VEC3)?;
+        expect_elem("cylinders' apexes", &c.apexes, VEC3)?;
+        let mut arrays = vec![c.bases, c.apexes];
+        let radius = radius_read("cylinders'", c.radius, &mut arrays)?;
+        let reader = CylinderReader {
+            radius,
+            offset: Default::default(),
+        };
+        let material = self.material_index(c.material)?;
+        Ok((
+            arrays,
+            Spec::Cylinders {
+                reader,
+                caps: c.caps,
+            },
+            material,
+        ))
+    }
+
+    fn add_array(&mut self, (arrays, spec, material): ArrayParts) -> Result<ObjectId, Error> {
+        if self.arrays.iter().flatten().count() >= MAX_OBJECTS {
+            return Err(Error::Api(format!(
+                "a scene holds at most {MAX_OBJECTS} array objects"
+            )));
+        }
+        let id = self.objects.insert();
+        self.arrays.push(Some(ArrayObject {
+            key: array_key(),
+            label: format!("{id} ({})", spec.kind()),
+            arrays,
+            spec,
+            material,
+        }));
+        Ok(id)
+    }
+
+    fn set_array(
+        &mut self,
+        id: ObjectId,
+        (arrays, spec, material): ArrayParts,
+    ) -> Result<(), Error> {
+        let i = self.objects.position(id)?;
+        let kind = spec.kind();
+        if !matches!(&self.arrays[i], Some(a) if a.spec.kind() == kind) {
+            return Err(Error::Api(format!("{id} is not an array object of {kind}")));
+        }
+        self.arrays[i] = Some(ArrayObject {
+            key: array_key(),
+            label: format!("{id} ({kind})"),
+            arrays,
+            spec,
+            material,
+        });
+        Ok(())
+    }
+
+    fn material_index(&self, m: Option<MaterialId>) -> Result<u32, Error> {
+        match m {
+            Some(m) => {
+                self.material_name(m)?;
+                Ok(m.index)
+            }
+            None => Ok(0),
+        }
+    }
+
+    fn mesh_parts(&self, m: Mesh) -> Result<ArrayParts, Error> {
+        expect_elem("mesh positions", &m.positions, VEC3)?;
+        let mut arrays = vec![m.positions];
+        let mut slot = |what: &str, a: Option<Array>, allowed| -> Result<Option<usize>, Error> {
+            let Some(a) = a else { return Ok(None) };
+            expect_elem(what, &a, allowed)?;
+            arrays.push(a);
+            Ok(Some(arrays.len() - 1))
+        };
+        let reader = MeshReader {
+            indices: slot("mesh indices", m.indices, INDEX3)?,
+            normals: slot("mesh normals", m.normals, VEC3)?,
+            colors: slot("mesh colours", m.colors, VEC3)?,
+            uvs: slot("mesh uvs", m.uvs, UV)?,
+            offset: Default::default(),
+        };
+        let material = self.material_index(m.material)?;
+        Ok((arrays, Spec::Mesh(reader), material))
+    }
+
+    fn spheres_parts(&self, s: Spheres) -> Result<ArrayParts, Error> {
+        expect_elem("spheres' centres", &s.centers, VEC3)?;
+        let mut arrays = vec![s.centers];
+        let radius = radius_read("spheres'", s.radius, &mut arrays)?;
+        let colors = match s.colors {
+            Some(a) => {
+                expect_elem("spheres' colours", &a, VEC3)?;
+                arrays.push(a);
+                Some(arrays.len() - 1)
+            }
+            None => None,
+        };
+        let material = self.material_index(s.material)?;
+        let reader = SphereReader {
+            radius,
+            colors,
+            offset: Default::default(),
+        };
+        Ok((arrays, Spec::Spheres(reader), material))
     }
 
     fn objects_can_change(&self) -> Result<(), Error> {
@@ -633,11 +860,87 @@ impl Scene {
     /// there is none yet or it is out of date (objects, origin, the settings a build reads),
     /// else only what changed among the settings, camera, background, lights, materials, fog
     /// and ambient occlusion. A scene without a camera ([`Scene::new`]) is refused.
+    ///
+    /// Array objects are read (their arrays pinned: writers wait) during the commit only, and
+    /// their BVHs refitted or built again as [`CommitReport`] tells.
     pub fn commit(&mut self, on: &Renderer) -> Result<CommitReport, Error> {
+        let report = self.commit_pinned(on);
+        self.unpin();
+        report
+    }
+
+    /// [`Scene::commit`], leaving the array objects' arrays pinned for a render: call
+    /// [`Scene::unpin`] after it.
+    pub(super) fn commit_pinned(&mut self, on: &Renderer) -> Result<CommitReport, Error> {
         let t0 = Instant::now();
-        let mut report = on.pool.install(|| self.commit_here())?;
+        // Pinned on this thread first: one that is writing an array is refused here (on the
+        // pool's threads its pin would wait for itself), and no write starts meanwhile.
+        let held = self
+            .arrays
+            .iter()
+            .flatten()
+            .map(|a| Pins::new(&a.arrays))
+            .collect::<Result<Vec<Pins>, Error>>()?;
+        let report = on.pool.install(|| self.commit_here());
+        drop(held);
+        let mut report = report?;
         report.commit_time = t0.elapsed();
         Ok(report)
+    }
+
+    /// Releases the array objects' arrays (after a render): the caller may write them.
+    pub(super) fn unpin(&mut self) {
+        if let Some(b) = self.built.as_mut() {
+            b.objects.unpin();
+        }
+    }
+
+    /// Brings the built array objects up to date with their descriptions (in the built
+    /// scene's render space): kept, refitted or built again, as `report` then says.
+    fn commit_arrays(
+        arrays: &[Option<ArrayObject>],
+        previous: Vec<Object>,
+        built: &mut Built,
+        render: &RenderDesc,
+        report: &mut CommitReport,
+    ) -> Result<(), Error> {
+        if previous.is_empty() && arrays.iter().all(Option::is_none) {
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let offset = built.world_offset;
+        let mut previous: HashMap<u64, Object> = previous.into_iter().map(|o| (o.key, o)).collect();
+        let mut list = Vec::new();
+        for a in arrays.iter().flatten() {
+            let (object, outcome) = match previous.remove(&a.key) {
+                Some(o) => o.update(offset)?,
+                None => {
+                    let (arrays, spec) = (a.arrays.clone(), a.spec);
+                    let label = a.label.clone();
+                    let o = Object::build(a.key, label, arrays, spec, a.material, offset)?;
+                    (o, Outcome::Built)
+                }
+            };
+            match outcome {
+                Outcome::Kept => {}
+                Outcome::Built => report.rebuilt += 1,
+                Outcome::Refitted(r) => {
+                    report.refitted += 1;
+                    report.worst_ratio = report.worst_ratio.max(r);
+                }
+                Outcome::Degraded(r) => {
+                    report.rebuilt += 1;
+                    report.degraded += 1;
+                    report.worst_ratio = report.worst_ratio.max(r);
+                }
+            }
+            list.push(object);
+        }
+        // Objects removed since are dropped here (their arrays released).
+        drop(previous);
+        report.bvh_time += t0.elapsed();
+        built.set_objects(Objects::new(list), render);
+        Ok(())
     }
 
     fn commit_here(&mut self) -> Result<CommitReport, Error> {
@@ -661,6 +964,11 @@ impl Scene {
             }
             d.materials = false;
         }
+        // The array objects outlive a build of the rest (their trees are kept).
+        let previous = match self.built.as_mut() {
+            Some(b) => b.objects.take(),
+            None => Vec::new(),
+        };
         if self.built.is_none() || self.dirty.build {
             if let Some(why) = self.consumed {
                 return Err(Error::Api(why.into()));
@@ -696,6 +1004,13 @@ impl Scene {
         let Some(built) = self.built.as_mut() else {
             return Err(Error::Api("the scene is not built".into()));
         };
+        Scene::commit_arrays(
+            &self.arrays,
+            previous,
+            built,
+            &self.desc.render,
+            &mut report,
+        )?;
         if self.dirty.lights {
             built.update_lights(&self.desc);
             self.dirty.lights = false;

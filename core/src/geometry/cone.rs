@@ -145,36 +145,43 @@ impl Set<Cone> {
 
     /// The surface at a hit; its texture coordinates only when `uv` asks.
     pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
-        let c = &self.data[hit.index as usize];
-        let (b, a) = (Vec3A::from(c.base), Vec3A::from(c.apex));
-        let h = (a - b).length();
-        let w = (a - b) / h;
-        let k = (c.apex_radius - c.base_radius) / h;
-        let p = ray.at(hit.t);
-        let s = (p - b).dot(w);
-        let ortho = crate::math::orthogonal(w);
-        let q = ((p - b) - s * w).normalize_or_zero();
-        let q = if q == Vec3A::ZERO { ortho } else { q };
-        let n = (q - k * w).normalize();
-        let r_max = c.base_radius.max(c.apex_radius);
-        let p_error = gamma(16) * (p.abs() + b.abs().max(a.abs()) + Vec3A::splat(r_max));
-        let uv = if uv {
-            let u = 0.5 + q.dot(w.cross(ortho)).atan2(q.dot(ortho)) / std::f32::consts::TAU;
-            [u, (s / h).clamp(0.0, 1.0)]
-        } else {
-            [0.0; 2]
-        };
-        Surface {
-            p,
-            p_error,
-            ng: n,
-            ns: n,
-            uv,
-            material: material_of(self.material[hit.index as usize]),
-            color: None,
-            lift: Vec3A::ZERO,
-            uv_scale: 0.0,
-        }
+        let i = hit.index as usize;
+        surface(&self.data[i], hit.t, ray, uv, material_of(self.material[i]))
+    }
+}
+
+/// The surface of cone `c` hit at distance `t` along `ray`, of `material`; its texture
+/// coordinates only when `uv` asks. Shared with the cylinders read from the caller's arrays.
+#[inline]
+pub fn surface(c: &Cone, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface {
+    let (b, a) = (Vec3A::from(c.base), Vec3A::from(c.apex));
+    let h = (a - b).length();
+    let w = (a - b) / h;
+    let k = (c.apex_radius - c.base_radius) / h;
+    let p = ray.at(t);
+    let s = (p - b).dot(w);
+    let ortho = crate::math::orthogonal(w);
+    let q = ((p - b) - s * w).normalize_or_zero();
+    let q = if q == Vec3A::ZERO { ortho } else { q };
+    let n = (q - k * w).normalize();
+    let r_max = c.base_radius.max(c.apex_radius);
+    let p_error = gamma(16) * (p.abs() + b.abs().max(a.abs()) + Vec3A::splat(r_max));
+    let uv = if uv {
+        let u = 0.5 + q.dot(w.cross(ortho)).atan2(q.dot(ortho)) / std::f32::consts::TAU;
+        [u, (s / h).clamp(0.0, 1.0)]
+    } else {
+        [0.0; 2]
+    };
+    Surface {
+        p,
+        p_error,
+        ng: n,
+        ns: n,
+        uv,
+        material,
+        color: None,
+        lift: Vec3A::ZERO,
+        uv_scale: 0.0,
     }
 }
 

@@ -84,33 +84,41 @@ impl Set<Disc> {
 
     /// The surface at a hit; its texture coordinates only when `uv` asks.
     pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
-        let d = &self.data[hit.index as usize];
-        let c = Vec3A::from(d.center);
-        let n = Vec3A::from(d.normal);
-        let p0 = ray.at(hit.t);
-        let p = p0 - n.dot(p0 - c) * n;
-        let uv = if uv {
-            let r = p - c;
-            let t = crate::math::orthogonal(n);
-            let angle = r.dot(n.cross(t)).atan2(r.dot(t));
-            [
-                (r.length() - d.inner) / (d.outer - d.inner),
-                0.5 + angle / std::f32::consts::TAU,
-            ]
-        } else {
-            [0.0; 2]
-        };
-        Surface {
-            p,
-            p_error: gamma(5) * (p.abs() + c.abs()),
-            ng: n,
-            ns: n,
-            uv,
-            material: material_of(self.material[hit.index as usize]),
-            color: None,
-            lift: Vec3A::ZERO,
-            uv_scale: 0.0,
-        }
+        let i = hit.index as usize;
+        surface(&self.data[i], hit.t, ray, uv, material_of(self.material[i]))
+    }
+}
+
+/// The surface of disc `d` hit at distance `t` along `ray`, of `material`; its texture
+/// coordinates only when `uv` asks. Shared with the cylinder caps read from the caller's
+/// arrays.
+#[inline]
+pub fn surface(d: &Disc, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface {
+    let c = Vec3A::from(d.center);
+    let n = Vec3A::from(d.normal);
+    let p0 = ray.at(t);
+    let p = p0 - n.dot(p0 - c) * n;
+    let uv = if uv {
+        let r = p - c;
+        let t = crate::math::orthogonal(n);
+        let angle = r.dot(n.cross(t)).atan2(r.dot(t));
+        [
+            (r.length() - d.inner) / (d.outer - d.inner),
+            0.5 + angle / std::f32::consts::TAU,
+        ]
+    } else {
+        [0.0; 2]
+    };
+    Surface {
+        p,
+        p_error: gamma(5) * (p.abs() + c.abs()),
+        ng: n,
+        ns: n,
+        uv,
+        material,
+        color: None,
+        lift: Vec3A::ZERO,
+        uv_scale: 0.0,
     }
 }
 

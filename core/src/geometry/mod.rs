@@ -1,6 +1,7 @@
 //! Native geometry (intersected inline) and custom plugin geometry (called through its table),
 //! each kind in its own BVH, so every traversal loop is monomorphic.
 
+pub mod array_set;
 pub mod cone;
 // Calls into plugin objects.
 #[allow(unsafe_code)]
@@ -8,6 +9,7 @@ pub mod custom;
 pub mod disc;
 pub mod group;
 pub mod instance;
+pub mod objects;
 pub mod plane;
 pub mod set;
 pub mod sphere;
@@ -17,6 +19,15 @@ pub mod triangle;
 
 #[cfg(test)]
 mod props;
+
+#[cfg(test)]
+mod tests {
+    /// A hit is copied on every closer find: the array objects' number took padding only.
+    #[test]
+    fn a_hit_stays_48_bytes() {
+        assert_eq!(std::mem::size_of::<super::Hit>(), 48);
+    }
+}
 
 use crate::math::Vec3A;
 
@@ -77,6 +88,9 @@ pub struct Hit {
     pub kind: Kind,
     /// On a keyed object (in the scene's moving group) rather than in the still geometry.
     pub moving: bool,
+    /// On array object `object - 1` of the scene's [`objects::Objects`] (0: not on one; 16
+    /// bits fit the padding after `kind` and `moving`, so a hit stays 48 bytes).
+    pub object: u16,
     /// The shared instance hit (`NO_INSTANCE`: none; the primitive is in the scene's own
     /// geometry or its moving group).
     pub instance: u32,
@@ -94,6 +108,7 @@ impl Hit {
             t,
             kind,
             moving: false,
+            object: 0,
             instance: NO_INSTANCE,
             index: index as u64,
             b1: 0.0,

@@ -264,3 +264,93 @@ proptest! {
         }
     }
 }
+
+/// Array objects: spheres and triangles read from arrays, moved and refitted, find exactly the
+/// closest hit brute force finds (every element tested) for random rays.
+mod arrays {
+    use super::super::array_set::{ArraySet, MeshReader, RadiusRead, Reader, SphereReader};
+    use super::super::set::Shape;
+    use super::super::Counters;
+    use crate::arrays::{Array, Pins, SharedVec};
+    use crate::bvh::BoxRay;
+    use crate::math::{DVec3, Vec3A};
+    use crate::ray::Ray;
+    use proptest::prelude::*;
+
+    fn point() -> impl Strategy<Value = [f64; 3]> {
+        [-5.0f64..5.0, -5.0f64..5.0, -5.0f64..5.0]
+    }
+
+    /// A closest hit's distance and element.
+    type Found = Option<(f32, u64)>;
+
+    /// The closest hit's (t, element) in the set, and by testing every element.
+    fn both<R: Reader>(set: &ArraySet<R>, pins: &Pins, ray: &Ray) -> (Found, Found) {
+        let mut hit = None;
+        let mut t_max = f32::INFINITY;
+        let boxes = BoxRay::new(ray.origin, ray.dir);
+        set.intersect(
+            pins,
+            ray,
+            &boxes,
+            &mut t_max,
+            &mut hit,
+            &mut Counters::default(),
+            1,
+        );
+        let found = hit.map(|h| (h.t, h.index));
+        let prep = R::Shape::prep(ray);
+        let mut brute: Found = None;
+        for i in 0..set.reader.len(pins) {
+            let Some(s) = set.reader.get(pins, i) else {
+                continue;
+            };
+            if let Some((t, _, _)) = s.hit(ray, &prep, brute.map_or(f32::INFINITY, |b| b.0)) {
+                brute = Some((t, i as u64));
+            }
+        }
+        (found, brute)
+    }
+
+    proptest! {
+        #![proptest_config(super::cases())]
+
+        #[test]
+        fn refitted_spheres_and_triangles_find_what_brute_force_finds(
+            start in prop::collection::vec(point(), 3..120),
+            steps in prop::collection::vec(point(), 120),
+            rays in prop::collection::vec((point(), super::unit()), 20),
+        ) {
+            // Whole triangles: every three points make one.
+            let n = start.len() / 3 * 3;
+            let centers = SharedVec::new(start[..n].to_vec());
+            let arrays = [Array::shared(&centers)];
+            let offset = DVec3::new(0.5, -0.25, 1.0);
+            let spheres = SphereReader { radius: RadiusRead::Const(0.4), colors: None, offset };
+            let mesh = MeshReader { indices: None, normals: None, colors: None, uvs: None, offset };
+            let (mut s, mut m) = {
+                let pins = Pins::new(&arrays).unwrap();
+                let s = ArraySet::build(spheres, &pins, 0).unwrap();
+                let m = ArraySet::build(mesh, &pins, 0).unwrap();
+                (s, m)
+            };
+            // Every point moves (up to 1.5 units): the trees are refitted, not rebuilt.
+            for (p, d) in centers.write().iter_mut().zip(&steps) {
+                for k in 0..3 {
+                    p[k] += d[k] * 0.3;
+                }
+            }
+            let pins = Pins::new(&arrays).unwrap();
+            s.refit(&pins).unwrap();
+            m.refit(&pins).unwrap();
+            prop_assert_eq!(m.len(), n / 3);
+            for (o, d) in &rays {
+                let ray = Ray::new(Vec3A::from((DVec3::from(*o) * 1.5).as_vec3()), *d, 0.0);
+                let (found, brute) = both(&s, &pins, &ray);
+                prop_assert_eq!(found, brute);
+                let (found, brute) = both(&m, &pins, &ray);
+                prop_assert_eq!(found.map(|f| f.0), brute.map(|b| b.0));
+            }
+        }
+    }
+}

@@ -122,53 +122,61 @@ impl Set<Sphere> {
     /// The surface at a hit; its texture coordinates only when `uv` asks (an `atan2` and an
     /// `acos`: no texture reads them on most spheres).
     pub fn surface(&self, hit: &Hit, ray: &Ray, uv: bool) -> Surface {
-        let s = self.data[hit.index as usize];
-        let c = Vec3A::from(s.center);
-        // Re-project onto the sphere: the error is then a few ulps of the coordinates. The
-        // direction from the centre is taken in f64: for a sphere smaller than the f32 spacing
-        // of its position, `ray.at(t) - c` can be exactly zero (a NaN normal).
-        let rel = ray.origin.as_dvec3() - c.as_dvec3() + ray.dir.as_dvec3() * hit.t as f64;
-        let n = match rel.try_normalize() {
-            Some(n) => Vec3A::from(n.as_vec3()),
-            None => -ray.dir,
-        };
-        let pr = n * s.radius;
-        let (p, p_error) = {
-            let p_proj = c + pr;
-            let e_proj = gamma(6) * (pr.abs() + c.abs());
-            // Far from the centre of a huge sphere (an Earth-sized ground near the camera), the
-            // re-projected point rounds to the f32 spacing at the centre's magnitude (0.5 at
-            // 6.4e6): a shadow ray offset by that bound starts above small things on the
-            // ground. The point along the ray is then far more precise: rounding of o + t·d
-            // and of t to f32, plus the f64 solve's error (relative to the sphere's size).
-            let p_ray = ray.at(hit.t);
-            let solve = 4.0 * f64::EPSILON as f32 * ((c - ray.origin).length() + s.radius);
-            let e_ray = gamma(3) * (ray.origin.abs() + (hit.t * ray.dir).abs()) + solve;
-            if e_ray.max_element() < e_proj.max_element() {
-                (p_ray, e_ray)
-            } else {
-                (p_proj, e_proj)
-            }
-        };
-        let uv = if uv {
-            let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
-            let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
-            [u, v]
+        let i = hit.index as usize;
+        surface(self.data[i], hit.t, ray, uv, material_of(self.material[i]))
+    }
+}
+
+/// The surface of sphere `s` hit at distance `t` along `ray`, of `material`; its texture
+/// coordinates only when `uv` asks. Shared by the spheres stored here and those read from the
+/// caller's arrays (`array_set`), so both shade alike.
+#[inline]
+pub fn surface(s: Sphere, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface {
+    let c = Vec3A::from(s.center);
+    // Re-project onto the sphere: the error is then a few ulps of the coordinates. The
+    // direction from the centre is taken in f64: for a sphere smaller than the f32 spacing
+    // of its position, `ray.at(t) - c` can be exactly zero (a NaN normal).
+    let rel = ray.origin.as_dvec3() - c.as_dvec3() + ray.dir.as_dvec3() * t as f64;
+    let n = match rel.try_normalize() {
+        Some(n) => Vec3A::from(n.as_vec3()),
+        None => -ray.dir,
+    };
+    let pr = n * s.radius;
+    let (p, p_error) = {
+        let p_proj = c + pr;
+        let e_proj = gamma(6) * (pr.abs() + c.abs());
+        // Far from the centre of a huge sphere (an Earth-sized ground near the camera), the
+        // re-projected point rounds to the f32 spacing at the centre's magnitude (0.5 at
+        // 6.4e6): a shadow ray offset by that bound starts above small things on the
+        // ground. The point along the ray is then far more precise: rounding of o + t·d
+        // and of t to f32, plus the f64 solve's error (relative to the sphere's size).
+        let p_ray = ray.at(t);
+        let solve = 4.0 * f64::EPSILON as f32 * ((c - ray.origin).length() + s.radius);
+        let e_ray = gamma(3) * (ray.origin.abs() + (t * ray.dir).abs()) + solve;
+        if e_ray.max_element() < e_proj.max_element() {
+            (p_ray, e_ray)
         } else {
-            [0.0; 2]
-        };
-        Surface {
-            p,
-            p_error,
-            ng: n,
-            ns: n,
-            uv,
-            material: material_of(self.material[hit.index as usize]),
-            color: None,
-            lift: Vec3A::ZERO,
-            // u spans 2πr, v spans πr: their geometric mean.
-            uv_scale: 1.0 / (std::f32::consts::PI * std::f32::consts::SQRT_2 * s.radius),
+            (p_proj, e_proj)
         }
+    };
+    let uv = if uv {
+        let u = 0.5 + n.z.atan2(n.x) / std::f32::consts::TAU;
+        let v = n.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
+        [u, v]
+    } else {
+        [0.0; 2]
+    };
+    Surface {
+        p,
+        p_error,
+        ng: n,
+        ns: n,
+        uv,
+        material,
+        color: None,
+        lift: Vec3A::ZERO,
+        // u spans 2πr, v spans πr: their geometric mean.
+        uv_scale: 1.0 / (std::f32::consts::PI * std::f32::consts::SQRT_2 * s.radius),
     }
 }
 

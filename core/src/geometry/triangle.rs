@@ -341,7 +341,7 @@ impl Triangles {
         let Triangle { v, attr: a } = self.set.data[i];
         let va =
             (a != NO_ATTR).then(|| self.corners[a as usize].map(|i| self.vertex_attrs[i as usize]));
-        surface_of(v, va, material_of(self.set.material[i]), hit, textured)
+        surface(v, va, hit, textured, material_of(self.set.material[i]))
     }
 
     /// The surface at a hit on triangle `hit.index` as it is after moving its corners by
@@ -366,24 +366,27 @@ impl Triangles {
                 }
             })
         });
-        surface_of(
+        surface(
             v.map(point),
             va,
-            material_of(self.set.material[i]),
             hit,
             textured,
+            material_of(self.set.material[i]),
         )
     }
 }
 
-/// The surface at a hit on the triangle with corners `v` and vertex attributes `va`.
+/// The surface of the triangle with vertices `v` (and vertex attributes `va`, when its mesh
+/// has them) at `hit`, of `material`; `textured`: the scene looks textures up, so the uvs and
+/// their scale are needed. Shared by the stored meshes and those read from the caller's arrays
+/// (`array_set`), so both shade alike.
 #[inline(always)]
-fn surface_of(
+pub fn surface(
     v: [Vec3; 3],
     va: Option<[VertexAttr; 3]>,
-    material: u32,
     hit: &Hit,
     textured: bool,
+    material: u32,
 ) -> Surface {
     let (b1, b2) = (hit.b1, hit.b2);
     let b0 = 1.0 - b1 - b2;

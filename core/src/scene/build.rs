@@ -231,6 +231,7 @@ impl Scene {
             plugin_time,
             moving: Default::default(),
             instances: shared,
+            objects: Default::default(),
             prototypes,
             animation: None,
             budget: b.budget,

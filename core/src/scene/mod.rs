@@ -30,6 +30,7 @@ use crate::geometry::custom::Customs;
 use crate::geometry::disc::Discs;
 use crate::geometry::group::Group;
 use crate::geometry::instance::Instances;
+use crate::geometry::objects::Objects;
 use crate::geometry::plane::Planes;
 use crate::geometry::sphere::Spheres;
 use crate::geometry::triangle::Triangles;
@@ -370,6 +371,9 @@ pub struct Scene {
     /// Instances sharing one copy of their prototype (a two-level BVH; empty unless some
     /// prototype is shared).
     pub instances: Instances,
+    /// A retained scene's array objects (read in place from the caller's arrays; empty
+    /// otherwise).
+    pub objects: Objects,
     /// The prototypes with instances, and how each was realised.
     pub prototypes: Vec<PrototypeUse>,
     /// How the scene changes from frame to frame; `None`: a still scene.
@@ -450,6 +454,9 @@ impl Scene {
         if !self.instances.is_empty() {
             (self.instances).intersect(ray, &boxes, &mut t_max, &mut hit, c);
         }
+        if !self.objects.is_empty() {
+            self.objects.intersect(ray, &boxes, &mut t_max, &mut hit, c);
+        }
         hit
     }
 
@@ -464,6 +471,9 @@ impl Scene {
         let uv = |packed: u32| {
             self.features.textures && self.materials[material_of(packed) as usize].reads_uv()
         };
+        if hit.object != 0 {
+            return self.objects.surface(hit, ray, uv);
+        }
         let i = hit.index as usize;
         match hit.kind {
             Kind::Sphere => (self.spheres).surface(hit, ray, uv(self.spheres.material[i])),
@@ -500,7 +510,9 @@ impl Scene {
                         .moving
                         .any(ray, t_max, &self.clips, c, &mut |_, _| true))
                 || (!self.instances.is_empty()
-                    && (self.instances).any(ray, b, t_max, c, &mut |_, _| true));
+                    && (self.instances).any(ray, b, t_max, c, &mut |_, _| true))
+                || (!self.objects.is_empty()
+                    && self.objects.any(ray, b, t_max, c, &mut |_, _| true));
             return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
         }
         let mut filter = Vec3A::ONE;
@@ -538,6 +550,7 @@ impl Scene {
             || self.customs.any(ray, t_max, &self.clips, c, &mut on_hit)
             || (!self.moving.is_empty() && self.moving.any(ray, t_max, &self.clips, c, &mut on_hit))
             || (!self.instances.is_empty() && self.instances.any(ray, b, t_max, c, &mut on_hit))
+            || (!self.objects.is_empty() && self.objects.any(ray, b, t_max, c, &mut on_hit))
         {
             return Vec3A::ZERO;
         }
@@ -563,5 +576,6 @@ impl Scene {
             + self.cones.len()
             + self.discs.len()
             + self.customs.len()
+            + self.objects.len()
     }
 }

@@ -29,13 +29,14 @@ impl Casters {
     /// The casters of `scene` when every used material either blocks shadow rays or lets them
     /// through unchanged, and some used one does the latter (otherwise the general query
     /// costs no more). Not for an animated scene, whose frames may change a material's shadow,
-    /// nor for one with shared instances (their prototypes' materials are not in the copy).
+    /// nor for one with shared instances or array objects (not in the copy).
     pub(super) fn of(scene: &Scene) -> Option<Casters> {
         let used = scene.materials.iter().zip(&scene.used_materials);
         let mut used = used.filter(|(_, u)| **u).map(|(m, _)| m.shadow);
         if !scene.features.see_through
             || scene.animation.is_some()
             || !scene.instances.is_empty()
+            || !scene.objects.is_empty()
             || !used.all(|s| s.is_none() || s == Some(Vec3A::ONE))
         {
             return None;

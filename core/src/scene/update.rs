@@ -7,6 +7,8 @@
 use super::build::{self, features, settings, Build};
 use super::{Casters, Scene};
 use crate::error::Error;
+use crate::geometry::material_of;
+use crate::geometry::objects::Objects;
 use luxon_formats::{RenderDesc, SceneDesc, Spanned};
 
 impl Scene {
@@ -86,13 +88,27 @@ impl Scene {
         Ok(true)
     }
 
-    /// The features, as the build's last stage finds them.
+    /// Takes a retained scene's array objects (their materials must be this scene's) and
+    /// finds the features again with their materials used.
+    pub(crate) fn set_objects(&mut self, objects: Objects, r: &RenderDesc) {
+        self.objects = objects;
+        self.update_features(r);
+    }
+
+    /// The features, as the build's last stage finds them (with the array objects' materials
+    /// and geometry).
     fn update_features(&mut self, r: &RenderDesc) {
+        let mut used = self.used_materials.clone();
+        for o in self.objects.list() {
+            if let Some(u) = used.get_mut(material_of(o.material()) as usize) {
+                *u = true;
+            }
+        }
         self.features = features(
             r,
             &self.materials,
-            &self.used_materials,
-            self.has_geometry,
+            &used,
+            self.has_geometry || !self.objects.is_empty(),
             &self.lights,
             &self.fog,
             &self.ao,
