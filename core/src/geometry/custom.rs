@@ -300,7 +300,8 @@ impl Customs {
                     }
                     let mut hh = Hit::new(t, Kind::Custom, i);
                     hh.n = n;
-                    hh.uv = h.uv;
+                    // A plugin object has no barycentrics: its uv takes their place.
+                    [hh.b1, hh.b2] = h.uv;
                     *hit = Some(hh);
                     Some(t)
                 }
@@ -371,7 +372,7 @@ impl Customs {
             p_error,
             ng: hit.n,
             ns: hit.n,
-            uv: hit.uv,
+            uv: [hit.b1, hit.b2],
             material: material_of(self.material[hit.index as usize]),
             color: None,
             lift: Vec3A::ZERO,

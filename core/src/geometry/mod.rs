@@ -22,7 +22,8 @@ mod props;
 
 #[cfg(test)]
 mod tests {
-    /// A hit is copied on every closer find: the array objects' number took padding only.
+    /// A hit is copied on every closer find: the array objects' and the instances' numbers
+    /// took padding and the room of the plugin objects' uv (kept in `b1`, `b2`).
     #[test]
     fn a_hit_stays_48_bytes() {
         assert_eq!(std::mem::size_of::<super::Hit>(), 48);
@@ -96,10 +97,10 @@ pub struct Hit {
     pub instance: u32,
     /// The primitive within its kind (64-bit: molecular scenes reach billions of atoms).
     pub index: u64,
+    /// Barycentrics of a triangle hit; a plugin object's uv.
     pub b1: f32,
     pub b2: f32,
     pub n: Vec3A,
-    pub uv: [f32; 2],
 }
 
 impl Hit {
@@ -114,7 +115,6 @@ impl Hit {
             b1: 0.0,
             b2: 0.0,
             n: Vec3A::ZERO,
-            uv: [0.0; 2],
         }
     }
 }
