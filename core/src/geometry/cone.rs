@@ -172,17 +172,7 @@ pub fn surface(c: &Cone, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface 
     } else {
         [0.0; 2]
     };
-    Surface {
-        p,
-        p_error,
-        ng: n,
-        ns: n,
-        uv,
-        material,
-        color: None,
-        lift: Vec3A::ZERO,
-        uv_scale: 0.0,
-    }
+    Surface::solid(p, p_error, n, uv, material)
 }
 
 #[cfg(test)]

@@ -367,17 +367,8 @@ impl Customs {
         // The plugin's root is as good as f64 allows; rounding to f32 and its unknown method
         // get a generous relative bound.
         let p_error = gamma(64) * (p.abs() + ray.origin.abs());
-        Surface {
-            p,
-            p_error,
-            ng: hit.n,
-            ns: hit.n,
-            uv: [hit.b1, hit.b2],
-            material: material_of(self.material[hit.index as usize]),
-            color: None,
-            lift: Vec3A::ZERO,
-            uv_scale: 0.0,
-        }
+        let material = material_of(self.material[hit.index as usize]);
+        Surface::solid(p, p_error, hit.n, [hit.b1, hit.b2], material)
     }
 }
 

@@ -109,17 +109,7 @@ pub fn surface(d: &Disc, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface 
     } else {
         [0.0; 2]
     };
-    Surface {
-        p,
-        p_error: gamma(5) * (p.abs() + c.abs()),
-        ng: n,
-        ns: n,
-        uv,
-        material,
-        color: None,
-        lift: Vec3A::ZERO,
-        uv_scale: 0.0,
-    }
+    Surface::solid(p, gamma(5) * (p.abs() + c.abs()), n, uv, material)
 }
 
 #[cfg(test)]

@@ -141,6 +141,25 @@ pub struct Surface {
     pub lift: Vec3A,
 }
 
+impl Surface {
+    /// The surface of a solid shape: one normal for shading and geometry, no vertex colour,
+    /// no lift, uv scale unknown.
+    #[inline(always)]
+    pub fn solid(p: Vec3A, p_error: Vec3A, n: Vec3A, uv: [f32; 2], material: u32) -> Surface {
+        Surface {
+            p,
+            p_error,
+            ng: n,
+            ns: n,
+            uv,
+            uv_scale: 0.0,
+            material,
+            color: None,
+            lift: Vec3A::ZERO,
+        }
+    }
+}
+
 /// Per-thread counters of work done (summed after the render; deterministic).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Counters {

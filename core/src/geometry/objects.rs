@@ -352,16 +352,6 @@ impl Objects {
         });
         // Only if the arrays were released between the hit and its shading (never in a
         // render): a flat surface facing the ray.
-        found.unwrap_or_else(|| Surface {
-            p: ray.at(hit.t),
-            p_error: Vec3A::ZERO,
-            ng: -ray.dir,
-            ns: -ray.dir,
-            uv: [0.0; 2],
-            uv_scale: 0.0,
-            material: m,
-            color: None,
-            lift: Vec3A::ZERO,
-        })
+        found.unwrap_or_else(|| Surface::solid(ray.at(hit.t), Vec3A::ZERO, -ray.dir, [0.0; 2], m))
     }
 }

@@ -119,17 +119,7 @@ impl Planes {
         } else {
             [0.0; 2]
         };
-        Surface {
-            p,
-            p_error,
-            ng: pl.normal,
-            ns: pl.normal,
-            uv,
-            material: material_of(pl.material),
-            color: None,
-            lift: Vec3A::ZERO,
-            uv_scale: 0.0,
-        }
+        Surface::solid(p, p_error, pl.normal, uv, material_of(pl.material))
     }
 }
 

@@ -167,16 +167,9 @@ pub fn surface(s: Sphere, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface
         [0.0; 2]
     };
     Surface {
-        p,
-        p_error,
-        ng: n,
-        ns: n,
-        uv,
-        material,
-        color: None,
-        lift: Vec3A::ZERO,
         // u spans 2πr, v spans πr: their geometric mean.
         uv_scale: 1.0 / (std::f32::consts::PI * std::f32::consts::SQRT_2 * s.radius),
+        ..Surface::solid(p, p_error, n, uv, material)
     }
 }
 
