@@ -510,8 +510,7 @@ fn capped_cylinders_from_arrays_render_as_the_cylinder_plugin() {
         .collect();
     let radii: Vec<f32> = radii.iter().map(|r| r * 1.5).collect();
     let real = |x: f32| format!("{:?}", x as f64);
-    // A stored scene of cones and discs only has no shadows (its build counts neither as
-    // geometry); a ground sphere in both makes the comparison one with shadows.
+    // A ground sphere in both, for the cylinders' shadows to fall on.
     const GROUND: &str = "(center: (0, -30, 0), radius: 27)";
     let (mut plugin, m) = base(&ctx);
     plugin

@@ -168,3 +168,27 @@ fn ambient_occlusion_scales_direct_light_like_vmd_aodirect() {
     let plain = floor("ao-direct-off", "Point(position: (0, 4, 0))", "");
     assert!(close(plain, [1.0; 3], 1e-5), "{plain:?}");
 }
+
+#[test]
+fn a_scene_of_cylinders_alone_casts_shadows() {
+    // The floor is a wide cylinder's top cap (a disc), the blocker a rod (a cone) between it
+    // and the light, out of the camera's view: nothing but cones and discs in the scene.
+    let scene = |rod: &str| {
+        format!(
+            r#"Scene(
+            camera: (position: (0, 1, 0), look_at: (0, 0, 0), up: (0, 0, 1), fov: 10),
+            lights: [Point(position: (2, 2, 0), color: (1, 1, 1))],
+            materials: {{ "floor": (color: (1, 1, 1), ambient: 0, diffuse: 1) }},
+            objects: [
+                (plugin: "cylinder", params: (base: (0, -1, 0), apex: (0, 0, 0), radius: 10), material: "floor"),
+                {rod}
+            ],
+        )"#
+        )
+    };
+    let rod = r#"(plugin: "cylinder", params: (base: (0.5, 0.5, -1), apex: (0.5, 0.5, 1), radius: 0.1), material: "floor"),"#;
+    let lit = centre("cyl-lit", &scene(""));
+    let shadowed = centre("cyl-shadow", &scene(rod));
+    assert!(lit[0] > 0.2, "the floor is lit without the rod: {lit:?}");
+    assert!(shadowed[0] < 0.01, "the rod's shadow: {shadowed:?}");
+}

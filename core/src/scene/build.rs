@@ -988,6 +988,8 @@ impl Stored {
         !(self.spheres.is_empty()
             && self.triangles.is_empty()
             && self.planes.planes.is_empty()
+            && self.cones.is_empty()
+            && self.discs.is_empty()
             && self.customs.is_empty()
             && self.keyed.iter().all(|k| k.geometry == Recorded::default())
             && self.shared.is_empty())
