@@ -57,6 +57,34 @@ pub enum RadiusRead {
     Each(usize),
 }
 
+impl RadiusRead {
+    /// The pin of per-element radii, if any.
+    fn each(self) -> Option<usize> {
+        match self {
+            RadiusRead::Each(k) => Some(k),
+            RadiusRead::Const(_) => None,
+        }
+    }
+}
+
+/// Checks that every pin in `arrays` (named, `None`: not given) holds `n` values; `wrong(m,
+/// name)` words the error for one that holds `m`.
+fn one_each<const N: usize>(
+    pins: &Pins,
+    n: usize,
+    arrays: [(&str, Option<usize>); N],
+    wrong: impl Fn(usize, &str) -> String,
+) -> Result<(), String> {
+    for (what, k) in arrays {
+        let Some(k) = k else { continue };
+        let m = pins.view(k).len();
+        if m != n {
+            return Err(wrong(m, what));
+        }
+    }
+    Ok(())
+}
+
 /// Spheres: centres from pin 0 (f32x3 or f64x3), radii (a constant or a pin of scalars) and
 /// optional linear RGB colours (a pin of f32x3 or f64x3).
 #[derive(Clone, Copy, Debug)]
@@ -125,18 +153,10 @@ impl Reader for SphereReader {
 
     fn check_arrays(&self, pins: &Pins) -> Result<(), String> {
         let n = self.len(pins);
-        let mut others = vec![("colours", self.colors)];
-        if let RadiusRead::Each(k) = self.radius {
-            others.push(("radii", Some(k)));
-        }
-        for (what, k) in others {
-            let Some(k) = k else { continue };
-            let m = pins.view(k).len();
-            if m != n {
-                return Err(format!("{m} {what} for {n} centres; give one per centre"));
-            }
-        }
-        Ok(())
+        let radii = ("radii", self.radius.each());
+        one_each(pins, n, [("colours", self.colors), radii], |m, what| {
+            format!("{m} {what} for {n} centres; give one per centre")
+        })
     }
 
     #[inline]
@@ -206,18 +226,10 @@ impl CylinderReader {
 
     fn check_all(&self, pins: &Pins) -> Result<(), String> {
         let n = self.count(pins);
-        let mut others = vec![("apexes", Some(1))];
-        if let RadiusRead::Each(k) = self.radius {
-            others.push(("radii", Some(k)));
-        }
-        for (what, k) in others {
-            let Some(k) = k else { continue };
-            let m = pins.view(k).len();
-            if m != n {
-                return Err(format!("{m} {what} for {n} bases; give one per base"));
-            }
-        }
-        Ok(())
+        let radii = ("radii", self.radius.each());
+        one_each(pins, n, [("apexes", Some(1)), radii], |m, what| {
+            format!("{m} {what} for {n} bases; give one per base")
+        })
     }
 }
 
@@ -434,18 +446,14 @@ impl Reader for MeshReader {
                 "{nv} positions and no indices: the positions are not whole triangles"
             ));
         }
-        for (what, k) in [
+        let per_vertex = [
             ("normals", self.normals),
             ("colours", self.colors),
             ("uvs", self.uvs),
-        ] {
-            let Some(k) = k else { continue };
-            let m = pins.view(k).len();
-            if m != nv {
-                return Err(format!("mesh has {nv} vertices but {m} {what}"));
-            }
-        }
-        Ok(())
+        ];
+        one_each(pins, nv, per_vertex, |m, what| {
+            format!("mesh has {nv} vertices but {m} {what}")
+        })
     }
 
     #[inline]
