@@ -6,6 +6,7 @@
 //! runs under `errors::guard`, so a Luxon error becomes a Python exception with the command
 //! line's message, and a panic becomes `luxon.LuxonError`, never a Python-killing abort.
 
+mod arrays;
 mod context;
 mod errors;
 mod image;

@@ -2,12 +2,19 @@
 //! its lights and objects named by id tokens. `luxon.Scene` (python/luxon/_scene.py) subclasses
 //! it with keyword arguments and the handles users see.
 
+use crate::arrays::{borrow, same_count, Kind};
 use crate::context::PyContext;
 use crate::errors::{guard, IntoPy};
-use luxon::api::{self, LightId, ObjectId, Renderer, RendererOptions};
+use luxon::api::{
+    self, Cylinders, LightId, MaterialId, Mesh, ObjectId, Radius, Renderer, RendererOptions,
+    Spheres,
+};
+use luxon::arrays::Array;
+use numpy::{PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -17,6 +24,28 @@ pub struct PyScene {
     pub(crate) scene: api::Scene,
     /// Renderers by thread count (`None`: the context's pool), made on first use.
     renderers: Vec<(Option<usize>, Arc<Renderer>)>,
+    /// The arrays of each array object, to mark modified.
+    arrays: HashMap<ObjectId, Vec<Array>>,
+}
+
+/// Radii: one number for all, or an (n,) array read in place (kept in `held`).
+fn radius(
+    value: &Bound<'_, PyAny>,
+    what: &str,
+    n: usize,
+    of: &str,
+    held: &mut Vec<Array>,
+) -> PyResult<Radius> {
+    let array = value.cast::<PyUntypedArray>().is_ok_and(|a| a.ndim() > 0);
+    if !array {
+        if let Ok(r) = value.extract::<f64>() {
+            return Ok(Radius::Const(r));
+        }
+    }
+    let (a, k) = borrow(value, what, Kind::Real)?;
+    same_count(what, k, n, of)?;
+    held.push(a.clone());
+    Ok(Radius::Each(a))
 }
 
 /// A light's id in its scene (compared and hashed; `luxon.Light` holds one).
@@ -59,6 +88,7 @@ impl PyScene {
                 context,
                 scene,
                 renderers: Vec::new(),
+                arrays: HashMap::new(),
             })
         })
     }
@@ -134,15 +164,7 @@ impl PyScene {
         clip: Option<&str>,
     ) -> PyResult<PyObjectId> {
         guard(|| {
-            let material = match material {
-                None => None,
-                Some(name) => Some(self.scene.material(name).ok_or_else(|| {
-                    PyValueError::new_err(format!(
-                        "no material named `{name}` in this scene; define it first with \
-                         scene.set_material(\"{name}\", ...)"
-                    ))
-                })?),
-            };
+            let material = self.material_id(material)?;
             let clip = match clip {
                 None => None,
                 Some(name) => Some(self.scene.clip_group(name).ok_or_else(|| {
@@ -158,7 +180,143 @@ impl PyScene {
     }
 
     fn _remove_object(&mut self, id: &PyObjectId) -> PyResult<()> {
-        guard(|| self.scene.remove(id.0).py_err())
+        guard(|| {
+            self.scene.remove(id.0).py_err()?;
+            self.arrays.remove(&id.0);
+            Ok(())
+        })
+    }
+
+    /// Spheres read from numpy arrays: `radii` a number or an (n,) array.
+    #[pyo3(signature = (centers, radii, colors = None, material = None, id = None))]
+    fn _spheres(
+        &mut self,
+        centers: &Bound<'_, PyAny>,
+        radii: &Bound<'_, PyAny>,
+        colors: Option<&Bound<'_, PyAny>>,
+        material: Option<&str>,
+        id: Option<&PyObjectId>,
+    ) -> PyResult<PyObjectId> {
+        guard(|| {
+            let (centers, n) = borrow(centers, "spheres: centers", Kind::Vec3)?;
+            let mut held = vec![centers.clone()];
+            let radius = radius(radii, "spheres: radii", n, "centers", &mut held)?;
+            let mut s = Spheres::new(centers, radius);
+            if let Some(c) = colors {
+                let (c, k) = borrow(c, "spheres: colors", Kind::Vec3)?;
+                same_count("spheres: colors", k, n, "centers")?;
+                held.push(c.clone());
+                s.colors = Some(c);
+            }
+            s.material = self.material_id(material)?;
+            let id = match id {
+                Some(id) => self.scene.set_spheres(id.0, s).py_err().map(|_| id.0)?,
+                None => self.scene.add_spheres(s).py_err()?,
+            };
+            self.arrays.insert(id, held);
+            Ok(PyObjectId(id))
+        })
+    }
+
+    /// Cylinders read from numpy arrays: `radii` a number or an (n,) array.
+    #[pyo3(signature = (bases, apexes, radii, caps = true, material = None, id = None))]
+    fn _cylinders(
+        &mut self,
+        bases: &Bound<'_, PyAny>,
+        apexes: &Bound<'_, PyAny>,
+        radii: &Bound<'_, PyAny>,
+        caps: bool,
+        material: Option<&str>,
+        id: Option<&PyObjectId>,
+    ) -> PyResult<PyObjectId> {
+        guard(|| {
+            let (bases, n) = borrow(bases, "cylinders: a", Kind::Vec3)?;
+            let (apexes, k) = borrow(apexes, "cylinders: b", Kind::Vec3)?;
+            same_count("cylinders: b", k, n, "bases (a)")?;
+            let mut held = vec![bases.clone(), apexes.clone()];
+            let radius = radius(radii, "cylinders: radii", n, "cylinders", &mut held)?;
+            let mut c = Cylinders::new(bases, apexes, radius);
+            c.caps = caps;
+            c.material = self.material_id(material)?;
+            let id = match id {
+                Some(id) => self.scene.set_cylinders(id.0, c).py_err().map(|_| id.0)?,
+                None => self.scene.add_cylinders(c).py_err()?,
+            };
+            self.arrays.insert(id, held);
+            Ok(PyObjectId(id))
+        })
+    }
+
+    /// A triangle mesh read from numpy arrays (`indices` None: every three vertices).
+    #[pyo3(signature = (vertices, indices = None, normals = None, colors = None, uvs = None, material = None, id = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn _mesh(
+        &mut self,
+        vertices: &Bound<'_, PyAny>,
+        indices: Option<&Bound<'_, PyAny>>,
+        normals: Option<&Bound<'_, PyAny>>,
+        colors: Option<&Bound<'_, PyAny>>,
+        uvs: Option<&Bound<'_, PyAny>>,
+        material: Option<&str>,
+        id: Option<&PyObjectId>,
+    ) -> PyResult<PyObjectId> {
+        guard(|| {
+            let (positions, n) = borrow(vertices, "mesh: vertices", Kind::Vec3)?;
+            if indices.is_none() && n % 3 != 0 {
+                return Err(PyValueError::new_err(format!(
+                    "mesh: {n} vertices without indices; a triangle soup needs a multiple of \
+                     three (or give indices of shape (m, 3))"
+                )));
+            }
+            let mut held = vec![positions.clone()];
+            let mut per_vertex = |a: Option<&Bound<'_, PyAny>>, what: &str, kind: Kind| {
+                a.map(|a| {
+                    let (a, k) = borrow(a, what, kind)?;
+                    same_count(what, k, n, "vertices")?;
+                    held.push(a.clone());
+                    Ok::<_, PyErr>(a)
+                })
+                .transpose()
+            };
+            let normals = per_vertex(normals, "mesh: normals", Kind::Vec3)?;
+            let colors = per_vertex(colors, "mesh: colors", Kind::Vec3)?;
+            let uvs = per_vertex(uvs, "mesh: uvs", Kind::Uv)?;
+            let indices = indices
+                .map(|i| borrow(i, "mesh: indices", Kind::Index3).map(|(a, _)| a))
+                .transpose()?;
+            held.extend(indices.clone());
+            let m = Mesh {
+                positions,
+                indices,
+                normals,
+                colors,
+                uvs,
+                material: self.material_id(material)?,
+            };
+            let id = match id {
+                Some(id) => self.scene.set_mesh(id.0, m).py_err().map(|_| id.0)?,
+                None => self.scene.add_mesh(m).py_err()?,
+            };
+            self.arrays.insert(id, held);
+            Ok(PyObjectId(id))
+        })
+    }
+
+    /// Marks every array of object `id` modified: the next commit reads them again.
+    fn _modified(&self, id: &PyObjectId) -> PyResult<()> {
+        match self.arrays.get(&id.0) {
+            Some(arrays) => {
+                arrays.iter().for_each(Array::mark_modified);
+                Ok(())
+            }
+            None if !self.scene.objects().contains(&id.0) => Err(crate::errors::to_py(
+                api::Error::Api(format!("{} was removed from this scene", id.0)),
+            )),
+            None => Err(PyValueError::new_err(format!(
+                "{} is made by a plugin, not read from arrays",
+                id.0
+            ))),
+        }
     }
 
     fn _objects(&self) -> Vec<PyObjectId> {
@@ -182,6 +340,8 @@ impl PyScene {
             let r = py.detach(|| scene.commit(&renderer)).py_err()?;
             let d = PyDict::new(py);
             d.set_item("rebuilt", r.rebuilt)?;
+            d.set_item("refitted", r.refitted)?;
+            d.set_item("degraded", r.degraded)?;
             d.set_item("shading", r.shading)?;
             d.set_item("bvh_seconds", r.bvh_time.as_secs_f64())?;
             d.set_item("commit_seconds", r.commit_time.as_secs_f64())?;
@@ -221,6 +381,18 @@ impl PyScene {
 }
 
 impl PyScene {
+    /// The material called `name` (`None`: the default one).
+    fn material_id(&self, name: Option<&str>) -> PyResult<Option<MaterialId>> {
+        let Some(name) = name else { return Ok(None) };
+        let id = self.scene.material(name).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "no material named `{name}` in this scene; define it first with \
+                 scene.set_material(\"{name}\", ...)"
+            ))
+        })?;
+        Ok(Some(id))
+    }
+
     /// The renderer for `threads` (made once per thread count).
     fn renderer(&mut self, threads: Option<usize>) -> PyResult<Arc<Renderer>> {
         if let Some((_, r)) = self.renderers.iter().find(|(t, _)| *t == threads) {

@@ -92,7 +92,9 @@ def test_every_exception_is_a_luxon_error():
 def test_help_documents_the_scene():
     text = pydoc.render_doc(luxon.Scene, renderer=pydoc.plaintext)
     for word in ("render(self, width, height", "add_light", "set_camera", "add_object",
-                 "KeyboardInterrupt", "SceneError", "save"):
+                 "KeyboardInterrupt", "SceneError", "save", "spheres(self, centers, radii",
+                 "cylinders(self, a, b, radii", "mesh(self, vertices, indices", "copy=True",
+                 "modified"):
         assert word in text, word
     stub = (Path(luxon.__file__).parent / "__init__.pyi").read_text()
     for name in luxon.__all__:

@@ -15,6 +15,10 @@ array::
     s.add_object("sphere", center=(0, 0.8, 0), radius=0.8, material="red")
     img = s.render(320, 240)                        # displays itself in Jupyter
 
+    atoms = s.spheres(centers, 0.3)                 # (n, 3) numpy array, read in place
+    centers += velocities * dt                      # a step of the simulation, in place
+    atoms.modified()                                # the next render refits
+
 Errors are exceptions (:class:`LuxonError` and its subclasses) with the command line's
 messages (``file:line:col: ...``). See ``help(luxon.Scene)``.
 """
@@ -35,9 +39,10 @@ from ._errors import (
 )
 from ._image import Image
 from ._ron import Ron, Variant, to_ron
-from ._scene import Context, Light, Object, Scene, default_context
+from ._scene import ArrayObject, Context, Light, Object, Scene, default_context
 
 __all__ = [
+    "ArrayObject",
     "CancelledError",
     "Context",
     "FileError",

@@ -7,9 +7,14 @@ import numpy.typing as npt
 
 _Path = Union[str, PathLike[str]]
 _Vec3 = Union[Sequence[float], npt.NDArray[np.floating[Any]]]
+# Arrays read in place: (n, 3) float32/float64 rows, (n,) radii, (m, 3) integer indices.
+_Rows = npt.NDArray[np.floating[Any]]
+_Radii = Union[float, npt.NDArray[np.floating[Any]]]
+_Indices = npt.NDArray[np.integer[Any]]
 
 __all__ = [
     "CancelledError",
+    "ArrayObject",
     "Context",
     "FileError",
     "Image",
@@ -83,8 +88,17 @@ class Object:
     scene: Scene
     def remove(self) -> None: ...
 
+class ArrayObject(Object):
+    kind: Literal["spheres", "cylinders", "mesh"]
+    arrays: dict[str, Any]
+    options: dict[str, Any]
+    def update(self, *, copy: bool | None = None, **arrays: Any) -> None: ...
+    def modified(self) -> None: ...
+
 class CommitReport(TypedDict):
     rebuilt: int
+    refitted: int
+    degraded: int
     shading: bool
     bvh_seconds: float
     commit_seconds: float
@@ -119,6 +133,36 @@ class Scene:
     ) -> Object: ...
     @property
     def objects(self) -> list[Object]: ...
+    def spheres(
+        self,
+        centers: _Rows,
+        radii: _Radii,
+        *,
+        colors: _Rows | None = None,
+        material: str | None = None,
+        copy: bool = False,
+    ) -> ArrayObject: ...
+    def cylinders(
+        self,
+        a: _Rows,
+        b: _Rows,
+        radii: _Radii,
+        *,
+        caps: bool = True,
+        material: str | None = None,
+        copy: bool = False,
+    ) -> ArrayObject: ...
+    def mesh(
+        self,
+        vertices: _Rows,
+        indices: _Indices | None = None,
+        *,
+        normals: _Rows | None = None,
+        colors: _Rows | None = None,
+        uvs: npt.NDArray[np.float32] | None = None,
+        material: str | None = None,
+        copy: bool = False,
+    ) -> ArrayObject: ...
     def commit(self) -> CommitReport: ...
     @overload
     def render(

@@ -66,11 +66,12 @@ def to_ron(value):
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, int):
-        return str(value)
+        return str(int(value))
     if isinstance(value, float):
         if not math.isfinite(value):
             raise ValueError(f"{value}: RON numbers must be finite")
-        return repr(value)
+        # float(): numpy's float64 is a float whose repr is "np.float64(...)".
+        return repr(float(value))
     if isinstance(value, str):
         return _string(value)
     if isinstance(value, os.PathLike):

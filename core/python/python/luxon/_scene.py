@@ -102,6 +102,107 @@ class Object:
         return f"<luxon.Object {self.id!r}>"
 
 
+class ArrayObject(Object):
+    """Spheres, cylinders or a mesh read from numpy arrays (from :meth:`Scene.spheres`,
+    :meth:`Scene.cylinders` or :meth:`Scene.mesh`).
+
+    Zero-copy arrays are read where they are at every commit and render, so a simulation can
+    write them in place between renders and call :meth:`modified`; :meth:`update` gives the
+    object other arrays. Never write an array while a render that reads it runs (in another
+    Python thread, say).
+    """
+
+    __slots__ = ("kind", "arrays", "options")
+
+    def __init__(self, scene, id, kind, arrays, options):
+        super().__init__(scene, id)
+        self.kind = kind
+        #: The arrays the object reads now (after ``copy=True``, Luxon's copies), by name.
+        self.arrays = arrays
+        self.options = options
+
+    def update(self, *, copy=None, **arrays):
+        """Replaces some of the object's arrays, keeping the others: ``update(centers=new)``,
+        ``update(radii=0.2)``. ``copy`` defaults to the object's. The object's BVH is built
+        again at the next commit (its size may change)."""
+        unknown = set(arrays) - set(_ARRAY_ARGS[self.kind])
+        if unknown:
+            raise TypeError(
+                f"{self.kind}.update: unknown array {sorted(unknown)[0]!r}; "
+                f"expected {', '.join(_ARRAY_ARGS[self.kind])}"
+            )
+        if copy is None:
+            copy = self.options["copy"]
+        merged = {**self.arrays, **arrays}
+        self.arrays = _make_object(self.scene, self.kind, merged, {**self.options, "copy": copy}, self.id)
+
+    def modified(self):
+        """Tells Luxon the object's arrays were written in place: the next commit (or render)
+        reads them again and refits the object's BVH (or builds it again when a refit would
+        make it slow, or a mesh's indices changed)."""
+        self.scene._modified(self.id)
+
+    def __repr__(self):
+        first = self.arrays[_ARRAY_ARGS[self.kind][0]]
+        return f"<luxon.ArrayObject {self.kind} {self.id!r}: {len(first)} rows>"
+
+
+# The array arguments of each kind, first the one that counts the rows.
+_ARRAY_ARGS = {
+    "spheres": ("centers", "radii", "colors"),
+    "cylinders": ("a", "b", "radii"),
+    "mesh": ("vertices", "indices", "normals", "colors", "uvs"),
+}
+
+
+def _copied(a, name):
+    """``copy=True``: a packed copy of ``a`` of a dtype Luxon reads (float arrays keep float32,
+    everything else real becomes float64; indices uint32 or uint64)."""
+    if a is None:
+        return None
+    if name == "radii" and np.ndim(a) == 0:
+        return float(a)
+    a = np.asarray(a)
+    if name == "indices":
+        if a.size and a.min() < 0:
+            raise ValueError("mesh: indices: negative vertex indices")
+        dtype = np.uint32 if a.size == 0 or a.max() < 2**32 else np.uint64
+    elif name == "uvs":
+        dtype = np.float32
+    else:
+        dtype = np.float32 if a.dtype == np.float32 else np.float64
+    return np.array(a, dtype=dtype, order="C", copy=True)
+
+
+def _make_object(scene, kind, arrays, options, id=None):
+    """Adds (or with ``id`` replaces) an array object; returns the arrays it reads."""
+    if options["copy"]:
+        arrays = {k: _copied(v, k) for k, v in arrays.items()}
+    idx = arrays.get("indices")
+    if isinstance(idx, np.ndarray) and idx.dtype.kind == "i" and idx.size and idx.min() < 0:
+        raise ValueError("mesh: indices: negative vertex indices")
+    material = options.get("material")
+    if kind == "spheres":
+        made = scene._spheres(arrays["centers"], arrays["radii"], arrays["colors"], material, id)
+    elif kind == "cylinders":
+        made = scene._cylinders(
+            arrays["a"], arrays["b"], arrays["radii"], options["caps"], material, id
+        )
+    else:
+        made = scene._mesh(
+            arrays["vertices"],
+            arrays["indices"],
+            arrays["normals"],
+            arrays["colors"],
+            arrays["uvs"],
+            material,
+            id,
+        )
+    if id is None:
+        return ArrayObject(scene, made, kind, arrays, options)
+    return arrays
+
+
 def _light_text(kind, params):
     if not isinstance(kind, str):
         raise TypeError(f"light kind: expected a str, not {type(kind).__name__}")
@@ -221,8 +322,71 @@ class Scene(_luxon.Scene):
 
     @property
     def objects(self):
-        """The scene's objects made by plugins, in order (imported geometry has no handle)."""
+        """The scene's objects made by plugins or from arrays, in order (imported geometry
+        has no handle)."""
         return [Object(self, i) for i in self._objects()]
+
+    # --- objects read from numpy arrays -------------------------------------------------
+    #
+    # Zero-copy: a numpy array of a dtype Luxon reads, rows side by side (C order, or a row
+    # slice such as atoms[:, :3]), is read in place; the scene keeps a reference to it.
+
+    def spheres(self, centers, radii, *, colors=None, material=None, copy=False):
+        """Adds spheres read from numpy arrays and returns their :class:`ArrayObject`.
+
+        ``centers``: ``(n, 3)`` float32 or float64 (world coordinates). ``radii``: one number
+        for all, or ``(n,)`` float32/float64. ``colors``: optional ``(n, 3)`` linear RGB
+        replacing the material's colour per sphere. ``material``: a name from
+        :meth:`set_material` (default: ``"default"``).
+
+        With ``copy=False`` (the default) the arrays are read in place, never copied: write
+        them between renders and call :meth:`ArrayObject.modified`. An array Luxon cannot
+        read in place raises ``TypeError`` (its dtype) or ``ValueError`` (its shape, its
+        layout or its length); ``copy=True`` converts and copies anything array-like instead
+        (the originals may then change freely)."""
+        return _make_object(
+            self,
+            "spheres",
+            {"centers": centers, "radii": radii, "colors": colors},
+            {"material": material, "copy": copy},
+        )
+
+    def cylinders(self, a, b, radii, *, caps=True, material=None, copy=False):
+        """Adds cylinders from ``a[i]`` to ``b[i]`` (both ``(n, 3)`` float32/float64) of
+        ``radii`` (a number or ``(n,)``), closed by discs unless ``caps=False``, and returns
+        their :class:`ArrayObject`. Arrays as in :meth:`spheres` (zero-copy unless
+        ``copy=True``)."""
+        return _make_object(
+            self,
+            "cylinders",
+            {"a": a, "b": b, "radii": radii},
+            {"material": material, "copy": copy, "caps": caps},
+        )
+
+    def mesh(
+        self, vertices, indices=None, *, normals=None, colors=None, uvs=None, material=None,
+        copy=False,
+    ):
+        """Adds a triangle mesh and returns its :class:`ArrayObject`.
+
+        ``vertices``: ``(n, 3)`` float32/float64. ``indices``: ``(m, 3)`` uint32, int32,
+        uint64 or int64 vertex numbers per triangle (``None``: every three vertices make
+        one). Optional per-vertex ``normals`` and ``colors`` (linear RGB) ``(n, 3)``
+        float32/float64, ``uvs`` ``(n, 2)`` float32. Arrays as in :meth:`spheres`
+        (zero-copy unless ``copy=True``). After writing the vertices in place call
+        :meth:`ArrayObject.modified` (a refit); new indices build the BVH again."""
+        return _make_object(
+            self,
+            "mesh",
+            {
+                "vertices": vertices,
+                "indices": indices,
+                "normals": normals,
+                "colors": colors,
+                "uvs": uvs,
+            },
+            {"material": material, "copy": copy},
+        )
 
     # --- building, rendering, saving ----------------------------------------------------
 
