@@ -289,3 +289,21 @@ def test_array_objects_beside_plugin_objects_and_lights_change():
     report = s.commit()
     assert report["rebuilt"] == 0 and report["refitted"] == 0
     assert not np.array_equal(first, s.render(48, 32))
+
+
+def test_array_objects_wear_a_custom_texture_plugin():
+    # examples/stripes: the SDK's example texture plugin, from its scene file; array spheres
+    # in its material render as the same spheres given to the spheres plugin.
+    from conftest import plugin_dir_with
+
+    ctx = luxon.Context(threads=2, plugin_path=[plugin_dir_with("libluxon_stripes.so")])
+    centers = np.array([[-1.2, 0.5, 2.0], [1.3, 0.6, 2.5], [0.2, 1.9, 3.5]])
+    radii = np.array([0.45, 0.55, 0.4])
+    a = luxon.load(REPO / "examples" / "stripes" / "scene.ron", context=ctx)
+    a.spheres(centers, radii, material="zebra")
+    b = luxon.load(REPO / "examples" / "stripes" / "scene.ron", context=ctx)
+    b.add_object("spheres", centers=centers, radii=radii.tolist(), material="zebra")
+    img = a.render(64, 48)
+    assert np.array_equal(img, b.render(64, 48))
+    a.set_material("zebra", texture="filtered", specular=0.5)
+    assert not np.array_equal(img, a.render(64, 48))

@@ -434,5 +434,5 @@ class Scene(_luxon.Scene):
 
     def __repr__(self):
         return (
-            f"<luxon.Scene: {len(self._lights())} lights, {len(self._objects())} plugin objects>"
+            f"<luxon.Scene: {len(self._lights())} lights, {len(self._objects())} objects>"
         )
