@@ -135,6 +135,12 @@
 //! ([`CommitReport`] counts both). Array objects are tested after the scene's other geometry;
 //! [`Scene::to_ron`] does not write them.
 //!
+//! Volumes come from arrays too ([`VolumeGrid`]: f32, f64, u8 or u16 values in any strided
+//! layout, placed by origin and spacing as the `raw` reader places its voxels), drawn as a
+//! scene file's volume `render:` says ([`Scene::add_volume_ron`]). They are copied into
+//! bricks at the commit that first sees them and again after their values changed
+//! ([`CommitReport::volumes_read`]), never read in place: the array is free between commits.
+//!
 //! ```
 //! use luxon::api::{Context, ContextOptions, Radius, Renderer, RendererOptions, Scene, Spheres};
 //! use luxon::arrays::{Array, SharedVec};
@@ -173,6 +179,7 @@ mod image;
 mod objects;
 mod renderer;
 mod scene;
+mod volumes;
 
 pub use crate::error::Error;
 pub use crate::framebuffer::{Color, Plane, Target};
@@ -180,6 +187,6 @@ pub use crate::render::{Progress, RenderStats};
 pub use context::{Context, ContextOptions};
 pub use ids::{ClipId, LightId, MaterialId, ObjectId};
 pub use image::write_image;
-pub use objects::{Cylinders, Mesh, Radius, Spheres};
+pub use objects::{Cylinders, Mesh, Radius, Spheres, VolumeGrid};
 pub use renderer::{Cancel, Renderer, RendererOptions};
 pub use scene::{CommitReport, Scene};

@@ -114,3 +114,46 @@ pub(super) const INDEX3: &[Elem] = &[Elem::U32x3, Elem::U64x3];
 pub(super) const UV: &[Elem] = &[Elem::F32x2];
 /// Real numbers (radii).
 pub(super) const REAL: &[Elem] = &[Elem::F32, Elem::F64];
+
+/// A scalar grid read from an array (f32, f64, u8 or u16), copied into Luxon's bricks at every
+/// commit that finds it changed (a volume is never read in place: sampling and empty-space
+/// skipping need bricks). Voxel `(i, j, k)` is element `first + i·sx + j·sy + k·sz` of `values`
+/// (`strides` `[sx, sy, sz]` in elements; `None`: x fastest, packed, as a Fortran array
+/// `v(nx, ny, nz)` or a C array `v[nz][ny][nx]`; negative strides run an axis backwards) and
+/// lies at world position `origin + (i·spacing.x, j·spacing.y, k·spacing.z)`, as the `raw`
+/// volume reader places its voxels. Integer voxels are divided by 255 (u8) or 65535 (u16)
+/// when `normalize`, as `raw` does by default. Added by [`super::Scene::add_volume`].
+#[derive(Clone, Debug)]
+pub struct VolumeGrid {
+    pub values: Array,
+    /// Voxels along x, y and z (each ≥ 1).
+    pub dims: [u64; 3],
+    pub strides: Option<[i64; 3]>,
+    /// The element of voxel (0, 0, 0) (a view into a larger array starts past 0).
+    pub first: u64,
+    pub origin: [f64; 3],
+    /// Each finite and non-zero (a negative one mirrors its axis).
+    pub spacing: [f64; 3],
+    pub normalize: bool,
+    /// The scene's name for the volume (its messages use it); empty: the object's id.
+    pub name: String,
+}
+
+impl VolumeGrid {
+    /// A grid of `dims` voxels, x fastest, at the world origin with unit spacing.
+    pub fn new(values: Array, dims: [u64; 3]) -> VolumeGrid {
+        VolumeGrid {
+            values,
+            dims,
+            strides: None,
+            first: 0,
+            origin: [0.0; 3],
+            spacing: [1.0; 3],
+            normalize: true,
+            name: String::new(),
+        }
+    }
+}
+
+/// A grid's voxel values.
+pub(super) const VOXEL: &[Elem] = &[Elem::F32, Elem::F64, Elem::U8, Elem::U16];

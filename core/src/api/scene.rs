@@ -2,7 +2,10 @@
 //! only as far as the changes since the last one need.
 
 use super::ids::{self, scene_serial, ClipId, LightId, MaterialId, ObjectId, Slots};
-use super::objects::{expect_elem, Cylinders, Mesh, Radius, Spheres, INDEX3, REAL, UV, VEC3};
+use super::objects::{
+    expect_elem, Cylinders, Mesh, Radius, Spheres, VolumeGrid, INDEX3, REAL, UV, VEC3,
+};
+use super::volumes;
 use super::{Context, Renderer};
 use crate::arrays::{Array, Pins};
 use crate::budget::Budget;
@@ -11,10 +14,12 @@ use crate::geometry::array_set::{CylinderReader, MeshReader, RadiusRead, SphereR
 use crate::geometry::objects::{Object, Objects, Outcome, Spec, MAX_OBJECTS};
 use crate::math::DVec3;
 use crate::plugin::{PluginKind, Registry};
+use crate::scene::update::ArrayVolume;
 use crate::scene::{shadowless_groups, Prebuilt, Scene as Built};
+use crate::volume::Volume;
 use luxon_formats::{
     fragment, AoDesc, BackgroundDesc, CameraDesc, FogDesc, LightDesc, MaterialDesc, ObjectDesc,
-    Origin, PluginCall, Projection, RenderDesc, SceneDesc, Spanned,
+    Origin, PluginCall, Projection, RenderDesc, SceneDesc, Spanned, VolumeRenderDesc,
 };
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -37,6 +42,9 @@ pub struct CommitReport {
     pub degraded: u32,
     /// The largest ratio of a refitted tree's cost to its cost when built (0: no refit).
     pub worst_ratio: f32,
+    /// Volumes read from their arrays into bricks: new ones, those given a new grid or look
+    /// ([`Scene::set_volume`]), and those whose values changed (marked modified).
+    pub volumes_read: u32,
     /// The commit took new lights, materials, fog or ambient occlusion into the built scene
     /// without building it again (no geometry touched).
     pub shading: bool,
@@ -100,14 +108,61 @@ pub struct Scene {
     serial: u32,
     lights: Slots<ids::Light>,
     objects: Slots<ids::Object>,
-    /// Per object, in the order of `objects`: an array object's description, `None` for a
-    /// plugin object (the description's `objects`, in the same order).
-    arrays: Vec<Option<ArrayObject>>,
+    /// Per object, in the order of `objects`: a plugin object (the description's `objects`,
+    /// in the same order), an array object's description or a volume grid's.
+    parts: Vec<Part>,
+    /// The key and generation of each volume read from an array that the built scene holds,
+    /// in order (its last volumes).
+    volumes_built: Vec<(u64, u64)>,
     /// The materials of the imported groups that cast no shadow (the build's copies of them
     /// depend on it), taken before a frozen scene's groups are consumed.
     shadowless: Vec<Option<Spanned<String>>>,
     /// [`Scene::new`]'s scene has no camera until one is set.
     has_camera: bool,
+}
+
+/// What an object id stands for.
+#[derive(Clone)]
+enum Part {
+    Plugin,
+    Array(ArrayObject),
+    // Boxed: a grid and its look are large, and plugin objects many.
+    Volume(Box<VolumeObject>),
+}
+
+impl Part {
+    fn array(&self) -> Option<&ArrayObject> {
+        match self {
+            Part::Array(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    fn volume(&self) -> Option<&VolumeObject> {
+        match self {
+            Part::Volume(v) => Some(v),
+            _ => None,
+        }
+    }
+}
+
+/// A volume read from an array, as the caller described it.
+#[derive(Clone)]
+struct VolumeObject {
+    /// Changes when the object is given a new grid or look: it is then read again.
+    key: u64,
+    /// `object 2 (volume)`.
+    label: String,
+    /// The volume's name (the grid's, or the object's id).
+    name: String,
+    grid: VolumeGrid,
+    look: Option<VolumeRenderDesc>,
+}
+
+/// A volume object and the name its grid gives it.
+struct Named {
+    object: VolumeObject,
+    name: Option<String>,
 }
 
 /// An array object as the caller described it.
@@ -242,7 +297,8 @@ impl Scene {
             size: (desc.render.width, desc.render.height),
             lights: Slots::new(serial, desc.lights.len()),
             objects: Slots::new(serial, desc.objects.len()),
-            arrays: vec![None; desc.objects.len()],
+            parts: vec![Part::Plugin; desc.objects.len()],
+            volumes_built: Vec::new(),
             shadowless: shadowless_groups(&desc),
             desc,
             registry: ctx.registry.clone(),
@@ -649,7 +705,7 @@ impl Scene {
             shadows: true,
         };
         self.desc.objects.push(Spanned { value: object, at });
-        self.arrays.push(None);
+        self.parts.push(Part::Plugin);
         self.dirty.build = true;
         Ok(id)
     }
@@ -659,17 +715,21 @@ impl Scene {
     /// their place).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), Error> {
         let i = self.objects.position(id)?;
-        if self.arrays[i].is_some() {
-            // An array object: dropped from the built scene at the next commit, no build.
+        if !matches!(self.parts[i], Part::Plugin) {
+            // An array object or a volume: dropped from the built scene at the next commit,
+            // no build.
             self.objects.remove(id)?;
-            self.arrays.remove(i);
+            self.parts.remove(i);
             return Ok(());
         }
         self.objects_can_change()?;
         self.not_animated("objects")?;
         let i = self.objects.remove(id)?;
-        self.arrays.remove(i);
-        let plugin = i - self.arrays[..i].iter().filter(|a| a.is_some()).count();
+        self.parts.remove(i);
+        let plugin = i - self.parts[..i]
+            .iter()
+            .filter(|p| !matches!(p, Part::Plugin))
+            .count();
         self.desc.objects.remove(plugin);
         self.dirty.build = true;
         Ok(())
@@ -749,13 +809,13 @@ impl Scene {
     }
 
     fn add_array(&mut self, (arrays, spec, material): ArrayParts) -> Result<ObjectId, Error> {
-        if self.arrays.iter().flatten().count() >= MAX_OBJECTS {
+        if self.parts.iter().filter_map(Part::array).count() >= MAX_OBJECTS {
             return Err(Error::Api(format!(
                 "a scene holds at most {MAX_OBJECTS} array objects"
             )));
         }
         let id = self.objects.insert();
-        self.arrays.push(Some(ArrayObject {
+        self.parts.push(Part::Array(ArrayObject {
             key: array_key(),
             label: format!("{id} ({})", spec.kind()),
             arrays,
@@ -772,10 +832,10 @@ impl Scene {
     ) -> Result<(), Error> {
         let i = self.objects.position(id)?;
         let kind = spec.kind();
-        if !matches!(&self.arrays[i], Some(a) if a.spec.kind() == kind) {
+        if !matches!(&self.parts[i], Part::Array(a) if a.spec.kind() == kind) {
             return Err(Error::Api(format!("{id} is not an array object of {kind}")));
         }
-        self.arrays[i] = Some(ArrayObject {
+        self.parts[i] = Part::Array(ArrayObject {
             key: array_key(),
             label: format!("{id} ({kind})"),
             arrays,
@@ -783,6 +843,98 @@ impl Scene {
             material,
         });
         Ok(())
+    }
+
+    /// Adds a volume read from an array, drawn as `look` says (`None`: data only, not drawn),
+    /// the settings a scene file gives a volume after `render:`. The grid's layout and element
+    /// type are checked now; its values are copied into bricks at the next commit (a NaN or
+    /// infinite voxel is refused then, naming it), and again at every commit after they were
+    /// marked modified ([`crate::arrays::Array::mark_modified`], or a
+    /// [`crate::arrays::SharedVec`] write): [`CommitReport::volumes_read`] counts these reads.
+    /// Between commits the array may be written freely (a volume is never read in place). No
+    /// BVH is built for it.
+    pub fn add_volume(
+        &mut self,
+        grid: VolumeGrid,
+        look: Option<VolumeRenderDesc>,
+    ) -> Result<ObjectId, Error> {
+        let v = self.volume_object(grid, look)?;
+        let id = self.objects.insert();
+        self.parts.push(Part::Volume(Box::new(VolumeObject {
+            label: format!("{id} (volume)"),
+            name: v.name.unwrap_or_else(|| id.to_string()),
+            ..v.object
+        })));
+        Ok(id)
+    }
+
+    /// [`Scene::add_volume`] drawn as RON text says, e.g. `(transfer: (preset: "viridis"),
+    /// step: 0.05)` (what follows `render:` in a scene file's volume); errors point into the
+    /// text as `<volume_render>:line:col`.
+    pub fn add_volume_ron(&mut self, grid: VolumeGrid, look_ron: &str) -> Result<ObjectId, Error> {
+        let look = fragment::volume_render(look_ron)?;
+        self.add_volume(grid, Some(look))
+    }
+
+    /// Gives volume `id` (added by [`Scene::add_volume`]) a new grid and look: read again at
+    /// the next commit.
+    pub fn set_volume(
+        &mut self,
+        id: ObjectId,
+        grid: VolumeGrid,
+        look: Option<VolumeRenderDesc>,
+    ) -> Result<(), Error> {
+        let i = self.objects.position(id)?;
+        if !matches!(self.parts[i], Part::Volume(_)) {
+            return Err(Error::Api(format!("{id} is not a volume")));
+        }
+        let v = self.volume_object(grid, look)?;
+        self.parts[i] = Part::Volume(Box::new(VolumeObject {
+            label: format!("{id} (volume)"),
+            name: v.name.unwrap_or_else(|| id.to_string()),
+            ..v.object
+        }));
+        Ok(())
+    }
+
+    /// [`Scene::set_volume`] with its look as RON text (see [`Scene::add_volume_ron`]).
+    pub fn set_volume_ron(
+        &mut self,
+        id: ObjectId,
+        grid: VolumeGrid,
+        look_ron: &str,
+    ) -> Result<(), Error> {
+        self.objects.position(id)?;
+        let look = fragment::volume_render(look_ron)?;
+        self.set_volume(id, grid, Some(look))
+    }
+
+    /// A volume object (its label to be set) and its grid's name if it has one.
+    fn volume_object(
+        &self,
+        grid: VolumeGrid,
+        look: Option<VolumeRenderDesc>,
+    ) -> Result<Named, Error> {
+        let name = (!grid.name.is_empty()).then(|| grid.name.clone());
+        let called = name.as_deref().unwrap_or("(unnamed)");
+        volumes::check(&grid, &format!("volume grid `{called}`"))?;
+        if let Some(l) = &look {
+            fragment::check_volume_render(l)
+                .map_err(|m| Error::Api(format!("volume `{called}`'s render settings: {m}")))?;
+            if let Some(c) = &l.clip {
+                if !self.desc.clip_groups.iter().any(|(n, _)| *n == c.value) {
+                    return Err(Error::Api(format!("no clip group named `{}`", c.value)));
+                }
+            }
+        }
+        let object = VolumeObject {
+            key: array_key(),
+            label: String::new(),
+            name: String::new(),
+            grid,
+            look,
+        };
+        Ok(Named { object, name })
     }
 
     fn material_index(&self, m: Option<MaterialId>) -> Result<u32, Error> {
@@ -862,7 +1014,8 @@ impl Scene {
     /// and ambient occlusion. A scene without a camera ([`Scene::new`]) is refused.
     ///
     /// Array objects are read (their arrays pinned: writers wait) during the commit only, and
-    /// their BVHs refitted or built again as [`CommitReport`] tells.
+    /// their BVHs refitted or built again as [`CommitReport`] tells; volumes from arrays are
+    /// read when new or changed.
     pub fn commit(&mut self, on: &Renderer) -> Result<CommitReport, Error> {
         let report = self.commit_pinned(on);
         self.unpin();
@@ -876,12 +1029,20 @@ impl Scene {
         // Pinned on this thread first: one that is writing an array is refused here (on the
         // pool's threads its pin would wait for itself), and no write starts meanwhile.
         let held = self
-            .arrays
+            .parts
             .iter()
-            .flatten()
+            .filter_map(Part::array)
             .map(|a| Pins::new(&a.arrays))
             .collect::<Result<Vec<Pins>, Error>>()?;
-        let report = on.pool.install(|| self.commit_here());
+        // Volumes are read during the commit only: their pins go with it.
+        let grids = self
+            .parts
+            .iter()
+            .filter_map(Part::volume)
+            .map(|v| Pins::new(std::slice::from_ref(&v.grid.values)))
+            .collect::<Result<Vec<Pins>, Error>>()?;
+        let report = on.pool.install(|| self.commit_here(&grids));
+        drop(grids);
         drop(held);
         let mut report = report?;
         report.commit_time = t0.elapsed();
@@ -898,20 +1059,20 @@ impl Scene {
     /// Brings the built array objects up to date with their descriptions (in the built
     /// scene's render space): kept, refitted or built again, as `report` then says.
     fn commit_arrays(
-        arrays: &[Option<ArrayObject>],
+        parts: &[Part],
         previous: Vec<Object>,
         built: &mut Built,
         render: &RenderDesc,
         report: &mut CommitReport,
     ) -> Result<(), Error> {
-        if previous.is_empty() && arrays.iter().all(Option::is_none) {
+        if previous.is_empty() && parts.iter().all(|p| p.array().is_none()) {
             return Ok(());
         }
         let t0 = Instant::now();
         let offset = built.world_offset;
         let mut previous: HashMap<u64, Object> = previous.into_iter().map(|o| (o.key, o)).collect();
         let mut list = Vec::new();
-        for a in arrays.iter().flatten() {
+        for a in parts.iter().filter_map(Part::array) {
             let (object, outcome) = match previous.remove(&a.key) {
                 Some(o) => o.update(offset)?,
                 None => {
@@ -943,7 +1104,56 @@ impl Scene {
         Ok(())
     }
 
-    fn commit_here(&mut self) -> Result<CommitReport, Error> {
+    /// Puts the volumes read from arrays into the built scene (which holds none of them now):
+    /// each read from `grids` (its pinned values, in the order of the volumes in `parts`)
+    /// unless `previous` has it read at the same generation. Returns their keys and
+    /// generations, in order.
+    fn commit_volumes(
+        parts: &[Part],
+        grids: &[Pins],
+        mut previous: HashMap<(u64, u64), Volume>,
+        desc: &SceneDesc,
+        built: &mut Built,
+        report: &mut CommitReport,
+    ) -> Result<Vec<(u64, u64)>, Error> {
+        let mut list = Vec::new();
+        let mut keys = Vec::new();
+        for (v, pins) in parts.iter().filter_map(Part::volume).zip(grids) {
+            let key = (v.key, pins.generation(0));
+            let volume = match previous.remove(&key) {
+                Some(volume) => volume,
+                None => {
+                    report.volumes_read += 1;
+                    volumes::read(&v.grid, &v.name, pins.view(0)).map_err(|e| match e {
+                        Error::Api(m) => Error::Api(format!("{}: {m}", v.label)),
+                        e => e,
+                    })?
+                }
+            };
+            let clip = match v.look.as_ref().and_then(|l| l.clip.as_ref()) {
+                Some(c) => {
+                    let i = desc.clip_groups.iter().position(|(n, _)| *n == c.value);
+                    i.map(|i| i as u32 + 1).ok_or_else(|| {
+                        Error::Api(format!("{}: no clip group named `{}`", v.label, c.value))
+                    })?
+                }
+                None => 0,
+            };
+            list.push(ArrayVolume {
+                volume,
+                look: v.look.as_ref(),
+                clip,
+                label: &v.label,
+            });
+            keys.push(key);
+        }
+        // Volumes removed since are dropped here.
+        drop(previous);
+        built.set_array_volumes(list, &desc.render)?;
+        Ok(keys)
+    }
+
+    fn commit_here(&mut self, grids: &[Pins]) -> Result<CommitReport, Error> {
         if !self.has_camera {
             return Err(Error::Api(
                 "this scene has no camera; give it one with Scene::set_camera before \
@@ -969,6 +1179,18 @@ impl Scene {
             Some(b) => b.objects.take(),
             None => Vec::new(),
         };
+        // So do the volumes read from arrays, taken out when they or the build change.
+        let generations: Vec<(u64, u64)> = (self.parts.iter().filter_map(Part::volume))
+            .zip(grids)
+            .map(|(v, p)| (v.key, p.generation(0)))
+            .collect();
+        let building = self.built.is_none() || self.dirty.build;
+        let volumes_change = building || generations != self.volumes_built;
+        let mut previous_volumes = HashMap::new();
+        if let (true, Some(b)) = (volumes_change, self.built.as_mut()) {
+            let keys = std::mem::take(&mut self.volumes_built);
+            previous_volumes = keys.into_iter().zip(b.take_array_volumes()).collect();
+        }
         if self.built.is_none() || self.dirty.build {
             if let Some(why) = self.consumed {
                 return Err(Error::Api(why.into()));
@@ -1004,13 +1226,17 @@ impl Scene {
         let Some(built) = self.built.as_mut() else {
             return Err(Error::Api("the scene is not built".into()));
         };
-        Scene::commit_arrays(
-            &self.arrays,
-            previous,
-            built,
-            &self.desc.render,
-            &mut report,
-        )?;
+        Scene::commit_arrays(&self.parts, previous, built, &self.desc.render, &mut report)?;
+        if volumes_change {
+            self.volumes_built = Scene::commit_volumes(
+                &self.parts,
+                grids,
+                previous_volumes,
+                &self.desc,
+                built,
+                &mut report,
+            )?;
+        }
         if self.dirty.lights {
             built.update_lights(&self.desc);
             self.dirty.lights = false;

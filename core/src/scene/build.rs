@@ -219,6 +219,7 @@ impl Scene {
             clips,
             volumes,
             render_volumes,
+            array_volumes: 0,
             world_offset: b.world_offset,
             settings: settings(r),
             outputs: r.outputs.clone(),

@@ -13,7 +13,7 @@ mod instances;
 mod place;
 mod shadows;
 mod sky;
-mod update;
+pub(crate) mod update;
 
 pub(crate) use build::shadowless_groups;
 pub use build::Prebuilt;
@@ -345,6 +345,8 @@ pub struct Scene {
     pub volumes: Vec<Volume>,
     /// The volumes that are drawn (those with `render` settings), ready for ray casting.
     pub render_volumes: Vec<RenderVolume>,
+    /// How many of `volumes` (the last ones) a retained scene read from arrays.
+    pub(crate) array_volumes: usize,
     /// World position of render space's origin (the camera): coordinates are stored relative
     /// to it in f32, so a scene far from the world origin keeps its precision.
     pub world_offset: DVec3,

@@ -9,7 +9,19 @@ use super::{Casters, Scene};
 use crate::error::Error;
 use crate::geometry::material_of;
 use crate::geometry::objects::Objects;
-use luxon_formats::{RenderDesc, SceneDesc, Spanned};
+use crate::volume::Volume;
+use crate::volume_render::{RenderVolume, MAX_RENDERED_VOLUMES};
+use luxon_formats::{RenderDesc, SceneDesc, Spanned, VolumeRenderDesc};
+
+/// A volume a retained scene read from an array, with how it is drawn (`None`: not drawn)
+/// and the number of its clip group (0: none).
+pub(crate) struct ArrayVolume<'a> {
+    pub volume: Volume,
+    pub look: Option<&'a VolumeRenderDesc>,
+    pub clip: u32,
+    /// `object 3 (volume)`, for messages.
+    pub label: &'a str,
+}
 
 impl Scene {
     /// Takes `desc`'s render settings (at `width`×`height`, the caller's image), outputs,
@@ -93,6 +105,53 @@ impl Scene {
     pub(crate) fn set_objects(&mut self, objects: Objects, r: &RenderDesc) {
         self.objects = objects;
         self.update_features(r);
+    }
+
+    /// Takes out the volumes a retained scene read from arrays (in the order it gave them),
+    /// with their render volumes.
+    pub(crate) fn take_array_volumes(&mut self) -> Vec<Volume> {
+        let first = self.volumes.len() - self.array_volumes;
+        self.render_volumes.retain(|rv| rv.volume < first);
+        self.array_volumes = 0;
+        self.volumes.split_off(first)
+    }
+
+    /// Puts a retained scene's volumes read from arrays after the scene's own (which
+    /// [`Scene::take_array_volumes`] must have left alone) and prepares those drawn for ray
+    /// casting in this build's render space, as the build does for a plugin's volume.
+    pub(crate) fn set_array_volumes(
+        &mut self,
+        volumes: Vec<ArrayVolume<'_>>,
+        r: &RenderDesc,
+    ) -> Result<(), Error> {
+        debug_assert_eq!(self.array_volumes, 0);
+        let mut drawn = Vec::new();
+        let first = self.volumes.len();
+        for (k, v) in volumes.iter().enumerate() {
+            let Some(look) = v.look else { continue };
+            if self.render_volumes.len() + drawn.len() == MAX_RENDERED_VOLUMES {
+                return Err(Error::Api(format!(
+                    "{}: more than {MAX_RENDERED_VOLUMES} volumes are drawn; at most \
+                     {MAX_RENDERED_VOLUMES} may have render settings",
+                    v.label
+                )));
+            }
+            let rv = RenderVolume::new(
+                look,
+                &v.volume,
+                first + k,
+                r.volume_step,
+                self.world_offset,
+                v.clip,
+            )
+            .map_err(|m| Error::Api(format!("{}: {m}", v.label)))?;
+            drawn.push(rv);
+        }
+        self.array_volumes = volumes.len();
+        self.volumes.extend(volumes.into_iter().map(|v| v.volume));
+        self.render_volumes.extend(drawn);
+        self.update_features(r);
+        Ok(())
     }
 
     /// The features, as the build's last stage finds them (with the array objects' materials
