@@ -175,3 +175,108 @@ pub fn same_count(what: &str, count: usize, n: usize, of: &str) -> PyResult<()> 
         of.trim_end_matches('s')
     )))
 }
+
+/// A 3-D numpy array as a volume's voxels, read in place: the array over the memory the
+/// view spans, the grid's dims and strides (in elements, x y z) and the element of voxel
+/// (0, 0, 0). `order` "zyx": `values[k, j, i]` is voxel (i, j, k) (a C array of slices, as
+/// a raw file reads); "xyz": `values[i, j, k]` (nibabel's order). Any strides that are whole
+/// elements, negative ones too.
+pub fn borrow_grid(value: &Bound<'_, PyAny>, order: &str) -> PyResult<Grid> {
+    let what = "volume: values";
+    let Ok(a) = value.cast::<PyUntypedArray>() else {
+        return Err(PyTypeError::new_err(format!(
+            "{what}: expected a numpy array of float32, float64, uint8 or uint16, not {}; pass \
+             copy=True, or np.asarray(values, dtype=np.float32)",
+            value
+                .get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        )));
+    };
+    let dtype = a.dtype();
+    let native = dtype.is_native_byteorder().unwrap_or(true);
+    let elem = match (dtype.kind(), dtype.itemsize()) {
+        (b'f', 4) => Some(Elem::F32),
+        (b'f', 8) => Some(Elem::F64),
+        (b'u', 1) => Some(Elem::U8),
+        (b'u', 2) => Some(Elem::U16),
+        _ => None,
+    }
+    .filter(|_| native && !dtype.has_subarray() && !dtype.has_fields());
+    let Some(elem) = elem else {
+        let shown = dtype.str().map(|s| s.to_string()).unwrap_or_default();
+        return Err(PyTypeError::new_err(format!(
+            "{what}: an array of dtype {shown}; expected float32, float64, uint8 or uint16{}. \
+             Pass copy=True to have Luxon convert it, or values.astype(np.float32)",
+            if native {
+                ""
+            } else {
+                " in this machine's byte order"
+            }
+        )));
+    };
+    let shape = a.shape();
+    if shape.len() != 3 || shape.contains(&0) {
+        return Err(PyValueError::new_err(format!(
+            "{what}: an array of shape {}; expected three dimensions of at least one voxel",
+            shape_text(shape)
+        )));
+    }
+    let item = elem.size() as isize;
+    let strides = a.strides();
+    if strides.iter().any(|s| s % item != 0) {
+        return Err(PyValueError::new_err(format!(
+            "{what}: strides {} bytes are not whole {}-byte elements; pass copy=True, or \
+             np.ascontiguousarray(values)",
+            shape_text(strides),
+            item
+        )));
+    }
+    // The lowest and highest element the view touches, in elements from voxel (0, 0, 0).
+    let (mut low, mut high) = (0isize, 0isize);
+    for (d, s) in shape.iter().zip(strides) {
+        let reach = (*d as isize - 1) * (s / item);
+        if reach < 0 {
+            low += reach;
+        } else {
+            high += reach;
+        }
+    }
+    let (axes, dims) = match order {
+        "zyx" => ([2, 1, 0], [shape[2], shape[1], shape[0]]),
+        "xyz" => ([0, 1, 2], [shape[0], shape[1], shape[2]]),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "volume: order {order:?}; expected \"zyx\" (values[z, y, x]) or \"xyz\""
+            )))
+        }
+    };
+    // SAFETY: `a` is a numpy array (the cast checked it), whose object struct Python keeps
+    // alive while `value` is borrowed.
+    let data = unsafe { (*a.as_array_ptr()).fields.data } as *const u8;
+    // The elements from the lowest the view touches to the highest lie in the array's buffer.
+    let base = data.wrapping_offset(low * item);
+    let len = (high - low + 1) as usize;
+    let owner: Py<PyAny> = value.clone().unbind();
+    // SAFETY: numpy's shape and strides say every voxel of the view lies in its buffer, so
+    // the `len` elements from `base` (the lowest voxel) to the highest one do too, packed
+    // (stride 0), and stay there while the owner (a reference to the array) lives; numpy
+    // memory is readable from any thread; Luxon copies it into bricks at the commit.
+    let values = unsafe { Array::external(base, len, 0, elem, owner) }
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok(Grid {
+        values,
+        dims: dims.map(|d| d as u64),
+        strides: axes.map(|ax| (strides[ax] / item) as i64),
+        first: (-low) as u64,
+    })
+}
+
+/// A volume's voxels as [`borrow_grid`] reads them.
+pub struct Grid {
+    pub values: Array,
+    pub dims: [u64; 3],
+    pub strides: [i64; 3],
+    pub first: u64,
+}

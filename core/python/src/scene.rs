@@ -2,12 +2,12 @@
 //! its lights and objects named by id tokens. `luxon.Scene` (python/luxon/_scene.py) subclasses
 //! it with keyword arguments and the handles users see.
 
-use crate::arrays::{borrow, same_count, Kind};
+use crate::arrays::{borrow, borrow_grid, same_count, Kind};
 use crate::context::PyContext;
 use crate::errors::{guard, IntoPy};
 use luxon::api::{
     self, Cylinders, LightId, MaterialId, Mesh, ObjectId, Radius, Renderer, RendererOptions,
-    Spheres,
+    Spheres, VolumeGrid,
 };
 use luxon::arrays::Array;
 use numpy::{PyUntypedArray, PyUntypedArrayMethods};
@@ -302,6 +302,45 @@ impl PyScene {
         })
     }
 
+    /// A volume from a 3-D numpy array (see `luxon.Scene.volume`), drawn as `look` (RON).
+    #[pyo3(signature = (values, order, origin, spacing, normalize, name, look, id = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn _volume(
+        &mut self,
+        values: &Bound<'_, PyAny>,
+        order: &str,
+        origin: [f64; 3],
+        spacing: [f64; 3],
+        normalize: bool,
+        name: Option<String>,
+        look: &str,
+        id: Option<&PyObjectId>,
+    ) -> PyResult<PyObjectId> {
+        guard(|| {
+            let g = borrow_grid(values, order)?;
+            let grid = VolumeGrid {
+                values: g.values.clone(),
+                dims: g.dims,
+                strides: Some(g.strides),
+                first: g.first,
+                origin,
+                spacing,
+                normalize,
+                name: name.unwrap_or_default(),
+            };
+            let id = match id {
+                Some(id) => self
+                    .scene
+                    .set_volume_ron(id.0, grid, look)
+                    .py_err()
+                    .map(|_| id.0)?,
+                None => self.scene.add_volume_ron(grid, look).py_err()?,
+            };
+            self.arrays.insert(id, vec![g.values]);
+            Ok(PyObjectId(id))
+        })
+    }
+
     /// Marks every array of object `id` modified: the next commit reads them again.
     fn _modified(&self, id: &PyObjectId) -> PyResult<()> {
         match self.arrays.get(&id.0) {
@@ -342,6 +381,7 @@ impl PyScene {
             d.set_item("rebuilt", r.rebuilt)?;
             d.set_item("refitted", r.refitted)?;
             d.set_item("degraded", r.degraded)?;
+            d.set_item("volumes_read", r.volumes_read)?;
             d.set_item("shading", r.shading)?;
             d.set_item("bvh_seconds", r.bvh_time.as_secs_f64())?;
             d.set_item("commit_seconds", r.commit_time.as_secs_f64())?;

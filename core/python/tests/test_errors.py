@@ -94,7 +94,7 @@ def test_help_documents_the_scene():
     for word in ("render(self, width, height", "add_light", "set_camera", "add_object",
                  "KeyboardInterrupt", "SceneError", "save", "spheres(self, centers, radii",
                  "cylinders(self, a, b, radii", "mesh(self, vertices, indices", "copy=True",
-                 "modified"):
+                 "modified", "volume(self, values, spacing"):
         assert word in text, word
     stub = (Path(luxon.__file__).parent / "__init__.pyi").read_text()
     for name in luxon.__all__:

@@ -39,7 +39,7 @@ from ._errors import (
 )
 from ._image import Image
 from ._ron import Ron, Variant, to_ron
-from ._scene import ArrayObject, Context, Light, Object, Scene, default_context
+from ._scene import ArrayObject, Context, Light, Object, Scene, Volume, default_context
 
 __all__ = [
     "ArrayObject",
@@ -57,6 +57,7 @@ __all__ = [
     "SceneError",
     "UsageError",
     "Variant",
+    "Volume",
     "default_context",
     "load",
     "to_ron",

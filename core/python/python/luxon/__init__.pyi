@@ -28,6 +28,7 @@ __all__ = [
     "SceneError",
     "UsageError",
     "Variant",
+    "Volume",
     "default_context",
     "load",
     "to_ron",
@@ -95,10 +96,17 @@ class ArrayObject(Object):
     def update(self, *, copy: bool | None = None, **arrays: Any) -> None: ...
     def modified(self) -> None: ...
 
+class Volume(Object):
+    values: npt.NDArray[Any]
+    options: dict[str, Any]
+    def update(self, values: npt.NDArray[Any] | None = None, **options: Any) -> None: ...
+    def modified(self) -> None: ...
+
 class CommitReport(TypedDict):
     rebuilt: int
     refitted: int
     degraded: int
+    volumes_read: int
     shading: bool
     bvh_seconds: float
     commit_seconds: float
@@ -163,6 +171,19 @@ class Scene:
         material: str | None = None,
         copy: bool = False,
     ) -> ArrayObject: ...
+    def volume(
+        self,
+        values: npt.NDArray[Any],
+        spacing: _Vec3 = (1.0, 1.0, 1.0),
+        origin: _Vec3 = (0.0, 0.0, 0.0),
+        *,
+        order: Literal["zyx", "xyz"] = "zyx",
+        normalize: bool = True,
+        name: str | None = None,
+        render: str | dict[str, Any] | None = None,
+        copy: bool = False,
+        **render_fields: Any,
+    ) -> Volume: ...
     def commit(self) -> CommitReport: ...
     @overload
     def render(

@@ -203,6 +203,49 @@ def _make_object(scene, kind, arrays, options, id=None):
     return arrays
 
 
+class Volume(Object):
+    """A volume from a numpy array (from :meth:`Scene.volume`)."""
+
+    __slots__ = ("values", "options")
+
+    def __init__(self, scene, id, values, options):
+        super().__init__(scene, id)
+        self.values = values
+        self.options = options
+
+    def update(self, values=None, **options):
+        """Replaces the voxels and/or options (``spacing``, ``origin``, ``order``,
+        ``normalize``, ``render``) of the volume; read at the next commit."""
+        if "render" in options:
+            r = options.pop("render")
+            options["look"] = r if isinstance(r, str) else _text(None, r or {}, "volume render")
+        opts = {**self.options, **options}
+        if values is None:
+            values = self.values
+        _make_volume(self.scene, values, opts, self.id)
+        self.values, self.options = values, opts
+
+    def modified(self):
+        """Tells Luxon the voxels were written in place: the next commit reads them again."""
+        self.scene._modified(self.id)
+
+    def __repr__(self):
+        return f"<luxon.Volume {self.id!r}: {np.shape(self.values)}>"
+
+
+def _make_volume(scene, values, o, id=None):
+    return scene._volume(
+        values,
+        o["order"],
+        [float(c) for c in o["origin"]],
+        [float(c) for c in o["spacing"]],
+        bool(o["normalize"]),
+        o["name"],
+        o["look"],
+        id,
+    )
+
+
 def _light_text(kind, params):
     if not isinstance(kind, str):
         raise TypeError(f"light kind: expected a str, not {type(kind).__name__}")
@@ -387,6 +430,43 @@ class Scene(_luxon.Scene):
             },
             {"material": material, "copy": copy},
         )
+
+    # --- volumes from 3-D arrays --------------------------------------------------------
+
+    def volume(
+        self, values, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), *, order="zyx",
+        normalize=True, name=None, render=None, copy=False, **render_fields,
+    ):
+        """Adds a volume from a 3-D numpy array and returns its :class:`Volume`.
+
+        ``values``: float32, float64, uint8 or uint16, indexed ``values[z, y, x]``
+        (``order="zyx"``, a C array of slices as a raw file holds them) or ``values[x, y, z]``
+        (``order="xyz"``, as nibabel gives them); any strides (slices, transposes) are read as
+        they are. Voxel ``(i, j, k)`` lies at ``origin + (i, j, k) * spacing`` (world units).
+        Integer voxels are divided by 255 or 65535 unless ``normalize=False``.
+
+        ``render``: how it is drawn, the RON text or dict a scene file's volume has after
+        ``render:`` (``transfer``, ``step``, ``shading``...), or keyword arguments:
+        ``volume(mri, spacing, transfer=dict(preset="viridis"), step=0.01)``; by default the
+        ``grayscale`` preset.
+
+        The array is referenced, not copied, but read only at commits: Luxon copies it into
+        its bricks at the next commit, and again at the first commit after
+        :meth:`Volume.modified`; between commits it may be written freely. ``copy=True``
+        converts any array-like first (to float32 unless it is one of the types above)."""
+        if copy:
+            a = np.asarray(values)
+            if a.dtype not in (np.float32, np.float64, np.uint8, np.uint16):
+                a = a.astype(np.float32)
+            values = np.array(a, order="C", copy=True)
+        if isinstance(render, dict):
+            render_fields = {**render, **render_fields}
+            render = None
+        if render is None and not render_fields:
+            render = '(transfer: (preset: "grayscale"))'
+        look = _text(render, render_fields, "volume render")
+        options = dict(spacing=spacing, origin=origin, order=order, normalize=normalize, name=name, look=look)
+        return Volume(self, _make_volume(self, values, options), values, options)
 
     # --- building, rendering, saving ----------------------------------------------------
 
