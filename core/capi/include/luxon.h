@@ -291,9 +291,11 @@ luxon_status luxon_write_image(struct luxon_context context,
 //
 // Then every rank holds the whole scene and calls `luxon_render` with a target of the same
 // size (collective too); rank 0 of the communicator receives the whole image, the same bits
-// as one process renders (other ranks' targets are not written: give them
-// `LUXON_PIXELS_NONE`). A failure on any rank is returned on every rank, naming the first
-// failing rank; the job goes on.
+// as one process renders (other ranks' targets are not written: they may give
+// `LUXON_PIXELS_NONE` without a depth plane). A failure on any rank (its scene, a plugin, an
+// internal error) is returned on every rank, naming the first failing rank; the job goes on.
+// Only a call refused for its own arguments (a NULL or malformed target, a released handle)
+// returns on its rank alone, before any MPI call: the other ranks then wait.
 //
 // Rules: the caller owns MPI. Luxon never calls `MPI_Init` or `MPI_Finalize`, never uses
 // `MPI_COMM_WORLD` on its own and never aborts. Call this after `MPI_Init_thread` and release

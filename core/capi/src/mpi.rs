@@ -18,9 +18,11 @@ use std::os::raw::c_int;
 ///
 /// Then every rank holds the whole scene and calls `luxon_render` with a target of the same
 /// size (collective too); rank 0 of the communicator receives the whole image, the same bits
-/// as one process renders (other ranks' targets are not written: give them
-/// `LUXON_PIXELS_NONE`). A failure on any rank is returned on every rank, naming the first
-/// failing rank; the job goes on.
+/// as one process renders (other ranks' targets are not written: they may give
+/// `LUXON_PIXELS_NONE` without a depth plane). A failure on any rank (its scene, a plugin, an
+/// internal error) is returned on every rank, naming the first failing rank; the job goes on.
+/// Only a call refused for its own arguments (a NULL or malformed target, a released handle)
+/// returns on its rank alone, before any MPI call: the other ranks then wait.
 ///
 /// Rules: the caller owns MPI. Luxon never calls `MPI_Init` or `MPI_Finalize`, never uses
 /// `MPI_COMM_WORLD` on its own and never aborts. Call this after `MPI_Init_thread` and release
@@ -56,4 +58,16 @@ fn set_communicator(_: &Renderer, _: c_int) -> Result<(), Failure> {
         "this libluxon was built without MPI: rebuild it with the cargo feature `mpi` \
          (cargo build --release --features mpi)",
     ))
+}
+
+/// Whether `r` renders over a communicator (then its ranks above 0 may give a target without
+/// planes).
+#[cfg(feature = "mpi")]
+pub(crate) fn has_communicator(r: &Renderer) -> bool {
+    r.communicator().is_some()
+}
+
+#[cfg(not(feature = "mpi"))]
+pub(crate) fn has_communicator(_: &Renderer) -> bool {
+    false
 }

@@ -20,12 +20,11 @@ fn a_communicator_is_refused_without_mpi_initialised_or_built_in() {
     unsafe {
         let s = (api.luxon_renderer_set_mpi_comm_f)(Handle::default(), 0);
         expect(s, INVALID_HANDLE, "the luxon_renderer is null");
+        assert_eq!((api.luxon_has_mpi)(), cfg!(feature = "mpi"));
         let s = (api.luxon_renderer_set_mpi_comm_f)(r, 0);
         if cfg!(feature = "mpi") {
-            assert!((api.luxon_has_mpi)());
             expect(s, MPI, "MPI is not initialised: call MPI_Init_thread");
         } else {
-            assert!(!(api.luxon_has_mpi)());
             expect(s, UNSUPPORTED, "this libluxon was built without MPI");
             assert!(
                 last_error().contains("cargo feature `mpi`"),

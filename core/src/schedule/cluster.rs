@@ -521,6 +521,9 @@ impl<'a> Run<'a> {
                 std::thread::sleep(POLL);
             }
             let mine = local.join();
+            if self.cluster.is_guest() {
+                self.injected.on_end();
+            }
             if mine.is_err() {
                 self.failed(Error::Render("a render thread panicked".into()));
             }
@@ -623,6 +626,9 @@ impl<'a> Run<'a> {
             }
             local.join()
         });
+        if self.cluster.is_guest() {
+            self.injected.on_end();
+        }
         let mut stats = stats.unwrap_or_else(|_| {
             self.failed(Error::Render("a render thread panicked".into()));
             RankStats::default()
