@@ -36,6 +36,10 @@ pub enum Error {
     /// An allocation the system refused, sized by the caller's data.
     #[error("cannot allocate {bytes} bytes for {what}; the system refused")]
     OutOfMemory { what: String, bytes: u128 },
+    /// MPI cannot be used as asked (not initialised, finalised, a thread level that forbids
+    /// this thread, a handle that is not a communicator).
+    #[error("{0}")]
+    Mpi(String),
 }
 
 impl Error {

@@ -210,9 +210,14 @@ typedef struct luxon_commit_report {
 // The scene is being rendered or committed on another thread; the call did nothing.
 #define LUXON_ERROR_BUSY 8
 
-// This library cannot run here: it was built for x86-64-v3 (AVX2, FMA, BMI2) and this CPU
-// lacks them (rebuild with RUSTFLAGS="-C target-cpu=x86-64").
+// This library cannot do that here: it was built without MPI (the cargo feature `mpi`), or
+// for x86-64-v3 (AVX2, FMA, BMI2) and this CPU lacks them (rebuild with
+// RUSTFLAGS="-C target-cpu=x86-64").
 #define LUXON_ERROR_UNSUPPORTED 9
+
+// MPI cannot be used as asked: not initialised or already finalised, a thread level that
+// forbids the calling thread, a handle that is not a communicator.
+#define LUXON_ERROR_MPI 10
 
 // An internal error (a bug in Luxon; please report it). The process goes on; the handles the
 // call used are unusable from then on (they can only be released).
@@ -277,6 +282,33 @@ luxon_status luxon_write_image(struct luxon_context context,
                                uint32_t width,
                                uint32_t height,
                                size_t row_floats);
+
+// From now on, renders on `renderer` are image-parallel over the ranks of the communicator
+// whose Fortran handle is `fortran_comm`: C callers pass `MPI_Comm_c2f(comm)` (or use
+// `luxon_renderer_set_mpi_comm` of `luxon_mpi.h`), Fortran callers their integer
+// communicator. Luxon works on a duplicate (`MPI_Comm_dup`), so the call is collective: every
+// rank of the communicator makes it.
+//
+// Then every rank holds the whole scene and calls `luxon_render` with a target of the same
+// size (collective too); rank 0 of the communicator receives the whole image, the same bits
+// as one process renders (other ranks' targets are not written: they may give
+// `LUXON_PIXELS_NONE` without a depth plane). A failure on any rank (its scene, a plugin, an
+// internal error) is returned on every rank, naming the first failing rank; the job goes on.
+// Only a call refused for its own arguments (a NULL or malformed target, a released handle)
+// returns on its rank alone, before any MPI call: the other ranks then wait.
+//
+// Rules: the caller owns MPI. Luxon never calls `MPI_Init` or `MPI_Finalize`, never uses
+// `MPI_COMM_WORLD` on its own and never aborts. Call this after `MPI_Init_thread` and release
+// the renderer before `MPI_Finalize` (else `LUXON_ERROR_MPI`). Only the thread that calls
+// Luxon makes its MPI calls: with `MPI_THREAD_FUNNELED` (or `SINGLE`) call it from the thread
+// that initialised MPI, with `MPI_THREAD_SERIALIZED` from any thread while no other MPI call
+// runs, with `MPI_THREAD_MULTIPLE` from any thread. A rank killed by a signal still leaves
+// the others waiting in `luxon_render`.
+//
+// Returns `LUXON_ERROR_UNSUPPORTED` when this library was built without MPI (the cargo
+// feature `mpi`; see `luxon_has_mpi`), `LUXON_ERROR_MPI` when MPI is not usable as above or
+// `fortran_comm` is not a communicator.
+luxon_status luxon_renderer_set_mpi_comm_f(struct luxon_renderer renderer, int fortran_comm);
 
 // A renderer on `context`'s pool (`threads` 0) or on a pool of its own of `threads` threads.
 // Its threads sleep between renders.

@@ -294,7 +294,10 @@ pub unsafe extern "C" fn luxon_render(
                 return Err(Failure::invalid("the pixels and depth planes overlap"));
             }
         }
-        if matches!(color, Color::None) && depth.is_none() {
+        // Ranks of a renderer with a communicator may render without planes (rank 0 gets
+        // the image).
+        let with_comm = crate::mpi::has_communicator(&r.value.renderer);
+        if matches!(color, Color::None) && depth.is_none() && !with_comm {
             return Err(Failure::invalid(
                 "the target has no colour (LUXON_PIXELS_NONE) and no depth plane",
             ));

@@ -29,9 +29,13 @@ pub const LUXON_ERROR_IO: luxon_status = 6;
 pub const LUXON_ERROR_CANCELLED: luxon_status = 7;
 /// The scene is being rendered or committed on another thread; the call did nothing.
 pub const LUXON_ERROR_BUSY: luxon_status = 8;
-/// This library cannot run here: it was built for x86-64-v3 (AVX2, FMA, BMI2) and this CPU
-/// lacks them (rebuild with RUSTFLAGS="-C target-cpu=x86-64").
+/// This library cannot do that here: it was built without MPI (the cargo feature `mpi`), or
+/// for x86-64-v3 (AVX2, FMA, BMI2) and this CPU lacks them (rebuild with
+/// RUSTFLAGS="-C target-cpu=x86-64").
 pub const LUXON_ERROR_UNSUPPORTED: luxon_status = 9;
+/// MPI cannot be used as asked: not initialised or already finalised, a thread level that
+/// forbids the calling thread, a handle that is not a communicator.
+pub const LUXON_ERROR_MPI: luxon_status = 10;
 /// An internal error (a bug in Luxon; please report it). The process goes on; the handles the
 /// call used are unusable from then on (they can only be released).
 pub const LUXON_ERROR_PANIC: luxon_status = 11;
@@ -74,5 +78,6 @@ pub(crate) fn status_of(e: &Error) -> luxon_status {
         Error::Usage(_) | Error::Target(_) | Error::Api(_) => LUXON_ERROR_INVALID_ARGUMENT,
         Error::Cancelled => LUXON_ERROR_CANCELLED,
         Error::OutOfMemory { .. } => LUXON_ERROR_OUT_OF_MEMORY,
+        Error::Mpi(_) => LUXON_ERROR_MPI,
     }
 }

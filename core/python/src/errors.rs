@@ -50,7 +50,7 @@ pub fn to_py(e: Error) -> PyErr {
             Error::Api(_) | Error::Target(_) | Error::Usage(_) => ("UsageError", None),
             Error::OutOfMemory { .. } => ("OutOfMemoryError", None),
             Error::Io { path, .. } => ("FileError", Some(Place::file(path))),
-            Error::Render(_) => ("LuxonError", None),
+            Error::Render(_) | Error::Mpi(_) => ("LuxonError", None),
         };
         raise(py, class, &message, at)
     })

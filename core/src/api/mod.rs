@@ -172,6 +172,42 @@
 //! assert_eq!((report.refitted, report.rebuilt), (1, 0));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! ## MPI owned by the caller
+//!
+//! With the `mpi` feature, a simulation that runs under MPI gives a renderer its communicator
+//! (`Renderer::with_communicator`, `Renderer::set_communicator`, or a Fortran handle with
+//! `Renderer::set_fortran_communicator`). Its renders are then image-parallel over the ranks of
+//! that communicator with the scene's decomposition: every rank holds the whole scene
+//! (replicated data: gather the simulation's data first, e.g. with `MPI_Allgatherv`), calls
+//! `render` with a target of the same size, and renders its share; rank 0 of the communicator
+//! receives the whole image, bit for bit the image of one process (other ranks' targets are
+//! not written: give them [`Color::None`]). The rules:
+//!
+//! - **The caller owns MPI.** Luxon never calls `MPI_Init` or `MPI_Finalize`, never uses
+//!   `MPI_COMM_WORLD` on its own, never aborts the job and installs no panic hook. It works on
+//!   a duplicate of the communicator (`MPI_Comm_dup`), so its messages never meet the caller's;
+//!   setting the communicator and each render are collective over it (every rank calls them,
+//!   in the same order). Other ranks of the job may meanwhile do anything, e.g. collectives on
+//!   a communicator of their own.
+//! - **Release renderers with a communicator before `MPI_Finalize`** (dropping one frees its
+//!   duplicate). Setting a communicator before `MPI_Init_thread` or after `MPI_Finalize` is an
+//!   [`Error::Mpi`](crate::Error::Mpi).
+//! - **Thread levels.** Only the thread that calls Luxon makes its MPI calls (render threads
+//!   never do). With `MPI_THREAD_SERIALIZED` or `MPI_THREAD_MULTIPLE` any thread may call
+//!   (with `SERIALIZED`, none of the caller's MPI calls may run at the same time); with
+//!   `MPI_THREAD_FUNNELED` (or `SINGLE`) only the thread that initialised MPI, else the call
+//!   returns `Error::Mpi` on that rank without any MPI call, and the other ranks wait for it.
+//! - **Errors are values on every rank.** A failure on one rank (a scene that cannot be
+//!   built, a plugin's error, a panic in a render thread) stops its part; the ranks finish the
+//!   render's messages and agree, and every rank returns the same error naming the first
+//!   failing rank (`rank 1: …`); a cancel ([`Cancel`]) on any rank makes every rank return
+//!   [`Error::Cancelled`](crate::Error::Cancelled). The renderer can render again.
+//! - **What cannot be caught:** a rank killed by a signal (or one that never calls `render`)
+//!   leaves the others waiting in the render, as with any collective MPI call.
+//! - Progress is reported on rank 0 only, for every rank's pixels; `render_chunks` refuses a
+//!   renderer with a communicator. A renderer without a communicator renders alone on each
+//!   rank: the library never reads the launcher's environment (`OMPI_COMM_WORLD_SIZE`…).
 
 mod context;
 pub mod ids;

@@ -32,10 +32,25 @@ impl Cancel {
 
 /// Renders scenes on its thread pool (its own, or its context's). Each render commits the scene
 /// first ([`Scene::commit`]), so what it shows is the scene as it is now.
+///
+/// With the `mpi` feature a renderer can be given the caller's communicator
+/// (`Renderer::with_communicator`): its renders are then image-parallel over the ranks of
+/// that communicator, see [the MPI rules](crate::api#mpi-owned-by-the-caller).
 pub struct Renderer {
     pub(super) pool: Arc<rayon::ThreadPool>,
     cancel: Arc<AtomicBool>,
+    /// A duplicate of the caller's communicator; the lock keeps two renders from driving MPI
+    /// at once.
+    #[cfg(feature = "mpi")]
+    cluster: std::sync::Mutex<Option<crate::schedule::guest::Guest>>,
 }
+
+// A renderer moves between threads and is shared by them (Python, C hosts), with or without
+// a communicator: this fails to compile otherwise.
+const _: () = {
+    const fn send_and_sync<T: Send + Sync>() {}
+    send_and_sync::<Renderer>();
+};
 
 impl Renderer {
     pub fn new(ctx: &Context, o: RendererOptions) -> Result<Renderer, Error> {
@@ -47,6 +62,8 @@ impl Renderer {
         Ok(Renderer {
             pool,
             cancel: Arc::new(AtomicBool::new(false)),
+            #[cfg(feature = "mpi")]
+            cluster: std::sync::Mutex::new(None),
         })
     }
 
@@ -74,6 +91,13 @@ impl Renderer {
         target: Target,
         progress: Progress,
     ) -> Result<RenderStats, Error> {
+        #[cfg(feature = "mpi")]
+        {
+            let cluster = self.cluster.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(guest) = cluster.as_ref() {
+                return self.render_across(&guest.0, scene, target, progress);
+            }
+        }
         target.check().map_err(Error::Target)?;
         scene.set_size(target.width, target.height);
         self.start();
@@ -96,6 +120,14 @@ impl Renderer {
     /// Commits `scene` (at its description's size, or its last render's) and renders it in this
     /// process, handing each finished chunk of pixels to `sink` (from the render threads).
     pub fn render_chunks(&self, scene: &mut Scene, sink: Sink) -> Result<RankStats, Error> {
+        #[cfg(feature = "mpi")]
+        if self.communicator().is_some() {
+            return Err(Error::Api(
+                "render_chunks renders in this process only, and this renderer has a \
+                 communicator: use render (rank 0 gets the image)"
+                    .into(),
+            ));
+        }
         self.start();
         let options = RunOptions {
             cancel: &self.cancel,
@@ -131,6 +163,126 @@ impl Renderer {
         });
         scene.unpin();
         rendered
+    }
+
+    /// A renderer whose renders are image-parallel over the ranks of `comm`, the caller's
+    /// communicator (see [`Renderer::set_communicator`]). Collective over `comm`.
+    #[cfg(feature = "mpi")]
+    pub fn with_communicator(
+        ctx: &Context,
+        o: RendererOptions,
+        comm: &mpi::topology::SimpleCommunicator,
+    ) -> Result<Renderer, Error> {
+        let r = Renderer::new(ctx, o)?;
+        r.set_communicator(comm)?;
+        Ok(r)
+    }
+
+    /// From now on, renders are image-parallel over the ranks of `comm` (a duplicate of it:
+    /// the caller keeps its own and Luxon's messages never meet the caller's). Collective over
+    /// `comm` (`MPI_Comm_dup`): every rank calls it. MPI must be initialised, by the caller
+    /// (Luxon never initialises or finalises it), with a thread level that allows this thread
+    /// (see [the MPI rules](crate::api#mpi-owned-by-the-caller)).
+    #[cfg(feature = "mpi")]
+    pub fn set_communicator(&self, comm: &mpi::topology::SimpleCommunicator) -> Result<(), Error> {
+        let cluster = crate::schedule::cluster::Cluster::from_communicator(comm)?;
+        self.put_cluster(Some(cluster));
+        Ok(())
+    }
+
+    /// [`Renderer::set_communicator`] for the communicator whose Fortran handle is `handle`
+    /// (C's `MPI_Comm_c2f(comm)`, or a Fortran integer communicator).
+    #[cfg(feature = "mpi")]
+    pub fn set_fortran_communicator(&self, handle: i32) -> Result<(), Error> {
+        let cluster = crate::schedule::cluster::Cluster::from_fortran(handle)?;
+        self.put_cluster(Some(cluster));
+        Ok(())
+    }
+
+    /// Renders in this process alone again; the duplicate communicator is freed (call it from
+    /// a thread that may call MPI, on every rank).
+    #[cfg(feature = "mpi")]
+    pub fn clear_communicator(&self) {
+        self.put_cluster(None);
+    }
+
+    /// This process's rank in the renderer's communicator and the communicator's size, when it
+    /// has one.
+    #[cfg(feature = "mpi")]
+    pub fn communicator(&self) -> Option<(usize, usize)> {
+        let cluster = self.cluster.lock().unwrap_or_else(|e| e.into_inner());
+        cluster.as_ref().map(|g| (g.0.rank(), g.0.size()))
+    }
+
+    #[cfg(feature = "mpi")]
+    fn put_cluster(&self, cluster: Option<crate::schedule::cluster::Cluster>) {
+        let old = std::mem::replace(
+            &mut *self.cluster.lock().unwrap_or_else(|e| e.into_inner()),
+            cluster.map(crate::schedule::guest::Guest),
+        );
+        drop(old);
+    }
+
+    /// `render_with` over the renderer's communicator (collective): every rank commits its
+    /// copy of the scene and the ranks agree that all are ready (and render the same size),
+    /// then each renders its share; rank 0's target receives the whole image (other ranks'
+    /// targets are not written). Every rank returns the same outcome.
+    #[cfg(feature = "mpi")]
+    fn render_across(
+        &self,
+        cluster: &crate::schedule::cluster::Cluster,
+        scene: &mut Scene,
+        target: Target,
+        progress: Progress,
+    ) -> Result<RenderStats, Error> {
+        use crate::framebuffer::Chunk;
+        use std::sync::atomic::AtomicU64;
+        // No MPI call may be made from this thread otherwise: a local error.
+        crate::schedule::guest::usable_here()?;
+        self.start();
+        let t0 = std::time::Instant::now();
+        let (width, height) = (target.width, target.height);
+        let ready = target
+            .check()
+            .map_err(Error::Target)
+            .and_then(|_| {
+                scene.set_size(width, height);
+                scene.commit_pinned(self)
+            })
+            .map(|_| {
+                let depth = u64::from(target.depth.is_some());
+                [self.threads() as u64, width.into(), height.into(), depth]
+            });
+        let target = std::sync::Mutex::new(target);
+        let total = u64::from(width) * u64::from(height);
+        let done = AtomicU64::new(0);
+        let sink = |c: Chunk| {
+            let n = c.pixels();
+            target
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .put_chunk(&c);
+            progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
+        };
+        let rendered = cluster.settle(ready).and_then(|all| {
+            let first = all[0];
+            if let Some((r, w)) = all.iter().enumerate().find(|(_, w)| w[1..3] != first[1..3]) {
+                return Err(Error::Target(format!(
+                    "rank {r}'s target is {}x{} pixels but rank 0's is {}x{}; every rank of the \
+                     communicator renders the same image",
+                    w[1], w[2], first[1], first[2]
+                )));
+            }
+            let threads: Vec<usize> = all.iter().map(|w| w[0] as usize).collect();
+            let depth = first[3] != 0;
+            let built = scene.committed()?;
+            cluster.render_guest(built, &self.pool, &threads, depth, &self.cancel, &sink)
+        });
+        scene.unpin();
+        if rendered.is_err() {
+            scene.after_failure();
+        }
+        rendered.map(|ranks| RenderStats::of(ranks, t0.elapsed()))
     }
 
     /// A render starts: a cancel meant for an earlier one is forgotten.

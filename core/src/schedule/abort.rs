@@ -113,6 +113,14 @@ impl Injected {
             raised: AtomicBool::new(false),
         }
     }
+    /// The rank's render ended (guest mode): an error injected here if no unit raised it
+    /// (under the dynamic decomposition a rank may get no tile at all).
+    pub(super) fn on_end(&self) {
+        if self.armed && !self.panic {
+            self.raised.store(true, Ordering::Relaxed);
+        }
+    }
+
     pub(super) fn on_chunk(&self) {
         if self.armed {
             if self.panic {

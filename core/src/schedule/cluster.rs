@@ -8,12 +8,23 @@
 //!   rank keeps `threads + 1` tiles requested (one ahead), asks for one more per finished tile,
 //!   and asks further ahead whenever one of its threads had to wait for a tile.
 //!
-//! All MPI calls are made by each rank's main thread, which polls (and sleeps briefly: OpenMPI's
-//! blocking calls spin and would steal a core from the render threads), except on failure: an
-//! error or panic anywhere ends the whole job through `abort::fail` (`MPI_Abort`), after rank 0 has
-//! printed the cause.
+//! All MPI calls are made by each rank's main thread (the thread that called render), which
+//! polls (and sleeps briefly: OpenMPI's blocking calls spin and would steal a core from the
+//! render threads).
+//!
+//! Two modes:
+//! - **Owner** ([`Cluster::init`], the command line): Luxon initialises MPI with
+//!   `MPI_THREAD_MULTIPLE`, renders over the world, and finalises it when the cluster drops. An
+//!   error or panic anywhere ends the whole job through `abort::fail` (`MPI_Abort`), after rank
+//!   0 has printed the cause.
+//! - **Guest** ([`Cluster::from_communicator`], [`Cluster::from_fortran`], a library caller's
+//!   MPI): renders over a duplicate of the caller's communicator, never initialises, finalises
+//!   or aborts, never touches the world on its own. A failure on a rank stops its rendering; the
+//!   ranks still finish the tile protocol (so no message is left behind for the next render),
+//!   then agree collectively, and every rank returns the first failing rank's error.
 
 use super::abort::{fail, Injected, TAG_ERROR};
+use super::guest;
 use super::mailbox::{bytes_of, word, Outbox, TileQueue, POLL};
 use super::{decompose, run_share, wire, RankStats, RunOptions, Share, Sink};
 use crate::error::Error;
@@ -22,7 +33,8 @@ use crate::scene::Scene;
 use luxon_formats::{Decomposition, ParallelMode};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{mpsc, Mutex};
 
 const TAG_REQUEST: i32 = 1;
@@ -30,8 +42,11 @@ const TAG_TILE: i32 = 2;
 const TAG_DONE: i32 = 3;
 const TAG_CHUNK: i32 = 4;
 const TAG_FINISHED: i32 = 5;
+/// A follower (guest mode) failed and takes no more tiles; rank 0 answers with `TAG_DONE`.
+const TAG_GIVE_UP: i32 = 7;
 
 pub struct Cluster {
+    /// The world (owner mode) or the duplicate of the caller's communicator (guest mode).
     world: SimpleCommunicator,
     rank: usize,
     size: usize,
@@ -39,14 +54,31 @@ pub struct Cluster {
     sharing: usize,
     /// Ranks on this node (they share its memory).
     node_ranks: usize,
-    // Dropped last: finalises MPI.
-    _universe: mpi::environment::Universe,
+    // Dropped last: in owner mode, finalises MPI.
+    mode: Mode,
+}
+
+enum Mode {
+    /// Luxon owns MPI (the command line): it finalises MPI when the universe drops.
+    Owner(#[allow(dead_code)] mpi::environment::Universe),
+    /// The caller owns MPI; `world` is our duplicate of its communicator.
+    Guest,
 }
 
 impl Drop for Cluster {
-    /// Runs before the fields drop (`_universe` finalises MPI): no MPI call after that.
+    /// Runs before the fields drop (in owner mode the universe finalises MPI: no MPI call after
+    /// that). In guest mode the duplicate communicator is freed, unless the caller has already
+    /// finalised MPI (then nothing may be called: the handle is forgotten).
     fn drop(&mut self) {
-        super::abort::on_finalize();
+        match self.mode {
+            Mode::Owner(_) => super::abort::on_finalize(),
+            Mode::Guest => {
+                if mpi::environment::is_finalized() {
+                    let dup = std::mem::replace(&mut self.world, SimpleCommunicator::self_comm());
+                    std::mem::forget(dup);
+                }
+            }
+        }
     }
 }
 
@@ -84,8 +116,34 @@ impl Cluster {
             size,
             sharing,
             node_ranks: all.len().max(1),
-            _universe: universe,
+            mode: Mode::Owner(universe),
         })
+    }
+
+    /// Guest mode: renders over a duplicate of `comm` (`MPI_Comm_dup`: collective, every rank
+    /// of `comm` must call it). MPI must be initialised by the caller (with a thread level that
+    /// allows this thread, see [`guest::usable_here`]) and stay so while the cluster lives.
+    pub fn from_communicator(comm: &SimpleCommunicator) -> Result<Cluster, Error> {
+        guest::usable_here()?;
+        Ok(Cluster::guest(comm.duplicate()))
+    }
+
+    /// [`Cluster::from_communicator`] for the communicator whose Fortran handle is `handle`
+    /// (what C's `MPI_Comm_c2f` gives).
+    pub fn from_fortran(handle: i32) -> Result<Cluster, Error> {
+        guest::duplicate_fortran(handle).map(Cluster::guest)
+    }
+
+    fn guest(world: SimpleCommunicator) -> Cluster {
+        let (rank, size) = (world.rank() as usize, world.size() as usize);
+        Cluster {
+            world,
+            rank,
+            size,
+            sharing: 1,
+            node_ranks: 1,
+            mode: Mode::Guest,
+        }
     }
 
     pub fn rank(&self) -> usize {
@@ -162,22 +220,86 @@ impl Cluster {
         keep: bool,
         sink: Sink,
     ) -> Rendered {
-        let s = &scene.settings;
-        let run = Run {
-            cluster: self,
-            scene,
-            pool,
-            tiles: decompose::tiles(s.width, s.height, s.tile_size),
-            threads,
-            gather,
-            keep,
-            injected: Injected::from_env(self.rank),
-        };
+        let run = Run::new(self, scene, pool, threads, gather, keep);
         if self.rank == 0 {
             run.lead(sink)
         } else {
             run.follow()
         }
+    }
+
+    /// Guest mode, collective: whether every rank is ready to render, with `words` of its own
+    /// (thread count, image size...). All ready: every rank's words. Otherwise every rank gets
+    /// the first failing rank's error: [`Error::Cancelled`] when it was a cancel, else its
+    /// message naming the rank.
+    pub fn settle<const N: usize>(
+        &self,
+        mine: Result<[u64; N], Error>,
+    ) -> Result<Vec<[u64; N]>, Error> {
+        let mut words = vec![0u64; N + 1];
+        let mut message = String::new();
+        match &mine {
+            Ok(w) => words[1..].copy_from_slice(w),
+            Err(Error::Cancelled) => words[0] = 2,
+            Err(e) => {
+                words[0] = 1;
+                message = e.to_string();
+            }
+        }
+        let mut all = vec![0u64; (N + 1) * self.size];
+        self.world.all_gather_into(&words[..], &mut all[..]);
+        let rows: Vec<&[u64]> = all.chunks_exact(N + 1).collect();
+        let Some(bad) = rows.iter().position(|r| r[0] != 0) else {
+            return Ok(rows
+                .iter()
+                .map(|r| {
+                    let mut w = [0u64; N];
+                    w.copy_from_slice(&r[1..]);
+                    w
+                })
+                .collect());
+        };
+        if rows[bad][0] == 2 {
+            return Err(Error::Cancelled);
+        }
+        let root = self.world.process_at_rank(bad as i32);
+        let mut bytes = message.into_bytes();
+        let mut len = bytes.len() as u64;
+        root.broadcast_into(&mut len);
+        bytes.resize(len as usize, 0);
+        root.broadcast_into(&mut bytes[..]);
+        let m = String::from_utf8_lossy(&bytes);
+        Err(Error::Render(format!("rank {bad}: {m}")))
+    }
+
+    /// Guest mode, collective: renders this rank's share on `pool` (of `threads[rank]`
+    /// threads); rank 0's `sink` gets every rank's chunks (with depth when `depth`). `cancel`
+    /// (this rank's renderer's) stops this rank's part. Every rank returns the same outcome:
+    /// its statistics (rank 0: every rank's), or the first failing rank's error.
+    pub fn render_guest(
+        &self,
+        scene: &Scene,
+        pool: &rayon::ThreadPool,
+        threads: &[usize],
+        depth: bool,
+        cancel: &AtomicBool,
+        sink: Sink,
+    ) -> Result<Vec<RankStats>, Error> {
+        let mut run = Run::new(self, scene, pool, threads, true, false);
+        run.depth = depth;
+        run.cancel = Some(cancel);
+        let rendered = if self.rank == 0 {
+            run.lead(sink)
+        } else {
+            run.follow()
+        };
+        let failure = run.failure.into_inner().map_or(Ok([]), Err);
+        self.settle::<0>(failure).map(|_| rendered.ranks)
+    }
+
+    /// Whether this cluster renders over a caller's communicator.
+    pub fn is_guest(&self) -> bool {
+        matches!(self.mode, Mode::Guest)
     }
 
     /// Collective: rank 0's process id, so every rank names the same temporary file.
@@ -227,10 +349,63 @@ struct Run<'a> {
     threads: &'a [usize],
     gather: bool,
     keep: bool,
+    depth: bool,
     injected: Injected,
+    /// Guest mode: the caller's cancel flag, copied into `stop` when seen.
+    cancel: Option<&'a AtomicBool>,
+    /// Stops this rank's render threads (guest mode, after a failure or cancel).
+    stop: AtomicBool,
+    /// Guest mode: this rank's first failure (owner mode ends the job instead).
+    failure: RefCell<Option<Error>>,
 }
 
-impl Run<'_> {
+impl<'a> Run<'a> {
+    fn new(
+        cluster: &'a Cluster,
+        scene: &'a Scene,
+        pool: &'a rayon::ThreadPool,
+        threads: &'a [usize],
+        gather: bool,
+        keep: bool,
+    ) -> Run<'a> {
+        let s = &scene.settings;
+        Run {
+            cluster,
+            scene,
+            pool,
+            tiles: decompose::tiles(s.width, s.height, s.tile_size),
+            threads,
+            gather,
+            keep,
+            depth: false,
+            injected: Injected::from_env(cluster.rank),
+            cancel: None,
+            stop: AtomicBool::new(false),
+            failure: RefCell::new(None),
+        }
+    }
+
+    fn options(&self) -> RunOptions<'_> {
+        RunOptions {
+            cancel: &self.stop,
+            depth: self.depth,
+        }
+    }
+
+    /// A failure on this rank: owner mode ends the job; guest mode records the first one and
+    /// stops this rank's render threads.
+    fn failed(&self, e: Error) {
+        if !self.cluster.is_guest() {
+            fail(&e.to_string());
+        }
+        self.stop.store(true, Ordering::Relaxed);
+        self.failure.borrow_mut().get_or_insert(e);
+    }
+
+    fn has_failed(&self) -> bool {
+        self.failure.borrow().is_some()
+    }
+
     fn share<'s>(&'s self, next: &'s (dyn Fn() -> Option<usize> + Sync)) -> Share<'s> {
         let rank = self.cluster.rank;
         match self.scene.settings.decomposition {
@@ -246,8 +421,19 @@ impl Run<'_> {
         }
     }
 
+    /// A plugin fault, an injected failure (tests) or the caller's cancel.
     fn check(&self) {
-        check(self.scene, &self.injected);
+        if let Some(m) = self.scene.customs.fault.message() {
+            self.failed(Error::Plugin(m));
+        }
+        if self.injected.raised.load(Ordering::Relaxed) {
+            self.failed(Error::Render(
+                "injected failure (LUXON_TEST_FAIL_RANK)".into(),
+            ));
+        }
+        if self.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            self.failed(Error::Cancelled);
+        }
     }
 
     /// Rank 0: renders, hands out tiles, takes chunks and statistics from the other ranks.
@@ -276,16 +462,20 @@ impl Run<'_> {
         let mut stats: Vec<Option<RankStats>> = vec![None; size];
         let mut done_sent = vec![false; size];
         let mut finished = 0;
+        let options = self.options();
         std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, self.pool);
-            let local =
-                sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &local_sink));
+            let local = sc.spawn(|| run_share(scene, pool, share, options, &local_sink));
             loop {
                 while let Some((msg, status)) = world.any_process().immediate_matched_probe() {
                     let (from, tag) = (status.source_rank(), status.tag());
                     let (bytes, _) = (msg, status).matched_receive_vec::<u8>();
                     let to = world.process_at_rank(from);
                     match tag {
+                        TAG_GIVE_UP if !done_sent[from as usize] => {
+                            done_sent[from as usize] = true;
+                            to.send_with_tag(&bytes_of(0)[..], TAG_DONE);
+                        }
                         TAG_REQUEST => {
                             for _ in 0..word(&bytes) {
                                 match take() {
@@ -300,13 +490,17 @@ impl Run<'_> {
                         }
                         TAG_CHUNK if self.gather => match wire::decode_chunk(&bytes) {
                             Some(c) => sink(c),
-                            None => fail(&format!("rank {from} sent a corrupt chunk")),
+                            None => self
+                                .failed(Error::Render(format!("rank {from} sent a corrupt chunk"))),
                         },
                         TAG_FINISHED => {
-                            let s = wire::decode_stats(&bytes).unwrap_or_else(|| {
-                                fail(&format!("rank {from} sent corrupt statistics"))
-                            });
-                            stats[from as usize] = Some(s);
+                            let s = wire::decode_stats(&bytes);
+                            if s.is_none() {
+                                self.failed(Error::Render(format!(
+                                    "rank {from} sent corrupt statistics"
+                                )));
+                            }
+                            stats[from as usize] = s;
                             finished += 1;
                         }
                         TAG_ERROR => {
@@ -317,16 +511,24 @@ impl Run<'_> {
                     }
                 }
                 self.check();
+                if self.has_failed() {
+                    // The render fails anyway: hand out no more tiles (here or to any rank).
+                    counter.store(tiles.len(), Ordering::Relaxed);
+                }
                 if finished == size - 1 && local.is_finished() {
                     break;
                 }
                 std::thread::sleep(POLL);
             }
-            let mine = local
-                .join()
-                .unwrap_or_else(|_| fail("a render thread panicked"));
+            let mine = local.join();
+            if self.cluster.is_guest() {
+                self.injected.on_end();
+            }
+            if mine.is_err() {
+                self.failed(Error::Render("a render thread panicked".into()));
+            }
             self.check();
-            stats[0] = Some(mine);
+            stats[0] = mine.ok();
         });
         let ranks = stats
             .into_iter()
@@ -365,15 +567,19 @@ impl Run<'_> {
         if dynamic {
             root.send_with_tag(&bytes_of(ahead as u64)[..], TAG_REQUEST);
         }
-        let mut stats = std::thread::scope(|sc| {
+        let options = self.options();
+        let mut gave_up = false;
+        let stats = std::thread::scope(|sc| {
             let (scene, pool) = (self.scene, self.pool);
-            let local = sc.spawn(|| run_share(scene, pool, share, RunOptions::default(), &to_main));
+            let local = sc.spawn(|| run_share(scene, pool, share, options, &to_main));
             loop {
                 let finished = local.is_finished();
                 match chunks.recv_timeout(POLL) {
                     Ok(c) => {
                         if self.gather {
-                            outbox.send(wire::encode_chunk(&c), TAG_CHUNK);
+                            if let Err(m) = outbox.send(wire::encode_chunk(&c), TAG_CHUNK) {
+                                self.failed(Error::Render(m));
+                            }
                         }
                         if !no_more_tiles {
                             // One more for the finished tile, and one further ahead when a
@@ -390,8 +596,9 @@ impl Run<'_> {
                             kept.push(c);
                         }
                     }
-                    // Every chunk is sent before the render threads finish.
-                    Err(_) if finished => break,
+                    // Every chunk is sent before the render threads finish, and every tile
+                    // message before rank 0's TAG_DONE (none is left for the next render).
+                    Err(_) if finished && no_more_tiles => break,
                     Err(_) => {}
                 }
                 while let Some((msg, status)) = root.immediate_matched_probe() {
@@ -408,10 +615,23 @@ impl Run<'_> {
                 }
                 outbox.progress();
                 self.check();
+                if self.has_failed() && !gave_up {
+                    // Guest mode: stop taking tiles; rank 0 answers with TAG_DONE.
+                    gave_up = true;
+                    queue.close();
+                    if !no_more_tiles {
+                        root.send_with_tag(&bytes_of(0)[..], TAG_GIVE_UP);
+                    }
+                }
             }
-            local
-                .join()
-                .unwrap_or_else(|_| fail("a render thread panicked"))
+            local.join()
+        });
+        if self.cluster.is_guest() {
+            self.injected.on_end();
+        }
+        let mut stats = stats.unwrap_or_else(|_| {
+            self.failed(Error::Render("a render thread panicked".into()));
+            RankStats::default()
         });
         self.check();
         outbox.flush();
@@ -421,16 +641,6 @@ impl Run<'_> {
             ranks: vec![stats],
             kept,
         }
-    }
-}
-
-/// Ends the job if a plugin faulted or a test asked for a failure.
-fn check(scene: &Scene, injected: &Injected) {
-    if let Some(m) = scene.customs.fault.message() {
-        fail(&m);
-    }
-    if injected.raised.load(Ordering::Relaxed) {
-        fail("injected failure (LUXON_TEST_FAIL_RANK)");
     }
 }
 

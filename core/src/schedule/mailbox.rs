@@ -1,7 +1,6 @@
 //! Passing tiles and chunks between a rank's main thread (the only one that talks MPI) and its
 //! render threads (feature `mpi`).
 
-use super::abort::fail;
 use mpi::ffi;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::AsRaw;
@@ -30,9 +29,9 @@ impl<'c> Outbox<'c> {
         }
     }
 
-    pub(super) fn send(&mut self, bytes: Vec<u8>, tag: i32) {
+    pub(super) fn send(&mut self, bytes: Vec<u8>, tag: i32) -> Result<(), String> {
         let Ok(len) = c_int::try_from(bytes.len()) else {
-            fail("a chunk is too large for one MPI message");
+            return Err("a chunk is too large for one MPI message".into());
         };
         // SAFETY: MPI is up (a `SimpleCommunicator` exists only while it is) and `comm` is a
         // live communicator; the `RSMPI_*` statics are rsmpi's constant handles. The send reads
@@ -54,9 +53,10 @@ impl<'c> Outbox<'c> {
             (code, req)
         };
         if code != 0 {
-            fail("MPI_Isend failed");
+            return Err("MPI_Isend failed".into());
         }
         self.pending.push((req, bytes));
+        Ok(())
     }
 
     /// Drops the buffers of completed sends.

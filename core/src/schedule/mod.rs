@@ -9,6 +9,10 @@ pub mod wire;
 mod abort;
 #[cfg(feature = "mpi")]
 pub mod cluster;
+// A caller's MPI (guest mode): thread-level checks, Fortran handles (the raw rsmpi FFI).
+#[cfg(feature = "mpi")]
+#[allow(unsafe_code)]
+pub mod guest;
 // MPI calls (the raw rsmpi FFI).
 #[cfg(feature = "mpi")]
 #[allow(unsafe_code)]

@@ -55,6 +55,8 @@ pub const PLUGIN_NOT_FOUND: i32 = 4;
 pub const IO: i32 = 6;
 pub const CANCELLED: i32 = 7;
 pub const BUSY: i32 = 8;
+pub const UNSUPPORTED: i32 = 9;
+pub const MPI: i32 = 10;
 pub const PANIC: i32 = 11;
 pub const RGBA8: i32 = 1;
 pub const RGBA32F: i32 = 2;
@@ -108,6 +110,7 @@ functions! {
     luxon_renderer_release(Handle) -> i32;
     luxon_renderer_cancel(Handle) -> i32;
     luxon_renderer_set_progress(Handle, ProgressFn, *mut c_void) -> i32;
+    luxon_renderer_set_mpi_comm_f(Handle, i32) -> i32;
     luxon_render(Handle, Handle, *const TargetDesc, *mut c_void) -> i32;
     luxon_write_image(Handle, *const c_char, *const f32, u32, u32, usize) -> i32;
     luxon_scene_save_ron(Handle, *const c_char) -> i32;
