@@ -86,11 +86,13 @@ fn a_moving_sphere_matches_the_analytic_profile() {
     let want = analytic(64, 4);
     let blurred = render(&desc, 0);
     let e = mean_error(&blurred, &want);
+    eprintln!("blurred profile: mean absolute error {e}");
     assert!(e <= 0.01, "mean absolute error {e}");
     // Without the shutter the sphere stands at the frame's time: far from the profile.
     let mut still = desc.clone();
     still.animation.as_mut().unwrap().value.shutter = None;
     let e = mean_error(&render(&still, 0), &want);
+    eprintln!("still frame against the profile: {e}");
     assert!(e >= 0.05, "the still frame is {e} from the blurred profile");
     let _ = std::fs::remove_dir_all(dir);
 }
@@ -150,7 +152,10 @@ fn a_shutter_of_no_length_is_the_still_frame_bitwise() {
     for instancing in ["auto", "share"] {
         let zero = with(Some(0.0), instancing);
         let scene = Scene::build(&zero, &registry(&zero)).unwrap();
-        assert!(scene.features.motion_blur, "a shutter of no length samples time");
+        assert!(
+            scene.features.motion_blur,
+            "a shutter of no length samples time"
+        );
         let still = bits(&render(&with(None, instancing), 5));
         assert_eq!(bits(&render(&zero, 5)), still, "{instancing}");
         let open = bits(&render(&with(Some(0.5), instancing), 5));
@@ -199,7 +204,10 @@ fn what_moves_is_evaluated_at_the_rays_time() {
     let text = SCENE
         .replace("(12, (1, 1.5, -6))", "(12, (0, 1, -6))")
         .replace("(6, (-1, 2, 0)), (12, (-1, 0.5, 0))", "(12, (-1, 0.5, 0))")
-        .replace("(12, (axis: (0, 0, 1), degrees: 720))", "(12, (axis: (0, 0, 1), degrees: 0))");
+        .replace(
+            "(12, (axis: (0, 0, 1), degrees: 720))",
+            "(12, (axis: (0, 0, 1), degrees: 0))",
+        );
     let held = load(&dir, &text);
     let scene = Scene::build(&held, &registry(&held)).unwrap();
     assert!(!scene.features.motion_blur);

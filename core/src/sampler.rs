@@ -191,9 +191,15 @@ mod tests {
             }
         }
         // Other pixels and frames shuffle differently.
-        let a: Vec<u32> = (0..16).map(|i| time_sample(0, 0, i, 16, 0).to_bits()).collect();
-        let b: Vec<u32> = (0..16).map(|i| time_sample(1, 0, i, 16, 0).to_bits()).collect();
-        let c: Vec<u32> = (0..16).map(|i| time_sample(0, 0, i, 16, 1).to_bits()).collect();
+        let a: Vec<u32> = (0..16)
+            .map(|i| time_sample(0, 0, i, 16, 0).to_bits())
+            .collect();
+        let b: Vec<u32> = (0..16)
+            .map(|i| time_sample(1, 0, i, 16, 0).to_bits())
+            .collect();
+        let c: Vec<u32> = (0..16)
+            .map(|i| time_sample(0, 0, i, 16, 1).to_bits())
+            .collect();
         assert!(a != b && a != c);
         // A shutter of no length gives +0.0 wherever it sits: the still frame's time.
         for (open, close) in [(0.0f32, 0.0f32), (-0.0, 0.0), (-0.0, -0.0)] {

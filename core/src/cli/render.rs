@@ -702,7 +702,11 @@ pub(super) fn print_stats(
         eprintln!(
             "  motion blur      shutter {open}..{close} frames from the frame's time; {moving} \
              moving instance(s) placed per ray{}",
-            if scene.camera_moves { ", camera per ray" } else { "" }
+            if scene.camera_moves {
+                ", camera per ray"
+            } else {
+                ""
+            }
         );
     }
     eprintln!(

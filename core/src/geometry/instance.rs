@@ -17,8 +17,8 @@ use super::{Clips, Counters, Hit, Kind, Surface, NO_INSTANCE};
 use crate::bvh::top::TopLevel;
 use crate::bvh::BoxRay;
 use crate::math::{gamma, next_down, next_up, Aabb, DVec3, Vec3A};
-use crate::ray::Ray;
 use crate::motion::bounds::swept_bounds;
+use crate::ray::Ray;
 use glam::{DAffine3, Mat3, Vec3};
 use luxon_formats::ObjectTracks;
 use std::borrow::Cow;
@@ -275,7 +275,10 @@ impl Instances {
             }
             Motion::Keyed(k) => {
                 let object = (b.min.as_dvec3(), b.max.as_dvec3());
-                let (t0, t1) = (self.frame_time + self.shutter.0, self.frame_time + self.shutter.1);
+                let (t0, t1) = (
+                    self.frame_time + self.shutter.0,
+                    self.frame_time + self.shutter.1,
+                );
                 let (lo, hi) = swept_bounds(&self.tracks[*k as usize], object, t0, t1);
                 (lo - self.world_offset, hi - self.world_offset)
             }

@@ -37,7 +37,12 @@ pub fn swept_bounds(tracks: &ObjectTracks, object: DBox, t0: f64, t1: f64) -> DB
             let mut a = DVec3::ZERO;
             let mut b = DVec3::ZERO;
             for i in 0..3 {
-                let p = [slo[i] * lo[i], slo[i] * hi[i], shi[i] * lo[i], shi[i] * hi[i]];
+                let p = [
+                    slo[i] * lo[i],
+                    slo[i] * hi[i],
+                    shi[i] * lo[i],
+                    shi[i] * hi[i],
+                ];
                 a[i] = p.iter().copied().fold(f64::INFINITY, f64::min);
                 b[i] = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             }
@@ -188,9 +193,8 @@ pub(crate) mod tests {
     pub(crate) fn tracks() -> impl Strategy<Value = ObjectTracks> {
         let vec_track = |r: f64| {
             (frames(), how()).prop_flat_map(move |(f, how)| {
-                proptest::collection::vec(v3(r), f.len()).prop_map(move |v| {
-                    track(f.iter().copied().zip(v).collect(), how)
-                })
+                proptest::collection::vec(v3(r), f.len())
+                    .prop_map(move |v| track(f.iter().copied().zip(v).collect(), how))
             })
         };
         let scale = (frames(), how()).prop_flat_map(|(f, how)| {

@@ -263,7 +263,13 @@ impl Animation {
 
     /// The camera at frame-relative time `time` of the current frame, in render space;
     /// `None` where it degenerates (the frame's camera is used there).
-    pub(super) fn camera_at_time(&self, time: f32, world_offset: DVec3, w: u32, h: u32) -> Option<Camera> {
+    pub(super) fn camera_at_time(
+        &self,
+        time: f32,
+        world_offset: DVec3,
+        w: u32,
+        h: u32,
+    ) -> Option<Camera> {
         let t = f64::from(self.frame) + f64::from(time);
         let c = self.camera_at(t, self.frame).ok()?;
         let origin = Vec3A::from((DVec3::from(c.position) - world_offset).as_vec3());

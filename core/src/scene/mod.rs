@@ -578,9 +578,10 @@ impl Scene {
     pub fn primary(&self, px: f32, py: f32, time: f32) -> Option<crate::ray::Ray> {
         let s = &self.settings;
         if self.camera_moves {
-            let moved = self.animation.as_ref().and_then(|a| {
-                a.camera_at_time(time, self.world_offset, s.width, s.height)
-            });
+            let moved = self
+                .animation
+                .as_ref()
+                .and_then(|a| a.camera_at_time(time, self.world_offset, s.width, s.height));
             if let Some(c) = moved {
                 return c.primary(px, py, s.width, s.height, time);
             }
