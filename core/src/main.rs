@@ -27,7 +27,7 @@ enum Command {
     Render {
         scene: PathBuf,
         #[command(flatten)]
-        overrides: cli::render::Overrides,
+        overrides: Box<cli::render::Overrides>,
     },
     /// Render a scene at a range of settings and report time, rays and error against a
     /// reference (Markdown table, CSV, SVG plot, contact sheet and images in DIR).
