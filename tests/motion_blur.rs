@@ -214,3 +214,31 @@ fn what_moves_is_evaluated_at_the_rays_time() {
     assert_eq!(scene.settings.shutter, None);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `--shutter` overrides the scene's: `check` shows it, `off` turns motion blur off, a length
+/// outside 0 to 2 or an unknown placement is a usage error naming the form.
+#[test]
+fn the_shutter_option_overrides_the_scene() {
+    let dir = temp_dir("blur-cli");
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, SCENE).unwrap();
+    let p = path.to_str().unwrap();
+    let o = common::run(&["check", p, "--shutter", "1.5:end"]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    assert!(out.contains("shutter 1.5 frame End"), "{out}");
+    assert!(out.contains("motion blur"), "{out}");
+    let o = common::run(&["check", p, "--shutter", "off"]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success() && !out.contains("motion blur"), "{out}");
+    for bad in ["3", "0.5:middle", "x"] {
+        let o = common::run(&["check", p, "--shutter", bad]);
+        assert!(!o.status.success());
+        assert!(
+            common::stderr(&o).contains("expected LENGTH[:start|centre|end]"),
+            "{}",
+            common::stderr(&o)
+        );
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
