@@ -381,17 +381,29 @@ fn what_cannot_be_moved_is_refused_at_the_build() {
         e.contains("custom geometry (drawn by its plugin) cannot be moved"),
         "{e}"
     );
-    // Motion blur is not rendered yet: an open shutter is refused where it is written.
-    let text = SCENE.replace("frames: (0, 2),", "frames: (0, 2), shutter: (length: 0.5),");
-    let e = build_error(&text, "anim-shutter");
-    assert!(
-        e.contains("scene.ron:15:34: this build reads the shutter but does not render motion blur"),
-        "{e}"
-    );
-    let text = SCENE.replace("frames: (0, 2),", "frames: (0, 2), shutter: (length: 0),");
-    let dir = temp_dir("anim-shutter0");
-    build(&text, &dir);
-    let _ = std::fs::remove_dir_all(dir);
+    // A keyed object in a clip group cannot be blurred (instances do not clip).
+    let text = SCENE
+        .replace("frames: (0, 2),", "frames: (0, 2), shutter: (length: 0.5),")
+        .replace(
+            "radius: 0.35), material: \"paint\")",
+            "radius: 0.35), material: \"paint\", clip: \"cut\")",
+        )
+        .replace(
+            "render: (",
+            "clip_groups: { \"cut\": [(point: (5, 0, 0), normal: (1, 0, 0))] },\n    render: (",
+        );
+    let e = build_error(&text, "anim-shutter-clip");
+    assert!(e.contains("object `ball` is keyed and clipped"), "{e}");
+    // Shutters build, with motion blur on (a shutter of no length too: it samples +0.0).
+    for length in ["0", "0.5"] {
+        let text = SCENE.replace(
+            "frames: (0, 2),",
+            &format!("frames: (0, 2), shutter: (length: {length}),"),
+        );
+        let dir = temp_dir("anim-shutter");
+        assert!(build(&text, &dir).features.motion_blur);
+        let _ = std::fs::remove_dir_all(dir);
+    }
 }
 
 /// The animation walkthrough (scenes/README.md): its scene loads (as a file of `scenes/`), animates what

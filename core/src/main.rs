@@ -27,7 +27,7 @@ enum Command {
     Render {
         scene: PathBuf,
         #[command(flatten)]
-        overrides: cli::render::Overrides,
+        overrides: Box<cli::render::Overrides>,
     },
     /// Render a scene at a range of settings and report time, rays and error against a
     /// reference (Markdown table, CSV, SVG plot, contact sheet and images in DIR).
@@ -49,6 +49,9 @@ enum Command {
         /// How instances are realised (as for `render`); `check` prints each prototype's way.
         #[arg(long, value_parser = ["auto", "bake", "share"])]
         instancing: Option<String>,
+        /// An animated scene's shutter (as for `render`): LENGTH[:start|centre|end] or off.
+        #[arg(long, value_name = "LENGTH[:start|centre|end]|off")]
+        shutter: Option<String>,
     },
     /// List every plugin found: file, kind, names, ABI version, parameters.
     Plugins {
@@ -166,7 +169,8 @@ fn main() -> ExitCode {
             scene,
             memory,
             instancing,
-        } => cli::check::run(&scene, memory, instancing.as_deref()),
+            shutter,
+        } => cli::check::run(&scene, memory, instancing, shutter),
         Command::Plugins { plugin_path } => {
             cli::plugins::run(&plugin_path);
             Ok(())

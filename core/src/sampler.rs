@@ -61,6 +61,28 @@ pub fn pixel_sample(px: u32, py: u32, i: u32, n: u32, frame: u32) -> (f32, f32) 
     }
 }
 
+/// Where in the shutter sample `i` of `n` of pixel (`px`, `py`) looks, in [0, 1): one stratum
+/// of the shutter per sample, the strata shuffled per pixel by a permutation of their own (so
+/// time is not tied to the sample's place in the pixel), jittered inside. Dimensions
+/// `0x4000_0000 | i` and `0xffff_ffe0` are used by no other sample (`pixel_sample` uses
+/// `2i`, `2i + 1` and `0xffff_fff0`; adaptive sampling `0xada9_5eed`).
+#[inline]
+pub fn time_sample(px: u32, py: u32, i: u32, n: u32, frame: u32) -> f32 {
+    let n = n.max(1);
+    let stratum = permute(i, n, hash(px, py, frame, 0xffff_ffe0));
+    let u = (stratum as f32 + to_unit(hash(px, py, frame, 0x4000_0000 | i))) / n as f32;
+    // The division can round up to 1.
+    u.min(1.0 - f32::EPSILON / 2.0)
+}
+
+/// The time of an adaptive sample, which has no index: a hash of its position in the pixel
+/// (each position is sampled once) and the pixel's own seed.
+#[inline]
+pub fn time_at(jx: f32, jy: f32, px: u32, py: u32, frame: u32) -> f32 {
+    let seed = hash(px, py, frame, 0xffff_ffe1);
+    to_unit(mix(jx.to_bits() ^ mix(jy.to_bits() ^ seed)))
+}
+
 /// [`pixel_sample`] for every pixel of one render (one sample count, one frame): what does not
 /// depend on the pixel is computed once, not per sample (the inner half of each `hash`, the
 /// square root, the grid cell's division), so a sample costs two hashes of two rounds. Same
@@ -149,6 +171,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// One sample per stratum of the shutter, in [0, 1), and not in the image-plane order.
+    #[test]
+    fn times_are_stratified_and_shuffled() {
+        for n in [1u32, 4, 7, 64] {
+            let mut strata = vec![0; n as usize];
+            let mut in_order = 0;
+            for i in 0..n {
+                let t = time_sample(5, 9, i, n, 3);
+                assert!((0.0..1.0).contains(&t));
+                strata[(t * n as f32) as usize] += 1;
+                in_order += u32::from((t * n as f32) as u32 == i);
+            }
+            assert!(strata.iter().all(|&c| c == 1), "n = {n}");
+            if n == 64 {
+                assert!(in_order < 8, "{in_order} samples in their own stratum");
+            }
+        }
+        // Other pixels and frames shuffle differently.
+        let a: Vec<u32> = (0..16)
+            .map(|i| time_sample(0, 0, i, 16, 0).to_bits())
+            .collect();
+        let b: Vec<u32> = (0..16)
+            .map(|i| time_sample(1, 0, i, 16, 0).to_bits())
+            .collect();
+        let c: Vec<u32> = (0..16)
+            .map(|i| time_sample(0, 0, i, 16, 1).to_bits())
+            .collect();
+        assert!(a != b && a != c);
+        // A shutter of no length gives +0.0 wherever it sits: the still frame's time.
+        for (open, close) in [(0.0f32, 0.0f32), (-0.0, 0.0), (-0.0, -0.0)] {
+            let t = open + time_sample(2, 3, 1, 4, 0) * (close - open);
+            assert_eq!(t.to_bits(), 0.0f32.to_bits());
+        }
+        assert!((0.0..1.0).contains(&time_at(0.25, 0.5, 1, 2, 3)));
     }
 
     #[test]

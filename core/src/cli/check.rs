@@ -7,15 +7,19 @@ use luxon_formats::{InlineGeometry, MemorySize, SceneDesc};
 use std::path::Path;
 use std::sync::Arc;
 
-pub fn run(path: &Path, memory: Option<MemorySize>, instancing: Option<&str>) -> Result<(), Error> {
+pub fn run(
+    path: &Path,
+    memory: Option<MemorySize>,
+    instancing: Option<String>,
+    shutter: Option<String>,
+) -> Result<(), Error> {
     let mut desc = luxon_formats::load_with(path, &Budget::for_load(memory, 1).load_options())?;
-    if let Some(how) = instancing {
-        let args = super::shading::ShadingArgs {
-            instancing: Some(how.to_string()),
-            ..Default::default()
-        };
-        args.apply(&mut desc)?;
-    }
+    let args = super::shading::ShadingArgs {
+        instancing,
+        shutter,
+        ..Default::default()
+    };
+    args.apply(&mut desc)?;
     super::warn_scene(&desc);
     // The build runs on every CPU, as a render's would by default.
     let ctx = Context::new(ContextOptions {

@@ -697,6 +697,18 @@ pub(super) fn print_stats(
         );
     }
     eprintln!("  effects          {}", scene.features);
+    if let Some((open, close)) = set.shutter {
+        let moving = scene.instances.keyed_count();
+        eprintln!(
+            "  motion blur      shutter {open}..{close} frames from the frame's time; {moving} \
+             moving instance(s) placed per ray{}",
+            if scene.camera_moves {
+                ", camera per ray"
+            } else {
+                ""
+            }
+        );
+    }
     eprintln!(
         "  memory budget    {}; the scene holds {}",
         scene.budget.describe(),

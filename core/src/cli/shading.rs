@@ -1,6 +1,6 @@
 //! Tachyon's shading switches for any scene: `--shade`, `--max-depth`, `--no-shadows`, `--ao`;
 //! the volume sampling switches `--volume-step`, `--volume-skip`; and how instances are
-//! realised, `--instancing`.
+//! realised, `--instancing`; an animated scene's shutter, `--shutter`.
 
 use luxon::Error;
 use luxon_formats::{AoDesc, LightDesc, SceneDesc};
@@ -31,6 +31,37 @@ pub struct ShadingArgs {
     /// copies, bitwise the flat scene), share (one copy per prototype, a two-level BVH), auto.
     #[arg(long, value_parser = ["auto", "bake", "share"])]
     pub instancing: Option<String>,
+    /// An animated scene's shutter (motion blur), overriding its `animation: (shutter: ...)`:
+    /// LENGTH in frames (0 to 2), optionally placed at the frame's start, centre (default) or
+    /// end; `off`: no shutter (frames at their own time).
+    #[arg(long, value_name = "LENGTH[:start|centre|end]|off")]
+    pub shutter: Option<String>,
+}
+
+/// The shutter `--shutter` asks for; `None`: `off`.
+pub fn parse_shutter(s: &str) -> Result<Option<luxon_formats::ShutterDesc>, Error> {
+    use luxon_formats::{ShutterAt, ShutterDesc};
+    if s == "off" {
+        return Ok(None);
+    }
+    let bad = || {
+        Error::Usage(format!(
+            "--shutter {s}: expected LENGTH[:start|centre|end] with LENGTH in frames from 0 to \
+             2 (e.g. 0.5:centre), or off"
+        ))
+    };
+    let (length, at) = s.split_once(':').unwrap_or((s, "centre"));
+    let length: f64 = length.trim().parse().map_err(|_| bad())?;
+    if !(0.0..=2.0).contains(&length) {
+        return Err(bad());
+    }
+    let at = match at.trim() {
+        "start" => ShutterAt::Start,
+        "centre" | "center" => ShutterAt::Centre,
+        "end" => ShutterAt::End,
+        _ => return Err(bad()),
+    };
+    Ok(Some(ShutterDesc { length, at }))
 }
 
 fn no_shadows(desc: &mut SceneDesc) {
@@ -88,6 +119,17 @@ impl ShadingArgs {
                 "share" => Instancing::Share,
                 _ => Instancing::Auto,
             };
+        }
+        if let Some(s) = &self.shutter {
+            let shutter = parse_shutter(s)?;
+            let Some(a) = &mut desc.animation else {
+                return Err(Error::Usage(format!(
+                    "--shutter {s}: {} has no `animation:`; a shutter needs an animated scene",
+                    desc.source.display()
+                )));
+            };
+            let at = a.at.clone();
+            a.value.shutter = shutter.map(|value| luxon_formats::Spanned { value, at });
         }
         if self.no_shadows {
             no_shadows(desc);

@@ -17,8 +17,11 @@ use super::{Clips, Counters, Hit, Kind, Surface, NO_INSTANCE};
 use crate::bvh::top::TopLevel;
 use crate::bvh::BoxRay;
 use crate::math::{gamma, next_down, next_up, Aabb, DVec3, Vec3A};
+use crate::motion::bounds::swept_bounds;
 use crate::ray::Ray;
 use glam::{DAffine3, Mat3, Vec3};
+use luxon_formats::ObjectTracks;
+use std::borrow::Cow;
 
 /// One placed copy of a bottom level.
 #[derive(Clone, Debug)]
@@ -35,6 +38,9 @@ pub enum Motion {
     Identity,
     /// Fixed by a transform.
     Fixed(Box<Placement>),
+    /// Keyed and blurred: placed at each ray's own time by its tracks (index into
+    /// [`Instances`]' tracks), so it moves during the shutter.
+    Keyed(u32),
 }
 
 /// A fixed transform, ready for rays and hit points both ways.
@@ -135,6 +141,14 @@ pub struct Instances {
     world_offset: DVec3,
     /// Prototypes cannot clip: every bottom level is traced with no clip groups.
     no_clips: Clips,
+    /// The tracks of the keyed instances ([`Motion::Keyed`]).
+    tracks: Vec<ObjectTracks>,
+    /// The frame being rendered: a ray at (frame-relative) time τ sees the keyed instances
+    /// where their tracks put them at `frame_time + τ`.
+    frame_time: f64,
+    /// The shutter (open, close), frames from `frame_time`: what the keyed instances' boxes
+    /// cover.
+    shutter: (f64, f64),
 }
 
 impl Instances {
@@ -146,6 +160,9 @@ impl Instances {
             top: TopLevel::default(),
             world_offset,
             no_clips: Clips::default(),
+            tracks: Vec::new(),
+            frame_time: 0.0,
+            shutter: (0.0, 0.0),
         };
         let bounds: Vec<Aabb> = out.list.iter().map(|i| out.bounds(i)).collect();
         out.top = TopLevel::build(&bounds);
@@ -154,6 +171,61 @@ impl Instances {
 
     pub fn is_empty(&self) -> bool {
         self.list.is_empty()
+    }
+
+    /// Whether some instance moves during the shutter (is placed per ray).
+    pub fn has_keyed(&self) -> bool {
+        !self.tracks.is_empty()
+    }
+
+    /// How many instances are placed per ray.
+    pub fn keyed_count(&self) -> usize {
+        self.tracks.len()
+    }
+
+    /// Instance `i` moves by `tracks`, placed at each ray's time from now on (its box is set
+    /// by the next [`Instances::set_time`]).
+    pub fn key(&mut self, i: u32, tracks: ObjectTracks) {
+        self.list[i as usize].motion = Motion::Keyed(self.tracks.len() as u32);
+        self.tracks.push(tracks);
+    }
+
+    /// A new bottom level (built, in object space) with one instance moving by `tracks`.
+    pub fn push_keyed(&mut self, blas: Group, tracks: ObjectTracks) {
+        self.blases.push(blas);
+        self.list.push(Instance {
+            blas: self.blases.len() as u32 - 1,
+            motion: Motion::Keyed(self.tracks.len() as u32),
+        });
+        self.tracks.push(tracks);
+    }
+
+    /// Goes to frame time `t` with the shutter `(open, close)` (frames from `t`): the keyed
+    /// instances' boxes cover their motion over `[t + open, t + close]`, and the top level is
+    /// rebuilt over every box (a function of `t` alone).
+    pub fn set_time(&mut self, t: f64, shutter: (f64, f64)) {
+        self.frame_time = t;
+        self.shutter = shutter;
+        let bounds: Vec<Aabb> = self.list.iter().map(|i| self.bounds(i)).collect();
+        self.top = TopLevel::build(&bounds);
+    }
+
+    /// Where instance `inst` is for a ray at frame-relative time `time`: `None` for the
+    /// identity (and for a keyed transform that is singular at that time, which holds
+    /// nothing).
+    #[inline]
+    fn placement<'a>(&'a self, inst: &'a Instance, time: f32) -> Option<Cow<'a, Placement>> {
+        match &inst.motion {
+            Motion::Identity => None,
+            Motion::Fixed(p) => Some(Cow::Borrowed(p)),
+            Motion::Keyed(k) => {
+                let t = self.frame_time + f64::from(time);
+                let m = crate::motion::Placement::at(&self.tracks[*k as usize], t);
+                let det = m.world_from_object.matrix3.determinant();
+                (det.is_finite() && det != 0.0)
+                    .then(|| Cow::Owned(Placement::new(m.world_from_object, self.world_offset)))
+            }
+        }
     }
 
     /// Moves instances (`(index, world_from_object)`, each invertible) and rebuilds the top
@@ -186,19 +258,31 @@ impl Instances {
             .iter()
             .filter(|(empty, _)| !empty)
             .fold(Aabb::EMPTY, |a, (_, b)| a.union(*b));
-        let Motion::Fixed(p) = &inst.motion else {
-            return b;
-        };
         if b.is_empty() {
             return b;
         }
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for k in 0..8 {
-            let pick = |i: usize| if k >> i & 1 == 0 { b.min[i] } else { b.max[i] };
-            let c = DVec3::new(pick(0) as f64, pick(1) as f64, pick(2) as f64);
-            let q = p.render_point(c);
-            (lo, hi) = (lo.min(q), hi.max(q));
-        }
+        let (lo, hi) = match &inst.motion {
+            Motion::Identity => return b,
+            Motion::Fixed(p) => {
+                let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+                for k in 0..8 {
+                    let pick = |i: usize| if k >> i & 1 == 0 { b.min[i] } else { b.max[i] };
+                    let c = DVec3::new(pick(0) as f64, pick(1) as f64, pick(2) as f64);
+                    let q = p.render_point(c);
+                    (lo, hi) = (lo.min(q), hi.max(q));
+                }
+                (lo, hi)
+            }
+            Motion::Keyed(k) => {
+                let object = (b.min.as_dvec3(), b.max.as_dvec3());
+                let (t0, t1) = (
+                    self.frame_time + self.shutter.0,
+                    self.frame_time + self.shutter.1,
+                );
+                let (lo, hi) = swept_bounds(&self.tracks[*k as usize], object, t0, t1);
+                (lo - self.world_offset, hi - self.world_offset)
+            }
+        };
         let pad = (hi - lo + lo.abs().max(hi.abs())) * 1e-6;
         let (lo, hi) = ((lo - pad).as_vec3(), (hi + pad).as_vec3());
         Aabb::new(
@@ -210,19 +294,23 @@ impl Instances {
     /// `ray` in instance `inst`'s object space, with its direction unit length, and how much
     /// longer distances are there (t_object = t_render · scale).
     #[inline]
-    pub fn object_ray(&self, inst: &Instance, ray: &Ray) -> (Ray, f32) {
-        match &inst.motion {
-            Motion::Identity => (*ray, 1.0),
-            Motion::Fixed(p) => {
-                let o = p
-                    .object_from_world
-                    .transform_point3(ray.origin.as_dvec3() + self.world_offset);
-                let d = p.dir_to_object * Vec3::from(ray.dir);
-                let scale = d.length();
-                let dir = Vec3A::from(d / scale);
-                (Ray::new(Vec3A::from(o.as_vec3()), dir, ray.time), scale)
-            }
+    pub fn object_ray(&self, inst: &Instance, ray: &Ray) -> Option<(Ray, f32)> {
+        if let Motion::Identity = inst.motion {
+            return Some((*ray, 1.0));
         }
+        let p = self.placement(inst, ray.time)?;
+        Some(self.moved_ray(&p, ray))
+    }
+
+    #[inline]
+    fn moved_ray(&self, p: &Placement, ray: &Ray) -> (Ray, f32) {
+        let o = p
+            .object_from_world
+            .transform_point3(ray.origin.as_dvec3() + self.world_offset);
+        let d = p.dir_to_object * Vec3::from(ray.dir);
+        let scale = d.length();
+        let dir = Vec3A::from(d / scale);
+        (Ray::new(Vec3A::from(o.as_vec3()), dir, ray.time), scale)
     }
 
     /// The closest hit of instance `k` before `t_max` (render-space distances), its `t` in
@@ -230,7 +318,7 @@ impl Instances {
     #[inline]
     pub fn hit_in(&self, k: u32, ray: &Ray, t_max: f32, c: &mut Counters) -> Option<Hit> {
         let inst = &self.list[k as usize];
-        let (r, scale) = self.object_ray(inst, ray);
+        let (r, scale) = self.object_ray(inst, ray)?;
         let mut t_object = t_max * scale;
         let blas = &self.blases[inst.blas as usize];
         let mut h = blas.closest(&r, &mut t_object, &self.no_clips, c)?;
@@ -279,7 +367,9 @@ impl Instances {
     ) -> bool {
         self.top.any(boxes, t_max, |k| {
             let inst = &self.list[k as usize];
-            let (r, scale) = self.object_ray(inst, ray);
+            let Some((r, scale)) = self.object_ray(inst, ray) else {
+                return false;
+            };
             let blas = &self.blases[inst.blas as usize];
             blas.any(&r, t_max * scale, &self.no_clips, c, &mut *on_hit)
         })
@@ -288,17 +378,21 @@ impl Instances {
     /// The surface at a hit in an instance (`hit.instance`), in render space.
     pub fn surface(&self, hit: &Hit, ray: &Ray, textured: bool) -> Surface {
         let inst = &self.list[hit.instance as usize];
-        let (r, scale) = self.object_ray(inst, ray);
-        let mut h = *hit;
-        h.t = hit.t * scale;
-        h.instance = NO_INSTANCE;
         let blas = &self.blases[inst.blas as usize];
-        match &inst.motion {
-            Motion::Identity => blas.surface(&h, &r, textured),
+        let mut h = *hit;
+        h.instance = NO_INSTANCE;
+        // The placement the hit was found through (a keyed one at the ray's time: the same
+        // bits, the same function of the same time).
+        let Some(p) = self.placement(inst, ray.time) else {
+            return blas.surface(&h, ray, textured);
+        };
+        let (r, scale) = self.moved_ray(&p, ray);
+        h.t = hit.t * scale;
+        match p {
             // A triangle is shaded as its moved copy (the corners and vertex normals moved),
             // as baking would store it: interpolating moved normals is not moving the
             // interpolated one under a stretch, and a mirror turns the edges' cross product.
-            Motion::Fixed(p) if hit.kind == Kind::Triangle => {
+            p if hit.kind == Kind::Triangle => {
                 let point = |v: Vec3| p.render_point(v.as_dvec3()).as_vec3();
                 let normal = |n: Vec3| (p.normal * n).normalize_or_zero();
                 let mut s = (blas.triangles).surface_moved(&h, textured, &point, &normal);
@@ -309,7 +403,7 @@ impl Instances {
                 s.p_error += Vec3A::from(p.move_error(far));
                 s
             }
-            Motion::Fixed(p) => p.surface_to_render(blas.surface(&h, &r, textured), hit.kind),
+            p => p.surface_to_render(blas.surface(&h, &r, textured), hit.kind),
         }
     }
 
@@ -412,7 +506,9 @@ mod tests {
         let mut best: Option<(f32, u32, Kind, u64)> = None;
         let mut tied = false;
         for (k, i) in inst.list.iter().enumerate() {
-            let (r, scale) = inst.object_ray(i, ray);
+            let Some((r, scale)) = inst.object_ray(i, ray) else {
+                continue;
+            };
             let g = &inst.blases[i.blas as usize];
             let mut consider = |t: Option<(f32, f32, f32)>, kind: Kind, p: usize| {
                 let Some((t, _, _)) = t else { return };
@@ -475,6 +571,54 @@ mod tests {
                     (g, w) => prop_assert_eq!(g, w.map(|w| w.0)),
                 }
                 let blocked = inst.any(ray, &boxes, *reach, &mut c, &mut |_, _| true);
+                let want = want.is_some_and(|(b, _)| f32::from_bits(b.0) < *reach);
+                prop_assert_eq!(blocked, want);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Moving instances (random keyed tracks) and rays at random times of the shutter:
+        /// the top level over the swept boxes finds what testing every primitive of every
+        /// instance, placed at the ray's time, finds.
+        #[test]
+        fn moving_instances_are_found_at_the_rays_time(
+            protos in proptest::collection::vec(prototype(), 1..3),
+            placed in proptest::collection::vec(
+                (0usize..3, crate::motion::bounds::tests::tracks(), any::<bool>()), 1..16),
+            frame in 0u32..8,
+            shutter in prop_oneof![Just((0.0, 1.0)), Just((-0.25, 0.25)), Just((-2.0, 0.0))],
+            rays in proptest::collection::vec((ray(), 0.0f32..1.0, 0.5f32..30.0), 60),
+        ) {
+            let n = protos.len();
+            let offset = DVec3::new(3.0, -2.0, 1.5);
+            let mut inst = Instances::new(
+                protos.iter().map(group).collect(),
+                placed.iter().map(|(b, _, _)| Instance { blas: (b % n) as u32, motion: Motion::Identity }).collect(),
+                offset,
+            );
+            for (k, (_, tracks, keyed)) in placed.iter().enumerate() {
+                if *keyed {
+                    inst.key(k as u32, tracks.clone());
+                }
+            }
+            inst.set_time(f64::from(frame), shutter);
+            let mut c = Counters::default();
+            for (ray, u, reach) in &rays {
+                let time = shutter.0 as f32 + u * (shutter.1 - shutter.0) as f32;
+                let ray = Ray::new(ray.origin, ray.dir, time);
+                let mut t_max = f32::INFINITY;
+                let mut hit = None;
+                let boxes = BoxRay::new(ray.origin, ray.dir);
+                inst.intersect(&ray, &boxes, &mut t_max, &mut hit, &mut c);
+                let got = hit.map(|h| (h.t.to_bits(), h.instance, h.kind, h.index));
+                let want = brute(&inst, &ray);
+                match (got, want) {
+                    (Some(g), Some((w, true))) => prop_assert_eq!(g.0, w.0),
+                    (g, w) => prop_assert_eq!(g, w.map(|w| w.0)),
+                }
+                let blocked = inst.any(&ray, &boxes, *reach, &mut c, &mut |_, _| true);
                 let want = want.is_some_and(|(b, _)| f32::from_bits(b.0) < *reach);
                 prop_assert_eq!(blocked, want);
             }

@@ -6,8 +6,27 @@ use crate::adaptive;
 use crate::framebuffer::Span;
 use crate::geometry::Counters;
 use crate::math::Vec3A;
-use crate::sampler::PixelSampler;
+use crate::sampler::{time_at, time_sample, PixelSampler};
 use crate::scene::Scene;
+
+/// The time of sample `i` of `n` of pixel (`x`, `y`): the scene's `time`, or with motion blur
+/// a point of the shutter (`time_sample`; a shutter of no length gives +0.0, the still
+/// frame's time). `at`: an adaptive sample's position in the pixel, which gives its time
+/// instead of its index.
+#[inline]
+fn sample_time(scene: &Scene, x: u32, y: u32, i: u32, n: u32, at: Option<(f32, f32)>) -> f32 {
+    let s = &scene.settings;
+    match s.shutter {
+        None => s.time,
+        Some((open, close)) => {
+            let u = match at {
+                Some((jx, jy)) => time_at(jx, jy, x, y, s.frame),
+                None => time_sample(x, y, i, n, s.frame),
+            };
+            open + u * (close - open)
+        }
+    }
+}
 
 /// Renders the pixels of `spans`, returning their RGBA values span after span.
 pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
@@ -23,10 +42,10 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     for span in spans {
         let y = span.y;
         for x in span.xs() {
-            let mut shade = |jx: f32, jy: f32| {
+            let mut shade = |jx: f32, jy: f32, time: f32| {
                 let (px, py) = (x as f32 + jx, y as f32 + jy);
                 // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
-                match scene.camera.primary(px, py, s.width, s.height, s.time) {
+                match scene.primary(px, py, time) {
                     Some(ray) => {
                         c.primary += 1;
                         integrator.radiance(&ray, 0, 1.0, &media, c)
@@ -35,13 +54,15 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
                 }
             };
             let mut v = match &plan {
-                Some(p) => p.pixel(x, y, s.frame, &mut shade),
+                Some(p) => p.pixel(x, y, s.frame, &mut |jx, jy| {
+                    shade(jx, jy, sample_time(scene, x, y, 0, n, Some((jx, jy))))
+                }),
                 None => {
                     let mut sum = Vec3A::ZERO;
                     let seed = sampler.pixel_seed(x, y);
                     for i in 0..n {
                         let (jx, jy) = sampler.sample(x, y, seed, i);
-                        sum += shade(jx, jy);
+                        sum += shade(jx, jy, sample_time(scene, x, y, i, n, None));
                     }
                     sum * inv_n
                 }
@@ -73,9 +94,9 @@ pub fn render_depth(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
         let y = span.y;
         for x in span.xs() {
             let mut nearest = f32::INFINITY;
-            let mut probe = |jx: f32, jy: f32| {
+            let mut probe = |jx: f32, jy: f32, time: f32| {
                 let (px, py) = (x as f32 + jx, y as f32 + jy);
-                if let Some(ray) = scene.camera.primary(px, py, s.width, s.height, s.time) {
+                if let Some(ray) = scene.primary(px, py, time) {
                     c.primary += 1;
                     if let Some(hit) = scene.intersect(&ray, f32::INFINITY, c) {
                         nearest = nearest.min(hit.t);
@@ -87,13 +108,15 @@ pub fn render_depth(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
             };
             match &plan {
                 Some(p) => {
-                    p.pixel(x, y, s.frame, &mut probe);
+                    p.pixel(x, y, s.frame, &mut |jx, jy| {
+                        probe(jx, jy, sample_time(scene, x, y, 0, n, Some((jx, jy))))
+                    });
                 }
                 None => {
                     let seed = sampler.pixel_seed(x, y);
                     for i in 0..n {
                         let (jx, jy) = sampler.sample(x, y, seed, i);
-                        probe(jx, jy);
+                        probe(jx, jy, sample_time(scene, x, y, i, n, None));
                     }
                 }
             }

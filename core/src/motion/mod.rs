@@ -2,6 +2,7 @@
 //! keyed objects built from them ([`transform`]). Everything here is f64 and a pure function
 //! of its arguments, so a frame's values never depend on which frames were computed before.
 
+pub mod bounds;
 pub mod keys;
 pub mod transform;
 

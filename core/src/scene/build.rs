@@ -231,6 +231,7 @@ impl Scene {
             bvh_time,
             plugin_time,
             moving: Default::default(),
+            camera_moves: false,
             instances: shared,
             objects: Default::default(),
             prototypes,
@@ -240,7 +241,24 @@ impl Scene {
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
-            let shared_keyed = std::mem::take(&mut stored.shared_keyed);
+            let mut shared_keyed = std::mem::take(&mut stored.shared_keyed);
+            let mut keyed = keyed;
+            if frame::per_ray(desc) {
+                // Motion blur: what moves is placed at each ray's time, as shared instances.
+                if scene.instances.is_empty() {
+                    scene.instances = Instances::new(Vec::new(), Vec::new(), b.world_offset);
+                }
+                shared_keyed.retain(|(i, tracks)| {
+                    let moves = frame::object_moves(tracks);
+                    if moves {
+                        scene.instances.key(*i, tracks.clone());
+                    }
+                    !moves
+                });
+                keyed = frame::blur_objects(keyed, &mut scene.instances, &scene.budget)?;
+            }
+            scene.settings.shutter = frame::shutter(desc).map(|(o, c)| (o as f32, c as f32));
+            scene.features.motion_blur = scene.settings.shutter.is_some();
             let animation = Animation::new(
                 desc,
                 &scene.material_names,
@@ -1039,6 +1057,7 @@ pub(super) fn features(
         }),
         antialiasing: r.samples > 1 || r.adaptive.is_some(),
         volumes: !render_volumes.is_empty(),
+        motion_blur: false,
     }
 }
 
@@ -1062,6 +1081,7 @@ pub(super) fn settings(r: &RenderDesc) -> Settings {
         adaptive: r.adaptive,
         light_scale: r.light_scale as f32,
         tachyon: r.tachyon,
+        shutter: None,
     }
 }
 

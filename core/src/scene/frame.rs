@@ -18,6 +18,7 @@ use super::build::{shadow_filter, Build};
 use super::place::place;
 use super::{Light, Scene};
 use crate::budget::{Budget, Use};
+use crate::camera::Camera;
 use crate::error::Error;
 use crate::geometry::group::Group;
 use crate::math::{DVec3, Vec3A};
@@ -58,6 +59,99 @@ pub struct Animation {
     /// Keyed shared instances (`Scene::instances` index) and their tracks.
     instances: Vec<(u32, ObjectTracks)>,
     frame: u32,
+    /// The shutter (open, close) in frames from the frame's time, when time is sampled (see
+    /// [`shutter`]).
+    shutter: Option<(f64, f64)>,
+}
+
+/// Whether a track's keys take more than one value (so it moves somewhere).
+fn moves<T: PartialEq>(t: &Option<Track<T>>) -> bool {
+    t.as_ref()
+        .is_some_and(|t| t.keys.iter().any(|k| k.value != t.keys[0].value))
+}
+
+/// Whether a track changes somewhere in `(t0, t1)`: it moves, and the interval meets its
+/// keys' span (outside it the value holds).
+fn changes_in<T: PartialEq>(t: &Option<Track<T>>, t0: f64, t1: f64) -> bool {
+    moves(t)
+        && t.as_ref().is_some_and(|t| {
+            let k = &t.keys;
+            t0 < k[k.len() - 1].frame && t1 > k[0].frame
+        })
+}
+
+/// Whether keyed tracks of an object or instance move it somewhere.
+pub(super) fn object_moves(t: &ObjectTracks) -> bool {
+    moves(&t.translate) || moves(&t.rotate) || moves(&t.scale)
+}
+
+/// The shutter (open, close), in frames from the frame's time, when the scene samples time:
+/// it has a shutter and something keyed that moves (an object, an instance, the camera).
+/// `None` otherwise — a still scene, or nothing that could blur — and then no time is sampled.
+pub fn shutter(desc: &SceneDesc) -> Option<(f64, f64)> {
+    let a = &desc.animation.as_ref()?.value;
+    let s = a.shutter.as_ref()?.value;
+    let c = &a.camera;
+    let camera = moves(&c.position)
+        || moves(&c.look_at)
+        || moves(&c.up)
+        || moves(&c.fov)
+        || moves(&c.focal_distance);
+    let objects = a.objects.iter().chain(&a.instances).any(object_moves);
+    (camera || objects).then(|| s.interval())
+}
+
+/// Whether keyed objects and instances that move are placed at each ray's time (traced as
+/// shared instances): a shutter that stays open for some time and something that moves in it.
+pub(super) fn per_ray(desc: &SceneDesc) -> bool {
+    shutter(desc).is_some_and(|(open, close)| close > open)
+}
+
+/// Keyed objects that move, as bottom levels of their own in object space, each traced
+/// through its tracks at every ray's time (motion blur); the others stay keyed as they were.
+/// A keyed object in a clip group cannot be blurred (bottom levels do not clip).
+pub(super) fn blur_objects(
+    objects: Vec<Keyed>,
+    instances: &mut crate::geometry::instance::Instances,
+    budget: &Arc<Budget>,
+) -> Result<Vec<Keyed>, Error> {
+    let mut kept = Vec::new();
+    for o in objects {
+        if !object_moves(&o.tracks) {
+            kept.push(o);
+            continue;
+        }
+        let name = &o.tracks.name.value;
+        if crate::geometry::clip_of(o.material) != 0 {
+            return Err(Error::at(
+                &o.at,
+                format!(
+                    "object `{name}` is keyed and clipped: motion blur traces moving objects \
+                     as instances, which cannot be clipped; expected no `clip` on it, or \
+                     `shutter: (length: 0)`"
+                ),
+            ));
+        }
+        let mut group = Group::default();
+        let before = budget.used(Use::Geometry);
+        let identity = Placement::from_desc(&luxon_formats::TransformDesc::IDENTITY);
+        let placed = place(
+            &o.geometry,
+            &identity,
+            DVec3::ZERO,
+            o.material,
+            group.sets(),
+            budget,
+        );
+        let grown = budget.used(Use::Geometry).saturating_sub(before);
+        group.charges.push(budget.guard(Use::Geometry, grown));
+        placed.map_err(|m| Error::at(&o.at, format!("object `{name}`: {m}")))?;
+        group
+            .build(budget)
+            .map_err(|e| Error::Render(format!("object `{name}`: {}", e.0)))?;
+        instances.push_keyed(group, o.tracks);
+    }
+    Ok(kept)
 }
 
 /// Where render space's origin sits in an animated scene: the camera's position at the first
@@ -76,9 +170,8 @@ pub(super) fn world_offset(desc: &SceneDesc) -> DVec3 {
 
 impl Animation {
     /// The animation of `desc`, with the objects the build recorded; `shadowless`: each
-    /// material's copy that casts no shadow (`Scene::materials` index). A shutter that stays
-    /// open is refused (motion blur is not rendered yet), as is a scale that would turn a
-    /// sphere, cone or disc into something it cannot store.
+    /// material's copy that casts no shadow (`Scene::materials` index). A scale that would
+    /// turn a sphere, cone or disc into something it cannot store is refused.
     pub(super) fn new(
         desc: &SceneDesc,
         material_names: &[String],
@@ -90,14 +183,6 @@ impl Animation {
             .animation
             .as_ref()
             .ok_or_else(|| Error::Render("the scene has no animation".into()))?;
-        if let Some(s) = a.value.shutter.as_ref().filter(|s| s.value.length > 0.0) {
-            return Err(Error::at(
-                &s.at,
-                "this build reads the shutter but does not render motion blur yet; expected \
-                 `shutter: (length: 0)` or no `shutter` (frames are rendered at their own \
-                 time)",
-            ));
-        }
         for o in &objects {
             let g = &o.geometry;
             let round = !(g.spheres.is_empty() && g.cones.is_empty() && g.discs.is_empty());
@@ -139,6 +224,7 @@ impl Animation {
             objects,
             instances,
             frame: a.value.first,
+            shutter: shutter(desc),
         })
     }
 
@@ -153,6 +239,41 @@ impl Animation {
 
     pub fn shutter(&self) -> Option<ShutterDesc> {
         self.desc.shutter.as_ref().map(|s| s.value)
+    }
+
+    /// The shutter (open, close) in frames from the frame's time when time is sampled.
+    pub fn sampled_shutter(&self) -> Option<(f64, f64)> {
+        self.shutter
+    }
+
+    /// Whether the camera changes during frame `k`'s shutter: then each camera ray is cast
+    /// by the camera at its own time.
+    fn camera_moves_in(&self, k: u32) -> bool {
+        let Some((open, close)) = self.shutter.filter(|(o, c)| c > o) else {
+            return false;
+        };
+        let (t0, t1) = (f64::from(k) + open, f64::from(k) + close);
+        let c = &self.desc.camera;
+        changes_in(&c.position, t0, t1)
+            || changes_in(&c.look_at, t0, t1)
+            || changes_in(&c.up, t0, t1)
+            || changes_in(&c.fov, t0, t1)
+            || changes_in(&c.focal_distance, t0, t1)
+    }
+
+    /// The camera at frame-relative time `time` of the current frame, in render space;
+    /// `None` where it degenerates (the frame's camera is used there).
+    pub(super) fn camera_at_time(
+        &self,
+        time: f32,
+        world_offset: DVec3,
+        w: u32,
+        h: u32,
+    ) -> Option<Camera> {
+        let t = f64::from(self.frame) + f64::from(time);
+        let c = self.camera_at(t, self.frame).ok()?;
+        let origin = Vec3A::from((DVec3::from(c.position) - world_offset).as_vec3());
+        Some(Camera::new(&c, origin, w, h))
     }
 
     /// The frame the scene is at.
@@ -361,6 +482,8 @@ impl Scene {
         let moving = anim.group_at(t, k, self.world_offset, &self.budget)?;
         let placed = anim.instances_at(t, k)?;
         let shadows = anim.shadows;
+        let camera_moves = anim.camera_moves_in(k);
+        let shutter = anim.shutter.unwrap_or((0.0, 0.0));
         let colors: Vec<(usize, Option<usize>, Vec3A)> = anim
             .materials
             .iter()
@@ -376,6 +499,11 @@ impl Scene {
         if !placed.is_empty() {
             self.instances.place(&placed);
         }
+        if self.instances.has_keyed() {
+            // Moving instances: their boxes cover this frame's shutter.
+            self.instances.set_time(t, shutter);
+        }
+        self.camera_moves = camera_moves;
         for (i, copy, c) in colors {
             let m = &mut self.materials[i];
             m.color = c;

@@ -20,7 +20,8 @@
 //! cannot be copied either way (the host cannot move it).
 //!
 //! An instance the animation keys (by its `name`) is not baked: its copies are recorded as
-//! keyed objects and placed anew at every frame in the scene's moving group (`frame`).
+//! keyed objects and placed anew at every frame in the scene's moving group (`frame`), or,
+//! under `Share` or when it moves during an open shutter (motion blur), shares its prototype.
 
 use super::frame::Keyed;
 use super::place::{place, Sets};
@@ -161,9 +162,13 @@ pub(super) fn bake(
         let what = || describe(k, inst, name);
         if let Some(tracks) = keyed(k) {
             let tracks = with_static(tracks, &inst.value.world_from_object, &what)?;
-            if desc.render.instancing == Instancing::Share {
-                // Shared like a static copy; `set_frame` places it at each frame and rebuilds
-                // the top level (here it stands where the first frame puts it).
+            // Motion blur traces what moves as shared instances whatever `instancing` says
+            // (a baked copy stands still for the whole shutter).
+            let blurred = super::frame::per_ray(desc) && super::frame::object_moves(&tracks);
+            if desc.render.instancing == Instancing::Share || blurred {
+                // Shared like a static copy; `set_frame` places it at each frame (or, blurred,
+                // at each ray's time) and rebuilds the top level (here it stands where the
+                // first frame puts it).
                 let first = desc.animation.as_ref().map_or(0, |a| a.value.first);
                 let placement = Placement::at(&tracks, f64::from(first));
                 shared.add(cx, material_of, (inst, p), parts, &placement, used, &what)?;

@@ -266,6 +266,9 @@ pub struct Features {
     pub antialiasing: bool,
     /// Some volume is drawn (has `render` settings).
     pub volumes: bool,
+    /// Camera rays sample a time in the shutter (an animated scene with a shutter and
+    /// something keyed that moves).
+    pub motion_blur: bool,
 }
 
 impl std::fmt::Display for Features {
@@ -281,6 +284,7 @@ impl std::fmt::Display for Features {
             (self.textures, "textures"),
             (self.antialiasing, "antialiasing"),
             (self.volumes, "volumes"),
+            (self.motion_blur, "motion blur"),
         ] {
             if on {
                 v.push(name);
@@ -318,6 +322,9 @@ pub struct Settings {
     pub light_scale: f32,
     /// Tachyon's shading rules.
     pub tachyon: luxon_formats::TachyonDesc,
+    /// The shutter (open, close) in frames from the frame's time when camera rays sample a
+    /// time in it (motion blur); `None`: every ray carries `time`.
+    pub shutter: Option<(f32, f32)>,
 }
 
 pub struct Scene {
@@ -370,6 +377,9 @@ pub struct Scene {
     pub plugin_time: Duration,
     /// Keyed objects placed at the current frame (empty in a still scene).
     pub moving: Group,
+    /// The camera changes during this frame's shutter: each camera ray is cast by the camera
+    /// at its own time.
+    pub camera_moves: bool,
     /// Instances sharing one copy of their prototype (a two-level BVH; empty unless some
     /// prototype is shared).
     pub instances: Instances,
@@ -564,6 +574,23 @@ impl Scene {
     /// geometry stays stored relative to `world_offset` (the first camera's position) and the
     /// new camera is placed in that space. Only the camera's position, direction and window
     /// change what a render computes; `settings` (resolution, samples) stay as built.
+    /// The camera ray through image point (`px`, `py`) at frame-relative time `time`: from
+    /// the camera at that time when the camera moves during the shutter, else the frame's.
+    #[inline]
+    pub fn primary(&self, px: f32, py: f32, time: f32) -> Option<crate::ray::Ray> {
+        let s = &self.settings;
+        if self.camera_moves {
+            let moved = self
+                .animation
+                .as_ref()
+                .and_then(|a| a.camera_at_time(time, self.world_offset, s.width, s.height));
+            if let Some(c) = moved {
+                return c.primary(px, py, s.width, s.height, time);
+            }
+        }
+        self.camera.primary(px, py, s.width, s.height, time)
+    }
+
     pub fn set_camera(&mut self, desc: &luxon_formats::CameraDesc) {
         let origin = Vec3A::from((DVec3::from(desc.position) - self.world_offset).as_vec3());
         let s = &self.settings;

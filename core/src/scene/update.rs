@@ -39,7 +39,10 @@ impl Scene {
         let r = &desc.render;
         let resized = (self.settings.width, self.settings.height) != (width, height);
         let frame = self.settings.frame;
+        // The shutter is the animation's (the build's), not a render setting.
+        let shutter = self.settings.shutter;
         self.settings = settings(r);
+        self.settings.shutter = shutter;
         self.settings.width = width;
         self.settings.height = height;
         self.outputs = r.outputs.clone();
