@@ -338,6 +338,24 @@ fn bad_grids_are_refused_with_clear_messages() {
         .unwrap();
     let e = s.set_volume(ball, VolumeGrid::new(v.clone(), [10, 10, 10]), None);
     assert!(e.unwrap_err().to_string().contains("is not a volume"));
+    // A scene file cannot refer to the caller's arrays: to_ron says so, naming the object.
+    let e = s.to_ron().unwrap_err().to_string();
+    assert!(
+        e.contains("(volume) is read from arrays and cannot be written as RON"),
+        "{e}"
+    );
     s.remove(id).unwrap();
     s.commit(&r).unwrap();
+    for v in s.objects() {
+        if v != ball {
+            s.remove(v).unwrap();
+        }
+    }
+    let e = s.to_ron().unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!("{ball} (spheres) is read from arrays")),
+        "{e}"
+    );
+    s.remove(ball).unwrap();
+    assert!(s.to_ron().unwrap().contains("camera"));
 }

@@ -17,6 +17,11 @@
  *   leaves the handles it used unusable (release them). The library prints nothing; install
  *   a log callback (luxon_set_log) to see its messages.
  * - Structs that start with `size` are versioned: set size = sizeof(the struct).
+ * - Arrays (luxon_array) are the caller's memory read in place, or Luxon's copy of it. Who
+ *   owns the memory and how long Luxon reads it: luxon_array_create_shared says (in short:
+ *   from the first commit that uses it until the last object using it is removed or set to
+ *   other arrays, or its scene released, and only during the commits and renders of those
+ *   scenes; releasing the handle ends nothing: a deleter tells when Luxon let go).
  */
 
 #ifndef LUXON_H
@@ -29,11 +34,23 @@
 // The version of this header's API: `luxon_api_version()` returns the version the library
 // was built with, so a program can check it loaded the library it was compiled for. Raised
 // whenever a function or struct changes or is added.
-#define LUXON_API_VERSION 1
+#define LUXON_API_VERSION 2
 
 // What a call returns: `LUXON_OK` (0) or one of the `LUXON_ERROR_*` codes, with the reason in
 // `luxon_last_error()`.
 typedef int32_t luxon_status;
+
+// The type of an array's elements (`LUXON_FLOAT32`...).
+typedef int32_t luxon_elem;
+
+// Called when Luxon no longer reads a shared array: `user` is what was passed with it.
+typedef void (*luxon_deleter_fn)(void *user);
+
+// An array of the caller's (read in place) or Luxon's copy of one, for the array objects and
+// volumes of scenes (see `luxon_array_create_shared`). `{0}` is the null handle.
+typedef struct luxon_array {
+  uint64_t id;
+} luxon_array;
 
 // How a context starts (`luxon_context_create`). Set `size` to `sizeof(luxon_context_options)`;
 // zero the fields you leave to their defaults.
@@ -64,14 +81,97 @@ typedef struct luxon_renderer {
   uint64_t id;
 } luxon_renderer;
 
-// Told about finished pixels from the render threads, several at once: `done` of `total`
-// pixels. A non-zero return cancels the render (as `luxon_renderer_cancel`).
-typedef int32_t (*luxon_progress_fn)(uint64_t done, uint64_t total, void *user);
+// Spheres read from arrays (`luxon_spheres_init` fills in the defaults).
+typedef struct luxon_spheres {
+  // `sizeof(luxon_spheres)`.
+  uint32_t size;
+  // Centres (LUXON_FLOAT32_VEC3 or LUXON_FLOAT64_VEC3), world coordinates.
+  struct luxon_array centers;
+  // One radius per centre (LUXON_FLOAT32 or LUXON_FLOAT64); `{0}`: `radius` for all.
+  struct luxon_array radii;
+  double radius;
+  // Linear RGB per sphere (FLOAT32_VEC3 or FLOAT64_VEC3, replacing the material's colour);
+  // `{0}`: none.
+  struct luxon_array colors;
+  // The material's name; NULL: `default`.
+  const char *material;
+} luxon_spheres;
+
+// Cylinders read from arrays (`luxon_cylinders_init` fills in the defaults).
+typedef struct luxon_cylinders {
+  // `sizeof(luxon_cylinders)`.
+  uint32_t size;
+  // Base and apex centres (FLOAT32_VEC3 or FLOAT64_VEC3), world coordinates.
+  struct luxon_array bases;
+  struct luxon_array apexes;
+  // One radius per cylinder (FLOAT32 or FLOAT64); `{0}`: `radius` for all.
+  struct luxon_array radii;
+  double radius;
+  // Non-zero: closed by discs at both ends (default 1).
+  uint32_t caps;
+  // The material's name; NULL: `default`.
+  const char *material;
+} luxon_cylinders;
+
+// A triangle mesh read from arrays (`luxon_mesh_init` fills in the defaults).
+typedef struct luxon_mesh {
+  // `sizeof(luxon_mesh)`.
+  uint32_t size;
+  // Vertex positions (FLOAT32_VEC3 or FLOAT64_VEC3), world coordinates.
+  struct luxon_array positions;
+  // Triangles' vertex indices (UINT32_VEC3 or UINT64_VEC3); `{0}`: every three positions
+  // make a triangle.
+  struct luxon_array indices;
+  // Per vertex, each optional (`{0}`): normals (FLOAT32_VEC3 or FLOAT64_VEC3), linear RGB
+  // colours (FLOAT32_VEC3 or FLOAT64_VEC3), texture coordinates (FLOAT32_VEC2).
+  struct luxon_array normals;
+  struct luxon_array colors;
+  struct luxon_array uvs;
+  // The material's name; NULL: `default`.
+  const char *material;
+} luxon_mesh;
+
+// A volume from an array of scalars (`luxon_volume_init` fills in the defaults). Voxel
+// `(i, j, k)` is element `first + i*strides[0] + j*strides[1] + k*strides[2]` of `values` and
+// lies at world position `origin + (i*spacing[0], j*spacing[1], k*spacing[2])`.
+typedef struct luxon_volume {
+  // `sizeof(luxon_volume)`.
+  uint32_t size;
+  // The voxels: LUXON_FLOAT32, LUXON_FLOAT64, LUXON_UINT8 or LUXON_UINT16.
+  struct luxon_array values;
+  // Voxels along x, y and z (each ≥ 1).
+  uint64_t dims[3];
+  // In elements (negative: an axis runs backwards); all 0: x fastest, packed (a Fortran
+  // array `v(nx, ny, nz)`, a C array `v[nz][ny][nx]`).
+  int64_t strides[3];
+  // The element of voxel (0, 0, 0) (a view into a larger array, e.g. without halo cells).
+  uint64_t first;
+  double origin[3];
+  // Each finite and non-zero (default 1).
+  double spacing[3];
+  // Non-zero (the default): integer voxels are divided by 255 (u8) or 65535 (u16).
+  uint32_t normalize;
+  // The volume's name in messages; NULL: the object's.
+  const char *name;
+  // How it is drawn, as RON text (what follows `render:` in a scene file's volume, e.g.
+  // `(transfer: (preset: "viridis"))`); NULL: not drawn.
+  const char *render_ron;
+} luxon_volume;
 
 // A scene kept between renders. `{0}` is the null handle.
 typedef struct luxon_scene {
   uint64_t id;
 } luxon_scene;
+
+// A part of one scene (a light or an object), valid until it is removed or its scene is
+// released. `{0}` is the null handle.
+typedef struct luxon_object {
+  uint64_t id;
+} luxon_object;
+
+// Told about finished pixels from the render threads, several at once: `done` of `total`
+// pixels. A non-zero return cancels the render (as `luxon_renderer_cancel`).
+typedef int32_t (*luxon_progress_fn)(uint64_t done, uint64_t total, void *user);
 
 // A target's pixel format (`luxon_target.format`).
 typedef int32_t luxon_pixel_format;
@@ -117,12 +217,6 @@ typedef struct luxon_render_stats {
   double render_seconds;
 } luxon_render_stats;
 
-// A part of one scene (a light or an object), valid until it is removed or its scene is
-// released. `{0}` is the null handle.
-typedef struct luxon_object {
-  uint64_t id;
-} luxon_object;
-
 // A point light (`luxon_point_light_init` fills in the defaults).
 typedef struct luxon_point_light {
   // `sizeof(luxon_point_light)`.
@@ -159,7 +253,8 @@ typedef struct luxon_material {
 typedef struct luxon_commit_report {
   // `sizeof(luxon_commit_report)`.
   uint32_t size;
-  // 1 when the commit built the scene's geometry (BVHs), 0 when it only took new settings,
+  // Geometry builds: 1 when the commit built the scene (its BVHs), plus one per array object
+  // whose BVH it built; 0 when it only took new settings,
   // camera, background, lights, materials, fog or ambient occlusion.
   uint32_t rebuilt;
   // 1 when it took new lights, materials, fog or ambient occlusion without a build.
@@ -168,7 +263,47 @@ typedef struct luxon_commit_report {
   double bvh_seconds;
   // Seconds the whole commit took.
   double commit_seconds;
+  // Array objects whose BVHs were refitted (their arrays marked modified, counts unchanged).
+  uint32_t refitted;
+  // Array objects refitted whose trees had become too costly, so built again (also in
+  // `rebuilt`, which counts every array object built besides the scene's 1).
+  uint32_t degraded;
+  // Volumes read from their arrays (new, set again, or marked modified).
+  uint32_t volumes_read;
 } luxon_commit_report;
+
+// `float`.
+#define LUXON_FLOAT32 1
+
+// `double`.
+#define LUXON_FLOAT64 2
+
+// `uint8_t`.
+#define LUXON_UINT8 3
+
+// `uint16_t`.
+#define LUXON_UINT16 4
+
+// `uint32_t`.
+#define LUXON_UINT32 5
+
+// `uint64_t`.
+#define LUXON_UINT64 6
+
+// `float[2]` (texture coordinates).
+#define LUXON_FLOAT32_VEC2 7
+
+// `float[3]` (positions, normals, colours).
+#define LUXON_FLOAT32_VEC3 8
+
+// `double[3]`.
+#define LUXON_FLOAT64_VEC3 9
+
+// `uint32_t[3]` (a triangle's vertex indices).
+#define LUXON_UINT32_VEC3 10
+
+// `uint64_t[3]`.
+#define LUXON_UINT64_VEC3 11
 
 // No colour (a depth-only render).
 #define LUXON_PIXELS_NONE 0
@@ -226,6 +361,82 @@ typedef struct luxon_commit_report {
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+// An array over the caller's memory, read in place: `count` elements of type `type_`, element
+// `i` at `data + i * stride_bytes` (0: packed). No alignment is needed, so a field of an array
+// of structs is an array (`data` = the first struct's field, `stride_bytes` = the struct's
+// size).
+//
+// Ownership rules:
+// 1. Luxon reads the memory in place at the commits and renders of the scenes whose objects use
+//    the array, until the last such object is removed, given other arrays, or its scene
+//    released; releasing the handle (`luxon_array_release`) does not end this. Then
+//    `deleter(user)` runs (if not NULL), once, on a thread that called Luxon or one of Luxon's,
+//    after the last read; it must not call Luxon. Until then the memory must stay valid.
+// 2. Do not write the memory while a commit or render of a scene using it runs (on any
+//    thread): Luxon reads it only then.
+// 3. After writing it between renders, call `luxon_array_mark_modified`: the next commit reads
+//    it again (refits the objects' BVHs, reads volumes again). Without it Luxon may show stale
+//    geometry (never reads outside the array: every read is checked against `count`).
+// 4. Volumes are copied into Luxon's bricks at the commit that reads them: their arrays may be
+//    written once it returned (mark them modified to have them read again).
+//
+// Refused (LUXON_ERROR_INVALID_ARGUMENT): a NULL `data` with `count` > 0, an unknown type, a
+// stride below the element's size, a span past the address space. `out` is `{0}` on failure
+// (then the deleter is not called: the memory stays the caller's).
+//
+// # Safety
+// `data` is valid as rule 1 says for reads of `count` elements at the stride; `out` is valid
+// for a write.
+luxon_status luxon_array_create_shared(const void *data,
+                                       size_t count,
+                                       size_t stride_bytes,
+                                       luxon_elem type_,
+                                       luxon_deleter_fn deleter,
+                                       void *user,
+                                       struct luxon_array *out);
+
+// An array holding Luxon's packed copy of `count` elements of type `type_` at `data`,
+// `stride_bytes` apart (0: packed). The caller's memory may be reused as soon as this returns;
+// `luxon_array_update` changes the copy. Refused as `luxon_array_create_shared` refuses;
+// LUXON_ERROR_OUT_OF_MEMORY when the copy does not fit.
+//
+// # Safety
+// `data` is valid for reads of `count` elements at the stride; `out` is valid for a write.
+luxon_status luxon_array_create_copy(const void *data,
+                                     size_t count,
+                                     size_t stride_bytes,
+                                     luxon_elem type_,
+                                     struct luxon_array *out);
+
+// Writes `count` elements (of the array's type, `stride_bytes` apart at `data`; 0: packed)
+// over elements `first` to `first + count - 1` of a copy array (`luxon_array_create_copy`),
+// waiting for a render that reads it to end, and marks it modified. A shared array is refused
+// (write its memory and call `luxon_array_mark_modified`).
+//
+// # Safety
+// `data` is valid for reads of `count` elements at the stride.
+luxon_status luxon_array_update(struct luxon_array array,
+                                const void *data,
+                                size_t first,
+                                size_t count,
+                                size_t stride_bytes);
+
+// Tells Luxon that elements `first` to `first + count - 1` of a shared array were written
+// (ownership rule 3 of `luxon_array_create_shared`): the next commit reads the objects using
+// the array again (today all of their elements). A range past the array is refused.
+luxon_status luxon_array_mark_modified(struct luxon_array array, size_t first, size_t count);
+
+// The number of elements of an array.
+//
+// # Safety
+// `count` is valid for a write.
+luxon_status luxon_array_count(struct luxon_array array, size_t *count);
+
+// Releases the handle: it is invalid from now on. Objects of scenes using the array keep it
+// (a shared array's memory is read until the last of them lets it go, then its deleter runs:
+// ownership rule 1 of `luxon_array_create_shared`); an array no object uses goes at once.
+luxon_status luxon_array_release(struct luxon_array array);
 
 // Starts a context: finds the plugins (once) and starts its thread pool, whose threads sleep
 // between renders. `options` may be NULL (every default). Plugin files that could not be
@@ -309,6 +520,111 @@ luxon_status luxon_write_image(struct luxon_context context,
 // feature `mpi`; see `luxon_has_mpi`), `LUXON_ERROR_MPI` when MPI is not usable as above or
 // `fortran_comm` is not a communicator.
 luxon_status luxon_renderer_set_mpi_comm_f(struct luxon_renderer renderer, int fortran_comm);
+
+// Fills `spheres` with the defaults (and its `size`): no arrays, radius 1.
+//
+// # Safety
+// `spheres` is valid for a write of a `luxon_spheres`.
+luxon_status luxon_spheres_init(struct luxon_spheres *spheres);
+
+// Fills `cylinders` with the defaults (and its `size`): no arrays, radius 1, capped.
+//
+// # Safety
+// `cylinders` is valid for a write of a `luxon_cylinders`.
+luxon_status luxon_cylinders_init(struct luxon_cylinders *cylinders);
+
+// Fills `mesh` with the defaults (and its `size`): no arrays.
+//
+// # Safety
+// `mesh` is valid for a write of a `luxon_mesh`.
+luxon_status luxon_mesh_init(struct luxon_mesh *mesh);
+
+// Fills `volume` with the defaults (and its `size`): no array, x fastest, at the origin,
+// spacing 1, normalized, unnamed, not drawn.
+//
+// # Safety
+// `volume` is valid for a write of a `luxon_volume`.
+luxon_status luxon_volume_init(struct luxon_volume *volume);
+
+// Adds spheres read from arrays (see `luxon_array_create_shared` for who owns the memory and
+// how long Luxon reads it). Element types are checked now; values (NaN, radius ≤ 0) at every
+// commit that reads them, naming the object and the sphere. After the arrays were marked
+// modified the next commit refits the object's BVH (builds it again when the count changed).
+//
+// # Safety
+// `spheres` is a valid `luxon_spheres` (its `material` NULL or a valid string); `out` is NULL
+// or valid for a write.
+luxon_status luxon_scene_add_spheres(struct luxon_scene scene,
+                                     const struct luxon_spheres *spheres,
+                                     struct luxon_object *out);
+
+// Gives the spheres `object` (from `luxon_scene_add_spheres`) new arrays: its BVH is built
+// again at the next commit; arrays it no longer uses are let go.
+//
+// # Safety
+// As `luxon_scene_add_spheres`.
+luxon_status luxon_scene_set_spheres(struct luxon_scene scene,
+                                     struct luxon_object object,
+                                     const struct luxon_spheres *spheres);
+
+// Adds cylinders read from arrays (ownership: `luxon_array_create_shared`). Checked as
+// `luxon_scene_add_spheres` (a base at its apex is refused at commit).
+//
+// # Safety
+// `cylinders` is a valid `luxon_cylinders` (its `material` NULL or a valid string); `out` is
+// NULL or valid for a write.
+luxon_status luxon_scene_add_cylinders(struct luxon_scene scene,
+                                       const struct luxon_cylinders *cylinders,
+                                       struct luxon_object *out);
+
+// Gives the cylinders `object` new arrays (as `luxon_scene_set_spheres`).
+//
+// # Safety
+// As `luxon_scene_add_cylinders`.
+luxon_status luxon_scene_set_cylinders(struct luxon_scene scene,
+                                       struct luxon_object object,
+                                       const struct luxon_cylinders *cylinders);
+
+// Adds a triangle mesh read from arrays (ownership: `luxon_array_create_shared`). Element
+// types are checked now; at every commit that reads them, an index past the vertices or a
+// non-finite coordinate is refused, naming the object, the triangle and the vertex. Moved
+// vertices (marked modified) are refitted; changed indices build the object's BVH again.
+//
+// # Safety
+// `mesh` is a valid `luxon_mesh` (its `material` NULL or a valid string); `out` is NULL or
+// valid for a write.
+luxon_status luxon_scene_add_mesh(struct luxon_scene scene,
+                                  const struct luxon_mesh *mesh,
+                                  struct luxon_object *out);
+
+// Gives the mesh `object` new arrays (as `luxon_scene_set_spheres`).
+//
+// # Safety
+// As `luxon_scene_add_mesh`.
+luxon_status luxon_scene_set_mesh(struct luxon_scene scene,
+                                  struct luxon_object object,
+                                  const struct luxon_mesh *mesh);
+
+// Adds a volume from an array of scalars, drawn as `render_ron` says. The layout is checked
+// now (every voxel's element inside the array); the values are copied into Luxon's bricks at
+// the next commit (a NaN or infinite voxel is refused then, naming it) and again at each
+// commit after the array was marked modified (`luxon_commit_report.volumes_read`). The array
+// is read only during those commits: it may be written between them.
+//
+// # Safety
+// `volume` is a valid `luxon_volume` (its strings NULL or valid); `out` is NULL or valid for
+// a write.
+luxon_status luxon_scene_add_volume(struct luxon_scene scene,
+                                    const struct luxon_volume *volume,
+                                    struct luxon_object *out);
+
+// Gives the volume `object` a new grid and look: read again at the next commit.
+//
+// # Safety
+// As `luxon_scene_add_volume`.
+luxon_status luxon_scene_set_volume(struct luxon_scene scene,
+                                    struct luxon_object object,
+                                    const struct luxon_volume *volume);
 
 // A renderer on `context`'s pool (`threads` 0) or on a pool of its own of `threads` threads.
 // Its threads sleep between renders.

@@ -37,6 +37,14 @@ pub struct luxon_object {
     pub id: u64,
 }
 
+/// An array of the caller's (read in place) or Luxon's copy of one, for the array objects and
+/// volumes of scenes (see `luxon_array_create_shared`). `{0}` is the null handle.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct luxon_array {
+    pub id: u64,
+}
+
 /// The kinds of handle, in the top 4 bits of an id (0 is never used, so no valid id is 0).
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Kind {
@@ -44,7 +52,7 @@ pub(crate) enum Kind {
     Scene = 2,
     Renderer = 3,
     Object = 4,
-    // 5: luxon_array (shared and copied arrays, next).
+    Array = 5,
 }
 
 impl Kind {

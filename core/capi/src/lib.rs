@@ -16,22 +16,26 @@ compile_error!(
     "luxon-capi needs panic = \"unwind\": a panic must become LUXON_ERROR_PANIC, never end the host"
 );
 
+mod arrays;
 mod context;
 mod guard;
 mod handles;
 mod image;
 mod mpi;
+mod objects;
 mod renderer;
 mod scene;
 mod status;
 mod text;
 mod version;
 
+pub use arrays::*;
 pub use context::*;
 pub use guard::{luxon_last_error, luxon_last_error_copy};
-pub use handles::{luxon_context, luxon_object, luxon_renderer, luxon_scene};
+pub use handles::{luxon_array, luxon_context, luxon_object, luxon_renderer, luxon_scene};
 pub use image::*;
 pub use mpi::*;
+pub use objects::*;
 pub use renderer::*;
 pub use scene::*;
 pub use status::*;

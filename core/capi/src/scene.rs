@@ -45,7 +45,7 @@ pub(crate) struct Part {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum PartId {
+pub(crate) enum PartId {
     Light(LightId),
     Object(ObjectId),
 }
@@ -105,7 +105,7 @@ impl SceneEntry {
 }
 
 /// Runs `f` on the scene `scene` names, locked (see [`SceneEntry::lock`]).
-fn with_scene<T>(
+pub(crate) fn with_scene<T>(
     scene: luxon_scene,
     f: impl FnOnce(&mut SceneState, &SceneEntry) -> Result<T, Failure>,
 ) -> Result<T, Failure> {
@@ -383,7 +383,11 @@ pub unsafe extern "C" fn luxon_scene_set_ambient_occlusion_ron(
 }
 
 /// The handle of a part, made on first use (the same part gets the same handle).
-fn part_handle(s: &mut SceneState, scene: u64, id: PartId) -> Result<luxon_object, Failure> {
+pub(crate) fn part_handle(
+    s: &mut SceneState,
+    scene: u64,
+    id: PartId,
+) -> Result<luxon_object, Failure> {
     if let Some((h, _)) = s.parts.iter().find(|(_, p)| *p == id) {
         return Ok(luxon_object { id: *h });
     }
@@ -393,7 +397,7 @@ fn part_handle(s: &mut SceneState, scene: u64, id: PartId) -> Result<luxon_objec
 }
 
 /// The part `object` names, which must be `scene`'s.
-fn part_of(object: luxon_object, scene: u64) -> Result<PartId, Failure> {
+pub(crate) fn part_of(object: luxon_object, scene: u64) -> Result<PartId, Failure> {
     let part = PARTS.get(object.id)?;
     if part.value.scene != scene {
         return Err(Failure::new(
@@ -789,7 +793,7 @@ unsafe fn put_list(
 ///
 /// # Safety
 /// `out` is NULL or valid for a write of a `T`.
-unsafe fn put_optional<T>(out: *mut T, value: T) -> Result<(), Failure> {
+pub(crate) unsafe fn put_optional<T>(out: *mut T, value: T) -> Result<(), Failure> {
     if !out.is_null() {
         // SAFETY: not NULL, so writable (this function's contract).
         unsafe { out.write(value) };
@@ -803,7 +807,8 @@ unsafe fn put_optional<T>(out: *mut T, value: T) -> Result<(), Failure> {
 pub struct luxon_commit_report {
     /// `sizeof(luxon_commit_report)`.
     pub size: u32,
-    /// 1 when the commit built the scene's geometry (BVHs), 0 when it only took new settings,
+    /// Geometry builds: 1 when the commit built the scene (its BVHs), plus one per array object
+    /// whose BVH it built; 0 when it only took new settings,
     /// camera, background, lights, materials, fog or ambient occlusion.
     pub rebuilt: u32,
     /// 1 when it took new lights, materials, fog or ambient occlusion without a build.
@@ -812,6 +817,13 @@ pub struct luxon_commit_report {
     pub bvh_seconds: f64,
     /// Seconds the whole commit took.
     pub commit_seconds: f64,
+    /// Array objects whose BVHs were refitted (their arrays marked modified, counts unchanged).
+    pub refitted: u32,
+    /// Array objects refitted whose trees had become too costly, so built again (also in
+    /// `rebuilt`, which counts every array object built besides the scene's 1).
+    pub degraded: u32,
+    /// Volumes read from their arrays (new, set again, or marked modified).
+    pub volumes_read: u32,
 }
 
 impl Versioned for luxon_commit_report {}
@@ -839,6 +851,9 @@ pub unsafe extern "C" fn luxon_scene_commit(
             shading: u32::from(done.shading),
             bvh_seconds: done.bvh_time.as_secs_f64(),
             commit_seconds: done.commit_time.as_secs_f64(),
+            refitted: done.refitted,
+            degraded: done.degraded,
+            volumes_read: done.volumes_read,
         };
         // SAFETY: NULL or writable as far as its size says (caller).
         unsafe { put_sized(report, &out) };

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 /// The version of this header's API: `luxon_api_version()` returns the version the library
 /// was built with, so a program can check it loaded the library it was compiled for. Raised
 /// whenever a function or struct changes or is added.
-pub const LUXON_API_VERSION: u32 = 1;
+pub const LUXON_API_VERSION: u32 = 2;
 
 /// `LUXON_API_VERSION` of the header the library was built with.
 #[unsafe(no_mangle)]

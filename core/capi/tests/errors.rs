@@ -311,7 +311,7 @@ fn the_last_error_is_per_thread_and_cleared_by_a_success() {
             INVALID_HANDLE,
             "the luxon_scene is null",
         );
-        assert_eq!((api.luxon_api_version)(), 1);
+        assert_eq!((api.luxon_api_version)(), 2);
         assert_eq!(last_error(), "");
         (api.luxon_scene_release)(Handle::default());
         expect((api.luxon_context_release)(ctx), OK, "");
@@ -365,7 +365,7 @@ fn versions_are_the_crates() {
     let mut v = [u32::MAX; 3];
     // SAFETY: the version string is static and NUL-terminated; the pointers are writable.
     unsafe {
-        assert_eq!((api.luxon_api_version)(), 1);
+        assert_eq!((api.luxon_api_version)(), 2);
         let text = std::ffi::CStr::from_ptr((api.luxon_version_string)());
         assert_eq!(text.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
         (api.luxon_version)(&mut v[0], &mut v[1], &mut v[2]);

@@ -133,7 +133,7 @@
 //! a commit refits the object's BVH; when the count changed, or the refitted tree became
 //! more than [`crate::bvh::REBUILD_RATIO`] times as costly as a fresh one, it builds it again
 //! ([`CommitReport`] counts both). Array objects are tested after the scene's other geometry;
-//! [`Scene::to_ron`] does not write them.
+//! [`Scene::to_ron`] refuses a scene that has them.
 //!
 //! Volumes come from arrays too ([`VolumeGrid`]: f32, f64, u8 or u16 values in any strided
 //! layout, placed by origin and spacing as the `raw` reader places its voxels), drawn as a

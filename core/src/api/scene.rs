@@ -997,8 +997,22 @@ impl Scene {
 
     /// The description as a RON scene (what `luxon convert` writes), for a bug report or to
     /// render it with the command line: paths relative to the scene file's directory when it
-    /// has one. A frozen scene's imported geometry is not in it once consumed.
+    /// has one. A frozen scene's imported geometry is not in it once consumed. A scene with
+    /// array objects or volumes from arrays is refused (their data live in the caller's
+    /// arrays, which a scene file cannot refer to): remove them first.
     pub fn to_ron(&self) -> Result<String, Error> {
+        let ids = self.objects.ids();
+        let from_arrays = self.parts.iter().zip(&ids).find_map(|(p, id)| match p {
+            Part::Plugin => None,
+            Part::Array(a) => Some(a.label.clone()),
+            Part::Volume(_) => Some(format!("{id} (volume)")),
+        });
+        if let Some(label) = from_arrays {
+            return Err(Error::Api(format!(
+                "{label} is read from arrays and cannot be written as RON (a scene file refers \
+                 to no caller's memory); remove the objects made from arrays to write the rest"
+            )));
+        }
         let base = self.desc.source.parent().unwrap_or(Path::new("."));
         luxon_formats::print::scene(&self.desc, base).map_err(Error::Api)
     }
