@@ -20,10 +20,10 @@
 //! | input       | `input`, `print`                                 |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
-//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation`, `instances` |
+//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation`, `instances`, `series` |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
 //! | includes    | `includes`                                       |
-//! | formats     | `ron_scene`, `spd`                               |
+//! | formats     | `ron_scene`, `spd`, `data_frames`                |
 //! | front door  | `load`, `fragment`                               |
 
 #![forbid(unsafe_code)]
@@ -31,6 +31,7 @@
 mod animation;
 mod camera;
 mod convert;
+pub mod data_frames;
 pub mod desc;
 mod effects;
 mod error;
@@ -50,6 +51,7 @@ mod ron_error;
 mod ron_scene;
 mod ron_text;
 mod scanner;
+mod series;
 mod spans;
 pub mod spd;
 pub mod tachyon;
@@ -62,6 +64,7 @@ pub use geometry::{InlineGeometry, InlineMesh};
 pub use includes::MAX_DEPTH as MAX_INCLUDE_DEPTH;
 pub use input::{DiskSource, LoadOptions, MemorySource, Source};
 pub use load::{load, load_with};
+pub use data_frames::{load_frame, missing_files, SeriesFrame};
 pub use pattern::FramePattern;
 pub use ron_scene::{load_ron_str, load_ron_with};
 pub use ron_text::{inline_as_objects, to_ron};
