@@ -260,3 +260,26 @@ fn a_missing_data_file_fails_its_frame_only() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn the_shipped_trajectory_renders_its_four_data_frames() {
+    let path = common::root().join("scenes/trajectory/water.ron");
+    let mut scene = build(&path);
+    let mut frames = Vec::new();
+    for k in 0..4 {
+        scene.set_frame(k).unwrap();
+        frames.push(render(&scene));
+    }
+    for (k, fb) in frames.iter().enumerate() {
+        // The oxygen (red) sits at the origin, seen near the middle of the picture.
+        let (w, h) = (fb.width, fb.height);
+        let i = 4 * ((h / 2 + 5) * w + w / 2) as usize;
+        let c = &fb.rgba[i..i + 3];
+        assert!(c[0] > 0.3 && c[1] < 0.2 && c[2] < 0.2, "frame {k}: {c:?}");
+        let white = fb.rgba.chunks(4).filter(|p| p[0] > 0.5 && p[1] > 0.5).count();
+        assert!(white > 100, "frame {k}: hydrogen pixels {white}");
+    }
+    for k in 1..4 {
+        assert_ne!(frames[k].rgba, frames[k - 1].rgba, "frames {k} and {}", k - 1);
+    }
+}
