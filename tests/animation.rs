@@ -530,13 +530,16 @@ fn a_preview_animates_the_frames_as_apng_and_gif() {
         out.join("f%d.png").to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("(a preview of 4 frames)"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("(a preview of 4 frames)"),
+        "{}",
+        stderr(&o)
+    );
     // An animated PNG of 4 frames of the frames' size (64 wide: under 320, kept).
-    let mut reader = png::Decoder::new(std::io::BufReader::new(
-        std::fs::File::open(&apng).unwrap(),
-    ))
-    .read_info()
-    .unwrap();
+    let mut reader =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&apng).unwrap()))
+            .read_info()
+            .unwrap();
     let control = reader.info().animation_control().expect("an animated PNG");
     assert_eq!(control.num_frames, 4);
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
@@ -548,7 +551,9 @@ fn a_preview_animates_the_frames_as_apng_and_gif() {
     }
     // Each frame of the preview is the frame written (RGBA of the PNG).
     for (k, d) in decoded.iter().enumerate() {
-        let frame = image::open(out.join(format!("f{k}.png"))).unwrap().to_rgba8();
+        let frame = image::open(out.join(format!("f{k}.png")))
+            .unwrap()
+            .to_rgba8();
         assert_eq!(d, frame.as_raw(), "preview frame {k}");
     }
     // A GIF of the same frames (the frames are done: only the preview is written).

@@ -138,7 +138,11 @@ fn per_frame_two_shows_every_other_data_frame() {
 fn a_frame_alone_is_the_same_bits_as_after_the_others() {
     let dir = temp_dir("series-bitwise");
     for (d, x) in [-1.2, 0.1, 1.3].iter().enumerate() {
-        write(&dir, &format!("traj/w_{d:03}.xyz"), &xyz(*x, 0.3 - 0.1 * d as f64));
+        write(
+            &dir,
+            &format!("traj/w_{d:03}.xyz"),
+            &xyz(*x, 0.3 - 0.1 * d as f64),
+        );
     }
     let path = scene_file(&dir, ATOMS);
     let text = std::fs::read_to_string(&path)
@@ -177,9 +181,7 @@ fn an_obj_series_shows_one_mesh_per_frame() {
         write(
             &dir,
             &format!("mesh/m{d}.obj"),
-            &format!(
-                "v {a} -0.25 0\nv {b} -0.25 0\nv {b} 0.25 0\nv {a} 0.25 0\nf 1 2 3 4\n"
-            ),
+            &format!("v {a} -0.25 0\nv {b} -0.25 0\nv {b} 0.25 0\nv {a} 0.25 0\nf 1 2 3 4\n"),
         );
     }
     let series = r#"(name: "sheet", files: "mesh/m#.obj", material: "blue")"#;
@@ -242,7 +244,13 @@ fn a_missing_data_file_fails_its_frame_only() {
     assert_eq!(px(-1.2, 0.4), [0, 0, 0]);
     // A missing first frame fails that frame, not the build.
     std::fs::rename(dir.join("traj/w_000.xyz"), dir.join("traj/w_001.xyz")).unwrap();
-    let o = run(&["render", s, "--force", "-o", out.join("g%d.png").to_str().unwrap()]);
+    let o = run(&[
+        "render",
+        s,
+        "--force",
+        "-o",
+        out.join("g%d.png").to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("1 of 3 frames failed (0)"),
@@ -276,10 +284,19 @@ fn the_shipped_trajectory_renders_its_four_data_frames() {
         let i = 4 * ((h / 2 + 5) * w + w / 2) as usize;
         let c = &fb.rgba[i..i + 3];
         assert!(c[0] > 0.3 && c[1] < 0.2 && c[2] < 0.2, "frame {k}: {c:?}");
-        let white = fb.rgba.chunks(4).filter(|p| p[0] > 0.5 && p[1] > 0.5).count();
+        let white = fb
+            .rgba
+            .chunks(4)
+            .filter(|p| p[0] > 0.5 && p[1] > 0.5)
+            .count();
         assert!(white > 100, "frame {k}: hydrogen pixels {white}");
     }
     for k in 1..4 {
-        assert_ne!(frames[k].rgba, frames[k - 1].rgba, "frames {k} and {}", k - 1);
+        assert_ne!(
+            frames[k].rgba,
+            frames[k - 1].rgba,
+            "frames {k} and {}",
+            k - 1
+        );
     }
 }

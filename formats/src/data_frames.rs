@@ -58,7 +58,10 @@ pub fn load_frame(
             })?;
             let names: Vec<&str> = atoms.iter().map(|(n, _)| n.as_str()).collect();
             let spheres = read_xyz(&text, &file, &prefix, &names, |i| {
-                atoms.get(i).map(|(_, a)| a.radius).or(default.as_ref().map(|d| d.radius))
+                atoms
+                    .get(i)
+                    .map(|(_, a)| a.radius)
+                    .or(default.as_ref().map(|d| d.radius))
             })?;
             Ok(SeriesFrame {
                 spheres,
@@ -229,7 +232,10 @@ fn read_xyz(
             }
         }
         let (col, element) = w[0];
-        let style = names.iter().position(|e| *e == element).unwrap_or(names.len());
+        let style = names
+            .iter()
+            .position(|e| *e == element)
+            .unwrap_or(names.len());
         let Some(r) = radius(style) else {
             let known = if names.is_empty() {
                 String::new()
@@ -299,17 +305,29 @@ mod tests {
     #[test]
     fn errors_point_at_the_word() {
         let e = xyz("2\nc\nO 0 0 0\n").unwrap_err();
-        assert!(e.starts_with("t.xyz:4:1: p: the file ends after 1 of 2 atoms"), "{e}");
+        assert!(
+            e.starts_with("t.xyz:4:1: p: the file ends after 1 of 2 atoms"),
+            "{e}"
+        );
         let e = xyz("1\nc\nO 0 1.2.3 0\n").unwrap_err();
-        assert!(e.starts_with("t.xyz:3:5: p: `1.2.3` is not a number"), "{e}");
+        assert!(
+            e.starts_with("t.xyz:3:5: p: `1.2.3` is not a number"),
+            "{e}"
+        );
         let e = xyz("1\nc\n Na 0 0 0\n").unwrap_err();
-        assert!(e.starts_with("t.xyz:3:2: p: element `Na` has no entry"), "{e}");
+        assert!(
+            e.starts_with("t.xyz:3:2: p: element `Na` has no entry"),
+            "{e}"
+        );
         assert!(e.contains("expected one of `O`, `H`"), "{e}");
         let e = xyz("two\nc\n").unwrap_err();
         assert!(e.starts_with("t.xyz:1:1: p: line 1 is `two`"), "{e}");
         let e = xyz("1\nc\nO 0 0 0\nH 0 0 0\n").unwrap_err();
         assert!(e.starts_with("t.xyz:4:1: p: more atom lines"), "{e}");
         let e = xyz("1\nc\nO 0 0 0 -1\n").unwrap_err();
-        assert!(e.starts_with("t.xyz:3:9: p: the radius `-1` is not positive"), "{e}");
+        assert!(
+            e.starts_with("t.xyz:3:9: p: the radius `-1` is not positive"),
+            "{e}"
+        );
     }
 }

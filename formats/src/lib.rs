@@ -58,13 +58,13 @@ pub mod tachyon;
 mod validate;
 mod volume_render;
 
+pub use data_frames::{load_frame, missing_files, SeriesFrame};
 pub use desc::*;
 pub use error::{shown, suggest, SceneError, Warning};
 pub use geometry::{InlineGeometry, InlineMesh};
 pub use includes::MAX_DEPTH as MAX_INCLUDE_DEPTH;
 pub use input::{DiskSource, LoadOptions, MemorySource, Source};
 pub use load::{load, load_with};
-pub use data_frames::{load_frame, missing_files, SeriesFrame};
 pub use pattern::FramePattern;
 pub use ron_scene::{load_ron_str, load_ron_with};
 pub use ron_text::{inline_as_objects, to_ron};

@@ -434,7 +434,11 @@ fn write_series(w: &mut Vec<u8>, series: &[Spanned<SeriesDesc>], base: &Path) {
         return;
     }
     let style = |a: &AtomStyle| match &a.material {
-        Some(m) => format!("(radius: {}, material: {})", num(a.radius), string(&m.value)),
+        Some(m) => format!(
+            "(radius: {}, material: {})",
+            num(a.radius),
+            string(&m.value)
+        ),
         None => format!("(radius: {})", num(a.radius)),
     };
     w.extend_from_slice(b"    series: [\n");

@@ -114,7 +114,12 @@ impl Checker<'_> {
                 ))
             }
         };
-        let dir = self.src.file.parent().unwrap_or(Path::new("")).to_path_buf();
+        let dir = self
+            .src
+            .file
+            .parent()
+            .unwrap_or(Path::new(""))
+            .to_path_buf();
         Ok(self.spanned(
             SeriesDesc {
                 name: self.spanned(s.name, field("name")),

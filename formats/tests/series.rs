@@ -78,7 +78,10 @@ fn entries_are_read_with_their_patterns_and_styles() {
     for (a, b) in again.series.iter().zip(&s.series) {
         assert_eq!(a.value.pattern, b.value.pattern);
         assert_eq!(a.value.kind.clone(), strip(&b.value.kind, &a.value.kind));
-        assert_eq!((a.value.first, a.value.per_frame), (b.value.first, b.value.per_frame));
+        assert_eq!(
+            (a.value.first, a.value.per_frame),
+            (b.value.first, b.value.per_frame)
+        );
     }
 }
 
@@ -104,7 +107,13 @@ fn strip(b: &SeriesKind, a: &SeriesKind) -> SeriesKind {
                 .zip(la)
                 .map(|((n, s), (_, l))| {
                     let material = at(&s.material, &l.material);
-                    (n.clone(), AtomStyle { material, ..s.clone() })
+                    (
+                        n.clone(),
+                        AtomStyle {
+                            material,
+                            ..s.clone()
+                        },
+                    )
                 })
                 .collect(),
             default: default.as_ref().zip(ld.as_ref()).map(|(d, l)| AtomStyle {
@@ -133,12 +142,7 @@ fn pattern_errors_point_at_the_files_string() {
             "expected %d, %04d or ####",
         ],
     );
-    check(
-        &s("t%04d_%d.xyz"),
-        5,
-        "\"t%04d",
-        &["has two frame numbers"],
-    );
+    check(&s("t%04d_%d.xyz"), 5, "\"t%04d", &["has two frame numbers"]);
     check(
         &s("t%5d.xyz"),
         5,
@@ -216,7 +220,11 @@ fn entry_errors_point_at_their_value() {
         r#"    series: [(name: "w", files: "t%d.xyz", default_atom: (radius: 1))],"#,
     )
     .expect_err("no animation");
-    assert!(e.to_string().starts_with("a.ron:3:14: `series:` needs an `animation:` block"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("a.ron:3:14: `series:` needs an `animation:` block"),
+        "{e}"
+    );
 }
 
 /// Data files of one series in `dir`: the scene and its `series` loaded.
