@@ -26,8 +26,9 @@ enum Command {
     /// Render a scene to its outputs (or to the files given with -o).
     Render {
         scene: PathBuf,
+        // Boxed: the render options are most of the command's size.
         #[command(flatten)]
-        overrides: cli::render::Overrides,
+        overrides: Box<cli::render::Overrides>,
     },
     /// Render a scene at a range of settings and report time, rays and error against a
     /// reference (Markdown table, CSV, SVG plot, contact sheet and images in DIR).

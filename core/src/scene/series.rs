@@ -13,8 +13,16 @@ use crate::error::Error;
 use crate::geometry::pack;
 use crate::geometry::triangle::MeshInput;
 use crate::math::DVec3;
-use luxon_formats::{load_frame, LoadOptions, SceneDesc, SeriesDesc, SeriesFrame, SeriesKind};
+use luxon_formats::{
+    load_frame, LoadOptions, SceneDesc, SeriesDesc, SeriesFrame, SeriesKind, Spanned,
+};
 use std::sync::{Arc, Mutex};
+
+/// Parsed data frames by (series, data frame), most recent last.
+type Cache = Vec<((usize, u32), Arc<SeriesFrame>)>;
+
+/// A material name (`None`: the default) to its index in the scene's materials.
+type MaterialOf<'a> = dyn FnMut(&Option<Spanned<String>>) -> Result<usize, Error> + 'a;
 
 /// How many parsed data frames the cache keeps.
 const CACHE_FRAMES: usize = 8;
@@ -33,14 +41,14 @@ pub(super) struct SeriesSet {
     /// The animation's first and last frame.
     range: (u32, u32),
     /// (series, data frame) to its parsed file, most recent last.
-    cache: Mutex<Vec<((usize, u32), Arc<SeriesFrame>)>>,
+    cache: Mutex<Cache>,
 }
 
 impl SeriesSet {
     /// The series of `desc`; `material(name)` gives a material's index, and marks it used.
     pub(super) fn new(
         desc: &SceneDesc,
-        material: &mut dyn FnMut(&Option<luxon_formats::Spanned<String>>) -> Result<usize, Error>,
+        material: &mut MaterialOf,
     ) -> Result<SeriesSet, Error> {
         let range = desc
             .animation
