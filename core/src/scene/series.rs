@@ -46,10 +46,7 @@ pub(super) struct SeriesSet {
 
 impl SeriesSet {
     /// The series of `desc`; `material(name)` gives a material's index, and marks it used.
-    pub(super) fn new(
-        desc: &SceneDesc,
-        material: &mut MaterialOf,
-    ) -> Result<SeriesSet, Error> {
+    pub(super) fn new(desc: &SceneDesc, material: &mut MaterialOf) -> Result<SeriesSet, Error> {
         let range = desc
             .animation
             .as_ref()
