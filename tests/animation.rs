@@ -523,3 +523,89 @@ fn a_keyed_colour_tints_the_shadows_of_its_material() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn a_preview_animates_the_frames_as_apng_and_gif() {
+    let dir = temp_dir("anim-preview");
+    let scene = write_scene(&dir, SCENE);
+    let s = scene.to_str().unwrap();
+    let out = dir.join("out");
+    let apng = dir.join("p.png");
+    let o = run(&[
+        "render",
+        s,
+        "--frames",
+        "0..3",
+        "--preview",
+        apng.to_str().unwrap(),
+        "-o",
+        out.join("f%d.png").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("(a preview of 4 frames)"),
+        "{}",
+        stderr(&o)
+    );
+    // An animated PNG of 4 frames of the frames' size (64 wide: under 320, kept).
+    let mut reader =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&apng).unwrap()))
+            .read_info()
+            .unwrap();
+    let control = reader.info().animation_control().expect("an animated PNG");
+    assert_eq!(control.num_frames, 4);
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let mut decoded = Vec::new();
+    for _ in 0..4 {
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (64, 32));
+        decoded.push(buf[..info.buffer_size()].to_vec());
+    }
+    // Each frame of the preview is the frame written (RGBA of the PNG).
+    for (k, d) in decoded.iter().enumerate() {
+        let frame = image::open(out.join(format!("f{k}.png")))
+            .unwrap()
+            .to_rgba8();
+        assert_eq!(d, frame.as_raw(), "preview frame {k}");
+    }
+    // A GIF of the same frames (the frames are done: only the preview is written).
+    let gif = dir.join("p.gif");
+    let o = run(&[
+        "render",
+        s,
+        "--frames",
+        "0..3",
+        "--preview",
+        gif.to_str().unwrap(),
+        "-o",
+        out.join("f%d.png").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    use image::AnimationDecoder;
+    let file = std::io::BufReader::new(std::fs::File::open(&gif).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len(), 4);
+    assert_eq!(frames[0].buffer().dimensions(), (64, 32));
+    assert_ne!(frames[0].buffer(), frames[3].buffer());
+    // Outputs it cannot read back are refused before rendering.
+    let o = run(&[
+        "render",
+        s,
+        "--preview",
+        gif.to_str().unwrap(),
+        "-o",
+        out.join("g%d.exr").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("needs a frame output it can read back"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.join("g0.exr").exists());
+    let _ = std::fs::remove_dir_all(dir);
+}

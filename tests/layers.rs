@@ -53,11 +53,12 @@ const FORMATS: &[(&str, &[&str])] = &[
             "volume_render",
             "animation",
             "instances",
+            "series",
         ],
     ),
     ("importers", &["nff", "obj", "tachyon"]),
     ("includes", &["includes"]),
-    ("formats", &["ron_scene", "spd"]),
+    ("formats", &["ron_scene", "spd", "data_frames"]),
     ("front door", &["load", "fragment"]),
 ];
 

@@ -26,6 +26,7 @@ enum Command {
     /// Render a scene to its outputs (or to the files given with -o).
     Render {
         scene: PathBuf,
+        // Boxed: the render options are most of the command's size.
         #[command(flatten)]
         overrides: Box<cli::render::Overrides>,
     },

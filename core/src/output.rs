@@ -13,6 +13,7 @@ pub mod commit;
 pub mod frames;
 pub mod inputs;
 pub mod manifest;
+pub mod preview;
 pub mod stream;
 
 pub use commit::OutputSet;

@@ -34,6 +34,7 @@ pub(crate) struct Part {
     pub object_names: Vec<(usize, Spanned<String>)>,
     pub prototypes: Vec<(String, Spanned<PrototypeDesc>)>,
     pub instances: Vec<Spanned<InstanceDesc>>,
+    pub series: Vec<Spanned<SeriesDesc>>,
     /// The named instances (index within this part's list).
     pub instance_names: Vec<(usize, Spanned<String>)>,
     /// Where this part's `render` gives `frame` or `time` (which an animation decides).
@@ -143,6 +144,10 @@ impl Checker<'_> {
         for (i, instance) in scene.instances.into_iter().enumerate() {
             let node = field("instances").item(i).unwrap_or(root);
             part.instances.push(self.instance(instance, node)?);
+        }
+        for (i, s) in scene.series.into_iter().enumerate() {
+            let node = field("series").item(i).unwrap_or(root);
+            part.series.push(self.series(s, node)?);
         }
         for (i, volume) in scene.volumes.into_iter().enumerate() {
             let node = field("volumes").item(i).unwrap_or(root);

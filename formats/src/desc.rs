@@ -55,6 +55,9 @@ pub struct SceneDesc {
     /// Copies of prototypes, in file order (includes first); stored after `objects` and
     /// `inline`.
     pub instances: Vec<Spanned<InstanceDesc>>,
+    /// Time-sampled data (`series:`), in file order (includes first); only in animated
+    /// scenes.
+    pub series: Vec<Spanned<SeriesDesc>>,
 }
 
 /// What a ray that hits nothing shows (`background:`).
@@ -413,6 +416,58 @@ impl PrototypeDesc {
 pub struct MeshFile {
     pub file: Spanned<PathBuf>,
     pub material: Option<Spanned<String>>,
+}
+
+/// Time-sampled data: one file per data frame. Movie frame `k` shows data frame
+/// `first + (k - animation.first) * per_frame`, `k` clamped to the animation's range (so any
+/// subset of frames reads the same files).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SeriesDesc {
+    pub name: Spanned<String>,
+    /// The pattern as written (relative to `dir`), where it is written.
+    pub files: Spanned<String>,
+    pub pattern: crate::pattern::FramePattern,
+    /// The directory of the scene file that names the series.
+    pub dir: PathBuf,
+    /// The data frame shown at the animation's first frame.
+    pub first: u32,
+    /// Data frames per movie frame (>= 1).
+    pub per_frame: u32,
+    pub kind: SeriesKind,
+}
+
+/// What a series' files hold.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SeriesKind {
+    /// `.xyz` trajectories: spheres drawn by element (`atoms`), else `default`.
+    Atoms {
+        atoms: Vec<(String, AtomStyle)>,
+        default: Option<AtomStyle>,
+    },
+    /// One `.obj` mesh per data frame, in `material` (`None`: the default material).
+    Mesh { material: Option<Spanned<String>> },
+}
+
+/// An element's sphere: its radius (a fifth column of the file overrides it) and material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AtomStyle {
+    pub radius: f64,
+    pub material: Option<Spanned<String>>,
+}
+
+impl SeriesDesc {
+    /// The data frame movie frame `k` shows (`range`: the animation's first and last frame).
+    pub fn data_frame(&self, k: u32, range: (u32, u32)) -> u32 {
+        let k = k.clamp(range.0, range.1);
+        let d = u64::from(self.first) + u64::from(k - range.0) * u64::from(self.per_frame);
+        // The loader checked that the range's last data frame fits.
+        u32::try_from(d).unwrap_or(u32::MAX)
+    }
+
+    /// The file of data frame `d`.
+    pub fn path(&self, d: u32) -> PathBuf {
+        self.dir.join(self.pattern.name(d))
+    }
 }
 
 /// A copy of a prototype in the world.

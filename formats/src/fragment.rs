@@ -308,6 +308,7 @@ fn only(kind: &Kind, part: Part, at: Origin) -> Result<(), SceneError> {
         animation,
         prototypes,
         instances,
+        series,
         light_names: _,
         object_names: _,
         instance_names: _,
@@ -331,6 +332,7 @@ fn only(kind: &Kind, part: Part, at: Origin) -> Result<(), SceneError> {
         ("animation", animation.is_some()),
         ("prototypes", !prototypes.is_empty()),
         ("instances", !instances.is_empty()),
+        ("series", !series.is_empty()),
     ];
     match extra.iter().find(|(_, set)| *set) {
         Some((field, _)) => Err(SceneError::at(

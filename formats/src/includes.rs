@@ -270,6 +270,7 @@ impl Accumulator {
         part.instance_names
             .extend(shift(later.instance_names, instances));
         part.instances.extend(later.instances);
+        part.series.extend(later.series);
         upsert(&mut part.prototypes, &mut self.prototypes, later.prototypes);
         part.lights.extend(later.lights);
         part.objects.extend(later.objects);

@@ -20,10 +20,10 @@
 //! | input       | `input`, `print`                                 |
 //! | scanner     | `scanner`                                        |
 //! | checks      | `validate`, `ron_error`                          |
-//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation`, `instances` |
+//! | conversion  | `convert`, `camera`, `effects`, `volume_render`, `animation`, `instances`, `series` |
 //! | importers   | `nff`, `obj`, `tachyon`                          |
 //! | includes    | `includes`                                       |
-//! | formats     | `ron_scene`, `spd`                               |
+//! | formats     | `ron_scene`, `spd`, `data_frames`                |
 //! | front door  | `load`, `fragment`                               |
 
 #![forbid(unsafe_code)]
@@ -31,6 +31,7 @@
 mod animation;
 mod camera;
 mod convert;
+pub mod data_frames;
 pub mod desc;
 mod effects;
 mod error;
@@ -50,12 +51,14 @@ mod ron_error;
 mod ron_scene;
 mod ron_text;
 mod scanner;
+mod series;
 mod spans;
 pub mod spd;
 pub mod tachyon;
 mod validate;
 mod volume_render;
 
+pub use data_frames::{load_frame, missing_files, SeriesFrame};
 pub use desc::*;
 pub use error::{shown, suggest, SceneError, Warning};
 pub use geometry::{InlineGeometry, InlineMesh};

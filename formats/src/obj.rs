@@ -747,6 +747,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<SceneDesc, SceneE
         animation: None,
         prototypes: Vec::new(),
         instances: Vec::new(),
+        series: Vec::new(),
         plugin_path: Vec::new(),
         warnings: import.warnings,
     })

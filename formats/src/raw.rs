@@ -46,6 +46,8 @@ pub(crate) struct Scene {
     pub prototypes: Named<Prototype>,
     #[serde(default)]
     pub instances: Vec<Instance>,
+    #[serde(default)]
+    pub series: Vec<Series>,
 }
 
 #[derive(Deserialize)]
@@ -402,6 +404,35 @@ pub(crate) struct Prototype {
     pub objects: Vec<Object>,
     #[serde(default)]
     pub meshes: Vec<Mesh>,
+}
+
+/// Time-sampled data: one file per data frame, named by a pattern (`traj_%04d.xyz`).
+#[derive(Deserialize)]
+#[serde(rename = "Series", deny_unknown_fields)]
+pub(crate) struct Series {
+    pub name: String,
+    pub files: String,
+    #[serde(default)]
+    pub first: Option<f64>,
+    #[serde(default)]
+    pub per_frame: Option<f64>,
+    /// `.xyz` files: element name to its sphere.
+    #[serde(default)]
+    pub atoms: Option<Named<AtomStyle>>,
+    #[serde(default)]
+    pub default_atom: Option<AtomStyle>,
+    /// `.obj` files: the material of every triangle.
+    #[serde(default)]
+    pub material: Option<String>,
+}
+
+/// How an element of an `.xyz` file is drawn.
+#[derive(Deserialize)]
+#[serde(rename = "AtomStyle", deny_unknown_fields)]
+pub(crate) struct AtomStyle {
+    pub radius: f64,
+    #[serde(default)]
+    pub material: Option<String>,
 }
 
 /// A copy of a prototype, placed by `world_from_object` (the identity when absent).

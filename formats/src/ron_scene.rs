@@ -11,6 +11,7 @@ use crate::includes::{resolve, upsert, Names};
 use crate::input::{file_error, DiskSource, LoadOptions, Source};
 use crate::instances::resolve_instances;
 use crate::obj::{is_obj_path, load_obj_with};
+use crate::series::resolve_series;
 use crate::spans::SourceMap;
 use crate::validate::references;
 
@@ -81,9 +82,11 @@ fn load_root(
         animation: part.animation,
         prototypes: part.prototypes,
         instances: part.instances,
+        series: part.series,
     };
     references(&scene)?;
     resolve_instances(&scene, &part.object_names, &part.instance_names)?;
+    resolve_series(&scene)?;
     resolve_animation(
         &mut scene,
         &part.light_names,

@@ -249,6 +249,7 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
         animation,
         prototypes,
         instances,
+        series,
     } = desc;
     let anim = animation.as_ref().map(|a| &a.value);
     // The names the animation uses, by index in `lights` / `objects`.
@@ -349,6 +350,7 @@ pub fn to_ron(desc: &SceneDesc, base: &Path) -> Result<String, String> {
         w.extend_from_slice(b"    ],\n");
     }
     write_instances(&mut w, prototypes, instances);
+    write_series(&mut w, series, base);
     if let Some(a) = anim {
         write_animation(&mut w, a);
     }
@@ -424,6 +426,54 @@ fn write_instances(
         }
         w.extend_from_slice(b"    ],\n");
     }
+}
+
+/// `series: [ ... ]` when not empty, patterns relative to `base`.
+fn write_series(w: &mut Vec<u8>, series: &[Spanned<SeriesDesc>], base: &Path) {
+    if series.is_empty() {
+        return;
+    }
+    let style = |a: &AtomStyle| match &a.material {
+        Some(m) => format!(
+            "(radius: {}, material: {})",
+            num(a.radius),
+            string(&m.value)
+        ),
+        None => format!("(radius: {})", num(a.radius)),
+    };
+    w.extend_from_slice(b"    series: [\n");
+    for s in series {
+        let s = &s.value;
+        let files = relative(&s.dir.join(&s.files.value), base);
+        let _ = write!(
+            w,
+            "        (name: {}, files: {}, first: {}, per_frame: {}",
+            string(&s.name.value),
+            string(&files),
+            s.first,
+            s.per_frame
+        );
+        match &s.kind {
+            SeriesKind::Atoms { atoms, default } => {
+                if !atoms.is_empty() {
+                    let list: Vec<String> = atoms
+                        .iter()
+                        .map(|(n, a)| format!("{}: {}", string(n), style(a)))
+                        .collect();
+                    let _ = write!(w, ", atoms: {{{}}}", list.join(", "));
+                }
+                if let Some(d) = default {
+                    let _ = write!(w, ", default_atom: {}", style(d));
+                }
+            }
+            SeriesKind::Mesh { material: Some(m) } => {
+                let _ = write!(w, ", material: {}", string(&m.value));
+            }
+            SeriesKind::Mesh { material: None } => {}
+        }
+        w.extend_from_slice(b"),\n");
+    }
+    w.extend_from_slice(b"    ],\n");
 }
 
 /// `(translate: ..., rotate: ..., scale: ...)` (the fields that are not the identity's) or

@@ -262,6 +262,7 @@ impl Scene {
             objects: Vec::new(),
             prototypes: Default::default(),
             instances: Vec::new(),
+            series: Vec::new(),
             inline: Vec::new(),
             volumes: Vec::new(),
             render: RenderDesc::default(),

@@ -42,7 +42,41 @@ pub fn run(
     let built = super::render::built(&scene)?;
     let outputs = luxon::output::resolve(&built.outputs, registry)?;
     describe(scene.desc(), built, &outputs);
-    Ok(())
+    missing_data(scene.desc())
+}
+
+/// Each series' data files over the scene's range: a line each, and an error naming the
+/// first missing file (the frames showing it would fail).
+fn missing_data(desc: &SceneDesc) -> Result<(), Error> {
+    let Some(a) = &desc.animation else {
+        return Ok(());
+    };
+    let range = (a.value.first, a.value.last);
+    let mut problems = Vec::new();
+    for s in &desc.series {
+        let s = &s.value;
+        let (total, missing) = luxon_formats::missing_files(s, range);
+        let kind = match s.kind {
+            luxon_formats::SeriesKind::Atoms { .. } => "atoms",
+            luxon_formats::SeriesKind::Mesh { .. } => "meshes",
+        };
+        println!(
+            "series     `{}`: {total} data file(s) `{}` ({kind}), first {}, {} per frame",
+            s.name.value, s.files.value, s.first, s.per_frame
+        );
+        if let Some((k, file)) = missing.first() {
+            problems.push(format!(
+                "series `{}`: {} of {total} data files are missing (first: {}, frame {k})",
+                s.name.value,
+                missing.len(),
+                file.display()
+            ));
+        }
+    }
+    match problems.is_empty() {
+        true => Ok(()),
+        false => Err(Error::Render(problems.join("; "))),
+    }
 }
 
 fn describe(desc: &SceneDesc, scene: &Scene, outputs: &[luxon::output::Output]) {

@@ -90,6 +90,10 @@ pub struct Overrides {
     /// scene; by default a sequence renders only the frames missing or stale).
     #[arg(long)]
     pub force: bool,
+    /// Also write an animation of the frames (at most 320 pixels wide) to FILE: `.png` for
+    /// an animated PNG, `.gif` for a GIF (an animated scene).
+    #[arg(long, value_name = "FILE")]
+    pub preview: Option<PathBuf>,
 }
 
 fn parse_adaptive(s: &str) -> Result<AdaptiveArg, String> {
@@ -296,7 +300,7 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     }
     let load_time = t0.elapsed();
     let animated = desc.as_ref().is_ok_and(|d| d.animation.is_some());
-    if animated || o.frames.is_some() || o.step.is_some() || o.force {
+    if animated || o.frames.is_some() || o.step.is_some() || o.force || o.preview.is_some() {
         return super::sequence::run(o, desc, &read, &ctx, &renderer, job);
     }
     let ready =

@@ -22,6 +22,7 @@ use luxon::budget::Budget;
 use luxon::output::frames::FrameNames;
 use luxon::output::inputs::{absolute, SceneFile, SceneInputs};
 use luxon::output::manifest::Manifest;
+use luxon::output::preview::Preview;
 use luxon::plugin::Registry;
 use luxon::Error;
 use luxon_formats::SceneDesc;
@@ -60,6 +61,8 @@ fn frame_list(o: &Overrides, desc: &SceneDesc) -> Result<Vec<u32>, Error> {
             "--frames"
         } else if o.step.is_some() {
             "--step"
+        } else if o.preview.is_some() {
+            "--preview"
         } else {
             "--force"
         };
@@ -83,6 +86,7 @@ struct Ready {
     frames: Vec<u32>,
     names: FrameNames,
     resume: Option<Resume>,
+    preview: Option<Preview>,
 }
 
 /// Loads nothing (the caller did), builds the scene once (within the memory budget, which
@@ -101,6 +105,16 @@ fn prepare(
     let scene_last = desc.animation.as_ref().map_or(0, |a| a.value.last);
     let last = frames.last().copied().unwrap_or(0).max(scene_last);
     let names = FrameNames::new(&desc.render.outputs, last, frames.len() == 1)?;
+    let preview = match (&o.preview, &desc.animation) {
+        (Some(p), Some(a)) => {
+            let seconds = f64::from(o.step.unwrap_or(1)) / a.value.fps;
+            let preview = Preview::new(p, seconds)?;
+            // Checked before any work: the frames must be readable back.
+            preview.source(&output_paths(&names, frames.first().copied().unwrap_or(0)))?;
+            Some(preview)
+        }
+        _ => None,
+    };
     // Writers first: an output no writer takes fails before any work.
     luxon::output::resolve(&desc.render.outputs, registry)?;
     let budget = Budget::for_render(&desc.render, o.memory, job.node_ranks());
@@ -121,7 +135,35 @@ fn prepare(
         frames,
         names,
         resume,
+        preview,
     })
+}
+
+/// The files frame `k` is written to.
+fn output_paths(names: &FrameNames, k: u32) -> Vec<PathBuf> {
+    names.outputs_for(k).into_iter().map(|o| o.path).collect()
+}
+
+/// Writes the preview of the frames of `frames` whose files exist (done now or before).
+fn write_preview(preview: &Preview, names: &FrameNames, frames: &[u32]) -> Result<(), Error> {
+    let mut files = Vec::new();
+    for &k in frames {
+        let outputs = output_paths(names, k);
+        let file = preview.source(&outputs)?;
+        if file.is_file() {
+            files.push(file.to_path_buf());
+        }
+    }
+    if files.is_empty() {
+        return Ok(());
+    }
+    preview.write(&files)?;
+    eprintln!(
+        "luxon: wrote {} (a preview of {} frames)",
+        preview.path().display(),
+        files.len()
+    );
+    Ok(())
 }
 
 /// The hash of everything the frames are rendered from (see [`luxon::output::inputs`]), after
@@ -204,6 +246,7 @@ pub fn run(
         frames,
         names,
         mut resume,
+        preview,
     }) = ready
     else {
         return Err(Error::Render("not ready to render".into()));
@@ -285,8 +328,15 @@ pub fn run(
     if let Some(note) = resume.as_ref().and_then(Resume::others) {
         eprintln!("luxon: {note}");
     }
+    let previewed = match (&preview, job.rank()) {
+        (Some(p), 0) => write_preview(p, &names, &frames),
+        _ => Ok(()),
+    };
     if failed.is_empty() || job.rank() != 0 {
-        return Ok(());
+        return previewed;
+    }
+    if let Err(e) = previewed {
+        luxon::error::print_error(&e.to_string());
     }
     let list: Vec<String> = failed.iter().map(u32::to_string).collect();
     Err(Error::Render(format!(

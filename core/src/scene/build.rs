@@ -8,6 +8,7 @@
 use super::frame::{self, Animation, Keyed};
 use super::instances::{self, PrototypeUse};
 use super::place::Sets;
+use super::series::SeriesSet;
 use super::{AngleRule, Ao, Casters, Fade, Features, Fog, Light, Material, Scene, Settings, Sky};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
@@ -175,7 +176,13 @@ impl Scene {
 
         let lights = b.lights();
         let (fog, ao) = Build::effects(&desc.fog, &desc.ambient_occlusion);
-        let has_geometry = stored.has_geometry();
+        // Series data arrive frame by frame: their materials count as used from the start.
+        let series = SeriesSet::new(desc, &mut |name| {
+            let m = material_index(&material_names, name)?;
+            stored.used[m] = true;
+            Ok(m)
+        })?;
+        let has_geometry = stored.has_geometry() || !series.is_empty();
         let features = features(
             &desc.render,
             &materials,
@@ -267,7 +274,10 @@ impl Scene {
                 shared_keyed,
             )?;
             scene.animation = Some(Box::new(animation));
-            scene.set_frame(a.value.first)?;
+            if let Some(animation) = scene.animation.as_mut() {
+                animation.series = series;
+            }
+            scene.set_frame_with(a.value.first, true)?;
         }
         scene.casters = Casters::of(&scene);
         Ok(scene)

@@ -16,6 +16,7 @@
 
 use super::build::{shadow_filter, Build};
 use super::place::place;
+use super::series::SeriesSet;
 use super::{Light, Scene};
 use crate::budget::{Budget, Use};
 use crate::camera::Camera;
@@ -58,6 +59,10 @@ pub struct Animation {
     objects: Vec<Keyed>,
     /// Keyed shared instances (`Scene::instances` index) and their tracks.
     instances: Vec<(u32, ObjectTracks)>,
+    /// Time-sampled data, stored in the moving group with the keyed objects.
+    pub(super) series: SeriesSet,
+    /// The data frames the moving group holds (`None`: not known, build it anew).
+    shown: Option<Vec<u32>>,
     frame: u32,
     /// The shutter (open, close) in frames from the frame's time, when time is sampled (see
     /// [`shutter`]).
@@ -223,6 +228,8 @@ impl Animation {
             materials,
             objects,
             instances,
+            series: SeriesSet::default(),
+            shown: None,
             frame: a.value.first,
             shutter: shutter(desc),
         })
@@ -421,7 +428,8 @@ impl Animation {
             .collect()
     }
 
-    /// The keyed objects placed at time `t`, in render space, with their BVHs, charged to
+    /// The keyed objects placed at time `t` and the series' data of frame `k` (`data`, as
+    /// `SeriesSet::load` gives it; empty: none), in render space, with their BVHs, charged to
     /// `budget` (the group keeps the charges).
     fn group_at(
         &self,
@@ -429,6 +437,7 @@ impl Animation {
         k: u32,
         world_offset: DVec3,
         budget: &Arc<Budget>,
+        data: &[Arc<luxon_formats::SeriesFrame>],
     ) -> Result<Group, Error> {
         let mut group = Group::default();
         // The sets charge their arrays as they grow, for good; the group takes that charge
@@ -453,6 +462,12 @@ impl Animation {
                 )
             })
         });
+        // Zero-area triangles of the data are dropped, as in any mesh.
+        let placed = placed.and_then(|()| {
+            (self.series)
+                .store(data, k, group.sets(), world_offset, budget)
+                .map(|_| ())
+        });
         let grown = budget.used(Use::Geometry).saturating_sub(before);
         group.charges.push(budget.guard(Use::Geometry, grown));
         placed?;
@@ -470,6 +485,13 @@ impl Scene {
     /// values of its ends. On an error (a camera or object that degenerates at this frame) the
     /// scene is left as it was.
     pub fn set_frame(&mut self, k: u32) -> Result<(), Error> {
+        self.set_frame_with(k, false)
+    }
+
+    /// `set_frame`; `tolerant`: a series whose data cannot be read leaves the moving group
+    /// without series data instead of failing (the build's first frame: a missing data file
+    /// fails the frame that shows it, when a sequence sets it, not the whole build).
+    pub(super) fn set_frame_with(&mut self, k: u32, tolerant: bool) -> Result<(), Error> {
         let Some(anim) = &self.animation else {
             return Err(Error::Render(format!(
                 "frame {k}: {} has no `animation:`",
@@ -479,7 +501,26 @@ impl Scene {
         let t = f64::from(k);
         let camera = anim.camera_at(t, k)?;
         let lights = anim.lights_at(t, k, self.world_offset)?;
-        let moving = anim.group_at(t, k, self.world_offset, &self.budget)?;
+        // Series data that did not change since the group was built keeps the group (keyed
+        // objects move with every frame, so they rebuild it).
+        let wanted = anim.series.data_frames(k);
+        let keep = !anim.series.is_empty()
+            && anim.objects.is_empty()
+            && anim.shown.as_ref() == Some(&wanted);
+        let mut shown = Some(wanted);
+        let moving = if keep {
+            None
+        } else {
+            let data = match anim.series.load(k) {
+                Ok(data) => data,
+                Err(_) if tolerant => {
+                    shown = None;
+                    Vec::new()
+                }
+                Err(e) => return Err(e),
+            };
+            Some(anim.group_at(t, k, self.world_offset, &self.budget, &data)?)
+        };
         let placed = anim.instances_at(t, k)?;
         let shadows = anim.shadows;
         let camera_moves = anim.camera_moves_in(k);
@@ -495,7 +536,9 @@ impl Scene {
         self.set_camera(&camera);
         self.lights = lights;
         // The previous frame's group goes, and its charges with it.
-        self.moving = moving;
+        if let Some(moving) = moving {
+            self.moving = moving;
+        }
         if !placed.is_empty() {
             self.instances.place(&placed);
         }
@@ -516,6 +559,7 @@ impl Scene {
         self.settings.frame = k;
         if let Some(anim) = &mut self.animation {
             anim.frame = k;
+            anim.shown = shown;
         }
         Ok(())
     }

@@ -11,6 +11,7 @@ mod build;
 mod frame;
 mod instances;
 mod place;
+mod series;
 mod shadows;
 mod sky;
 pub(crate) mod update;

@@ -582,6 +582,7 @@ impl<'o> Assembler<'o> {
             animation: None,
             prototypes: Vec::new(),
             instances: Vec::new(),
+            series: Vec::new(),
             plugin_path: Vec::new(),
             warnings: self
                 .warnings

@@ -633,6 +633,7 @@ impl Mapper {
             animation: None,
             prototypes: Vec::new(),
             instances: Vec::new(),
+            series: Vec::new(),
             plugin_path: Vec::new(),
             warnings: warnings
                 .into_iter()
