@@ -176,6 +176,8 @@ impl Scene {
             &self.ao,
             &self.render_volumes,
         );
+        // Set by the build from the animation, which `features` does not see.
+        self.features.motion_blur = self.settings.shutter.is_some();
         self.casters = Casters::of(self);
     }
 }
