@@ -42,7 +42,7 @@ mod with_mpi {
     use super::common::*;
     use std::path::{Path, PathBuf};
     use std::process::{Command, Output, Stdio};
-    use std::time::{Duration, Instant};
+    use std::time::Duration;
 
     const DEADLINE: Duration = Duration::from_secs(60);
 
@@ -68,17 +68,11 @@ mod with_mpi {
             .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
-        let start = Instant::now();
-        let mut child = cmd.spawn().expect("cannot run mpirun (install OpenMPI)");
-        while child.try_wait().expect("mpirun").is_none() {
-            if start.elapsed() > DEADLINE + Duration::from_secs(15) {
-                let _ = child.kill();
-                panic!("mpirun -np {ranks} {args:?} hung");
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let out = child.wait_with_output().expect("mpirun output");
-        (out, start.elapsed())
+        run_with_deadline(
+            &mut cmd,
+            DEADLINE + Duration::from_secs(15),
+            &format!("mpirun -np {ranks} {args:?}"),
+        )
     }
 
     fn render_mpi(ranks: usize, dir: &Path, tag: &str, extra: &[&str]) -> (Vec<u8>, Vec<u8>) {

@@ -23,7 +23,7 @@ mod with_mpi {
     use mpi::traits::*;
     use std::path::{Path, PathBuf};
     use std::process::{Command, Output, Stdio};
-    use std::time::{Duration, Instant};
+    use std::time::Duration;
 
     const DEADLINE: Duration = Duration::from_secs(90);
     /// Set in the processes mpirun starts: play one rank.
@@ -179,16 +179,12 @@ mod with_mpi {
             .args(["--exact", name, "--nocapture", "--test-threads=1"])
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
-        let start = Instant::now();
-        let mut child = cmd.spawn().expect("cannot run mpirun (install OpenMPI)");
-        while child.try_wait().expect("mpirun").is_none() {
-            if start.elapsed() > DEADLINE + Duration::from_secs(15) {
-                let _ = child.kill();
-                panic!("mpirun -np 4 {name} hung");
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        child.wait_with_output().expect("mpirun output")
+        run_with_deadline(
+            &mut cmd,
+            DEADLINE + Duration::from_secs(15),
+            &format!("mpirun -np 4 {name}"),
+        )
+        .0
     }
 
     fn report(o: &Output) -> String {

@@ -192,3 +192,26 @@ pub fn read_volume_of(
         &budget,
     )
 }
+
+/// Runs `cmd` (an `mpirun`, whose own `--timeout` should fire first) and kills it if it is still
+/// running `limit` after the start: a hung job fails the test instead of hanging the suite.
+#[allow(dead_code)]
+pub fn run_with_deadline(
+    cmd: &mut std::process::Command,
+    limit: std::time::Duration,
+    what: &str,
+) -> (std::process::Output, std::time::Duration) {
+    let start = std::time::Instant::now();
+    let mut child = cmd.spawn().expect("cannot run mpirun (install OpenMPI)");
+    while child.try_wait().expect("mpirun").is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{what} hung");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    (
+        child.wait_with_output().expect("mpirun output"),
+        start.elapsed(),
+    )
+}

@@ -139,34 +139,10 @@ fn controls(keys: &[Key<[f64; 3]>], i: usize, how: Interpolate) -> Vec<DVec3> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::motion::keys::tests::{at, track};
     use crate::motion::Placement;
-    use luxon_formats::{Origin, RotationDesc, Spanned};
+    use luxon_formats::{RotationDesc, Spanned};
     use proptest::prelude::*;
-    use std::path::PathBuf;
-    use std::sync::Arc;
-
-    fn at() -> Origin {
-        Origin {
-            file: Arc::new(PathBuf::from("t.ron")),
-            line: 1,
-            col: 1,
-        }
-    }
-
-    fn track<T>(keys: Vec<(f64, T)>, interpolation: Interpolate) -> Track<T> {
-        Track {
-            keys: keys
-                .into_iter()
-                .map(|(frame, value)| Key {
-                    frame,
-                    value,
-                    at: at(),
-                })
-                .collect(),
-            interpolation,
-            at: at(),
-        }
-    }
 
     fn v3(r: f64) -> impl Strategy<Value = [f64; 3]> {
         [-r..r, -r..r, -r..r]

@@ -187,13 +187,13 @@ fn exp(v: DVec3) -> DQuat {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use luxon_formats::Origin;
     use std::path::PathBuf;
     use std::sync::Arc;
 
-    fn at() -> Origin {
+    pub(crate) fn at() -> Origin {
         Origin {
             file: Arc::new(PathBuf::from("t.ron")),
             line: 1,
@@ -201,7 +201,7 @@ mod tests {
         }
     }
 
-    fn track<T>(keys: Vec<(f64, T)>, interpolation: Interpolate) -> Track<T> {
+    pub(crate) fn track<T>(keys: Vec<(f64, T)>, interpolation: Interpolate) -> Track<T> {
         Track {
             keys: keys
                 .into_iter()
