@@ -75,8 +75,12 @@ def test_a_callback_that_raises_cancels_the_render():
     assert np.array_equal(scene.render(32, 24), luxon.load(SCENES / "spheres.ron").render(32, 24))
 
 
+# The child restores Python's own Ctrl-C handler: a process started from a background job of a
+# non-interactive shell (`bash -c 'pytest ... &'`) inherits SIGINT ignored, and Python then
+# installs no handler, so the SIGINT would (rightly) do nothing.
 CHILD = r"""
-import sys, time, luxon
+import signal, sys, time, luxon
+signal.signal(signal.SIGINT, signal.default_int_handler)
 scene = luxon.load(sys.argv[1])
 scene.commit()
 print("rendering", flush=True)
