@@ -192,7 +192,7 @@
 //!   a communicator of their own.
 //! - **Release renderers with a communicator before `MPI_Finalize`** (dropping one frees its
 //!   duplicate). Setting a communicator before `MPI_Init_thread` or after `MPI_Finalize` is an
-//!   [`Error::Mpi`](crate::Error::Mpi).
+//!   [`Error::Mpi`].
 //! - **Thread levels.** Only the thread that calls Luxon makes its MPI calls (render threads
 //!   never do). With `MPI_THREAD_SERIALIZED` or `MPI_THREAD_MULTIPLE` any thread may call
 //!   (with `SERIALIZED`, none of the caller's MPI calls may run at the same time); with
@@ -202,7 +202,7 @@
 //!   built, a plugin's error, a panic in a render thread) stops its part; the ranks finish the
 //!   render's messages and agree, and every rank returns the same error naming the first
 //!   failing rank (`rank 1: …`); a cancel ([`Cancel`]) on any rank makes every rank return
-//!   [`Error::Cancelled`](crate::Error::Cancelled). The renderer can render again.
+//!   [`Error::Cancelled`]. The renderer can render again.
 //! - **What cannot be caught:** a rank killed by a signal (or one that never calls `render`)
 //!   leaves the others waiting in the render, as with any collective MPI call.
 //! - Progress is reported on rank 0 only, for every rank's pixels; `render_chunks` refuses a
