@@ -98,3 +98,48 @@ fn adaptive_supersampling_agrees_bitwise() {
         }
     }
 }
+
+/// Motion blur: the carousel (keyed camera, objects turning and bouncing) and the water
+/// trajectory (a series blended between its data frames) under an open shutter, at a frame
+/// inside their range: the same bits on any thread count, tile size and decomposition.
+#[test]
+fn blurred_animations_agree_bitwise() {
+    let blurred = |name: &str, frame: u32, threads: u32, tile: u32, how: Decomposition| {
+        let mut desc = luxon_formats::load(&root().join("scenes").join(format!("{name}.ron")))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let a = desc.animation.as_mut().unwrap();
+        a.value.shutter = Some(luxon_formats::Spanned {
+            value: luxon_formats::ShutterDesc {
+                length: 0.5,
+                at: luxon_formats::ShutterAt::Centre,
+            },
+            at: a.at.clone(),
+        });
+        desc.render.width = 61;
+        desc.render.height = 43;
+        desc.render.samples = 2;
+        desc.render.parallel.threads = Some(threads);
+        desc.render.parallel.tile_size = tile;
+        desc.render.parallel.decomposition = how;
+        let mut scene = luxon::Scene::build(&desc, &registry(&desc)).unwrap();
+        assert!(scene.features.motion_blur, "{name}");
+        scene.set_frame(frame).unwrap();
+        luxon::render::render(&scene, &|_, _| {}).unwrap().0.rgba
+    };
+    for (name, frame) in [("carousel", 5), ("trajectory/water", 1)] {
+        let one = blurred(name, frame, 1, 16, Decomposition::Dynamic);
+        assert!(one.iter().any(|&v| v > 0.05), "{name}: image is black");
+        for (threads, tile, how) in [
+            (2, 16, Decomposition::Dynamic),
+            (3, 7, Decomposition::Dynamic),
+            (2, 5, Decomposition::PixelCyclic),
+            (2, 16, Decomposition::ScanlineCyclic),
+            (3, 4, Decomposition::BlockCyclic),
+        ] {
+            assert!(
+                same(&one, &blurred(name, frame, threads, tile, how)),
+                "{name}: blurred on {threads} threads, {how:?} (tile {tile}) differs"
+            );
+        }
+    }
+}

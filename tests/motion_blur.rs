@@ -97,6 +97,45 @@ fn a_moving_sphere_matches_the_analytic_profile() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// The same sphere moving as time-sampled data: two `.xyz` data frames, at x −0.5 and 0.5,
+/// blended at each ray's time, match the profile too.
+#[test]
+fn a_moving_series_sphere_matches_the_analytic_profile() {
+    let dir = temp_dir("blur-profile-series");
+    for (d, x) in [-0.5, 0.5].iter().enumerate() {
+        std::fs::write(
+            dir.join(format!("ball{d}.xyz")),
+            format!("1\nball\nC {x} 0 0\n"),
+        )
+        .unwrap();
+    }
+    let text = PROFILE
+        .replace(
+            r#"(plugin: "sphere", name: "ball", params: (center: (0, 0, 0), radius: 0.4), material: "white"),"#,
+            "",
+        )
+        .replace(
+            r#"objects: { "ball": (translate: (keys: [(0, (-0.5, 0, 0)), (1, (0.5, 0, 0))])) },"#,
+            "",
+        )
+        .replace(
+            "animation: (",
+            r#"series: [(name: "ball", files: "ball%d.xyz", default_atom: (radius: 0.4, material: "white"))],
+    animation: ("#,
+        );
+    let desc = load(&dir, &text);
+    assert!(desc.objects.is_empty() && desc.series.len() == 1);
+    let want = analytic(64, 4);
+    let e = mean_error(&render(&desc, 0), &want);
+    eprintln!("blurred series profile: mean absolute error {e}");
+    assert!(e <= 0.01, "mean absolute error {e}");
+    let mut still = desc.clone();
+    still.animation.as_mut().unwrap().value.shutter = None;
+    let e = mean_error(&render(&still, 0), &want);
+    assert!(e >= 0.05, "the still frame is {e} from the blurred profile");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 /// A perspective scene with a bouncing ball (keyed object), a turning shared instance and a
 /// camera that moves, 4 samples per pixel.
 const SCENE: &str = r#"Scene(

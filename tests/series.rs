@@ -300,3 +300,188 @@ fn the_shipped_trajectory_renders_its_four_data_frames() {
         );
     }
 }
+
+/// `SCENE` with a shutter (`shutter`: its RON) and `samples` per pixel.
+fn blurred_scene(dir: &Path, series: &str, shutter: &str, samples: u32) -> PathBuf {
+    let text = SCENE
+        .replace("SERIES", series)
+        .replace(
+            "animation: (frames: (0, 2))",
+            &format!("animation: (frames: (0, 2), shutter: {shutter})"),
+        )
+        .replace(
+            "width: 64, height: 32,",
+            &format!("width: 64, height: 32, samples: {samples},"),
+        );
+    write(dir, "scene.ron", &text)
+}
+
+fn bits(fb: &Framebuffer) -> Vec<u32> {
+    fb.rgba.iter().map(|v| v.to_bits()).collect()
+}
+
+/// Under an open shutter the atoms move from one data frame to the next during the frame:
+/// smeared along their path (neither sharp nor black), the same bits on any number of
+/// threads and tiles; a shutter of no length is the still frame bit for bit.
+#[test]
+fn a_blurred_series_moves_between_its_data_frames() {
+    let dir = temp_dir("series-blur");
+    for (d, x) in [-1.0, 0.0, 1.0].iter().enumerate() {
+        write(&dir, &format!("traj/w_{d:03}.xyz"), &xyz(*x, 0.4));
+    }
+    // Open for the whole frame from its start: frame 0 moves the atoms from x -1 to 0.
+    let path = blurred_scene(&dir, ATOMS, "(length: 1, at: Start)", 64);
+    let mut scene = build(&path);
+    assert!(scene.features.motion_blur);
+    scene.set_frame(0).unwrap();
+    let fb = render(&scene);
+    // The O atom's centre passes every x in [-1, 0]: partly covered there, not at its ends'
+    // far sides.
+    for x in [-0.75, -0.5, -0.25] {
+        let [r, g, b] = at(&fb, x, 0.4);
+        assert!(
+            r > 0.2 && r < 0.9 && g == 0.0 && b < 0.05,
+            "x {x}: {:?}",
+            [r, g, b]
+        );
+    }
+    near(at(&fb, 0.5, 0.4), BLACK);
+    near(at(&fb, -1.5, 0.4), BLACK);
+    // Threads and tiles do not change a bit.
+    let mut images = Vec::new();
+    for (threads, tile) in [(1, 16), (2, 16), (2, 5)] {
+        let mut desc = luxon_formats::load(&path).unwrap();
+        desc.render.parallel.threads = Some(threads);
+        desc.render.parallel.tile_size = tile;
+        let mut scene = Scene::build(&desc, &registry(&desc)).unwrap();
+        scene.set_frame(1).unwrap();
+        images.push(bits(&render(&scene)));
+    }
+    assert_eq!(images[0], images[1]);
+    assert_eq!(images[0], images[2]);
+    // A shutter of no length: the still frames' bits.
+    let zero = build(&blurred_scene(&dir, ATOMS, "(length: 0)", 64));
+    let mut still = luxon_formats::load(&path).unwrap();
+    still.animation.as_mut().unwrap().value.shutter = None;
+    let mut still = Scene::build(&still, &registry(&still)).unwrap();
+    let mut zero = zero;
+    for k in 0..3 {
+        zero.set_frame(k).unwrap();
+        still.set_frame(k).unwrap();
+        assert_eq!(bits(&render(&zero)), bits(&render(&still)), "frame {k}");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A deforming `.obj` series: the square grows from one data frame to the next, so the band
+/// it sweeps is partly covered; a data frame joining other triangles is refused.
+#[test]
+fn a_blurred_obj_series_deforms_between_its_data_frames() {
+    let dir = temp_dir("series-blur-obj");
+    for (d, b) in [-0.5f64, 0.5, 1.5].iter().enumerate() {
+        write(
+            &dir,
+            &format!("mesh/m{d}.obj"),
+            &format!("v -1 -0.25 0\nv {b} -0.25 0\nv {b} 0.25 0\nv -1 0.25 0\nf 1 2 3 4\n"),
+        );
+    }
+    let series = r#"(name: "sheet", files: "mesh/m#.obj", material: "blue")"#;
+    let path = blurred_scene(&dir, series, "(length: 1, at: Start)", 64);
+    let mut scene = build(&path);
+    scene.set_frame(0).unwrap();
+    let fb = render(&scene);
+    near(at(&fb, -0.75, 0.0), BLUE);
+    let [r, g, b] = at(&fb, 0.0, 0.0);
+    assert!(
+        r == 0.0 && g == 0.0 && b > 0.2 && b < 0.8,
+        "{:?}",
+        [r, g, b]
+    );
+    near(at(&fb, 0.75, 0.0), BLACK);
+    // Other triangles in the next data frame: an error naming both files and the frame.
+    write(
+        &dir,
+        "mesh/m1.obj",
+        "v -1 -0.25 0\nv 0.5 -0.25 0\nv 0.5 0.25 0\nv -1 0.25 0\nf 1 3 4 2\n",
+    );
+    // (A scene keeps the data frames it read: a fresh one reads the edit.)
+    let e = build(&path).set_frame(0).unwrap_err().to_string();
+    assert!(e.contains("series `sheet`, frame 0: "), "{e}");
+    assert!(
+        e.contains("m1.obj` joins its vertices into other triangles than"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Under an open shutter a frame needs the data frames its shutter spans: a missing one fails
+/// the frame, naming the file and the frame; a data frame with other atoms is refused.
+#[test]
+fn a_blurred_frame_needs_every_data_frame_its_shutter_spans() {
+    let dir = temp_dir("series-blur-missing");
+    write(&dir, "traj/w_000.xyz", &xyz(-1.0, 0.4));
+    write(&dir, "traj/w_002.xyz", &xyz(1.0, 0.4));
+    // Centred on the frame: frame 0 reaches half-way to data frame 1.
+    let path = blurred_scene(&dir, ATOMS, "(length: 1)", 4);
+    let desc = luxon_formats::load(&path).unwrap();
+    let mut scene = Scene::build(&desc, &registry(&desc)).unwrap();
+    let e = scene.set_frame(0).unwrap_err().to_string();
+    assert!(e.contains("series `water`, frame 0: data file"), "{e}");
+    assert!(e.contains("w_001.xyz` does not exist"), "{e}");
+    write(&dir, "traj/w_001.xyz", "1\nonly O\nO 0 0.4 0\n");
+    let e = scene.set_frame(0).unwrap_err().to_string();
+    assert!(e.contains("w_001.xyz` has 1 atoms but `"), "{e}");
+    assert!(e.contains("w_000.xyz` has 2"), "{e}");
+    write(&dir, "traj/w_001.xyz", &xyz(0.0, 0.4));
+    build(&path).set_frame(0).unwrap();
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The frame numbers a run says it wrote.
+fn wrote(o: &std::process::Output) -> Vec<u32> {
+    let mut v: Vec<u32> = stderr(o)
+        .lines()
+        .filter_map(|l| l.strip_prefix("luxon: wrote "))
+        .filter_map(|l| l.split("(frame ").nth(1)?.split(',').next()?.parse().ok())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A resumed sequence renders again the frames whose data files changed, and only those:
+/// each frame's record covers the data frames it reads (under an open shutter, those its
+/// shutter spans).
+#[test]
+fn an_edited_data_file_makes_the_frames_reading_it_stale() {
+    let dir = temp_dir("series-resume");
+    for (d, x) in [-1.0, 0.0, 1.0].iter().enumerate() {
+        write(&dir, &format!("traj/w_{d:03}.xyz"), &xyz(*x, 0.4));
+    }
+    let out = dir.join("out");
+    let pattern = out.join("f%d.ppm");
+    let render = |scene: &Path| {
+        let o = run(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            pattern.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        wrote(&o)
+    };
+    // Sharp frames: frame k reads data frame k.
+    let sharp = scene_file(&dir, ATOMS);
+    assert_eq!(render(&sharp), [0, 1, 2]);
+    assert_eq!(render(&sharp), [] as [u32; 0]);
+    write(&dir, "traj/w_001.xyz", &xyz(0.25, 0.4));
+    assert_eq!(render(&sharp), [1]);
+    // Centred shutter of one frame: frame 0 reads data frames 0 and 1, frame 1 all three,
+    // frame 2 the last two.
+    let blurred = blurred_scene(&dir, ATOMS, "(length: 1)", 1);
+    assert_eq!(render(&blurred), [0, 1, 2]);
+    write(&dir, "traj/w_000.xyz", &xyz(-0.75, 0.4));
+    assert_eq!(render(&blurred), [0, 1]);
+    write(&dir, "traj/w_002.xyz", &xyz(0.75, 0.4));
+    assert_eq!(render(&blurred), [1, 2]);
+    let _ = std::fs::remove_dir_all(dir);
+}

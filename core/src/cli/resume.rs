@@ -16,6 +16,8 @@ pub struct Resume {
     manifest: Manifest,
     names: FrameNames,
     scene: u64,
+    /// The data files frame k reads (they join its inputs hash).
+    data: Box<dyn Fn(u32) -> Vec<PathBuf>>,
     total: usize,
     /// Done when this run started.
     pub done_at_start: usize,
@@ -29,11 +31,12 @@ pub struct Resume {
 
 impl Resume {
     /// Opens the records beside the first output (`force`: forgets those of `frames`) and
-    /// counts the frames done already.
+    /// counts the frames done already; `data(k)`: the data files frame k reads.
     pub fn start(
         names: &FrameNames,
         frames: &[u32],
         scene: u64,
+        data: Box<dyn Fn(u32) -> Vec<PathBuf>>,
         force: bool,
         about: &str,
     ) -> Result<Resume, Error> {
@@ -63,6 +66,7 @@ impl Resume {
             manifest,
             names: names.clone(),
             scene,
+            data,
             total: frames.len(),
             done_at_start: 0,
             queue: frames.iter().copied().collect(),
@@ -75,6 +79,10 @@ impl Resume {
         Ok(r)
     }
 
+    fn hash(&self, k: u32) -> u64 {
+        frame_hash(self.scene, k, &(self.data)(k))
+    }
+
     fn outputs(&self, k: u32) -> Vec<PathBuf> {
         self.names
             .outputs_for(k)
@@ -84,8 +92,7 @@ impl Resume {
     }
 
     fn is_done(&self, k: u32) -> bool {
-        self.manifest
-            .is_done(k, frame_hash(self.scene, k), &self.outputs(k))
+        self.manifest.is_done(k, self.hash(k), &self.outputs(k))
     }
 
     /// What the start found, for the user (`None` when nothing was done).
@@ -147,9 +154,7 @@ impl Resume {
 
     /// Frame `k` is written (its outputs committed): records it and lets its claim go.
     pub fn finished(&mut self, k: u32) -> Result<(), Error> {
-        let recorded = self
-            .manifest
-            .record(k, frame_hash(self.scene, k), &self.outputs(k));
+        let recorded = self.manifest.record(k, self.hash(k), &self.outputs(k));
         self.claim = None;
         recorded.map_err(|e| {
             Error::Render(format!(

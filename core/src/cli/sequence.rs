@@ -126,7 +126,10 @@ fn prepare(
         0 => {
             let hash = scene_hash(o, desc, read, registry, &names, &frames);
             let about = about(desc, &frames, hash, o);
-            Some(Resume::start(&names, &frames, hash, o.force, &about)?)
+            // The data files of a `series:` are per frame: each frame's own join its hash.
+            let data = luxon::scene::DataFiles::new(desc);
+            let data = Box::new(move |k| data.of(k));
+            Some(Resume::start(&names, &frames, hash, data, o.force, &about)?)
         }
         _ => None,
     };

@@ -149,6 +149,30 @@ pub struct Instances {
     /// The shutter (open, close), frames from `frame_time`: what the keyed instances' boxes
     /// cover.
     shutter: (f64, f64),
+    /// Names the tracks, world offset and frame time the keyed placements come from (new with
+    /// every change of them): the key of each thread's cache of placements ([`LAST`]).
+    id: u64,
+}
+
+/// A fresh [`Instances::id`].
+fn next_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Slots of each thread's cache of keyed placements (instance k uses slot k mod `SLOTS`).
+const SLOTS: usize = 8;
+
+/// A keyed placement as computed: (instances id, instance, time bits) and the placement
+/// (`None`: singular at that time).
+type Cached = (u64, u32, u64, Option<Placement>);
+
+thread_local! {
+    /// The last keyed placements this thread computed. A camera sample's rays (primary,
+    /// shadow, reflected, and its shading) share one time, so each meets the same placements:
+    /// the same values the same function gives for the same time, computed once.
+    static LAST: std::cell::RefCell<[Option<Cached>; SLOTS]> =
+        const { std::cell::RefCell::new([const { None }; SLOTS]) };
 }
 
 impl Instances {
@@ -163,6 +187,7 @@ impl Instances {
             tracks: Vec::new(),
             frame_time: 0.0,
             shutter: (0.0, 0.0),
+            id: next_id(),
         };
         let bounds: Vec<Aabb> = out.list.iter().map(|i| out.bounds(i)).collect();
         out.top = TopLevel::build(&bounds);
@@ -188,6 +213,7 @@ impl Instances {
     pub fn key(&mut self, i: u32, tracks: ObjectTracks) {
         self.list[i as usize].motion = Motion::Keyed(self.tracks.len() as u32);
         self.tracks.push(tracks);
+        self.id = next_id();
     }
 
     /// A new bottom level (built, in object space) with one instance moving by `tracks`.
@@ -198,6 +224,7 @@ impl Instances {
             motion: Motion::Keyed(self.tracks.len() as u32),
         });
         self.tracks.push(tracks);
+        self.id = next_id();
     }
 
     /// Goes to frame time `t` with the shutter `(open, close)` (frames from `t`): the keyed
@@ -206,6 +233,7 @@ impl Instances {
     pub fn set_time(&mut self, t: f64, shutter: (f64, f64)) {
         self.frame_time = t;
         self.shutter = shutter;
+        self.id = next_id();
         let bounds: Vec<Aabb> = self.list.iter().map(|i| self.bounds(i)).collect();
         self.top = TopLevel::build(&bounds);
     }
@@ -220,10 +248,23 @@ impl Instances {
             Motion::Fixed(p) => Some(Cow::Borrowed(p)),
             Motion::Keyed(k) => {
                 let t = self.frame_time + f64::from(time);
-                let m = crate::motion::Placement::at(&self.tracks[*k as usize], t);
-                let det = m.world_from_object.matrix3.determinant();
-                (det.is_finite() && det != 0.0)
-                    .then(|| Cow::Owned(Placement::new(m.world_from_object, self.world_offset)))
+                let key = (self.id, *k, t.to_bits());
+                let slot = *k as usize % SLOTS;
+                let cached = LAST.with_borrow(|last| match &last[slot] {
+                    Some((id, i, bits, p)) if (*id, *i, *bits) == key => Some(p.clone()),
+                    _ => None,
+                });
+                let p = cached.unwrap_or_else(|| {
+                    let m = crate::motion::Placement::at(&self.tracks[*k as usize], t);
+                    let det = m.world_from_object.matrix3.determinant();
+                    let p = (det.is_finite() && det != 0.0)
+                        .then(|| Placement::new(m.world_from_object, self.world_offset));
+                    LAST.with_borrow_mut(|last| {
+                        last[slot] = Some((key.0, key.1, key.2, p.clone()))
+                    });
+                    p
+                });
+                p.map(Cow::Owned)
             }
         }
     }

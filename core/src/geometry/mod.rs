@@ -13,6 +13,7 @@ pub mod objects;
 pub mod plane;
 pub mod set;
 pub mod sphere;
+pub mod sweep;
 // An unchecked axis index and a prefetch.
 #[allow(unsafe_code)]
 pub mod triangle;
@@ -90,7 +91,8 @@ pub struct Hit {
     /// On a keyed object (in the scene's moving group) rather than in the still geometry.
     pub moving: bool,
     /// On array object `object - 1` of the scene's [`objects::Objects`] (0: not on one; 16
-    /// bits fit the padding after `kind` and `moving`, so a hit stays 48 bytes).
+    /// bits fit the padding after `kind` and `moving`, so a hit stays 48 bytes). On a
+    /// `moving` hit: on the moving group's sweep `object - 1` (see `group`).
     pub object: u16,
     /// The shared instance hit (`NO_INSTANCE`: none; the primitive is in the scene's own
     /// geometry or its moving group).

@@ -67,6 +67,26 @@ pub fn intersect_sphere(
     }
 }
 
+impl Sphere {
+    /// Sphere `i` of a batch given in world coordinates (x, y, z, radius), checked, in render
+    /// space (`offset`: the world position of its origin).
+    pub fn from_world(i: usize, s: [f64; 4], offset: DVec3) -> Result<Sphere, String> {
+        if s.iter().any(|x| !x.is_finite()) {
+            return Err(format!("sphere {i} has a non-finite value {s:?}"));
+        }
+        if s[3] <= 0.0 {
+            return Err(format!(
+                "sphere {i} has radius {}; expected a radius > 0",
+                s[3]
+            ));
+        }
+        Ok(Sphere {
+            center: (DVec3::new(s[0], s[1], s[2]) - offset).as_vec3(),
+            radius: s[3] as f32,
+        })
+    }
+}
+
 impl Shape for Sphere {
     const KIND: Kind = Kind::Sphere;
     type Prep = ();
@@ -99,23 +119,7 @@ impl Set<Sphere> {
         offset: DVec3,
         material: u32,
     ) -> Result<(), String> {
-        if s.iter().any(|x| !x.is_finite()) {
-            return Err(format!("sphere {i} has a non-finite value {s:?}"));
-        }
-        if s[3] <= 0.0 {
-            return Err(format!(
-                "sphere {i} has radius {}; expected a radius > 0",
-                s[3]
-            ));
-        }
-        let center = (DVec3::new(s[0], s[1], s[2]) - offset).as_vec3();
-        self.push(
-            Sphere {
-                center,
-                radius: s[3] as f32,
-            },
-            material,
-        );
+        self.push(Sphere::from_world(i, s, offset)?, material);
         Ok(())
     }
 

@@ -163,6 +163,80 @@ pub struct MeshInput<'a> {
     pub uvs: &'a [f32],
 }
 
+impl MeshInput<'_> {
+    /// The mesh's vertices in render space (`offset`: the world position of its origin) and,
+    /// when it has normals, colours or uvs, their shading attributes (unit or zero normals),
+    /// after checking the arrays' lengths and that every value is finite.
+    #[allow(clippy::type_complexity)]
+    pub fn vertices(&self, offset: DVec3) -> Result<(Vec<Vec3>, Option<Vec<VertexAttr>>), String> {
+        let m = self;
+        let nv = m.positions.len() / 3;
+        if !m.positions.len().is_multiple_of(3) || !m.indices.len().is_multiple_of(3) {
+            return Err("mesh arrays are not whole vertices or triangles".into());
+        }
+        for (what, len, per) in [
+            ("normals", m.normals.len(), 3),
+            ("colors", m.colors.len(), 3),
+            ("uvs", m.uvs.len(), 2),
+        ] {
+            if len != 0 && len != nv * per {
+                return Err(format!("mesh has {nv} vertices but {} {what}", len / per));
+            }
+        }
+        if let Some(i) = m.positions.iter().position(|x| !x.is_finite()) {
+            return Err(format!("vertex {} has a non-finite coordinate", i / 3));
+        }
+        if m.normals.iter().any(|x| !x.is_finite())
+            || m.colors.iter().any(|x| !x.is_finite())
+            || m.uvs.iter().any(|x| !x.is_finite())
+        {
+            return Err("mesh has a non-finite normal, colour or uv".into());
+        }
+        let verts: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|p| (DVec3::new(p[0], p[1], p[2]) - offset).as_vec3())
+            .collect();
+        let has_attr = !m.normals.is_empty() || !m.colors.is_empty() || !m.uvs.is_empty();
+        let attr_of = |v: usize| VertexAttr {
+            n: if m.normals.is_empty() {
+                Vec3::ZERO
+            } else {
+                DVec3::new(m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2])
+                    .normalize_or_zero()
+                    .as_vec3()
+            },
+            c: if m.colors.is_empty() {
+                Vec3::splat(-1.0)
+            } else {
+                Vec3::new(m.colors[3 * v], m.colors[3 * v + 1], m.colors[3 * v + 2])
+            },
+            uv: if m.uvs.is_empty() {
+                [0.0; 2]
+            } else {
+                [m.uvs[2 * v], m.uvs[2 * v + 1]]
+            },
+        };
+        Ok((verts, has_attr.then(|| (0..nv).map(attr_of).collect())))
+    }
+}
+
+/// The corners of triangle `t` (vertex indices `tri`) among `verts`, each index checked.
+pub fn corners(t: usize, tri: &[u64], verts: &[Vec3]) -> Result<[Vec3; 3], String> {
+    let mut v = [Vec3::ZERO; 3];
+    for k in 0..3 {
+        let i = tri[k];
+        let Some(p) = verts.get(i as usize) else {
+            return Err(format!(
+                "triangle {t} uses vertex {i}, but the mesh has {} vertices",
+                verts.len()
+            ));
+        };
+        v[k] = *p;
+    }
+    Ok(v)
+}
+
 impl Shape for Triangle {
     const KIND: Kind = Kind::Triangle;
     type Prep = TriRay;
@@ -231,74 +305,21 @@ impl Triangles {
         offset: DVec3,
         material: u32,
     ) -> Result<u64, String> {
-        let nv = m.positions.len() / 3;
-        if !m.positions.len().is_multiple_of(3) || !m.indices.len().is_multiple_of(3) {
-            return Err("mesh arrays are not whole vertices or triangles".into());
-        }
-        for (what, len, per) in [
-            ("normals", m.normals.len(), 3),
-            ("colors", m.colors.len(), 3),
-            ("uvs", m.uvs.len(), 2),
-        ] {
-            if len != 0 && len != nv * per {
-                return Err(format!("mesh has {nv} vertices but {} {what}", len / per));
-            }
-        }
-        if let Some(i) = m.positions.iter().position(|x| !x.is_finite()) {
-            return Err(format!("vertex {} has a non-finite coordinate", i / 3));
-        }
-        if m.normals.iter().any(|x| !x.is_finite())
-            || m.colors.iter().any(|x| !x.is_finite())
-            || m.uvs.iter().any(|x| !x.is_finite())
-        {
-            return Err("mesh has a non-finite normal, colour or uv".into());
-        }
-        let verts: Vec<Vec3> = m
-            .positions
-            .chunks_exact(3)
-            .map(|p| (DVec3::new(p[0], p[1], p[2]) - offset).as_vec3())
-            .collect();
-        let has_attr = !m.normals.is_empty() || !m.colors.is_empty() || !m.uvs.is_empty();
-        let attr_of = |v: usize| VertexAttr {
-            n: if m.normals.is_empty() {
-                Vec3::ZERO
-            } else {
-                DVec3::new(m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2])
-                    .normalize_or_zero()
-                    .as_vec3()
-            },
-            c: if m.colors.is_empty() {
-                Vec3::splat(-1.0)
-            } else {
-                Vec3::new(m.colors[3 * v], m.colors[3 * v + 1], m.colors[3 * v + 2])
-            },
-            uv: if m.uvs.is_empty() {
-                [0.0; 2]
-            } else {
-                [m.uvs[2 * v], m.uvs[2 * v + 1]]
-            },
-        };
+        let (verts, attrs) = m.vertices(offset)?;
+        let nv = verts.len();
         let base = self.vertex_attrs.len();
-        if has_attr {
+        let has_attr = attrs.is_some();
+        if let Some(attrs) = attrs {
             if base + nv > NO_ATTR as usize {
                 return Err("too many vertices with normals, colours or uvs in one scene".into());
             }
-            self.vertex_attrs.extend((0..nv).map(attr_of));
+            self.vertex_attrs.extend(attrs);
         }
         let mut dropped = 0;
         self.set.data.reserve(m.indices.len() / 3);
         self.set.material.reserve(m.indices.len() / 3);
         for (t, tri) in m.indices.chunks_exact(3).enumerate() {
-            let mut v = [Vec3::ZERO; 3];
-            for k in 0..3 {
-                let i = tri[k];
-                if i >= nv as u64 {
-                    return Err(format!(
-                        "triangle {t} uses vertex {i}, but the mesh has {nv} vertices"
-                    ));
-                }
-                v[k] = verts[i as usize];
-            }
+            let v = corners(t, tri, &verts)?;
             if (v[1] - v[0]).cross(v[2] - v[0]) == Vec3::ZERO {
                 dropped += 1;
                 continue;

@@ -6,8 +6,10 @@
 //! `world_from_object = translate · rotate · scale`, so a point p of the object box is at
 //! `T(t) + R(t)·S(t)·p`. Each part is bounded on its own and the bounds added (a Minkowski sum
 //! of boxes): the translation by the hull of the curve's control points, the scale the same
-//! way per axis, and the rotation exactly where it holds still over the interval, else by the
-//! ball its largest scaled corner distance sweeps.
+//! way per axis, and the rotation exactly where it holds still over the interval; a rotation
+//! whose keys all turn about one axis by the box turned through the angle's range a few degrees
+//! at a time (grown by how far an arc strays from its chord), any other by the ball its
+//! largest scaled corner distance sweeps.
 
 use super::keys::{quaternion, rotation, value};
 use glam::{DQuat, DVec3};
@@ -31,28 +33,30 @@ pub fn swept_bounds(tracks: &ObjectTracks, object: DBox, t0: f64, t1: f64) -> DB
     let still = tracks.rotate.as_ref().map_or(Some(DQuat::IDENTITY), |r| {
         holds(r, t0, t1).then(|| rotation(r, t0))
     });
+    // The scaled box: per axis the products of the scale's and the box's ends.
+    let mut a = DVec3::ZERO;
+    let mut b = DVec3::ZERO;
+    for i in 0..3 {
+        let p = [
+            slo[i] * lo[i],
+            slo[i] * hi[i],
+            shi[i] * lo[i],
+            shi[i] * hi[i],
+        ];
+        a[i] = p.iter().copied().fold(f64::INFINITY, f64::min);
+        b[i] = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    }
+    let turning = || {
+        let r = tracks.rotate.as_ref()?;
+        turned_about_axis(r, (a, b), t0, t1)
+    };
     let (rlo, rhi) = match still {
-        Some(q) => {
-            // The scaled box: per axis the products of the scale's and the box's ends.
-            let mut a = DVec3::ZERO;
-            let mut b = DVec3::ZERO;
-            for i in 0..3 {
-                let p = [
-                    slo[i] * lo[i],
-                    slo[i] * hi[i],
-                    shi[i] * lo[i],
-                    shi[i] * hi[i],
-                ];
-                a[i] = p.iter().copied().fold(f64::INFINITY, f64::min);
-                b[i] = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            }
-            corners_turned(q, (a, b))
-        }
-        None => {
+        Some(q) => corners_turned(q, (a, b)),
+        None => turning().unwrap_or_else(|| {
             let far = slo.abs().max(shi.abs()) * lo.abs().max(hi.abs());
             let r = far.length();
             (DVec3::splat(-r), DVec3::splat(r))
-        }
+        }),
     };
     let (lo, hi) = (tlo + rlo, thi + rhi);
     // The evaluation's own rounding (slerp, the pyramid, the product) is far below this.
@@ -69,6 +73,52 @@ fn corners_turned(q: DQuat, (lo, hi): DBox) -> DBox {
         out = (out.0.min(c), out.1.max(c));
     }
     out
+}
+
+/// The box holding `b` turned over `[t0, t1]` by a rotation track whose keys all turn about
+/// one axis (its angle then interpolated as a number, see `keys::rotation`): the box turned
+/// at angles at most `STEP` degrees apart over the angle's range (from `hull`, which holds a
+/// Catmull-Rom overshoot), grown by the most an arc between two of them strays from its chord
+/// (the sagitta at the box's farthest corner). `None`: keys about several axes, or a range of
+/// a whole turn or more.
+fn turned_about_axis(
+    r: &Track<luxon_formats::RotationDesc>,
+    b: DBox,
+    t0: f64,
+    t1: f64,
+) -> Option<DBox> {
+    const STEP: f64 = 5.0;
+    let axis = r.keys[0].value.axis;
+    if r.keys.iter().any(|k| k.value.axis != axis) {
+        return None;
+    }
+    let angles = Track {
+        keys: (r.keys.iter())
+            .map(|k| Key {
+                frame: k.frame,
+                value: [k.value.degrees, 0.0, 0.0],
+                at: k.at.clone(),
+            })
+            .collect(),
+        interpolation: r.interpolation,
+        at: r.at.clone(),
+    };
+    let (lo, hi) = hull(&angles, t0, t1);
+    let (a0, a1) = (lo.x, hi.x);
+    if !(a1 - a0 < 360.0) {
+        return None;
+    }
+    let n = ((a1 - a0) / STEP).ceil().max(1.0);
+    let mut out = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for j in 0..=n as u32 {
+        let degrees = a0 + (a1 - a0) * f64::from(j) / n;
+        let q = quaternion(&luxon_formats::RotationDesc { axis, degrees });
+        let c = corners_turned(q, b);
+        out = (out.0.min(c.0), out.1.max(c.1));
+    }
+    let half_step = ((a1 - a0) / n).to_radians() * 0.5;
+    let sagitta = b.0.abs().max(b.1.abs()).length() * (1.0 - half_step.cos());
+    Some((out.0 - sagitta, out.1 + sagitta))
 }
 
 /// Whether a rotation track holds one rotation over `[t0, t1]`: the interval lies outside
@@ -236,6 +286,35 @@ pub(crate) mod tests {
                 }
             }
         }
+    }
+
+    /// A turn about one axis is bounded by the turned box, not the ball around it: a bar
+    /// along x turning 4 degrees about y stays thin in y and z.
+    #[test]
+    fn a_small_turn_about_one_axis_stays_close() {
+        let turn = |degrees| RotationDesc {
+            axis: [0.0, 1.0, 0.0],
+            degrees,
+        };
+        let tracks = ObjectTracks {
+            object: 0,
+            name: Spanned {
+                value: "o".into(),
+                at: at(),
+            },
+            translate: None,
+            rotate: Some(track(
+                vec![(0.0, turn(0.0)), (48.0, turn(360.0))],
+                Interpolate::Linear,
+            )),
+            scale: None,
+        };
+        let bar = (DVec3::new(-1.3, -0.15, -0.15), DVec3::new(1.3, 0.15, 0.15));
+        let (lo, hi) = swept_bounds(&tracks, bar, 4.75, 5.25);
+        assert!(hi.y < 0.151 && lo.y > -0.151, "{lo:?} {hi:?}");
+        // sin(40°) · 1.3 plus the bar's half-width, about 0.95: far inside the 1.3 ball.
+        assert!(hi.z < 1.0 && lo.z > -1.0, "{lo:?} {hi:?}");
+        assert!(hi.x <= 1.31 && lo.x >= -1.31, "{lo:?} {hi:?}");
     }
 
     /// A translation alone is bounded tightly: its path's ends for a line.

@@ -9,7 +9,8 @@
 //! modification time of each plugin library the scene used; and the render settings
 //! after the command line's overrides, except those proven not to change a pixel (threads,
 //! tile size, decomposition, parallel mode, output I/O). The hash is 64-bit FNV-1a, our own
-//! code: std's hashers are not stable across releases.
+//! code: std's hashers are not stable across releases. A frame's inputs hash adds the data
+//! files that frame reads (`frame_hash`).
 
 use luxon_formats::RenderDesc;
 use std::path::{Component, Path, PathBuf};
@@ -107,9 +108,17 @@ pub fn scene_hash(i: &SceneInputs) -> u64 {
     h.finish()
 }
 
-/// The inputs hash of frame `k` (frame-specific data files will join it).
-pub fn frame_hash(scene: u64, k: u32) -> u64 {
-    Fnv::new().u64(scene).u64(u64::from(k)).finish()
+/// The inputs hash of frame `k`: the scene hash and the size and modification time of each
+/// data file the frame reads (`files`: a `series:`'s data frames, see
+/// [`DataFiles`](crate::scene::DataFiles)), so editing one makes stale only the frames that
+/// read it.
+pub fn frame_hash(scene: u64, k: u32, files: &[PathBuf]) -> u64 {
+    let mut h = Fnv::new();
+    h.u64(scene).u64(u64::from(k));
+    for f in files {
+        stamp(&mut h, f);
+    }
+    h.finish()
 }
 
 /// The render settings that change pixels, as text: the settings' debug form (so a setting

@@ -61,8 +61,9 @@ pub struct Animation {
     instances: Vec<(u32, ObjectTracks)>,
     /// Time-sampled data, stored in the moving group with the keyed objects.
     pub(super) series: SeriesSet,
-    /// The data frames the moving group holds (`None`: not known, build it anew).
-    shown: Option<Vec<u32>>,
+    /// The data frames (and their times) the moving group holds (`None`: not known, build it
+    /// anew).
+    shown: Option<Vec<Vec<super::series::Step>>>,
     frame: u32,
     /// The shutter (open, close) in frames from the frame's time, when time is sampled (see
     /// [`shutter`]).
@@ -91,8 +92,9 @@ pub(super) fn object_moves(t: &ObjectTracks) -> bool {
 }
 
 /// The shutter (open, close), in frames from the frame's time, when the scene samples time:
-/// it has a shutter and something keyed that moves (an object, an instance, the camera).
-/// `None` otherwise — a still scene, or nothing that could blur — and then no time is sampled.
+/// it has a shutter and something keyed that moves (an object, an instance, the camera) or
+/// time-sampled data (`series:`, which moves from one data frame to the next). `None`
+/// otherwise — a still scene, or nothing that could blur — and then no time is sampled.
 pub fn shutter(desc: &SceneDesc) -> Option<(f64, f64)> {
     let a = &desc.animation.as_ref()?.value;
     let s = a.shutter.as_ref()?.value;
@@ -103,7 +105,7 @@ pub fn shutter(desc: &SceneDesc) -> Option<(f64, f64)> {
         || moves(&c.fov)
         || moves(&c.focal_distance);
     let objects = a.objects.iter().chain(&a.instances).any(object_moves);
-    (camera || objects).then(|| s.interval())
+    (camera || objects || !desc.series.is_empty()).then(|| s.interval())
 }
 
 /// Whether keyed objects and instances that move are placed at each ray's time (traced as
@@ -437,7 +439,7 @@ impl Animation {
         k: u32,
         world_offset: DVec3,
         budget: &Arc<Budget>,
-        data: &[Arc<luxon_formats::SeriesFrame>],
+        data: &[Vec<(f64, Arc<luxon_formats::SeriesFrame>)>],
     ) -> Result<Group, Error> {
         let mut group = Group::default();
         // The sets charge their arrays as they grow, for good; the group takes that charge
@@ -465,7 +467,7 @@ impl Animation {
         // Zero-area triangles of the data are dropped, as in any mesh.
         let placed = placed.and_then(|()| {
             (self.series)
-                .store(data, k, group.sets(), world_offset, budget)
+                .store(data, k, &mut group, world_offset, budget)
                 .map(|_| ())
         });
         let grown = budget.used(Use::Geometry).saturating_sub(before);
@@ -502,25 +504,28 @@ impl Scene {
         let camera = anim.camera_at(t, k)?;
         let lights = anim.lights_at(t, k, self.world_offset)?;
         // Series data that did not change since the group was built keeps the group (keyed
-        // objects move with every frame, so they rebuild it).
-        let wanted = anim.series.data_frames(k);
+        // objects move with every frame, so they rebuild it). Under an open shutter a series
+        // reads the data frames its shutter spans.
+        let open = anim.shutter.filter(|(o, c)| c > o);
+        let wanted = anim.series.steps(k, open);
         let keep = !anim.series.is_empty()
             && anim.objects.is_empty()
             && anim.shown.as_ref() == Some(&wanted);
-        let mut shown = Some(wanted);
+        let mut read = true;
         let moving = if keep {
             None
         } else {
-            let data = match anim.series.load(k) {
+            let data = match anim.series.load(&wanted, k) {
                 Ok(data) => data,
                 Err(_) if tolerant => {
-                    shown = None;
+                    read = false;
                     Vec::new()
                 }
                 Err(e) => return Err(e),
             };
             Some(anim.group_at(t, k, self.world_offset, &self.budget, &data)?)
         };
+        let shown = read.then_some(wanted);
         let placed = anim.instances_at(t, k)?;
         let shadows = anim.shadows;
         let camera_moves = anim.camera_moves_in(k);

@@ -14,12 +14,14 @@ mod place;
 mod series;
 mod shadows;
 mod sky;
+mod sweep;
 pub(crate) mod update;
 
 pub(crate) use build::shadowless_groups;
 pub use build::Prebuilt;
 pub use frame::Animation;
 pub use instances::PrototypeUse;
+pub use series::DataFiles;
 pub use shadows::Casters;
 pub use sky::Sky;
 

@@ -3,6 +3,10 @@
 //! objects, with BVHs of its own. When no keyed object moves and every series shows the data
 //! frames the group already holds, the group is kept (`Animation` decides).
 //!
+//! Under an open shutter a frame reads every data frame its shutter spans (the steps) and
+//! stores each series that moves across several as a sweep (`sweep`): spheres and vertices
+//! blended between the steps at each ray's time.
+//!
 //! Parsed data frames are pure data, so a small cache of the last few ([`CACHE_FRAMES`])
 //! cannot change a frame: frame k holds the same spheres and triangles whether it is read
 //! fresh or from the cache.
@@ -10,6 +14,7 @@
 use super::place::Sets;
 use crate::budget::Budget;
 use crate::error::Error;
+use crate::geometry::group::Group;
 use crate::geometry::pack;
 use crate::geometry::triangle::MeshInput;
 use crate::math::DVec3;
@@ -27,11 +32,83 @@ type MaterialOf<'a> = dyn FnMut(&Option<Spanned<String>>) -> Result<usize, Error
 /// How many parsed data frames the cache keeps.
 const CACHE_FRAMES: usize = 8;
 
+/// A data frame a series shows during a frame, and when: (data frame, frames from the
+/// frame's time).
+pub(super) type Step = (u32, f64);
+
 /// A series and the packed material of each of its styles (`.xyz`: each element of `atoms`,
 /// then `default_atom`; `.obj`: one).
 struct Entry {
     desc: SeriesDesc,
     materials: Vec<u32>,
+}
+
+/// The data frames series `s` shows during movie frame `k` of an animation over `range`.
+/// Without a shutter (or one of no length) one: the frame's own, at time 0. Under an open
+/// `shutter` (open, close), frames from `k`: every data frame from the last at or before the
+/// shutter opens to the first at or after it closes, at their own times; the animation's
+/// first and last data frames bound them (beyond its range the data holds), and a single one
+/// is shown at 0.
+pub(super) fn steps(
+    s: &SeriesDesc,
+    range: (u32, u32),
+    k: u32,
+    shutter: Option<(f64, f64)>,
+) -> Vec<Step> {
+    let still = vec![(s.data_frame(k, range), 0.0)];
+    let Some((open, close)) = shutter.filter(|(o, c)| c > o) else {
+        return still;
+    };
+    let (first, per) = (f64::from(s.first), f64::from(s.per_frame));
+    let start = f64::from(range.0);
+    let (lo, hi) = (
+        f64::from(s.data_frame(range.0, range)),
+        f64::from(s.data_frame(range.1, range)),
+    );
+    // The data frame (a real number) shown at movie time t.
+    let at = |t: f64| first + (t - start) * per;
+    let k = f64::from(k);
+    let a = at(k + open).floor().clamp(lo, hi) as u32;
+    let b = at(k + close).ceil().clamp(lo, hi) as u32;
+    if a >= b {
+        return vec![(a, 0.0)];
+    }
+    // Exact for whole numbers: the frame's own data frame is at 0.
+    let time = |d: u32| (f64::from(d) - first) / per + start - k;
+    (a..=b).map(|d| (d, time(d))).collect()
+}
+
+/// Which data files each frame of a scene reads (every series' data frames during the
+/// frame's shutter), for a resumed sequence to notice an edited one.
+#[derive(Clone, Debug, Default)]
+pub struct DataFiles {
+    series: Vec<SeriesDesc>,
+    range: (u32, u32),
+    shutter: Option<(f64, f64)>,
+}
+
+impl DataFiles {
+    pub fn new(desc: &SceneDesc) -> DataFiles {
+        let Some(a) = &desc.animation else {
+            return DataFiles::default();
+        };
+        DataFiles {
+            series: desc.series.iter().map(|s| s.value.clone()).collect(),
+            range: (a.value.first, a.value.last),
+            shutter: super::frame::shutter(desc),
+        }
+    }
+
+    /// The data files frame `k` reads.
+    pub fn of(&self, k: u32) -> Vec<std::path::PathBuf> {
+        (self.series.iter())
+            .flat_map(|s| {
+                steps(s, self.range, k, self.shutter)
+                    .into_iter()
+                    .map(|(d, _)| s.path(d))
+            })
+            .collect()
+    }
 }
 
 /// The series of an animated scene and the data frames read lately.
@@ -68,6 +145,14 @@ impl SeriesSet {
                 materials,
             });
         }
+        // A hit on a blurred series names it in 16 bits (`Hit::object`).
+        if list.len() >= usize::from(u16::MAX) {
+            return Err(Error::Render(format!(
+                "{} series; expected fewer than {}",
+                list.len(),
+                u16::MAX
+            )));
+        }
         Ok(SeriesSet {
             list,
             range,
@@ -79,34 +164,40 @@ impl SeriesSet {
         self.list.is_empty()
     }
 
-    /// The data frame each series shows at movie frame `k`.
-    pub(super) fn data_frames(&self, k: u32) -> Vec<u32> {
+    /// The data frames each series shows during movie frame `k` (see [`steps`]).
+    pub(super) fn steps(&self, k: u32, shutter: Option<(f64, f64)>) -> Vec<Vec<Step>> {
         (self.list.iter())
-            .map(|e| e.desc.data_frame(k, self.range))
+            .map(|e| steps(&e.desc, self.range, k, shutter))
             .collect()
     }
 
-    /// The data of every series at movie frame `k`, read or taken from the cache. An error
-    /// names the file and the frame.
-    pub(super) fn load(&self, k: u32) -> Result<Vec<Arc<SeriesFrame>>, Error> {
+    /// The data of every series at its `steps` during movie frame `k` (as `steps` gives
+    /// them), read or taken from the cache. An error names the file and the frame.
+    pub(super) fn load(
+        &self,
+        steps: &[Vec<Step>],
+        k: u32,
+    ) -> Result<Vec<Vec<(f64, Arc<SeriesFrame>)>>, Error> {
         let options = LoadOptions::default();
         let mut out = Vec::with_capacity(self.list.len());
-        for (i, e) in self.list.iter().enumerate() {
-            let d = e.desc.data_frame(k, self.range);
-            let cached = self.cached(i, d);
-            let frame = match cached {
-                Some(f) => f,
-                None => {
-                    let f = Arc::new(load_frame(&e.desc, d, k, &options)?);
-                    let mut cache = self.cache.lock().unwrap_or_else(|p| p.into_inner());
-                    if cache.len() >= CACHE_FRAMES {
-                        cache.remove(0);
+        for (i, (e, steps)) in self.list.iter().zip(steps).enumerate() {
+            let mut frames = Vec::with_capacity(steps.len());
+            for &(d, time) in steps {
+                let frame = match self.cached(i, d) {
+                    Some(f) => f,
+                    None => {
+                        let f = Arc::new(load_frame(&e.desc, d, k, &options)?);
+                        let mut cache = self.cache.lock().unwrap_or_else(|p| p.into_inner());
+                        if cache.len() >= CACHE_FRAMES {
+                            cache.remove(0);
+                        }
+                        cache.push(((i, d), f.clone()));
+                        f
                     }
-                    cache.push(((i, d), f.clone()));
-                    f
-                }
-            };
-            out.push(frame);
+                };
+                frames.push((time, frame));
+            }
+            out.push(frames);
         }
         Ok(out)
     }
@@ -121,19 +212,35 @@ impl SeriesSet {
         Some(frame)
     }
 
-    /// Stores `frames` (one per series, as `load` gives them) into `sets`, in render space
-    /// (`offset`: the world position of its origin), charging `budget` as the sets grow.
-    /// Returns the zero-area triangles dropped.
+    /// Stores `frames` (each series' steps, as `load` gives them) into `group`, in render
+    /// space (`offset`: the world position of its origin), charging `budget` as the sets
+    /// grow: a series at one step into the group's sets, one at several as a sweep. Returns
+    /// the zero-area triangles dropped.
     pub(super) fn store(
         &self,
-        frames: &[Arc<SeriesFrame>],
+        frames: &[Vec<(f64, Arc<SeriesFrame>)>],
         k: u32,
-        mut sets: Sets,
+        group: &mut Group,
         offset: DVec3,
         budget: &Arc<Budget>,
     ) -> Result<u64, Error> {
         let mut dropped = 0;
-        for (e, f) in self.list.iter().zip(frames) {
+        for (e, steps) in self.list.iter().zip(frames) {
+            let f = match steps.as_slice() {
+                [] => continue,
+                [(_, f)] => f,
+                _ => {
+                    let name = &e.desc.name.value;
+                    let fail = |m: String| {
+                        Error::at(&e.desc.files.at, format!("series `{name}`, frame {k}: {m}"))
+                    };
+                    let sweep =
+                        super::sweep::sweep(steps, &e.materials, offset, budget).map_err(fail)?;
+                    group.sweeps.push(sweep);
+                    continue;
+                }
+            };
+            let mut sets = group.sets();
             let fail = |m: String| {
                 Error::at(
                     &e.desc.files.at,
