@@ -402,7 +402,7 @@ fn a_blurred_obj_series_deforms_between_its_data_frames() {
     write(
         &dir,
         "mesh/m1.obj",
-        "v -1 -0.25 0\nv 0.5 -0.25 0\nv 0.5 0.25 0\nv -1 0.25 0\nf 1 3 4 2\n",
+        "v -1 -0.25 0\nv 0.5 -0.25 0\nv 0.5 0.25 0\nv -1 0.25 0\nf 1 2 4\nf 2 3 4\n",
     );
     // (A scene keeps the data frames it read: a fresh one reads the edit.)
     let e = build(&path).set_frame(0).unwrap_err().to_string();

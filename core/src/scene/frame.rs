@@ -490,8 +490,8 @@ impl Scene {
         self.set_frame_with(k, false)
     }
 
-    /// `set_frame`; `tolerant`: a series whose data cannot be read leaves the moving group
-    /// without series data instead of failing (the build's first frame: a missing data file
+    /// `set_frame`; `tolerant`: a series whose data cannot be read (or stored) leaves the
+    /// moving group without series data instead of failing (the build's first frame: a missing data file
     /// fails the frame that shows it, when a sequence sets it, not the whole build).
     pub(super) fn set_frame_with(&mut self, k: u32, tolerant: bool) -> Result<(), Error> {
         let Some(anim) = &self.animation else {
@@ -523,7 +523,16 @@ impl Scene {
                 }
                 Err(e) => return Err(e),
             };
-            Some(anim.group_at(t, k, self.world_offset, &self.budget, &data)?)
+            let group = anim.group_at(t, k, self.world_offset, &self.budget, &data);
+            Some(match group {
+                // Data that cannot be stored (data frames that differ in what they hold)
+                // fails the frame showing it, like a missing file, not the build.
+                Err(_) if tolerant && !data.is_empty() => {
+                    read = false;
+                    anim.group_at(t, k, self.world_offset, &self.budget, &[])?
+                }
+                group => group?,
+            })
         };
         let shown = read.then_some(wanted);
         let placed = anim.instances_at(t, k)?;
