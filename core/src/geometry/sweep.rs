@@ -327,9 +327,12 @@ mod tests {
         steps
     }
 
+    /// Per step, positions and normals (flat x, y, z); and the shared indices.
+    type MeshSteps = (Vec<(Vec<f64>, Vec<f64>)>, Vec<u64>);
+
     /// A grid mesh over 6x6 vertices whose vertices (and normals) move at each step: per
     /// step, positions and normals (flat x, y, z), and the shared indices.
-    fn mesh_steps(rng: &mut Random) -> (Vec<(Vec<f64>, Vec<f64>)>, Vec<u64>) {
+    fn mesh_steps(rng: &mut Random) -> MeshSteps {
         let side = 6u64;
         let mut indices = Vec::new();
         for y in 0..side - 1 {
@@ -357,7 +360,7 @@ mod tests {
     }
 
     /// The sweep over `spheres` and the mesh, as a series' data frames would store it.
-    fn sweep_of(spheres: &[Vec<Sphere>], mesh: &(Vec<(Vec<f64>, Vec<f64>)>, Vec<u64>)) -> Sweep {
+    fn sweep_of(spheres: &[Vec<Sphere>], mesh: &MeshSteps) -> Sweep {
         let mut sweep = Sweep::new(TIMES.to_vec());
         let (steps, indices) = mesh;
         let ends: Vec<_> = (steps.iter())

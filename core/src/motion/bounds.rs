@@ -105,7 +105,8 @@ fn turned_about_axis(
     };
     let (lo, hi) = hull(&angles, t0, t1);
     let (a0, a1) = (lo.x, hi.x);
-    if !(a1 - a0 < 360.0) {
+    // A full turn (or a NaN span) is bounded by the loose sphere instead.
+    if a1 - a0 >= 360.0 || (a1 - a0).is_nan() {
         return None;
     }
     let n = ((a1 - a0) / STEP).ceil().max(1.0);

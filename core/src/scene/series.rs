@@ -23,6 +23,9 @@ use luxon_formats::{
 };
 use std::sync::{Arc, Mutex};
 
+/// One series' data frames during a movie frame, each with its time.
+type TimedFrames = Vec<(f64, Arc<SeriesFrame>)>;
+
 /// Parsed data frames by (series, data frame), most recent last.
 type Cache = Vec<((usize, u32), Arc<SeriesFrame>)>;
 
@@ -173,11 +176,7 @@ impl SeriesSet {
 
     /// The data of every series at its `steps` during movie frame `k` (as `steps` gives
     /// them), read or taken from the cache. An error names the file and the frame.
-    pub(super) fn load(
-        &self,
-        steps: &[Vec<Step>],
-        k: u32,
-    ) -> Result<Vec<Vec<(f64, Arc<SeriesFrame>)>>, Error> {
+    pub(super) fn load(&self, steps: &[Vec<Step>], k: u32) -> Result<Vec<TimedFrames>, Error> {
         let options = LoadOptions::default();
         let mut out = Vec::with_capacity(self.list.len());
         for (i, (e, steps)) in self.list.iter().zip(steps).enumerate() {

@@ -138,12 +138,12 @@ fn mesh(
         for (s, (_, attrs)) in ends.iter().enumerate() {
             let list = &mut sweep.vertex_attrs[s];
             budget
-                .grow(list, nv, Use::Geometry, &what)
+                .grow(list, nv, Use::Geometry, what)
                 .map_err(|e| e.0)?;
             list.extend(attrs.iter().flatten().copied());
         }
         budget
-            .grow(&mut sweep.corners, triangles, Use::Geometry, &what)
+            .grow(&mut sweep.corners, triangles, Use::Geometry, what)
             .map_err(|e| e.0)?;
         first_corner = Some(sweep.corners.len());
         sweep
