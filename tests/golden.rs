@@ -23,9 +23,18 @@ fn check(name: &str) {
 
 /// Frame `k` of an animated scene, against `golden/{name}-f{k}.png`.
 fn check_frame(name: &str, k: u32) {
+    check_frame_with(name, k, None);
+}
+
+/// `check_frame` with `samples` per pixel instead of the scene's (blurred scenes, which ask
+/// for many, stay quick in a debug build).
+fn check_frame_with(name: &str, k: u32, samples: Option<u32>) {
     let path = root().join("scenes").join(format!("{name}.ron"));
     let mut desc = luxon_formats::load(&path).unwrap_or_else(|e| panic!("{e}"));
     small(&mut desc);
+    if let Some(n) = samples {
+        desc.render.samples = n;
+    }
     let reg = registry(&desc);
     let mut scene = luxon::Scene::build(&desc, &reg).unwrap_or_else(|e| panic!("{e}"));
     scene.set_frame(k).unwrap_or_else(|e| panic!("{e}"));
@@ -73,6 +82,26 @@ fn compare(name: &str, fb: &luxon::Framebuffer) {
 fn animation_carousel_frames() {
     check_frame("carousel", 0);
     check_frame("carousel", 17);
+}
+
+#[test]
+fn animation_orbit_molecule() {
+    check_frame("orbit", 0);
+    check_frame("orbit", 12);
+}
+
+/// Landing (squashed, the blur turning back up) and in flight (smeared along its path).
+#[test]
+fn animation_bouncing_ball_blurred() {
+    check_frame_with("bouncing-ball", 12, Some(4));
+    check_frame_with("bouncing-ball", 15, Some(4));
+}
+
+/// Keyed shared instances with motion blur: 25 gears meshing, neighbours turning apart.
+#[test]
+fn animation_gears_instanced_and_blurred() {
+    check_frame_with("gears", 0, Some(1));
+    check_frame_with("gears", 5, Some(1));
 }
 
 #[test]

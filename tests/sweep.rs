@@ -1,5 +1,5 @@
 //! `luxon sweep`: the report files, error falling with samples, the texture filter override
-//! and clear errors for bad `--vary`.
+//! and clear errors for bad `--vary`; a frame of an animated scene (`--frame`, `--shutter`).
 
 mod common;
 
@@ -176,6 +176,7 @@ fn texture_filter_rewrites_the_image_textures() {
         reference: None,
         reference_samples: Some(16),
         runs: 1,
+        frame: None,
     };
     let s = luxon::sweep::run(&desc, &reg, &options, &|_| {}).unwrap();
     assert_eq!(s.rows.len(), 3);
@@ -215,4 +216,71 @@ fn volume_step_sweep_error_falls_with_the_step() {
     // The reference is the finest step: coarser steps are further from it.
     let rmse: Vec<f64> = rows.iter().map(|r| r[5].parse().unwrap()).collect();
     assert!(rmse[0] > rmse[1] && rmse[1] > rmse[2], "{rmse:?}");
+}
+
+/// `Options::frame` sweeps that frame of an animated scene: the rows are the frame as
+/// `set_frame` gives it (here a blurred one), not the scene's first frame.
+#[test]
+fn a_frame_of_an_animation_is_swept() {
+    let mut desc = luxon_formats::load(&root().join("scenes/bouncing-ball.ron")).unwrap();
+    desc.render.width = 24;
+    desc.render.height = 16;
+    let reg = registry(&desc);
+    let sweep_at = |frame| {
+        let options = Options {
+            curves: vec!["samples=2".parse::<Curve>().unwrap()],
+            reference: None,
+            reference_samples: Some(4),
+            runs: 1,
+            frame,
+        };
+        luxon::sweep::run(&desc, &reg, &options, &|_| {}).unwrap()
+    };
+    let mut d = desc.clone();
+    d.render.samples = 2;
+    let mut scene = luxon::Scene::build(&d, &reg).unwrap();
+    scene.set_frame(15).unwrap();
+    let (fb, _) = luxon::render::render(&scene, &|_, _| {}).unwrap();
+    let at15 = sweep_at(Some(15));
+    assert_eq!(at15.rows[0].rgb, luxon::sweep::to_rgb8(&fb));
+    assert_ne!(sweep_at(None).rows[0].rgb, at15.rows[0].rgb);
+}
+
+/// `--frame` and `--shutter` on the command line, and their errors.
+#[test]
+fn frame_and_shutter_options() {
+    let dir = temp_dir("sweep-frame");
+    let ball = root().join("scenes/bouncing-ball.ron");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "sweep",
+            ball.to_str().unwrap(),
+            "--res",
+            "24x16",
+            "--runs",
+            "1",
+            "--reference-samples",
+            "4",
+            "--vary",
+            "samples=1,2",
+            "-o",
+            dir.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let o = args(&["--frame", "15", "--shutter", "off"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.join("sweep.csv").is_file());
+    for (extra, expected) in [
+        (&["--frame", "48"][..], "the scene's frames are 0 to 47"),
+        (&["--shutter", "3"][..], "--shutter 3: expected LENGTH"),
+    ] {
+        let o = args(extra);
+        assert!(!o.status.success(), "{extra:?}");
+        assert!(stderr(&o).contains(expected), "{extra:?}: {}", stderr(&o));
+    }
+    let o = sweep(&["--vary", "samples=1", "--frame", "2"], &dir);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("has no `animation:`"), "{}", stderr(&o));
 }

@@ -64,6 +64,20 @@ pub fn parse_shutter(s: &str) -> Result<Option<luxon_formats::ShutterDesc>, Erro
     Ok(Some(ShutterDesc { length, at }))
 }
 
+/// `--shutter s` on an animated scene (`render`, `check` and `sweep`).
+pub fn set_shutter(desc: &mut SceneDesc, s: &str) -> Result<(), Error> {
+    let shutter = parse_shutter(s)?;
+    let Some(a) = &mut desc.animation else {
+        return Err(Error::Usage(format!(
+            "--shutter {s}: {} has no `animation:`; a shutter needs an animated scene",
+            desc.source.display()
+        )));
+    };
+    let at = a.at.clone();
+    a.value.shutter = shutter.map(|value| luxon_formats::Spanned { value, at });
+    Ok(())
+}
+
 fn no_shadows(desc: &mut SceneDesc) {
     for l in &mut desc.lights {
         match &mut l.value {
@@ -121,15 +135,7 @@ impl ShadingArgs {
             };
         }
         if let Some(s) = &self.shutter {
-            let shutter = parse_shutter(s)?;
-            let Some(a) = &mut desc.animation else {
-                return Err(Error::Usage(format!(
-                    "--shutter {s}: {} has no `animation:`; a shutter needs an animated scene",
-                    desc.source.display()
-                )));
-            };
-            let at = a.at.clone();
-            a.value.shutter = shutter.map(|value| luxon_formats::Spanned { value, at });
+            set_shutter(desc, s)?;
         }
         if self.no_shadows {
             no_shadows(desc);

@@ -37,6 +37,13 @@ pub struct Args {
     /// Memory budget of every build and render (as for `render`).
     #[arg(long, value_name = "SIZE", value_parser = super::parse_memory)]
     pub memory: Option<luxon_formats::MemorySize>,
+    /// Render frame K of an animated scene (default: its first frame).
+    #[arg(long, value_name = "K")]
+    pub frame: Option<u32>,
+    /// An animated scene's shutter (motion blur), as for `render`: LENGTH[:start|centre|end]
+    /// in frames, or off.
+    #[arg(long, value_name = "LENGTH[:start|centre|end]|off")]
+    pub shutter: Option<String>,
     /// Directory for the report.
     #[arg(short, long = "output", value_name = "OUTPUT")]
     pub out: PathBuf,
@@ -80,6 +87,23 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
     if let Some(m) = a.memory {
         desc.render.memory = Some(m);
     }
+    if let Some(s) = &a.shutter {
+        super::shading::set_shutter(&mut desc, s)?;
+    }
+    if let Some(k) = a.frame {
+        let Some(anim) = &desc.animation else {
+            return Err(Error::Usage(format!(
+                "--frame {k}: {} has no `animation:`",
+                desc.source.display()
+            )));
+        };
+        let (first, last) = (anim.value.first, anim.value.last);
+        if !(first..=last).contains(&k) {
+            return Err(Error::Usage(format!(
+                "--frame {k}: the scene's frames are {first} to {last}"
+            )));
+        }
+    }
     // The sweep writes its own files, not the scene's outputs.
     desc.render.outputs.clear();
     let registry = Registry::discover(&desc.plugin_path);
@@ -89,6 +113,7 @@ pub fn run(path: &Path, a: &Args) -> Result<(), Error> {
         reference: a.reference.clone(),
         reference_samples: a.reference_samples,
         runs: a.runs,
+        frame: a.frame,
     };
     let result = sweep::run(&desc, &registry, &options, &|what| {
         eprintln!("luxon: rendering {what}")

@@ -228,6 +228,9 @@ pub struct Options {
     pub reference_samples: Option<u32>,
     /// Renders per setting; the reported time is their median.
     pub runs: u32,
+    /// The frame of an animated scene to render (reference and settings alike); `None`: the
+    /// scene as built (its first frame).
+    pub frame: Option<u32>,
 }
 
 /// One rendered setting.
@@ -311,6 +314,15 @@ fn reference_desc(desc: &SceneDesc, curves: &[Curve], samples: u32) -> Result<Sc
     Ok(d)
 }
 
+/// The scene of `desc` at `frame` (`None`: as built).
+fn build(desc: &SceneDesc, registry: &Registry, frame: Option<u32>) -> Result<Scene, Error> {
+    let mut scene = Scene::build(desc, registry)?;
+    if let Some(k) = frame {
+        scene.set_frame(k)?;
+    }
+    Ok(scene)
+}
+
 fn render_timed(scene: &Scene, runs: u32) -> Result<(Framebuffer, u64, u64, Duration), Error> {
     let mut times = Vec::new();
     let mut last = None;
@@ -363,7 +375,7 @@ pub fn run(
                 .unwrap_or_else(|| reference_samples(desc, &options.curves));
             progress(&format!("reference ({samples} samples per pixel)"));
             let d = reference_desc(desc, &options.curves, samples)?;
-            let scene = Scene::build(&d, registry)?;
+            let scene = build(&d, registry, options.frame)?;
             let (fb, _, _, time) = render_timed(&scene, 1)?;
             (
                 format!(
@@ -390,11 +402,11 @@ pub fn run(
             let scene: &Scene = if setting.rebuilds() {
                 let mut d = desc.clone();
                 setting.apply(&mut d)?;
-                rebuilt = Scene::build(&d, registry)?;
+                rebuilt = build(&d, registry, options.frame)?;
                 &rebuilt
             } else {
                 if base.is_none() {
-                    base = Some(Scene::build(desc, registry)?);
+                    base = Some(build(desc, registry, options.frame)?);
                 }
                 let scene = base
                     .as_mut()
