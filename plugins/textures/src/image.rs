@@ -158,16 +158,18 @@ impl Texture for ImageTexture {
     }
 
     fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
-        let l = self.mapping.lookup(q);
         let (wrap, img) = (self.wrap, &*self.image);
         let got = match self.filter {
-            Filter::Nearest => self
-                .cache
-                .with_levels(img, 0, 0, |a, _| nearest(a, l.s, l.t, wrap)),
-            Filter::Bilinear => self
-                .cache
-                .with_levels(img, 0, 0, |a, _| bilinear(a, l.s, l.t, wrap)),
+            Filter::Nearest => {
+                let (s, t) = self.mapping.point(q);
+                (self.cache).with_levels(img, 0, 0, |a, _| nearest(a, s, t, wrap))
+            }
+            Filter::Bilinear => {
+                let (s, t) = self.mapping.point(q);
+                (self.cache).with_levels(img, 0, 0, |a, _| bilinear(a, s, t, wrap))
+            }
             Filter::Mip => {
+                let l = self.mapping.lookup(q);
                 // The footprint in level-0 texels: the wider of the two directions.
                 let texels = (l.ds * img.width() as f64).max(l.dt * img.height() as f64);
                 let n = img.levels();
