@@ -591,7 +591,11 @@ mod tests {
             for k in 0..50 {
                 let uv = [k as f32 * 0.071 - 0.3, k as f32 * 0.043 + 0.1];
                 let (a, b) = (at_uv(&plain, uv, 0.0), at_uv(&beside, uv, 0.0));
-                assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "{filter} at {uv:?}");
+                assert_eq!(
+                    a.map(f32::to_bits),
+                    b.map(f32::to_bits),
+                    "{filter} at {uv:?}"
+                );
             }
         }
     }

@@ -256,7 +256,10 @@ mod tests {
                     ..Default::default()
                 };
                 let (full, (s, t)) = (mp.lookup(&q), mp.point(&q));
-                assert_eq!((full.s.to_bits(), full.t.to_bits()), (s.to_bits(), t.to_bits()));
+                assert_eq!(
+                    (full.s.to_bits(), full.t.to_bits()),
+                    (s.to_bits(), t.to_bits())
+                );
             }
             // The centre itself (NaN cleaned to 0 in both).
             let q = TexQuery {

@@ -381,7 +381,10 @@ mod tests {
             for n in [1, 2, 5] {
                 let far = [i64::MIN, i64::MIN + 1, i64::MAX - 1, i64::MAX];
                 for i in (-12..12).chain(far) {
-                    let want = (wrap_index(i, n, wrap), wrap_index(i.saturating_add(1), n, wrap));
+                    let want = (
+                        wrap_index(i, n, wrap),
+                        wrap_index(i.saturating_add(1), n, wrap),
+                    );
                     assert_eq!(wrap_pair(i, n, wrap), want, "{wrap:?} {i} of {n}");
                 }
             }

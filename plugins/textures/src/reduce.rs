@@ -260,7 +260,10 @@ mod tests {
 
     #[test]
     fn without_mip_only_the_first_level_is_built_the_same() {
-        for (n, &(w, h)) in [(1, 1), (5, 3), (37, 23), (64, 64), (6, 1)].iter().enumerate() {
+        for (n, &(w, h)) in [(1, 1), (5, 3), (37, 23), (64, 64), (6, 1)]
+            .iter()
+            .enumerate()
+        {
             let base = noise(w, h, n as u64 + 20);
             let want = build_pyramid(base.clone());
             for first in 0..want.len() + 1 {
@@ -305,6 +308,8 @@ mod tests {
         let mut p = Pyramid::new(4, 1, 0, true);
         p.push_row(&base.texels[..4]).unwrap();
         assert!(p.push_row(&base.texels[4..8]).is_err());
-        assert!(Pyramid::new(4, 1, 0, true).push_row(&base.texels[..3]).is_err());
+        assert!(Pyramid::new(4, 1, 0, true)
+            .push_row(&base.texels[..3])
+            .is_err());
     }
 }
