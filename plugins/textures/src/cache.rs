@@ -13,10 +13,10 @@
 //! mutex, so two threads never decode the same file at once while other images keep being
 //! read: the file is decoded, its MIP pyramid built from the plan's first level on (`decode.rs`:
 //! an image larger than the decode cap is used at a smaller size; a texture that reads only
-//! the first level, nearest or bilinear, gets an entry of that level alone), and every level not already
-//! resident is installed — the wanted ones marked as just used, the others as never used, so they are
-//! the first to go. The missing thread samples through `Arc`s it holds itself, so it makes
-//! progress even if its levels are evicted again at once.
+//! the first level, nearest or bilinear, gets an entry of that level alone), and every level
+//! not already resident is installed — the wanted ones marked as just used, the others as
+//! never used, so they are the first to go. The missing thread samples through `Arc`s it
+//! holds itself, so it makes progress even if its levels are evicted again at once.
 //!
 //! **Eviction.** After each install, while the resident texel bytes exceed the budget, the
 //! least recently used level (ties: the largest) is evicted: its pointer is swapped to null,
