@@ -12,10 +12,11 @@
 //! **Misses.** A missing level (never loaded, or evicted) is filled under the image's own load
 //! mutex, so two threads never decode the same file at once while other images keep being
 //! read: the file is decoded, its MIP pyramid built from the plan's first level on (`decode.rs`:
-//! an image larger than the decode cap is used at a smaller size), and every level not already
-//! resident is installed — the wanted ones marked as just used, the others as never used, so they are
-//! the first to go. The missing thread samples through `Arc`s it holds itself, so it makes
-//! progress even if its levels are evicted again at once.
+//! an image larger than the decode cap is used at a smaller size; a texture that reads only
+//! the first level, nearest or bilinear, gets an entry of that level alone), and every level
+//! not already resident is installed — the wanted ones marked as just used, the others as
+//! never used, so they are the first to go. The missing thread samples through `Arc`s it
+//! holds itself, so it makes progress even if its levels are evicted again at once.
 //!
 //! **Eviction.** After each install, while the resident texel bytes exceed the budget, the
 //! least recently used level (ties: the largest) is evicted: its pointer is swapped to null,
@@ -287,6 +288,8 @@ impl Cache {
                 && i.header == header
                 && i.modified == modified
                 && i.plan.first_level == plan.first_level
+                // An entry with MIP levels serves a texture that reads only the first.
+                && (i.plan.mip || !plan.mip)
         }) {
             return img.clone();
         }
@@ -294,8 +297,14 @@ impl Cache {
             (self.log)(1, &warning);
         }
         let size = plan.size(&header);
+        let levels = if plan.mip {
+            level_sizes(size.0, size.1).len()
+        } else {
+            1
+        };
         let slots = level_sizes(size.0, size.1)
             .into_iter()
+            .take(levels)
             .map(|(w, h)| Slot {
                 data: AtomicPtr::new(ptr::null_mut()),
                 stamp: AtomicU64::new(0),
@@ -503,6 +512,7 @@ mod tests {
     const FULL: Plan = Plan {
         first_level: 0,
         cap: u64::MAX,
+        mip: true,
     };
 
     /// Messages a test cache logged: (level, text).
@@ -618,6 +628,30 @@ mod tests {
             .unwrap();
         assert_eq!(v, (2, 1));
         assert!(!img.is_resident(0) && img.is_resident(2) && img.is_resident(3));
+    }
+
+    #[test]
+    fn an_entry_without_mip_levels_holds_one_and_is_shared_only_downward() {
+        let dir = TempDir::new("cache-no-mip");
+        let p = flat(&dir, "a.png", 255);
+        let (log, _) = recorder();
+        let cache = Cache::new(0, log);
+        let h = probe(&p).unwrap();
+        let single = Plan { mip: false, ..FULL };
+        let first = cache.register(&p, h, true, single);
+        assert_eq!((first.levels(), first.bytes()), (1, 64 * 16));
+        // A MIP texture needs an entry of its own...
+        let mip = cache.register(&p, h, true, FULL);
+        assert!(!Arc::ptr_eq(&first, &mip));
+        assert_eq!(mip.levels(), 4);
+        assert_eq!(level0(&cache, &first), Ok(1.0));
+        assert_eq!(cache.stats().resident, 64 * 16);
+        assert_eq!(level0(&cache, &mip), Ok(1.0));
+        // ...while a plain texture can use a MIP entry's first level.
+        let q = flat(&dir, "b.png", 0);
+        let hq = probe(&q).unwrap();
+        let mip = cache.register(&q, hq, true, FULL);
+        assert!(Arc::ptr_eq(&cache.register(&q, hq, true, single), &mip));
     }
 
     #[test]

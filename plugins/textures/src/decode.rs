@@ -270,12 +270,17 @@ pub fn size(bytes: u64) -> String {
     }
 }
 
-/// How an image is decoded: from which MIP level on, within how many bytes.
+/// How an image is decoded: from which MIP level on, within how many bytes, and whether the
+/// coarser levels are built at all.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Plan {
     /// The first MIP level kept: the image is used at that level's size.
     pub first_level: usize,
     pub cap: u64,
+    /// Whether the levels below the first are kept too: only MIP filtering reads them, so a
+    /// nearest or bilinear texture skips building them. The first level is chosen as if they
+    /// were kept, so an image is used at the same size whatever its filter.
+    pub mip: bool,
 }
 
 /// The first level whose decode fits `cap`, or an error naming the image (`shown`), its size
@@ -283,7 +288,11 @@ pub struct Plan {
 pub fn plan(shown: &str, header: &Header, cap: u64) -> Result<Plan, Error> {
     let levels = level_sizes(header.width, header.height).len();
     match (0..levels).find(|&k| header.decode_bytes(k) <= cap) {
-        Some(first_level) => Ok(Plan { first_level, cap }),
+        Some(first_level) => Ok(Plan {
+            first_level,
+            cap,
+            mip: true,
+        }),
         None => {
             let hint = match header.layout {
                 Layout::Rows => "use a smaller image",
@@ -329,7 +338,8 @@ impl Plan {
     }
 }
 
-/// The MIP levels `plan.first_level..` of the image `header` describes (rows top to bottom).
+/// The MIP levels `plan.first_level..` of the image `header` describes (rows top to bottom);
+/// only the first of them without `plan.mip`.
 /// Errors are plain text: they are logged, not returned to the host.
 pub fn decode(path: &Path, header: &Header, srgb: bool, plan: &Plan) -> Result<Vec<Level>, String> {
     let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
@@ -385,7 +395,7 @@ fn decode_png_rows<R: BufRead + Seek>(
     let format = RowFormat::of_png(colour, depth)
         .ok_or_else(|| format!("unsupported PNG sample layout {colour:?} {depth:?}"))?;
     let convert = Converter::new(format, srgb);
-    let mut pyramid = Pyramid::new(w, h, plan.first_level);
+    let mut pyramid = Pyramid::new(w, h, plan.first_level, plan.mip);
     let mut row = texel_row(w)?;
     while let Some(r) = reader.next_row().map_err(|e| e.to_string())? {
         if r.data().len() != w * format.bytes_per_texel() {
@@ -440,7 +450,7 @@ fn decode_whole<R: BufRead + Seek>(
     buf.resize(len, 0u8);
     decoder.read_image(&mut buf).map_err(|e| e.to_string())?;
     let convert = Converter::new(format, srgb);
-    let mut pyramid = Pyramid::new(w, h, plan.first_level);
+    let mut pyramid = Pyramid::new(w, h, plan.first_level, plan.mip);
     let mut row = texel_row(w)?;
     for samples in buf.chunks_exact(w * format.bytes_per_texel()) {
         convert.row(samples, &mut row);
@@ -489,10 +499,10 @@ fn decode_exr<R: BufRead + Seek>(r: R, header: &Header, plan: &Plan) -> Result<V
     }
     let px = image.layer_data.channel_data.pixels.px;
     let (w, h) = want;
-    if level_sizes(w, h).len() == 1 {
+    if level_sizes(w, h).len() == 1 || (plan.first_level == 0 && !plan.mip) {
         return Ok(vec![Level::new(w, h, px)]);
     }
-    let mut pyramid = Pyramid::new(w, h, plan.first_level.max(1));
+    let mut pyramid = Pyramid::new(w, h, plan.first_level.max(1), plan.mip);
     for row in px.chunks_exact(w) {
         pyramid.push_row(row)?;
     }
@@ -658,6 +668,10 @@ mod tests {
     }
 
     fn decoded(path: &Path, srgb: bool, first_level: usize) -> Vec<Level> {
+        decoded_as(path, srgb, first_level, true)
+    }
+
+    fn decoded_as(path: &Path, srgb: bool, first_level: usize, mip: bool) -> Vec<Level> {
         let h = probe(path).unwrap();
         decode(
             path,
@@ -666,6 +680,7 @@ mod tests {
             &Plan {
                 first_level,
                 cap: ALL,
+                mip,
             },
         )
         .unwrap()
@@ -718,6 +733,28 @@ mod tests {
                 for (g, l) in got.iter().zip(want) {
                     assert!(bits(g) == bits(l), "{name} from level {first}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn without_mip_levels_only_the_first_is_decoded_the_same() {
+        let dir = TempDir::new("decode-no-mip");
+        let mut paths = fixtures(&dir);
+        write_exr(&dir.path("hdr.exr"), 37, 23, |x, y| {
+            let v = (x * 31 + y * 17) as f32;
+            [v.sin() * 4.0, v.cos(), v * 0.01, 0.5]
+        });
+        paths.push(dir.path("hdr.exr"));
+        for path in paths {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let full = decoded(&path, false, 0);
+            for first in 0..full.len() + 2 {
+                let got = decoded_as(&path, false, first, false);
+                let want = &full[first.min(full.len() - 1)];
+                assert_eq!(got.len(), 1, "{name} from {first}");
+                assert_eq!((got[0].width, got[0].height), (want.width, want.height));
+                assert!(bits(&got[0]) == bits(want), "{name}: level {first} differs");
             }
         }
     }

@@ -1,7 +1,7 @@
 //! The `image` entry: an image file mapped onto surfaces, filtered, through the shared cache.
 
 use crate::cache::{self, Cache, CachedImage};
-use crate::decode::{plan, probe};
+use crate::decode::{plan, probe, Plan};
 use crate::mapping::{Kind, Mapping};
 use crate::mipmap::{bilinear, level_pair, mip_level, nearest, trilinear, Wrap};
 use crate::params::{up, yes, Factors};
@@ -121,7 +121,11 @@ impl ImageTexture {
         }
         let path = ctx.resolve(&p.file);
         let header = probe(&path)?;
-        let plan = plan(&path.display().to_string(), &header, decode_cap(ctx))?;
+        let plan = Plan {
+            // Only MIP filtering reads the coarser levels.
+            mip: p.filter == Filter::Mip,
+            ..plan(&path.display().to_string(), &header, decode_cap(ctx))?
+        };
         let image = cache.register(&path, header, p.srgb, plan);
         Ok(ImageTexture {
             cache,
@@ -154,16 +158,18 @@ impl Texture for ImageTexture {
     }
 
     fn try_eval(&self, q: &TexQuery) -> Result<[f32; 4], Error> {
-        let l = self.mapping.lookup(q);
         let (wrap, img) = (self.wrap, &*self.image);
         let got = match self.filter {
-            Filter::Nearest => self
-                .cache
-                .with_levels(img, 0, 0, |a, _| nearest(a, l.s, l.t, wrap)),
-            Filter::Bilinear => self
-                .cache
-                .with_levels(img, 0, 0, |a, _| bilinear(a, l.s, l.t, wrap)),
+            Filter::Nearest => {
+                let (s, t) = self.mapping.point(q);
+                (self.cache).with_levels(img, 0, 0, |a, _| nearest(a, s, t, wrap))
+            }
+            Filter::Bilinear => {
+                let (s, t) = self.mapping.point(q);
+                (self.cache).with_levels(img, 0, 0, |a, _| bilinear(a, s, t, wrap))
+            }
             Filter::Mip => {
+                let l = self.mapping.lookup(q);
                 // The footprint in level-0 texels: the wider of the two directions.
                 let texels = (l.ds * img.width() as f64).max(l.dt * img.height() as f64);
                 let n = img.levels();
@@ -492,7 +498,8 @@ mod tests {
         let near = mk(r#"(file: "wide.png", filter: nearest)"#);
         let _again = mk(r#"(file: "wide.png", filter: bilinear)"#);
         assert_eq!((near.image.width(), near.image.height()), (16, 16));
-        assert_eq!(near.image.levels(), 5);
+        // No MIP levels: nearest and bilinear filtering read only the first.
+        assert_eq!(near.image.levels(), 1);
         let seen = seen.lock().unwrap().clone();
         assert_eq!(seen.len(), 1, "one warning per image: {seen:?}");
         assert_eq!(seen[0].0, 1);
@@ -561,6 +568,39 @@ mod tests {
     }
 
     #[test]
+    fn plain_filters_read_the_same_texels_without_mip_levels() {
+        let dir = TempDir::new("img-no-mip");
+        write_png(&dir.path("n.png"), 13, 7, |x, y| {
+            let v = (x * 19 + y * 37) as u8;
+            [v, v / 2, 255 - v, 255]
+        });
+        let mk = |cache: &Arc<Cache>, params: &str| {
+            let p: ImageParams = luxon_plugin::parse_params(params).unwrap();
+            ImageTexture::create_in(p, &ctx_in(dir.dir()), cache.clone()).unwrap()
+        };
+        // Alone, a bilinear texture's entry has no MIP levels; after a MIP texture of the same
+        // file, it shares that one's pyramid.
+        let alone = Arc::new(Cache::new(0, quiet()));
+        let shared = Arc::new(Cache::new(0, quiet()));
+        for filter in ["nearest", "bilinear"] {
+            let params = format!(r#"(file: "n.png", filter: {filter})"#);
+            let plain = mk(&alone, &params);
+            let _mip = mk(&shared, r#"(file: "n.png")"#);
+            let beside = mk(&shared, &params);
+            assert_eq!((plain.image.levels(), beside.image.levels()), (1, 4));
+            for k in 0..50 {
+                let uv = [k as f32 * 0.071 - 0.3, k as f32 * 0.043 + 0.1];
+                let (a, b) = (at_uv(&plain, uv, 0.0), at_uv(&beside, uv, 0.0));
+                assert_eq!(
+                    a.map(f32::to_bits),
+                    b.map(f32::to_bits),
+                    "{filter} at {uv:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn instances_share_one_cached_image() {
         let dir = TempDir::new("img-share");
         fixture(&dir);
@@ -570,7 +610,7 @@ mod tests {
             ImageTexture::create_in(p, &ctx_in(dir.dir()), cache.clone()).unwrap()
         };
         let a = mk(r#"(file: "ramp.png", filter: nearest)"#);
-        let b = mk(r#"(file: "ramp.png", mapping: planar)"#);
+        let b = mk(r#"(file: "ramp.png", filter: bilinear, mapping: planar)"#);
         assert!(Arc::ptr_eq(&a.image, &b.image));
         at_uv(&a, [0.5, 0.5], 0.0);
         at(&b, [0.5, 0.0, -0.5]);

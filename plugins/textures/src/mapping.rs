@@ -119,8 +119,9 @@ impl Mapping {
         })
     }
 
-    /// `(u, v)` and the footprint's size in `(u, v)` units along u and v.
-    fn uv(&self, q: &TexQuery) -> (f64, f64, f64, f64) {
+    /// `(u, v)` and the footprint's size in `(u, v)` units along u and v (0 without
+    /// `FOOTPRINT`: only MIP filtering reads it, and its `hypot` is not free).
+    fn uv<const FOOTPRINT: bool>(&self, q: &TexQuery) -> (f64, f64, f64, f64) {
         if self.kind == Kind::Uv {
             let f = q.uv_footprint.max(0.0) as f64;
             return (q.uv[0] as f64, q.uv[1] as f64, f, f);
@@ -142,6 +143,7 @@ impl Mapping {
         };
         match self.kind {
             Kind::Uv | Kind::Planar => (a, b, fp, fp),
+            Kind::Cylindrical if !FOOTPRINT => (longitude(), h, 0.0, 0.0),
             Kind::Cylindrical => {
                 // An arc of length fp at distance r from the axis spans fp / (2π r) in u.
                 let r = a.hypot(b);
@@ -150,6 +152,9 @@ impl Mapping {
             Kind::Spherical => {
                 let r = dot(d, d).sqrt();
                 let lat = (h / r).clamp(-1.0, 1.0).asin();
+                if !FOOTPRINT {
+                    return (longitude(), 0.5 + lat / PI, 0.0, 0.0);
+                }
                 let ring = a.hypot(b);
                 (
                     longitude(),
@@ -164,15 +169,37 @@ impl Mapping {
     /// Image coordinates and footprint for a query. Degenerate points (on the axis, at the
     /// centre) give infinite footprints (the coarsest level) rather than NaN.
     pub fn lookup(&self, q: &TexQuery) -> Lookup {
-        let (u, v, du, dv) = self.uv(q);
+        self.resolve::<true>(q)
+    }
+
+    /// Image coordinates `(s, t)` alone, as [`Self::lookup`] gives them (for the filters that
+    /// read no footprint).
+    pub fn point(&self, q: &TexQuery) -> (f64, f64) {
+        let l = self.resolve::<false>(q);
+        (l.s, l.t)
+    }
+
+    /// [`Self::lookup`]; the footprint is left 0 without `FOOTPRINT`.
+    #[inline(always)]
+    fn resolve<const FOOTPRINT: bool>(&self, q: &TexQuery) -> Lookup {
+        let (u, v, du, dv) = self.uv::<FOOTPRINT>(q);
         let (u, v) = (u - self.offset[0], v - self.offset[1]);
         let (c, s) = self.rot;
         let (ru, rv) = (c * u - s * v, s * u + c * v);
         let clean = |x: f64| if x.is_nan() { 0.0 } else { x };
         let fix = |x: f64| if x.is_nan() { f64::INFINITY } else { x };
+        let (s, t) = (clean(ru / self.scale[0]), clean(rv / self.scale[1]));
+        if !FOOTPRINT {
+            return Lookup {
+                s,
+                t,
+                ds: 0.0,
+                dt: 0.0,
+            };
+        }
         Lookup {
-            s: clean(ru / self.scale[0]),
-            t: clean(rv / self.scale[1]),
+            s,
+            t,
             ds: fix(du / self.scale[0].abs()),
             dt: fix(dv / self.scale[1].abs()),
         }
@@ -204,6 +231,44 @@ mod tests {
 
     fn near(l: Lookup, s: f64, t: f64) -> bool {
         (l.s - s).abs() < 1e-12 && (l.t - t).abs() < 1e-12
+    }
+
+    #[test]
+    fn the_point_alone_is_the_lookups_point_bit_for_bit() {
+        let kinds = [Kind::Uv, Kind::Planar, Kind::Cylindrical, Kind::Spherical];
+        for (n, kind) in kinds.into_iter().enumerate() {
+            let mp = Mapping::new(
+                kind,
+                [0.3, -1.0, 2.0],
+                [0.2, 1.0, -0.4],
+                Factors([0.7, -1.3]),
+                25.0,
+                [0.1, 0.2],
+            )
+            .unwrap();
+            for k in 0..200 {
+                let f = (k * 7 + n) as f64;
+                let q = TexQuery {
+                    p: [f.sin() * 5.0, (f * 0.37).cos() * 3.0, f * 0.01 - 1.0],
+                    uv: [(f * 0.13).sin() as f32, (f * 0.07).cos() as f32],
+                    footprint: 0.01,
+                    uv_footprint: 0.002,
+                    ..Default::default()
+                };
+                let (full, (s, t)) = (mp.lookup(&q), mp.point(&q));
+                assert_eq!(
+                    (full.s.to_bits(), full.t.to_bits()),
+                    (s.to_bits(), t.to_bits())
+                );
+            }
+            // The centre itself (NaN cleaned to 0 in both).
+            let q = TexQuery {
+                p: [0.3, -1.0, 2.0],
+                ..Default::default()
+            };
+            let full = mp.lookup(&q);
+            assert_eq!((full.s, full.t), mp.point(&q), "{kind:?}");
+        }
     }
 
     #[test]

@@ -178,6 +178,18 @@ pub fn wrap_index(i: i64, n: usize, wrap: Wrap) -> usize {
     }) as usize
 }
 
+/// Texel indices `i` and `i + 1` on an axis of `n` texels under `wrap`, as [`wrap_index`]
+/// gives them; repeating, the second follows from the first without a second division.
+#[inline(always)]
+pub fn wrap_pair(i: i64, n: usize, wrap: Wrap) -> (usize, usize) {
+    let a = wrap_index(i, n, wrap);
+    if wrap == Wrap::Repeat && i < i64::MAX {
+        // (i + 1) mod n = (i mod n + 1) mod n.
+        return (a, if a + 1 < n { a + 1 } else { 0 });
+    }
+    (a, wrap_index(i.saturating_add(1), n, wrap))
+}
+
 /// Continuous texel coordinates of `(s, t)` on `level` (texel centres at integers + 0.5);
 /// non-finite coordinates become 0.
 fn texel_coords(level: &Level, s: f64, t: f64) -> (f64, f64) {
@@ -202,10 +214,8 @@ pub fn bilinear(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
     let (x0, y0) = (x0 as i64, y0 as i64);
-    let xa = wrap_index(x0, level.width, wrap);
-    let xb = wrap_index(x0.saturating_add(1), level.width, wrap);
-    let ya = wrap_index(y0, level.height, wrap);
-    let yb = wrap_index(y0.saturating_add(1), level.height, wrap);
+    let (xa, xb) = wrap_pair(x0, level.width, wrap);
+    let (ya, yb) = wrap_pair(y0, level.height, wrap);
     let (p00, p10, p01, p11) = (
         level.at(xa, ya),
         level.at(xb, ya),
@@ -366,6 +376,19 @@ mod tests {
                 .collect::<Vec<_>>(),
             [2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]
         );
+        // Pairs of neighbours agree with the rule applied to each, also at the extremes.
+        for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror] {
+            for n in [1, 2, 5] {
+                let far = [i64::MIN, i64::MIN + 1, i64::MAX - 1, i64::MAX];
+                for i in (-12..12).chain(far) {
+                    let want = (
+                        wrap_index(i, n, wrap),
+                        wrap_index(i.saturating_add(1), n, wrap),
+                    );
+                    assert_eq!(wrap_pair(i, n, wrap), want, "{wrap:?} {i} of {n}");
+                }
+            }
+        }
         let l = ramp(4, 1);
         // s = 1.1 is texel 4.4: repeat -> 0, clamp -> 3, mirror -> 3.
         assert_eq!(nearest(&l, 1.1, 0.5, Wrap::Repeat), grey(0.0));

@@ -1,7 +1,7 @@
 //! MIP levels built row by row, as an image is decoded: a cascade of 2× reducers.
 //!
 //! [`Pyramid`] takes the rows of level 0, top to bottom, and keeps only the levels from
-//! `first` down to 1×1. Level 0 is never held whole (unless `first` is 0): each reducer holds
+//! `first` down to 1×1 (or level `first` alone, when no MIP levels are wanted). Level 0 is never held whole (unless `first` is 0): each reducer holds
 //! at most three rows of its input, reduced horizontally, and emits a row of the next level as
 //! soon as the rows it covers have arrived. The arithmetic is [`reduce_sample`]'s, in the order
 //! `mipmap::downsample` uses (each row horizontally, then each column vertically), so every
@@ -105,15 +105,17 @@ pub struct Pyramid {
 }
 
 impl Pyramid {
-    /// `first` may be past the last level (1×1): then only the last level is kept.
-    pub fn new(width: usize, height: usize, first: usize) -> Pyramid {
+    /// `first` may be past the last level (1×1): then only the last level is kept. Without
+    /// `mip`, only level `first` is kept, and nothing coarser is computed.
+    pub fn new(width: usize, height: usize, first: usize, mip: bool) -> Pyramid {
         let sizes = level_sizes(width, height);
         let first = first.min(sizes.len() - 1);
-        let reducers = sizes[..sizes.len() - 1]
+        let last = if mip { sizes.len() - 1 } else { first };
+        let reducers = sizes[..last]
             .iter()
             .map(|&(w, h)| Reducer::new(w, h))
             .collect();
-        let levels = vec![Vec::new(); sizes.len() - first];
+        let levels = vec![Vec::new(); last + 1 - first];
         Pyramid {
             sizes,
             first,
@@ -212,7 +214,7 @@ mod tests {
     }
 
     fn streamed(base: &Level, first: usize) -> Vec<Level> {
-        let mut p = Pyramid::new(base.width, base.height, first);
+        let mut p = Pyramid::new(base.width, base.height, first, true);
         for row in base.texels.chunks(base.width) {
             p.push_row(row).unwrap();
         }
@@ -257,9 +259,32 @@ mod tests {
     }
 
     #[test]
+    fn without_mip_only_the_first_level_is_built_the_same() {
+        for (n, &(w, h)) in [(1, 1), (5, 3), (37, 23), (64, 64), (6, 1)]
+            .iter()
+            .enumerate()
+        {
+            let base = noise(w, h, n as u64 + 20);
+            let want = build_pyramid(base.clone());
+            for first in 0..want.len() + 1 {
+                let mut p = Pyramid::new(w, h, first, false);
+                assert_eq!(p.reducers.len(), first.min(want.len() - 1));
+                for row in base.texels.chunks(w) {
+                    p.push_row(row).unwrap();
+                }
+                let got = p.finish().unwrap();
+                let l = &want[first.min(want.len() - 1)];
+                assert_eq!(got.len(), 1, "{w}x{h} from {first}");
+                assert_eq!((got[0].width, got[0].height), (l.width, l.height));
+                assert!(bits(&got[0]) == bits(l), "{w}x{h}: level {first} differs");
+            }
+        }
+    }
+
+    #[test]
     fn only_the_kept_levels_are_held() {
         let base = noise(1024, 1024, 9);
-        let mut p = Pyramid::new(1024, 1024, 2);
+        let mut p = Pyramid::new(1024, 1024, 2, true);
         for row in base.texels.chunks(1024) {
             p.push_row(row).unwrap();
             // Each reducer holds at most three rows.
@@ -276,13 +301,15 @@ mod tests {
     #[test]
     fn missing_and_extra_rows_are_errors() {
         let base = noise(4, 3, 3);
-        let mut p = Pyramid::new(4, 3, 0);
+        let mut p = Pyramid::new(4, 3, 0, true);
         p.push_row(&base.texels[..4]).unwrap();
         let e = p.finish().unwrap_err();
         assert!(e.contains("ends after 1 of its 3 rows"), "{e}");
-        let mut p = Pyramid::new(4, 1, 0);
+        let mut p = Pyramid::new(4, 1, 0, true);
         p.push_row(&base.texels[..4]).unwrap();
         assert!(p.push_row(&base.texels[4..8]).is_err());
-        assert!(Pyramid::new(4, 1, 0).push_row(&base.texels[..3]).is_err());
+        assert!(Pyramid::new(4, 1, 0, true)
+            .push_row(&base.texels[..3])
+            .is_err());
     }
 }
