@@ -26,7 +26,7 @@ use luxon::output::preview::Preview;
 use luxon::plugin::Registry;
 use luxon::schedule::wire::FrameResult;
 use luxon::Error;
-use luxon_formats::SceneDesc;
+use luxon_formats::{OutputIo, SceneDesc};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -270,6 +270,11 @@ pub fn run(
         registry: ctx.registry(),
         scene_dir: scene_dir_of(scene.desc()),
         build_time: t0.elapsed(),
+        // Several groups render frames side by side into the same directories: MPI-IO
+        // outputs are then written by each group's leader (as `Async`), since an MPI-IO
+        // temporary file is unlocked while the ranks write it, and another group starting a
+        // frame there would sweep it as stale.
+        mpi_io: group >= job.size(),
     };
     if group < job.size() {
         #[cfg(feature = "mpi")]
@@ -407,6 +412,8 @@ pub(super) struct Each<'a> {
     registry: &'a Registry,
     scene_dir: PathBuf,
     build_time: Duration,
+    /// Whether MPI-IO outputs are written by every rank (one group) or gathered.
+    mpi_io: bool,
 }
 
 impl Each<'_> {
@@ -427,6 +434,7 @@ impl Each<'_> {
             self.registry,
             job,
             &self.scene_dir,
+            self.mpi_io,
         ) {
             Ok(Some(image)) => image,
             Ok(None) => return None,
@@ -466,19 +474,17 @@ fn frame(
     registry: &Registry,
     job: &Job,
     scene_dir: &Path,
+    mpi_io: bool,
 ) -> Result<Option<Image>, Error> {
     let ready = scene.set_frame(k).and_then(|()| {
         scene.commit(renderer)?;
         let outputs = luxon::output::resolve(&names.outputs_for(k), registry)?;
         let budget = &built(scene)?.budget;
-        plan(
-            &scene.desc().render,
-            outputs,
-            job,
-            registry,
-            scene_dir,
-            budget,
-        )
+        let mut render = scene.desc().render.clone();
+        if !mpi_io && render.parallel.io == OutputIo::MpiIo {
+            render.parallel.io = OutputIo::Async;
+        }
+        plan(&render, outputs, job, registry, scene_dir, budget)
     });
     let (ready, status) = match ready {
         Ok(p) => (Some(p), Ok(renderer.threads())),
