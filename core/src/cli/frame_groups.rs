@@ -72,7 +72,7 @@ pub(super) fn run(
             let report = |r: FrameResult| lock().report(r);
             std::thread::scope(|sc| {
                 sc.spawn(|| queue.deal(groups - 1, &next, &report));
-                frames(each, scene, &group, next, |r| report(r));
+                frames(each, scene, &group, next, report);
             });
             Some(tally.into_inner().unwrap_or_else(PoisonError::into_inner))
         }

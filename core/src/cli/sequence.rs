@@ -426,16 +426,7 @@ impl Each<'_> {
         job: &Job,
     ) -> Option<Result<Vec<String>, String>> {
         let t = Instant::now();
-        let image = match frame(
-            k,
-            scene,
-            self.names,
-            self.renderer,
-            self.registry,
-            job,
-            &self.scene_dir,
-            self.mpi_io,
-        ) {
+        let image = match frame(self, k, scene, job) {
             Ok(Some(image)) => image,
             Ok(None) => return None,
             Err(e) => return (job.rank() == 0).then(|| Err(e.to_string())),
@@ -466,28 +457,26 @@ impl Each<'_> {
 
 /// Sets, renders and writes frame `k` on every rank; rank 0 gets what it wrote. A frame that
 /// cannot be set up on some rank is skipped by all (the ranks agree first).
-fn frame(
-    k: u32,
-    scene: &mut Scene,
-    names: &FrameNames,
-    renderer: &Renderer,
-    registry: &Registry,
-    job: &Job,
-    scene_dir: &Path,
-    mpi_io: bool,
-) -> Result<Option<Image>, Error> {
+fn frame(each: &Each, k: u32, scene: &mut Scene, job: &Job) -> Result<Option<Image>, Error> {
     let ready = scene.set_frame(k).and_then(|()| {
-        scene.commit(renderer)?;
-        let outputs = luxon::output::resolve(&names.outputs_for(k), registry)?;
+        scene.commit(each.renderer)?;
+        let outputs = luxon::output::resolve(&each.names.outputs_for(k), each.registry)?;
         let budget = &built(scene)?.budget;
         let mut render = scene.desc().render.clone();
-        if !mpi_io && render.parallel.io == OutputIo::MpiIo {
+        if !each.mpi_io && render.parallel.io == OutputIo::MpiIo {
             render.parallel.io = OutputIo::Async;
         }
-        plan(&render, outputs, job, registry, scene_dir, budget)
+        plan(
+            &render,
+            outputs,
+            job,
+            each.registry,
+            &each.scene_dir,
+            budget,
+        )
     });
     let (ready, status) = match ready {
-        Ok(p) => (Some(p), Ok(renderer.threads())),
+        Ok(p) => (Some(p), Ok(each.renderer.threads())),
         Err(e) => (None, Err(e)),
     };
     let threads = match job.agree(status) {
@@ -498,5 +487,13 @@ fn frame(
     let Some(plan) = ready else {
         return Err(Error::Render(format!("frame {k} is not ready")));
     };
-    write_image(scene, plan, job, renderer, &threads, registry, scene_dir)
+    write_image(
+        scene,
+        plan,
+        job,
+        each.renderer,
+        &threads,
+        each.registry,
+        &each.scene_dir,
+    )
 }
