@@ -239,6 +239,200 @@ mod with_mpi {
         }
     }
 
+    /// The files of a sequence in `d` (name, bytes), without the record directory.
+    fn files(d: &Path) -> Vec<(String, Vec<u8>)> {
+        let mut v: Vec<_> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap())
+            .filter(|e| !e.file_name().to_string_lossy().ends_with(".luxon-frames"))
+            .map(|e| {
+                let name = e.file_name().to_string_lossy().to_string();
+                (name, std::fs::read(e.path()).unwrap())
+            })
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// `scenes/carousel.ron` (in `dir`) whose camera's `up` passes through zero length at
+    /// frame 1, so frame 1 fails and frames 0 and 2 render.
+    fn broken_carousel(dir: &Path) -> PathBuf {
+        let s = root().join("scenes/carousel.ron");
+        let studio = root().join("scenes/include/studio.ron");
+        let text = std::fs::read_to_string(&s)
+            .unwrap()
+            .replace(
+                "\"include/studio.ron\"",
+                &format!("{:?}", studio.display().to_string()),
+            )
+            .replace(
+                "        camera: (\n",
+                "        camera: (\n            up: (keys: [(0, (0, 1, 0)), (2, (0, -1, 0))]),\n",
+            );
+        let broken = dir.join("broken.ron");
+        std::fs::write(&broken, text).unwrap();
+        broken
+    }
+
+    /// How many frames a run announced as written.
+    fn wrote(o: &Output) -> usize {
+        stderr(o).matches("luxon: wrote ").count()
+    }
+
+    /// Whole frames per rank, groups of two ranks (the last of three alone) and every rank on
+    /// every frame all write the files one process writes; rerun under MPI, a finished
+    /// sequence renders nothing, and a deleted frame is the only one rendered again.
+    #[test]
+    fn frame_groups_match_one_process_and_resume() {
+        let dir = temp_dir("mpi-frame-groups");
+        let s = root().join("scenes/carousel.ron").display().to_string();
+        let frames = ["--frames", "0..47", "--step", "12", "--res", "40x30"];
+        let one = dir.join("one");
+        let pattern = one.join("f%02d.ppm").display().to_string();
+        let mut args = vec!["render", &s, "--threads", "1", "-o", &pattern];
+        args.extend(frames);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let want = files(&one);
+        assert_eq!(want.len(), 4);
+        let runs: &[(usize, &[&str])] = &[
+            (2, &["--frame-groups", "whole"]),
+            (
+                3,
+                &["--frame-groups", "whole", "--decomposition", "pixel-cyclic"],
+            ),
+            (3, &["--frame-groups", "2"]),
+            (
+                3,
+                &[
+                    "--frame-groups",
+                    "2",
+                    "--parallel",
+                    "hybrid",
+                    "--threads",
+                    "2",
+                ],
+            ),
+            (2, &["--frame-groups", "shared"]),
+            (3, &["--frame-groups", "2", "--io", "mpi-io"]),
+        ];
+        for (i, (ranks, extra)) in runs.iter().enumerate() {
+            let out = dir.join(format!("run{i}"));
+            let pattern = out.join("f%02d.ppm").display().to_string();
+            let mut args = vec!["render", &s, "-o", &pattern];
+            args.extend(frames);
+            args.extend(*extra);
+            let (o, _) = mpirun(*ranks, &args, &[]);
+            assert!(o.status.success(), "-np {ranks} {extra:?}: {}", stderr(&o));
+            assert_eq!(wrote(&o), 4, "-np {ranks} {extra:?}: {}", stderr(&o));
+            assert!(
+                files(&out) == want,
+                "-np {ranks} {extra:?}: the frames differ"
+            );
+            if i != 2 {
+                continue;
+            }
+            let (o, _) = mpirun(*ranks, &args, &[]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            assert!(
+                stderr(&o).contains("all 4 frames are done already") && wrote(&o) == 0,
+                "{}",
+                stderr(&o)
+            );
+            std::fs::remove_file(out.join("f24.ppm")).unwrap();
+            let (o, _) = mpirun(*ranks, &args, &[]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            assert_eq!(wrote(&o), 1, "{}", stderr(&o));
+            assert!(stderr(&o).contains("f24.ppm (frame 24"), "{}", stderr(&o));
+            assert!(files(&out) == want, "resumed: the frames differ");
+        }
+    }
+
+    /// Under whole frames and groups, a frame that fails is reported by its number, the
+    /// others are written, and the job ends with status 1 (not an abort).
+    #[test]
+    fn a_failed_frame_under_frame_groups_is_a_result() {
+        let dir = temp_dir("mpi-frame-fail");
+        let b = broken_carousel(&dir).display().to_string();
+        for (ranks, groups) in [(2, "whole"), (3, "whole"), (3, "2")] {
+            let out = dir.join(format!("np{ranks}-{groups}"));
+            let pattern = out.join("f%d.ppm").display().to_string();
+            let args = [
+                "render",
+                &b,
+                "--frames",
+                "0..2",
+                "--res",
+                "24x18",
+                "--frame-groups",
+                groups,
+                "-o",
+                &pattern,
+            ];
+            let (o, _) = mpirun(ranks, &args, &[]);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(1), "{ranks} {groups}: {e}");
+            assert!(
+                e.contains("luxon: error: frame 1: "),
+                "{ranks} {groups}: {e}"
+            );
+            assert!(
+                e.contains("1 of 3 frames failed (1); the other frames are written"),
+                "{ranks} {groups}: {e}"
+            );
+            assert!(!e.contains("MPI_ABORT"), "{ranks} {groups}: {e}");
+            let names: Vec<String> = files(&out).into_iter().map(|(n, _)| n).collect();
+            assert_eq!(names, ["f0.ppm", "f2.ppm"], "{ranks} {groups}");
+        }
+    }
+
+    /// Ranks that cannot see the directory rank 0 writes the frame records to are refused
+    /// before any frame: here the two ranks start in different directories and the output
+    /// name is relative.
+    #[test]
+    fn frame_groups_need_a_shared_output_directory() {
+        ensure_plugins();
+        let dir = temp_dir("mpi-frame-dir");
+        let (a, b) = (dir.join("a"), dir.join("b"));
+        std::fs::create_dir_all(&a).unwrap();
+        std::fs::create_dir_all(&b).unwrap();
+        let s = root().join("scenes/carousel.ron").display().to_string();
+        let exe = env!("CARGO_BIN_EXE_luxon");
+        let luxon_args = [
+            exe,
+            "render",
+            &s,
+            "--frames",
+            "0..1",
+            "--res",
+            "16x12",
+            "--frame-groups",
+            "whole",
+            "-o",
+            "out/f%d.ppm",
+        ];
+        let mut cmd = Command::new("mpirun");
+        cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .args(["--oversubscribe", "--bind-to", "none", "--timeout"])
+            .arg(DEADLINE.as_secs().to_string())
+            .args(["-np", "1", "-wdir", a.to_str().unwrap()])
+            .args(luxon_args)
+            .args([":", "-np", "1", "-wdir", b.to_str().unwrap()])
+            .args(luxon_args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        let (o, _) = run_with_deadline(&mut cmd, DEADLINE + Duration::from_secs(15), "mpirun");
+        let e = stderr(&o);
+        assert!(!o.status.success(), "{e}");
+        assert!(
+            e.contains("rank 1: the output directory is not shared between ranks")
+                && e.contains("out/.f%d.ppm.luxon-frames"),
+            "{e}"
+        );
+        assert!(!a.join("out/f0.ppm").exists() && !b.join("out").exists());
+    }
+
     /// An animated scene's frames under 2 and 3 ranks equal one process's, file for file;
     /// a frame that fails (its camera degenerates) is skipped by every rank, the others
     /// written, and the job ends with status 1.
@@ -246,19 +440,6 @@ mod with_mpi {
     fn animation_frames_match_one_process() {
         let dir = temp_dir("mpi-frames");
         let s = root().join("scenes/carousel.ron").display().to_string();
-        let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
-            let mut v: Vec<_> = std::fs::read_dir(d)
-                .unwrap()
-                .map(|e| e.unwrap())
-                .filter(|e| !e.file_name().to_string_lossy().ends_with(".luxon-frames"))
-                .map(|e| {
-                    let name = e.file_name().to_string_lossy().to_string();
-                    (name, std::fs::read(e.path()).unwrap())
-                })
-                .collect();
-            v.sort();
-            v
-        };
         let frames = ["--frames", "0..47", "--step", "23", "--res", "48x36"];
         let one = dir.join("one");
         let pattern = one.join("f%02d.ppm").display().to_string();
@@ -287,20 +468,7 @@ mod with_mpi {
                 stderr(&o)
             );
         }
-        // At frame 1 the camera's `up` passes through zero length.
-        let studio = root().join("scenes/include/studio.ron");
-        let text = std::fs::read_to_string(&s)
-            .unwrap()
-            .replace(
-                "\"include/studio.ron\"",
-                &format!("{:?}", studio.display().to_string()),
-            )
-            .replace(
-                "        camera: (\n",
-                "        camera: (\n            up: (keys: [(0, (0, 1, 0)), (2, (0, -1, 0))]),\n",
-            );
-        let broken = dir.join("broken.ron");
-        std::fs::write(&broken, text).unwrap();
+        let broken = broken_carousel(&dir);
         let out = dir.join("broken");
         let pattern = out.join("f%d.ppm").display().to_string();
         let b = broken.display().to_string();

@@ -568,6 +568,16 @@ impl Checker<'_> {
                 Some(raw::IoMode::MpiIo) => OutputIo::MpiIo,
                 None => d.io,
             },
+            frames: match p.frames {
+                Some(raw::Frames::Whole) => FrameGroups::Whole,
+                Some(raw::Frames::Shared) => FrameGroups::Shared,
+                Some(raw::Frames::Groups(n)) => {
+                    let at = field("frames");
+                    let n = self.whole(at.item(0).unwrap_or(at), "Groups", n, 1, 65536)?;
+                    FrameGroups::Groups(n)
+                }
+                None => d.frames,
+            },
         })
     }
 }

@@ -928,6 +928,8 @@ pub struct ParallelDesc {
     pub tile_size: u32,
     /// How finished pixels reach the output files.
     pub io: OutputIo,
+    /// How the MPI ranks share the frames of a sequence.
+    pub frames: FrameGroups,
 }
 
 impl Default for ParallelDesc {
@@ -938,6 +940,7 @@ impl Default for ParallelDesc {
             decomposition: Decomposition::Dynamic,
             tile_size: 16,
             io: OutputIo::Async,
+            frames: FrameGroups::Auto,
         }
     }
 }
@@ -970,6 +973,37 @@ pub enum OutputIo {
     /// Every MPI rank writes its own pixels of 8-bit PPM outputs (`MPI_File_write_at_all`);
     /// other outputs, and runs without MPI, as `Async`.
     MpiIo,
+}
+
+/// How the MPI ranks of a job share the frames of a sequence (`render: (parallel: (frames:
+/// ...))`). Every choice gives the same images; they differ in speed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FrameGroups {
+    /// `Whole` when the run has at least as many frames as ranks, else `Shared`.
+    #[default]
+    Auto,
+    /// Each rank renders whole frames taken from a queue (groups of one rank).
+    Whole,
+    /// Consecutive ranks form groups of this many (the last may be smaller); each group takes
+    /// frames from the queue and shares each frame's pixels by `decomposition`.
+    Groups(u32),
+    /// Every rank works on every frame (one group of all ranks).
+    Shared,
+}
+
+impl FrameGroups {
+    /// Ranks per group for a run of `frames` frames on `ranks` ranks (at least 1, at most
+    /// `ranks`).
+    pub fn group_size(self, frames: usize, ranks: usize) -> usize {
+        let ranks = ranks.max(1);
+        let n = match self {
+            FrameGroups::Auto if frames >= ranks => 1,
+            FrameGroups::Auto | FrameGroups::Shared => ranks,
+            FrameGroups::Whole => 1,
+            FrameGroups::Groups(n) => n as usize,
+        };
+        n.clamp(1, ranks)
+    }
 }
 
 /// A scene's time: which frames it has and how keyed values change from frame to frame. Time is

@@ -668,6 +668,15 @@ pub(crate) struct Parallel {
     pub decomposition: Option<Decomposition>,
     pub tile_size: Option<f64>,
     pub io: Option<IoMode>,
+    pub frames: Option<Frames>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename = "FrameGroups")]
+pub(crate) enum Frames {
+    Whole,
+    Groups(f64),
+    Shared,
 }
 
 #[derive(Deserialize, Clone, Copy)]

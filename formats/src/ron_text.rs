@@ -1126,6 +1126,7 @@ pub(crate) fn render_fields(
         decomposition,
         tile_size,
         io,
+        frames,
     } = parallel;
     let mode = match mode {
         ParallelMode::Threads => "Threads",
@@ -1144,11 +1145,17 @@ pub(crate) fn render_fields(
         OutputIo::MpiIo => "MpiIo",
     };
     let threads = threads.map_or(String::new(), |t| format!(" threads: {t},"));
+    let frames = match frames {
+        FrameGroups::Auto => String::new(),
+        FrameGroups::Whole => ", frames: Whole".into(),
+        FrameGroups::Groups(n) => format!(", frames: Groups({n})"),
+        FrameGroups::Shared => ", frames: Shared".into(),
+    };
     f.push((
         "parallel",
         format!(
             "parallel: (mode: {mode},{threads} decomposition: {decomposition}, tile_size: \
-             {tile_size}, io: {io})"
+             {tile_size}, io: {io}{frames})"
         ),
     ));
     let TransparencyDesc {

@@ -481,6 +481,29 @@ fn render_limits() {
     );
 }
 
+#[test]
+fn frame_groups() {
+    // Reported at the group size inside `Groups(...)`, or at the unknown name.
+    check(
+        render_error("parallel: (frames: Groups(0))"),
+        3,
+        40,
+        &["`Groups` is 0", "1 to 65536"],
+    );
+    check(
+        render_error("parallel: (frames: Groups(1.5))"),
+        3,
+        40,
+        &["`Groups` is 1.5", "whole number"],
+    );
+    check(
+        render_error("parallel: (frames: Hole)"),
+        3,
+        33,
+        &["unknown variant `Hole`", "`Whole`", "`Shared`"],
+    );
+}
+
 // ---- Hostile and careless input ----
 
 /// ron's recursion limit, in words for a scene's author (not ron's options).

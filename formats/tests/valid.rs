@@ -146,6 +146,7 @@ fn render_outputs_and_paths() {
             decomposition: Decomposition::BlockCyclic,
             tile_size: 32,
             io: OutputIo::Sync,
+            frames: FrameGroups::Auto,
         }
     );
     assert_eq!(r.outputs.len(), 2);
@@ -293,4 +294,41 @@ fn gradient_backgrounds() {
         load("(0.5, 0.25, 1)"),
         BackgroundDesc::Color([0.5, 0.25, 1.0])
     );
+}
+
+/// `parallel: (frames: ...)`: each spelling, its default, and the text `to_ron` writes back.
+#[test]
+fn frame_groups_parse_and_round_trip() {
+    let cases = [
+        ("", FrameGroups::Auto),
+        (", frames: Whole", FrameGroups::Whole),
+        (", frames: Groups(2)", FrameGroups::Groups(2)),
+        (", frames: Shared", FrameGroups::Shared),
+    ];
+    for (text, want) in cases {
+        let scene = format!(
+            "(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), \
+             render: (parallel: (mode: Mpi{text})))"
+        );
+        let desc = load_ron_str(&scene, Path::new("/scenes/f.ron")).unwrap();
+        assert_eq!(desc.render.parallel.frames, want, "{text}");
+        let written = to_ron(&desc, Path::new("/scenes")).unwrap();
+        let again = load_ron_str(&written, Path::new("/scenes/f.ron")).unwrap();
+        assert_eq!(again.render.parallel.frames, want, "{written}");
+    }
+}
+
+#[test]
+fn frame_group_sizes() {
+    use FrameGroups::*;
+    // Auto: whole frames when every rank can have one, else every rank on every frame.
+    assert_eq!(Auto.group_size(48, 2), 1);
+    assert_eq!(Auto.group_size(2, 2), 1);
+    assert_eq!(Auto.group_size(3, 4), 4);
+    assert_eq!(Whole.group_size(1, 4), 1);
+    assert_eq!(Shared.group_size(48, 3), 3);
+    assert_eq!(Groups(2).group_size(48, 3), 2);
+    // More than the ranks: one group of all.
+    assert_eq!(Groups(8).group_size(48, 3), 3);
+    assert_eq!(Whole.group_size(5, 0), 1);
 }

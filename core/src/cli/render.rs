@@ -16,8 +16,8 @@ use luxon::scene::Settings;
 use luxon::schedule::RankStats;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{
-    Decomposition, InlineGeometry, MemorySize, Origin, OutputDesc, OutputIo, ParallelMode,
-    RenderDesc, SceneDesc,
+    Decomposition, FrameGroups, InlineGeometry, MemorySize, Origin, OutputDesc, OutputIo,
+    ParallelMode, RenderDesc, SceneDesc,
 };
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -75,6 +75,11 @@ pub struct Overrides {
     /// Output: written while rendering, after it, or by every MPI rank (8-bit PPM).
     #[arg(long, value_parser = ["async", "sync", "mpi-io"])]
     pub io: Option<String>,
+    /// How MPI ranks share a sequence's frames: each rank whole frames, groups of N ranks
+    /// sharing each frame, or every rank on every frame (default: whole when there are at
+    /// least as many frames as ranks, else shared).
+    #[arg(long, value_name = "whole|shared|N", value_parser = parse_frame_groups)]
+    pub frame_groups: Option<FrameGroups>,
     #[command(flatten)]
     pub shading: super::shading::ShadingArgs,
     /// Frames of an animated scene to render, A to B inclusive (or one frame K); default:
@@ -94,6 +99,19 @@ pub struct Overrides {
     /// an animated PNG, `.gif` for a GIF (an animated scene).
     #[arg(long, value_name = "FILE")]
     pub preview: Option<PathBuf>,
+}
+
+fn parse_frame_groups(s: &str) -> Result<FrameGroups, String> {
+    match s {
+        "whole" => Ok(FrameGroups::Whole),
+        "shared" => Ok(FrameGroups::Shared),
+        n => match n.parse::<u32>() {
+            Ok(n) if (1..=65536).contains(&n) => Ok(FrameGroups::Groups(n)),
+            _ => Err(format!(
+                "`{n}`: expected whole, shared or a number of ranks per group (1 to 65536)"
+            )),
+        },
+    }
 }
 
 fn parse_adaptive(s: &str) -> Result<AdaptiveArg, String> {
@@ -177,6 +195,9 @@ pub(super) fn load(
         Some("block-cyclic") => r.parallel.decomposition = Decomposition::BlockCyclic,
         Some("dynamic") => r.parallel.decomposition = Decomposition::Dynamic,
         _ => {}
+    }
+    if let Some(g) = o.frame_groups {
+        r.parallel.frames = g;
     }
     match o.io.as_deref() {
         Some("async") => r.parallel.io = OutputIo::Async,

@@ -17,7 +17,7 @@ pub struct Resume {
     names: FrameNames,
     scene: u64,
     /// The data files frame k reads (they join its inputs hash).
-    data: Box<dyn Fn(u32) -> Vec<PathBuf>>,
+    data: Box<dyn Fn(u32) -> Vec<PathBuf> + Send + Sync>,
     total: usize,
     /// Done when this run started.
     pub done_at_start: usize,
@@ -26,7 +26,8 @@ pub struct Resume {
     later: Vec<u32>,
     busy: Vec<u32>,
     second_pass: bool,
-    claim: Option<(u32, Claim)>,
+    /// The frames being rendered (several at once when MPI groups take whole frames).
+    claims: Vec<(u32, Claim)>,
 }
 
 impl Resume {
@@ -36,7 +37,7 @@ impl Resume {
         names: &FrameNames,
         frames: &[u32],
         scene: u64,
-        data: Box<dyn Fn(u32) -> Vec<PathBuf>>,
+        data: Box<dyn Fn(u32) -> Vec<PathBuf> + Send + Sync>,
         force: bool,
         about: &str,
     ) -> Result<Resume, Error> {
@@ -73,7 +74,7 @@ impl Resume {
             later: Vec::new(),
             busy: Vec::new(),
             second_pass: false,
-            claim: None,
+            claims: Vec::new(),
         };
         r.done_at_start = frames.iter().filter(|&&k| r.is_done(k)).count();
         Ok(r)
@@ -117,7 +118,6 @@ impl Resume {
     /// The next frame for this process, claimed; `None` when none is left. An error names the
     /// frame whose claim failed (the others go on).
     pub fn next(&mut self) -> Result<Option<u32>, (u32, Error)> {
-        self.claim = None;
         loop {
             let Some(k) = self.queue.pop_front() else {
                 if self.second_pass || self.later.is_empty() {
@@ -142,7 +142,7 @@ impl Resume {
             if self.is_done(k) {
                 continue;
             }
-            self.claim = Some((k, claim));
+            self.claims.push((k, claim));
             return Ok(Some(k));
         }
     }
@@ -155,7 +155,7 @@ impl Resume {
     /// Frame `k` is written (its outputs committed): records it and lets its claim go.
     pub fn finished(&mut self, k: u32) -> Result<(), Error> {
         let recorded = self.manifest.record(k, self.hash(k), &self.outputs(k));
-        self.claim = None;
+        self.release(k);
         recorded.map_err(|e| {
             Error::Render(format!(
                 "its outputs are written but its record is not ({e}); the next run renders it again"
@@ -163,9 +163,9 @@ impl Resume {
         })
     }
 
-    /// Lets the claim of a failed frame go.
-    pub fn failed(&mut self) {
-        self.claim = None;
+    /// Lets the claim of frame `k` go (it failed, or is recorded).
+    pub fn release(&mut self, k: u32) {
+        self.claims.retain(|(c, _)| *c != k);
     }
 
     /// The frames left to other processes, for the user (`None`: none).

@@ -24,15 +24,17 @@ use luxon::output::inputs::{absolute, SceneFile, SceneInputs};
 use luxon::output::manifest::Manifest;
 use luxon::output::preview::Preview;
 use luxon::plugin::Registry;
+use luxon::schedule::wire::FrameResult;
 use luxon::Error;
-use luxon_formats::SceneDesc;
+use luxon_formats::{OutputIo, SceneDesc};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// Broadcast by rank 0 when no frame is left.
-const NO_FRAME: u64 = u64::MAX;
 use std::time::{Duration, Instant};
+
+/// Broadcast by rank 0 when no frame is left.
+pub(super) const NO_FRAME: u64 = u64::MAX;
 
 /// `--frames A..B` or `--frames K`.
 pub fn parse_frames(s: &str) -> Result<(u32, u32), String> {
@@ -233,7 +235,6 @@ pub fn run(
     job: Job,
 ) -> Result<(), Error> {
     let t0 = Instant::now();
-    let registry = ctx.registry();
     let ready = desc.and_then(|d| prepare(o, d, read, ctx, renderer, &job));
     let (ready, status) = match ready {
         Ok(r) => (Some(r), Ok(renderer.threads())),
@@ -248,133 +249,237 @@ pub fn run(
         mut scene,
         frames,
         names,
-        mut resume,
+        resume,
         preview,
     }) = ready
     else {
         return Err(Error::Render("not ready to render".into()));
     };
-    let build_time = t0.elapsed();
-    let scene_dir = scene_dir_of(scene.desc());
     let total = frames.len();
     if let Some(note) = resume.as_ref().and_then(Resume::start_note) {
         eprintln!("luxon: {note}");
     }
-    let to_render = total - resume.as_ref().map_or(0, |r| r.done_at_start);
-    let mut failed = Vec::new();
-    let mut spent = Duration::ZERO;
-    let mut done = 0;
-    loop {
-        // Rank 0 picks (and claims) the next frame; every rank renders it.
-        let next = match resume.as_mut().map(Resume::next) {
-            Some(Ok(Some(k))) => u64::from(k),
-            Some(Err((k, e))) => {
-                luxon::error::print_error(&format!("frame {k}: {e}"));
-                failed.push(k);
-                continue;
+    let mut tally = resume.map(|r| Tally::new(r, total));
+    let group = scene
+        .desc()
+        .render
+        .parallel
+        .frames
+        .group_size(total, job.size());
+    let each = Each {
+        o,
+        names: &names,
+        renderer,
+        registry: ctx.registry(),
+        scene_dir: scene_dir_of(scene.desc()),
+        build_time: t0.elapsed(),
+        // Several groups render frames side by side into the same directories: MPI-IO
+        // outputs are then written by each group's leader (as `Async`), since an MPI-IO
+        // temporary file is unlocked while the ranks write it, and another group starting a
+        // frame there would sweep it as stale.
+        mpi_io: group >= job.size(),
+    };
+    if group < job.size() {
+        #[cfg(feature = "mpi")]
+        if let Job::Mpi(cluster) = &job {
+            if let Err(e) = super::frame_groups::check_shared_dir(&names, &job) {
+                match e {
+                    Some(e) => return Err(e),
+                    None => job.exit_quietly(),
+                }
             }
-            _ => NO_FRAME,
-        };
-        let next = job.root_value(next);
-        if next == NO_FRAME {
-            break;
+            tally = super::frame_groups::run(&each, &mut scene, cluster, group, tally)?;
         }
-        let k = next as u32;
-        let t = Instant::now();
-        let result = frame(k, &mut scene, &names, renderer, registry, &job, &scene_dir);
-        let result = match (result, resume.as_mut()) {
-            (Ok(Some(image)), Some(r)) => r.finished(k).map(|()| Some(image)),
-            (Err(e), Some(r)) => {
-                r.failed();
-                Err(e)
+    } else {
+        // Rank 0 picks (and claims) the next frame; every rank renders it.
+        loop {
+            let next = tally
+                .as_mut()
+                .and_then(Tally::next)
+                .map_or(NO_FRAME, u64::from);
+            let next = job.root_value(next);
+            if next == NO_FRAME {
+                break;
             }
-            (result, _) => result,
-        };
-        match result {
-            Ok(None) => {}
-            Ok(Some(image)) => {
-                spent += t.elapsed();
-                done += 1;
-                let left = resume.as_ref().map_or(0, Resume::left);
-                let eta = spent.as_secs_f64() / done as f64 * left as f64;
-                let written: Vec<String> = image
-                    .written
-                    .iter()
-                    .map(|w| w.display().to_string())
-                    .collect();
-                if o.stats {
-                    eprintln!("luxon: frame {k}");
-                    print_stats(
-                        built(&scene)?,
-                        &job,
-                        &image.stats,
-                        build_time,
-                        image.write_time,
-                        t.elapsed(),
-                    );
-                }
-                eprintln!(
-                    "luxon: wrote {} (frame {k}, {done} of {to_render}, {:.2} s, ETA {eta:.1} s)",
-                    written.join(", "),
-                    t.elapsed().as_secs_f64(),
-                );
-                warn_nan(built(&scene)?, &image.stats);
-            }
-            Err(e) => {
-                if job.rank() == 0 {
-                    luxon::error::print_error(&format!("frame {k}: {e}"));
-                }
-                failed.push(k);
+            let k = next as u32;
+            let t = Instant::now();
+            let outcome = each.frame(k, &mut scene, &job);
+            if let (Some(tally), Some(outcome)) = (tally.as_mut(), outcome) {
+                tally.report(FrameResult {
+                    frame: k,
+                    outcome,
+                    seconds: t.elapsed().as_secs_f64(),
+                });
             }
         }
     }
-    if let Some(note) = resume.as_ref().and_then(Resume::others) {
+    let Some(tally) = tally else {
+        return Ok(());
+    };
+    if let Some(note) = tally.resume.others() {
         eprintln!("luxon: {note}");
     }
-    let previewed = match (&preview, job.rank()) {
-        (Some(p), 0) => write_preview(p, &names, &frames),
-        _ => Ok(()),
+    let previewed = match &preview {
+        Some(p) => write_preview(p, &names, &frames),
+        None => Ok(()),
     };
-    if failed.is_empty() || job.rank() != 0 {
+    if tally.failed.is_empty() {
         return previewed;
     }
     if let Err(e) = previewed {
         luxon::error::print_error(&e.to_string());
     }
-    let list: Vec<String> = failed.iter().map(u32::to_string).collect();
+    let list: Vec<String> = tally.failed.iter().map(u32::to_string).collect();
     Err(Error::Render(format!(
         "{} of {total} frames failed ({}); the other frames are written",
-        failed.len(),
+        tally.failed.len(),
         list.join(", ")
     )))
 }
 
+/// Rank 0's account of the sequence: which frame is next (claimed), and what each gave.
+pub(super) struct Tally {
+    resume: Resume,
+    to_render: usize,
+    failed: Vec<u32>,
+    spent: f64,
+    done: usize,
+}
+
+impl Tally {
+    fn new(resume: Resume, total: usize) -> Tally {
+        Tally {
+            to_render: total - resume.done_at_start,
+            resume,
+            failed: Vec::new(),
+            spent: 0.0,
+            done: 0,
+        }
+    }
+
+    /// The next frame to render, claimed (`None`: none left); a frame whose claim fails is
+    /// reported and counted as failed.
+    pub(super) fn next(&mut self) -> Option<u32> {
+        loop {
+            match self.resume.next() {
+                Ok(k) => return k,
+                Err((k, e)) => {
+                    luxon::error::print_error(&format!("frame {k}: {e}"));
+                    self.failed.push(k);
+                }
+            }
+        }
+    }
+
+    /// How frame `r.frame` ended: records it (or lets its claim go) and tells the user.
+    pub(super) fn report(&mut self, r: FrameResult) {
+        let k = r.frame;
+        let outcome = match r.outcome {
+            Ok(files) => self
+                .resume
+                .finished(k)
+                .map(|()| files)
+                .map_err(|e| e.to_string()),
+            Err(m) => {
+                self.resume.release(k);
+                Err(m)
+            }
+        };
+        match outcome {
+            Ok(files) => {
+                self.spent += r.seconds;
+                self.done += 1;
+                let left = self.resume.left();
+                let eta = self.spent / self.done as f64 * left as f64;
+                eprintln!(
+                    "luxon: wrote {} (frame {k}, {} of {}, {:.2} s, ETA {eta:.1} s)",
+                    files.join(", "),
+                    self.done,
+                    self.to_render,
+                    r.seconds,
+                );
+            }
+            Err(m) => {
+                luxon::error::print_error(&format!("frame {k}: {m}"));
+                self.failed.push(k);
+            }
+        }
+    }
+}
+
+/// What rendering any frame needs besides the scene and the ranks.
+pub(super) struct Each<'a> {
+    o: &'a Overrides,
+    names: &'a FrameNames,
+    renderer: &'a Renderer,
+    registry: &'a Registry,
+    scene_dir: PathBuf,
+    build_time: Duration,
+    /// Whether MPI-IO outputs are written by every rank (one group) or gathered.
+    mpi_io: bool,
+}
+
+impl Each<'_> {
+    /// Renders frame `k` on the ranks of `job` and writes it; the rank that wrote it (rank 0 of
+    /// `job`) gets the files written or why the frame failed, and prints its statistics.
+    pub(super) fn frame(
+        &self,
+        k: u32,
+        scene: &mut Scene,
+        job: &Job,
+    ) -> Option<Result<Vec<String>, String>> {
+        let t = Instant::now();
+        let image = match frame(self, k, scene, job) {
+            Ok(Some(image)) => image,
+            Ok(None) => return None,
+            Err(e) => return (job.rank() == 0).then(|| Err(e.to_string())),
+        };
+        let built = match built(scene) {
+            Ok(b) => b,
+            Err(e) => return Some(Err(e.to_string())),
+        };
+        if self.o.stats {
+            eprintln!("luxon: frame {k}");
+            print_stats(
+                built,
+                job,
+                &image.stats,
+                self.build_time,
+                image.write_time,
+                t.elapsed(),
+            );
+        }
+        warn_nan(built, &image.stats);
+        Some(Ok(image
+            .written
+            .iter()
+            .map(|w| w.display().to_string())
+            .collect()))
+    }
+}
+
 /// Sets, renders and writes frame `k` on every rank; rank 0 gets what it wrote. A frame that
 /// cannot be set up on some rank is skipped by all (the ranks agree first).
-fn frame(
-    k: u32,
-    scene: &mut Scene,
-    names: &FrameNames,
-    renderer: &Renderer,
-    registry: &Registry,
-    job: &Job,
-    scene_dir: &Path,
-) -> Result<Option<Image>, Error> {
+fn frame(each: &Each, k: u32, scene: &mut Scene, job: &Job) -> Result<Option<Image>, Error> {
     let ready = scene.set_frame(k).and_then(|()| {
-        scene.commit(renderer)?;
-        let outputs = luxon::output::resolve(&names.outputs_for(k), registry)?;
+        scene.commit(each.renderer)?;
+        let outputs = luxon::output::resolve(&each.names.outputs_for(k), each.registry)?;
         let budget = &built(scene)?.budget;
+        let mut render = scene.desc().render.clone();
+        if !each.mpi_io && render.parallel.io == OutputIo::MpiIo {
+            render.parallel.io = OutputIo::Async;
+        }
         plan(
-            &scene.desc().render,
+            &render,
             outputs,
             job,
-            registry,
-            scene_dir,
+            each.registry,
+            &each.scene_dir,
             budget,
         )
     });
     let (ready, status) = match ready {
-        Ok(p) => (Some(p), Ok(renderer.threads())),
+        Ok(p) => (Some(p), Ok(each.renderer.threads())),
         Err(e) => (None, Err(e)),
     };
     let threads = match job.agree(status) {
@@ -385,5 +490,13 @@ fn frame(
     let Some(plan) = ready else {
         return Err(Error::Render(format!("frame {k} is not ready")));
     };
-    write_image(scene, plan, job, renderer, &threads, registry, scene_dir)
+    write_image(
+        scene,
+        plan,
+        job,
+        each.renderer,
+        &threads,
+        each.registry,
+        &each.scene_dir,
+    )
 }

@@ -63,6 +63,9 @@ enum Mode {
     Owner(#[allow(dead_code)] mpi::environment::Universe),
     /// The caller owns MPI; `world` is our duplicate of its communicator.
     Guest,
+    /// A group of an owner cluster's ranks ([`Cluster::split`]): failures end the whole job as
+    /// in owner mode; the owner finalises MPI.
+    Group,
 }
 
 impl Drop for Cluster {
@@ -72,6 +75,7 @@ impl Drop for Cluster {
     fn drop(&mut self) {
         match self.mode {
             Mode::Owner(_) => super::abort::on_finalize(),
+            Mode::Group => {}
             Mode::Guest => {
                 if mpi::environment::is_finalized() {
                     let dup = std::mem::replace(&mut self.world, SimpleCommunicator::self_comm());
@@ -132,6 +136,31 @@ impl Cluster {
     /// (what C's `MPI_Comm_c2f` gives).
     pub fn from_fortran(handle: i32) -> Result<Cluster, Error> {
         guest::duplicate_fortran(handle).map(Cluster::guest)
+    }
+
+    /// Collective over this cluster's ranks: groups of `n` consecutive ranks (the last may be
+    /// smaller), each a cluster of its own that renders over its own communicator (so its
+    /// messages never meet this cluster's). Drop it before this cluster.
+    pub fn split(&self, n: usize) -> Cluster {
+        let color = mpi::topology::Color::with_value((self.rank / n.max(1)) as i32);
+        let group = self
+            .world
+            .split_by_color(color)
+            .unwrap_or_else(|| fail("MPI_Comm_split gave no communicator"));
+        let (rank, size) = (group.rank() as usize, group.size() as usize);
+        Cluster {
+            world: group,
+            rank,
+            size,
+            sharing: self.sharing,
+            node_ranks: self.node_ranks,
+            mode: Mode::Group,
+        }
+    }
+
+    /// Collective: a duplicate of this cluster's communicator, for messages of another protocol.
+    pub(super) fn duplicate(&self) -> SimpleCommunicator {
+        self.world.duplicate()
     }
 
     fn guest(world: SimpleCommunicator) -> Cluster {

@@ -13,6 +13,10 @@ pub mod cluster;
 #[cfg(feature = "mpi")]
 #[allow(unsafe_code)]
 pub mod guest;
+// Frames of a sequence dealt to groups of ranks (a communicator moved to a thread).
+#[cfg(feature = "mpi")]
+#[allow(unsafe_code)]
+pub mod frames;
 // MPI calls (the raw rsmpi FFI).
 #[cfg(feature = "mpi")]
 #[allow(unsafe_code)]

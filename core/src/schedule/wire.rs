@@ -148,6 +148,66 @@ pub fn decode_stats(bytes: &[u8]) -> Option<RankStats> {
     })
 }
 
+/// How a group's frame ended, sent by its leader to the rank that deals frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameResult {
+    pub frame: u32,
+    /// The files written (`Ok`) or why the frame failed.
+    pub outcome: Result<Vec<String>, String>,
+    /// Seconds from taking the frame to writing its files.
+    pub seconds: f64,
+}
+
+/// `[frame][ok][seconds][count]([length][bytes])*` (ok: `count` file names; failed: one
+/// message).
+pub fn encode_frame_result(r: &FrameResult) -> Vec<u8> {
+    let mut b = Vec::new();
+    put32(&mut b, r.frame);
+    put32(&mut b, u32::from(r.outcome.is_ok()));
+    put64(&mut b, r.seconds.to_bits());
+    let texts = match &r.outcome {
+        Ok(files) => files.clone(),
+        Err(m) => vec![m.clone()],
+    };
+    put32(&mut b, texts.len() as u32);
+    for t in texts {
+        put32(&mut b, t.len() as u32);
+        b.extend_from_slice(t.as_bytes());
+    }
+    b
+}
+
+pub fn decode_frame_result(bytes: &[u8]) -> Option<FrameResult> {
+    let mut r = Reader(bytes);
+    let frame = r.u32()?;
+    let ok = match r.u32()? {
+        0 => false,
+        1 => true,
+        _ => return None,
+    };
+    let seconds = f64::from_bits(r.u64()?);
+    let n = r.u32()? as usize;
+    let mut texts = Vec::with_capacity(n.min(bytes.len() / 4));
+    for _ in 0..n {
+        let len = r.u32()? as usize;
+        let (text, rest) = r.0.split_at_checked(len)?;
+        r.0 = rest;
+        texts.push(String::from_utf8_lossy(text).into_owned());
+    }
+    if !r.0.is_empty() || (!ok && texts.len() != 1) {
+        return None;
+    }
+    let outcome = match ok {
+        true => Ok(texts),
+        false => Err(texts.remove(0)),
+    };
+    Some(FrameResult {
+        frame,
+        outcome,
+        seconds,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -220,5 +280,29 @@ mod tests {
             nan_sources: vec![0, 12, 0],
         };
         assert_eq!(decode_stats(&encode_stats(&s)), Some(s));
+    }
+
+    #[test]
+    fn frame_results_round_trip() {
+        let results = [
+            FrameResult {
+                frame: 37,
+                outcome: Ok(vec!["out/f0037.png".into(), "out/f0037.exr".into()]),
+                seconds: 1.25,
+            },
+            FrameResult {
+                frame: 3,
+                outcome: Err("the camera's `up` has zero length at frame 3".into()),
+                seconds: 0.0,
+            },
+        ];
+        for r in results {
+            let b = encode_frame_result(&r);
+            assert_eq!(decode_frame_result(&b), Some(r));
+            assert_eq!(decode_frame_result(&b[..b.len() - 1]), None);
+            let mut longer = b.clone();
+            longer.push(0);
+            assert_eq!(decode_frame_result(&longer), None);
+        }
     }
 }
