@@ -202,7 +202,7 @@ static int simulate(const options *o, void *comm, int writer) {
 #endif
     CHECK(luxon_scene_create(ctx, &scene));
     CHECK(luxon_scene_set_camera_ron(
-        scene, "(position: (1.25, 0.9, 1.65), look_at: (0, -0.03, 0), up: (0, 1, 0), fov: 38)"));
+        scene, "(position: (0.35, 0.75, 2.1), look_at: (0, 0, 0), up: (0, 1, 0), fov: 34)"));
     CHECK(luxon_scene_set_background(scene, 0.02, 0.02, 0.04));
     CHECK(luxon_scene_add_light_ron(scene, "Point(position: (2, 3, 2), intensity: 1)", NULL));
 
@@ -215,7 +215,7 @@ static int simulate(const options *o, void *comm, int writer) {
     volume.origin[0] = volume.origin[1] = volume.origin[2] = -0.5;
     volume.spacing[0] = volume.spacing[1] = volume.spacing[2] = 1.0 / (n - 1);
     volume.name = "temperature";
-    volume.render_ron = "(transfer: (preset: \"hot\", range: (0, 1), opacity: 12), "
+    volume.render_ron = "(transfer: (preset: \"hot\", range: (0, 0.6), opacity: 12), step: 0.012, "
                         "shading: (ambient: 0.45, diffuse: 0.6, specular: 0.2, shininess: 20, "
                         "shadows: false))";
     CHECK(luxon_scene_add_volume(scene, &volume, NULL));
@@ -243,7 +243,8 @@ static int simulate(const options *o, void *comm, int writer) {
         commit_seconds += now() - t;
         t = now();
         CHECK(luxon_render(renderer, scene, &target, NULL));
-        render_seconds += now() - t;
+        t = now() - t;
+        render_seconds += t;
         if (writer) {
             snprintf(path, sizeof path, "%s/frame%04d.png", o->out, frame);
             CHECK(luxon_write_image(ctx, path, pixels, width, height, 0));
@@ -251,7 +252,7 @@ static int simulate(const options *o, void *comm, int writer) {
                 printf("step %5d: sim %8.2f ms/step, commit %6.2f ms (%u volume read), render "
                        "%7.1f ms -> %s\n",
                        s, 1e3 * sim_seconds / s, 1e3 * report.commit_seconds,
-                       report.volumes_read, 1e3 * (now() - t), path);
+                       report.volumes_read, 1e3 * t, path);
             }
         }
         frame++;
