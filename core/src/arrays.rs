@@ -798,6 +798,16 @@ impl Source for External {
     }
 }
 
+/// Bytes copied from the caller's memory into arrays of Luxon's own since the process started.
+static COPIED_BYTES: AtomicU64 = AtomicU64::new(0);
+
+/// Bytes [`Array::copy`] and [`Array::update`] have copied since the process started: a
+/// program that hands its data over in place checks with it that nothing was copied (the
+/// in-situ example does, and its test).
+pub fn copied_bytes() -> u64 {
+    COPIED_BYTES.load(Ordering::Relaxed)
+}
+
 /// A typed, strided sequence Luxon reads: see the [module documentation](self). Clones share
 /// the source.
 #[derive(Clone)]
@@ -826,6 +836,7 @@ impl Array {
                 bytes: data.len() as u128 * T::ELEM.size() as u128,
             })?;
         v.extend_from_slice(data);
+        COPIED_BYTES.fetch_add(size_of::<T>() as u64 * data.len() as u64, Ordering::Relaxed);
         Ok(Array::from_vec(v))
     }
 
@@ -988,6 +999,7 @@ impl Array {
             )));
         };
         w[first..end].copy_from_slice(data);
+        COPIED_BYTES.fetch_add(size_of::<T>() as u64 * data.len() as u64, Ordering::Relaxed);
         Ok(())
     }
 }
@@ -1013,6 +1025,16 @@ mod tests {
                 q: i as f32 * 0.1,
             })
             .collect()
+    }
+
+    /// The counter the in-situ example checks (tests/insitu.rs: zero for shared arrays):
+    /// copies and updates add their bytes (other tests may copy meanwhile: at least these).
+    #[test]
+    fn copies_are_counted() {
+        let before = copied_bytes();
+        let a = Array::copy(&[[1.0f64, 2.0, 3.0]; 10]).unwrap();
+        a.update(2, &[[0.0f64; 3]; 3]).unwrap();
+        assert!(copied_bytes() - before >= 13 * 24);
     }
 
     #[test]

@@ -119,6 +119,12 @@ impl Bvh {
         (self.nodes.capacity() * std::mem::size_of::<Wide>()) as u64
     }
 
+    /// Bytes of the nodes in use (the allocation may be larger: its untouched pages are not
+    /// resident).
+    pub fn used_bytes(&self) -> u64 {
+        (self.nodes.len() * std::mem::size_of::<Wide>()) as u64
+    }
+
     pub fn bounds(&self) -> Aabb {
         match self.nodes.first() {
             Some(n) => n.bounds(),

@@ -561,9 +561,9 @@ impl<R: Reader> ArraySet<R> {
         self.material
     }
 
-    /// Bytes of the tree and the leaf order.
+    /// Bytes of the tree and the leaf order in use.
     pub fn bytes(&self) -> u64 {
-        self.bvh.memory_bytes() + (self.order.capacity() * 8) as u64
+        self.bvh.used_bytes() + (self.order.len() * 8) as u64
     }
 
     /// The closest hit before `t_max`, if closer than `hit` (marked as object `object`).

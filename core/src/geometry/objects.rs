@@ -234,7 +234,7 @@ impl Object {
         &self.label
     }
 
-    /// Bytes of its tree and leaf order (the arrays are the caller's).
+    /// Bytes of its tree and leaf order in use (the arrays are the caller's).
     pub fn bytes(&self) -> u64 {
         match &self.shapes {
             Shapes::Spheres(s) => s.bytes(),
