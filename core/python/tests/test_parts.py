@@ -137,5 +137,5 @@ def test_a_small_memory_budget_refuses_big_arrays_with_a_message():
         s.commit()
     big.remove()
     s.volume(np.random.default_rng(1).random((96, 96, 96), dtype=np.float32))
-    with pytest.raises(luxon.LuxonError, match=r"volume `object 1`.*memory budget"):
+    with pytest.raises(luxon.LuxonError, match=r"^volume `object \d+` .*memory budget of 1 MiB"):
         s.commit()
