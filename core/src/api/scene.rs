@@ -215,6 +215,12 @@ fn array_key() -> u64 {
     NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
+/// Volumes read from arrays by their keys and generations, with their budget charges.
+type ReadVolumes = HashMap<(u64, u64), (Volume, Charge)>;
+
+/// The keys and generations of the volumes a commit put in the built scene, and their charges.
+type PutVolumes = (Vec<(u64, u64)>, Vec<Charge>);
+
 /// What the next commit must redo besides the camera and settings.
 #[derive(Clone, Copy, Debug, Default)]
 struct Dirty {
@@ -1338,11 +1344,11 @@ impl Scene {
     fn commit_volumes(
         parts: &[Part],
         grids: &[Pins],
-        mut previous: HashMap<(u64, u64), (Volume, Charge)>,
+        mut previous: ReadVolumes,
         desc: &SceneDesc,
         built: &mut Built,
         report: &mut CommitReport,
-    ) -> Result<(Vec<(u64, u64)>, Vec<Charge>), Error> {
+    ) -> Result<PutVolumes, Error> {
         let mut list = Vec::new();
         let mut keys = Vec::new();
         let mut charges = Vec::new();
