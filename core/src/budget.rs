@@ -335,6 +335,26 @@ pub struct Charge {
 }
 
 impl Charge {
+    /// The bytes charged.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// The same bytes charged to `budget` instead (this charge given back), unless they are
+    /// charged to it already: for what outlives the build whose budget charged it.
+    pub fn move_to(
+        self,
+        budget: &Arc<Budget>,
+        what: impl FnOnce() -> String,
+    ) -> Result<Charge, BudgetError> {
+        if Arc::ptr_eq(&self.budget, budget) {
+            return Ok(self);
+        }
+        let moved = budget.charge(self.kind, self.bytes, what)?;
+        drop(self);
+        Ok(moved)
+    }
+
     /// Keeps the bytes charged for the life of the budget.
     pub fn keep(mut self) {
         self.bytes = 0;

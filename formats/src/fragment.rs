@@ -6,7 +6,7 @@
 //! in a scene file. [`crate::print`] writes fragments; `check_*` print a typed value and read
 //! it back, so typed values obey the same rules as text.
 //!
-//! Kinds: [`camera`], [`light`], [`material`], [`fog`], [`ambient_occlusion`],
+//! Kinds: [`camera`], [`light`], [`material`], [`texture`], [`fog`], [`ambient_occlusion`],
 //! [`render_settings`], [`clip_planes`], [`volume_render`].
 //!
 //! - The file name in messages is the kind in angle brackets, and columns on the fragment's
@@ -25,8 +25,8 @@ use std::path::Path;
 
 use crate::convert::Part;
 use crate::desc::{
-    AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, Origin, RenderDesc,
-    VolumeRenderDesc,
+    AoDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc, Origin, PluginCall,
+    RenderDesc, VolumeRenderDesc,
 };
 use crate::error::SceneError;
 use crate::includes::resolve;
@@ -56,6 +56,11 @@ const LIGHT: Kind = Kind {
 const MATERIAL: Kind = Kind {
     name: "material",
     before: "Scene(materials: {\"m\": ",
+    after: "})",
+};
+const TEXTURE: Kind = Kind {
+    name: "texture",
+    before: "Scene(textures: {\"t\": ",
     after: "})",
 };
 const FOG: Kind = Kind {
@@ -134,6 +139,25 @@ pub fn material(text: &str) -> Result<MaterialDesc, SceneError> {
         shift(&mut t.at, &MATERIAL);
     }
     Ok(m)
+}
+
+/// A texture: `(plugin: "stripes", params: (width: 0.1))`, as a scene file's `textures`
+/// map holds one after its name (`plugin` left out: `checker`). The plugin is not looked up
+/// and its parameters not read (the scene that holds the texture does both); their position
+/// (`params_at`) is in the fragment's own columns, so the plugin's errors point into it.
+pub fn texture(text: &str) -> Result<PluginCall, SceneError> {
+    let (mut part, at) = read(&TEXTURE, text)?;
+    let mut textures = std::mem::take(&mut part.textures);
+    only(&TEXTURE, part, at.clone())?;
+    match (textures.pop(), textures.is_empty()) {
+        (Some((_, t)), true) => {
+            let mut call = t.value;
+            shift(&mut call.plugin.at, &TEXTURE);
+            shift(&mut call.params_at, &TEXTURE);
+            Ok(call)
+        }
+        _ => Err(missing(&TEXTURE, at)),
+    }
 }
 
 /// Fog: `(mode: Exp(density: 0.1), color: (0.5, 0.5, 0.5))`.

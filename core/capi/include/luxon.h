@@ -809,6 +809,52 @@ luxon_status luxon_scene_set_material_ron(struct luxon_scene scene,
                                           const char *name,
                                           const char *ron);
 
+// Defines the texture `name` made by the texture plugin `plugin` (e.g. `checker`, `image`,
+// `stripes`) from its parameters in RON (`params_ron`, e.g. `(width: 0.1)`; NULL: `()`), or
+// replaces it; materials name it in their `texture` (`luxon_scene_set_material_ron`). The
+// plugin reads the parameters now: its errors come from this call, pointing into them as
+// `<texture>:line:col` (LUXON_ERROR_SCENE). Textures are never removed; the next commit
+// builds the scene again (array objects keep their trees).
+//
+// # Safety
+// `name` and `plugin` are valid strings, `params_ron` NULL or a valid string.
+luxon_status luxon_scene_set_texture(struct luxon_scene scene,
+                                     const char *name,
+                                     const char *plugin,
+                                     const char *params_ron);
+
+// Defines the clip group `name` or replaces its planes, from RON text: the list a scene
+// file's `clip_groups` holds, e.g. `[(point: (0, 0, 0), normal: (0, 1, 0))]` (an object or
+// volume cut by the group loses what lies on the side a plane's normal points to). Errors
+// point into the text as `<clip_planes>:line:col`. Objects name the group in
+// `luxon_scene_add_object`, volumes in their render settings (`clip: "name"`). Clip groups
+// are never removed; the next commit builds the scene again.
+//
+// # Safety
+// `name` and `planes_ron` are valid strings.
+luxon_status luxon_scene_set_clip_group(struct luxon_scene scene,
+                                        const char *name,
+                                        const char *planes_ron);
+
+// Adds a volume read by the volume reader plugin `plugin` (`raw`, `vdb`, as scene files name
+// them) from its parameters in RON (`params_ron`, e.g. `(file: "head.raw", dims: (256, 256,
+// 109))`; relative paths start at the working directory, or a loaded scene's directory),
+// called `name` (NULL: unnamed) and drawn as `render_ron` says (what follows `render:` in a
+// scene file's volume, e.g. `(transfer: (preset: "viridis"))`; NULL: data only, not drawn).
+// The plugin reads the file at the next commit; its errors point into the parameters as
+// `<object N>:line:col`. Adding or removing one (`luxon_scene_remove`) builds the scene
+// again at the next commit.
+//
+// # Safety
+// `plugin` and `params_ron` are valid strings, `name` and `render_ron` NULL or valid
+// strings; `out` is NULL or valid for a write.
+luxon_status luxon_scene_add_volume_plugin(struct luxon_scene scene,
+                                           const char *plugin,
+                                           const char *params_ron,
+                                           const char *name,
+                                           const char *render_ron,
+                                           struct luxon_object *out);
+
 // Adds an object made by the primitive plugin `plugin` (e.g. `sphere`, `plane`, from
 // luxon-shapes) from its parameters in RON (`params_ron`, e.g.
 // `(center: (0, 1, 0), radius: 0.5)`), of the material named `material` (NULL: `default`),

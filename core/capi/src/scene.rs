@@ -66,6 +66,17 @@ impl Drop for Locked<'_> {
 }
 
 impl SceneEntry {
+    /// Fails with PLUGIN_NOT_FOUND when the scene's context has no plugin `name` of `kind`
+    /// (one of another kind is left for the scene to refuse, naming its kind).
+    fn plugin_found(&self, name: &str, kind: PluginKind) -> Result<(), Failure> {
+        match self.context.value.registry().get(name, kind) {
+            Err(e @ LookupError::NotFound { .. }) => {
+                Err(Failure::new(LUXON_ERROR_PLUGIN_NOT_FOUND, e.to_string()))
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// Locks the scene for a call. While another thread renders or commits it (`busy`), the
     /// call fails with BUSY at once; a short call on another thread is waited for. `long`
     /// marks this call busy (a render or a commit).
@@ -642,6 +653,110 @@ pub unsafe extern "C" fn luxon_scene_set_material_ron(
     })
 }
 
+/// Defines the texture `name` made by the texture plugin `plugin` (e.g. `checker`, `image`,
+/// `stripes`) from its parameters in RON (`params_ron`, e.g. `(width: 0.1)`; NULL: `()`), or
+/// replaces it; materials name it in their `texture` (`luxon_scene_set_material_ron`). The
+/// plugin reads the parameters now: its errors come from this call, pointing into them as
+/// `<texture>:line:col` (LUXON_ERROR_SCENE). Textures are never removed; the next commit
+/// builds the scene again (array objects keep their trees).
+///
+/// # Safety
+/// `name` and `plugin` are valid strings, `params_ron` NULL or a valid string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn luxon_scene_set_texture(
+    scene: luxon_scene,
+    name: *const c_char,
+    plugin: *const c_char,
+    params_ron: *const c_char,
+) -> luxon_status {
+    guard("luxon_scene_set_texture", || {
+        // SAFETY: valid strings or NULL where allowed (caller).
+        let (name, plugin, params) = unsafe {
+            (
+                text(name, "name")?,
+                text(plugin, "plugin")?,
+                optional_text(params_ron, "params_ron")?,
+            )
+        };
+        with_scene(scene, |s, entry| {
+            entry.plugin_found(plugin, PluginKind::Texture)?;
+            let params = params.unwrap_or("()");
+            Ok(s.scene.set_texture(name, plugin, params)?)
+        })
+    })
+}
+
+/// Defines the clip group `name` or replaces its planes, from RON text: the list a scene
+/// file's `clip_groups` holds, e.g. `[(point: (0, 0, 0), normal: (0, 1, 0))]` (an object or
+/// volume cut by the group loses what lies on the side a plane's normal points to). Errors
+/// point into the text as `<clip_planes>:line:col`. Objects name the group in
+/// `luxon_scene_add_object`, volumes in their render settings (`clip: "name"`). Clip groups
+/// are never removed; the next commit builds the scene again.
+///
+/// # Safety
+/// `name` and `planes_ron` are valid strings.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn luxon_scene_set_clip_group(
+    scene: luxon_scene,
+    name: *const c_char,
+    planes_ron: *const c_char,
+) -> luxon_status {
+    guard("luxon_scene_set_clip_group", || {
+        // SAFETY: valid strings (caller).
+        let (name, planes) = unsafe { (text(name, "name")?, text(planes_ron, "planes_ron")?) };
+        with_scene(scene, |s, _| {
+            s.scene
+                .set_clip_group_ron(name, planes)
+                .map(drop)
+                .map_err(Into::into)
+        })
+    })
+}
+
+/// Adds a volume read by the volume reader plugin `plugin` (`raw`, `vdb`, as scene files name
+/// them) from its parameters in RON (`params_ron`, e.g. `(file: "head.raw", dims: (256, 256,
+/// 109))`; relative paths start at the working directory, or a loaded scene's directory),
+/// called `name` (NULL: unnamed) and drawn as `render_ron` says (what follows `render:` in a
+/// scene file's volume, e.g. `(transfer: (preset: "viridis"))`; NULL: data only, not drawn).
+/// The plugin reads the file at the next commit; its errors point into the parameters as
+/// `<object N>:line:col`. Adding or removing one (`luxon_scene_remove`) builds the scene
+/// again at the next commit.
+///
+/// # Safety
+/// `plugin` and `params_ron` are valid strings, `name` and `render_ron` NULL or valid
+/// strings; `out` is NULL or valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn luxon_scene_add_volume_plugin(
+    scene: luxon_scene,
+    plugin: *const c_char,
+    params_ron: *const c_char,
+    name: *const c_char,
+    render_ron: *const c_char,
+    out: *mut luxon_object,
+) -> luxon_status {
+    guard("luxon_scene_add_volume_plugin", || {
+        // SAFETY: valid strings or NULL where allowed (caller).
+        let (plugin, params, name, look) = unsafe {
+            (
+                text(plugin, "plugin")?,
+                text(params_ron, "params_ron")?,
+                optional_text(name, "name")?,
+                optional_text(render_ron, "render_ron")?,
+            )
+        };
+        let object = with_scene(scene, |s, entry| {
+            entry.plugin_found(plugin, PluginKind::VolumeReader)?;
+            let id = match look {
+                Some(look) => s.scene.add_plugin_volume_ron(plugin, params, name, look)?,
+                None => s.scene.add_plugin_volume(plugin, params, name, None)?,
+            };
+            part_handle(s, scene.id, PartId::Object(id))
+        })?;
+        // SAFETY: NULL or writable (caller).
+        unsafe { put_optional(out, object) }
+    })
+}
+
 /// Adds an object made by the primitive plugin `plugin` (e.g. `sphere`, `plane`, from
 /// luxon-shapes) from its parameters in RON (`params_ron`, e.g.
 /// `(center: (0, 1, 0), radius: 0.5)`), of the material named `material` (NULL: `default`),
@@ -673,14 +788,7 @@ pub unsafe extern "C" fn luxon_scene_add_object(
             )
         };
         let object = with_scene(scene, |s, entry| {
-            if let Err(e @ LookupError::NotFound { .. }) = entry
-                .context
-                .value
-                .registry()
-                .get(plugin, PluginKind::Primitive)
-            {
-                return Err(Failure::new(LUXON_ERROR_PLUGIN_NOT_FOUND, e.to_string()));
-            }
+            entry.plugin_found(plugin, PluginKind::Primitive)?;
             let material = match material {
                 None => None,
                 Some(m) => Some(s.scene.material(m).ok_or_else(|| {

@@ -151,6 +151,35 @@ impl PyScene {
         guard(|| self.scene.set_material_ron(name, text).py_err().map(|_| ()))
     }
 
+    fn _set_texture(&mut self, name: &str, plugin: &str, params: &str) -> PyResult<()> {
+        guard(|| self.scene.set_texture(name, plugin, params).py_err())
+    }
+
+    fn _set_clip_group_ron(&mut self, name: &str, text: &str) -> PyResult<()> {
+        guard(|| self.scene.set_clip_group_ron(name, text).py_err().map(drop))
+    }
+
+    fn _has_clip_group(&self, name: &str) -> bool {
+        self.scene.clip_group(name).is_some()
+    }
+
+    #[pyo3(signature = (plugin, params, name = None, look = None))]
+    fn _add_plugin_volume(
+        &mut self,
+        plugin: &str,
+        params: &str,
+        name: Option<&str>,
+        look: Option<&str>,
+    ) -> PyResult<PyObjectId> {
+        guard(|| {
+            let id = match look {
+                Some(look) => self.scene.add_plugin_volume_ron(plugin, params, name, look),
+                None => self.scene.add_plugin_volume(plugin, params, name, None),
+            };
+            Ok(PyObjectId(id.py_err()?))
+        })
+    }
+
     fn _has_material(&self, name: &str) -> bool {
         self.scene.material(name).is_some()
     }

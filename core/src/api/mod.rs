@@ -63,13 +63,19 @@
 //!
 //! Lights and objects get ids when they are added ([`Scene::add_light`],
 //! [`Scene::add_plugin_object`]; a loaded scene's are [`Scene::lights`] and
-//! [`Scene::objects`], in file order); materials and clip groups are named ([`Scene::material`],
-//! [`Scene::set_material`], [`Scene::clip_group`]) and never removed. Every typed value is
-//! checked by the scene files' rules, and each setter has a `_ron` form whose errors point
-//! into its text (`<light>:1:7: unknown field ...`). A removed part's id is refused, as is
-//! another scene's. Lights, materials, fog and ambient occlusion change without touching the
-//! geometry; adding or removing objects builds the scene again at the next commit, once:
-//! plugin objects are for what does not change every step. [`Scene::to_ron`] writes the
+//! [`Scene::objects`], in file order; volumes read by plugins too, [`Scene::add_plugin_volume`]);
+//! materials, textures and clip groups are named ([`Scene::material`], [`Scene::set_material`],
+//! [`Scene::set_texture`], [`Scene::set_clip_group`], [`Scene::clip_group`]) and never
+//! removed. Every typed value is checked by the scene files' rules, and each setter has a
+//! `_ron` form whose errors point into its text (`<light>:1:7: unknown field ...`). A removed
+//! part's id is refused, as is another scene's. Lights, materials, fog and ambient occlusion
+//! change without touching the geometry; adding or removing objects or plugin volumes, and
+//! new textures or clip groups, build the scene again at the next commit, once: plugin
+//! objects are for what does not change every step.
+//!
+//! The BVHs of array objects and the bricks of volumes from arrays are charged to the memory
+//! budget ([`Scene::set_budget`], else the render settings' `memory`) before they are made: a
+//! request beyond it fails the commit with a message naming it, not an abort. [`Scene::to_ron`] writes the
 //! scene as a scene file (for a bug report, or to render it with the command line).
 //!
 //! ```

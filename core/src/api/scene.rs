@@ -8,18 +8,20 @@ use super::objects::{
 use super::volumes;
 use super::{Context, Renderer};
 use crate::arrays::{Array, Pins};
-use crate::budget::Budget;
+use crate::budget::{Budget, Charge};
 use crate::error::Error;
 use crate::geometry::array_set::{CylinderReader, MeshReader, RadiusRead, SphereReader};
 use crate::geometry::objects::{Object, Objects, Outcome, Spec, MAX_OBJECTS};
 use crate::math::DVec3;
+use crate::plugin::texture::create_texture;
 use crate::plugin::{PluginKind, Registry};
 use crate::scene::update::ArrayVolume;
 use crate::scene::{shadowless_groups, Prebuilt, Scene as Built};
 use crate::volume::Volume;
 use luxon_formats::{
-    fragment, AoDesc, BackgroundDesc, CameraDesc, FogDesc, LightDesc, MaterialDesc, ObjectDesc,
-    Origin, PluginCall, Projection, RenderDesc, SceneDesc, Spanned, VolumeRenderDesc,
+    fragment, AoDesc, BackgroundDesc, CameraDesc, ClipPlaneDesc, FogDesc, LightDesc, MaterialDesc,
+    ObjectDesc, Origin, PluginCall, Projection, RenderDesc, SceneDesc, Spanned, VolumeDescEntry,
+    VolumeRenderDesc,
 };
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -68,8 +70,8 @@ pub struct CommitReport {
 ///
 /// Lights and objects have ids ([`LightId`], [`ObjectId`]): a scene loaded from a file gives
 /// them to its own in file order ([`Scene::lights`], [`Scene::objects`]). A removed part's id,
-/// or another scene's, is refused with an error that says so. Materials and clip groups are
-/// named and never removed ([`MaterialId`], [`ClipId`]).
+/// or another scene's, is refused with an error that says so. Materials, textures and clip
+/// groups are named and never removed ([`MaterialId`], [`ClipId`]).
 ///
 /// Render space's origin (the world point coordinates are stored relative to, in f32) is fixed
 /// at the first commit: [`Scene::set_origin`]'s point when given, else the camera's position
@@ -114,6 +116,8 @@ pub struct Scene {
     /// The key and generation of each volume read from an array that the built scene holds,
     /// in order (its last volumes).
     volumes_built: Vec<(u64, u64)>,
+    /// What each of those volumes' bricks are charged to the built scene's memory budget.
+    volume_charges: Vec<Charge>,
     /// The materials of the imported groups that cast no shadow (the build's copies of them
     /// depend on it), taken before a frozen scene's groups are consumed.
     shadowless: Vec<Option<Spanned<String>>>,
@@ -125,12 +129,19 @@ pub struct Scene {
 #[derive(Clone)]
 enum Part {
     Plugin,
+    /// A volume read by a volume reader plugin: an entry of the description's `volumes`,
+    /// after those the scene was loaded with (which have no ids).
+    PluginVolume,
     Array(ArrayObject),
     // Boxed: a grid and its look are large, and plugin objects many.
     Volume(Box<VolumeObject>),
 }
 
 impl Part {
+    fn plugin_volume(&self) -> bool {
+        matches!(self, Part::PluginVolume)
+    }
+
     fn array(&self) -> Option<&ArrayObject> {
         match self {
             Part::Array(a) => Some(a),
@@ -203,6 +214,12 @@ fn array_key() -> u64 {
     static NEXT: AtomicU64 = AtomicU64::new(1);
     NEXT.fetch_add(1, Ordering::Relaxed)
 }
+
+/// Volumes read from arrays by their keys and generations, with their budget charges.
+type ReadVolumes = HashMap<(u64, u64), (Volume, Charge)>;
+
+/// The keys and generations of the volumes a commit put in the built scene, and their charges.
+type PutVolumes = (Vec<(u64, u64)>, Vec<Charge>);
 
 /// What the next commit must redo besides the camera and settings.
 #[derive(Clone, Copy, Debug, Default)]
@@ -300,6 +317,7 @@ impl Scene {
             objects: Slots::new(serial, desc.objects.len()),
             parts: vec![Part::Plugin; desc.objects.len()],
             volumes_built: Vec::new(),
+            volume_charges: Vec::new(),
             shadowless: shadowless_groups(&desc),
             desc,
             registry: ctx.registry.clone(),
@@ -605,6 +623,113 @@ impl Scene {
         self.set_material(name, m)
     }
 
+    /// Defines the texture `name` made by the texture plugin `plugin` (`checker`, `image`,
+    /// `stripes`... or one of your own) from its parameters (RON text, as after `params:` in
+    /// a scene file), or replaces it; materials refer to it by name
+    /// ([`MaterialDesc::texture`]). The plugin is found and reads the parameters now, so its
+    /// errors come from this call, pointing into them as `<texture>:line:col`. Textures are
+    /// never removed. The next commit builds the scene again (a texture is part of the build;
+    /// array objects keep their trees).
+    pub fn set_texture(&mut self, name: &str, plugin: &str, params_ron: &str) -> Result<(), Error> {
+        let at = origin("<texture>");
+        let call = PluginCall {
+            plugin: Spanned {
+                value: plugin.to_string(),
+                at: at.clone(),
+            },
+            params: params_ron.to_string(),
+            params_at: at,
+        };
+        self.put_texture(name, call)
+    }
+
+    /// [`Scene::set_texture`] from RON text, as a scene file's `textures` map holds one after
+    /// its name: `(plugin: "stripes", params: (width: 0.1))`; errors point into the text as
+    /// `<texture>:line:col` (the plugin's too).
+    pub fn set_texture_ron(&mut self, name: &str, text: &str) -> Result<(), Error> {
+        let call = fragment::texture(text)?;
+        self.put_texture(name, call)
+    }
+
+    fn put_texture(&mut self, name: &str, call: PluginCall) -> Result<(), Error> {
+        if name.is_empty() {
+            return Err(Error::Api("a texture needs a name".into()));
+        }
+        self.can_build(&format!("texture `{name}`"))?;
+        let entry = self
+            .registry
+            .get(&call.plugin.value, PluginKind::Texture)
+            .map_err(|e| Error::at(&call.plugin.at, e.to_string()))?;
+        // Made once and dropped, so that a bad parameter is this call's error, not a later
+        // commit's (the build makes the scene's own instance, within its budget).
+        let dir = self.desc.source.parent().unwrap_or(Path::new(""));
+        let budget = Budget::unlimited();
+        create_texture(
+            &self.registry,
+            entry,
+            &call.params,
+            &call.params_at,
+            dir,
+            name,
+            &budget,
+        )
+        .map_err(|(at, m)| Error::at(&at, m))?;
+        let value = Spanned {
+            at: call.params_at.clone(),
+            value: call,
+        };
+        match self.desc.textures.iter_mut().find(|(n, _)| n == name) {
+            Some((_, t)) => *t = value,
+            None => self.desc.textures.push((name.to_string(), value)),
+        }
+        self.dirty.build = true;
+        Ok(())
+    }
+
+    /// Refuses a change that needs a build in a scene that cannot be built again.
+    fn can_build(&self, what: &str) -> Result<(), Error> {
+        match self.consumed {
+            Some(why) => Err(Error::Api(format!("{what} cannot change: {why}"))),
+            None => Ok(()),
+        }
+    }
+
+    /// Defines the clip group `name` (checked by the scene files' rules: at least one plane,
+    /// each a finite point and a non-zero normal) or replaces its planes. Objects and volumes
+    /// cut by it lose what lies on the side any of its planes' normals points to. Clip groups are never removed. The
+    /// next commit builds the scene again.
+    pub fn set_clip_group(
+        &mut self,
+        name: &str,
+        planes: Vec<ClipPlaneDesc>,
+    ) -> Result<ClipId, Error> {
+        if name.is_empty() {
+            return Err(Error::Api("a clip group needs a name".into()));
+        }
+        fragment::check_clip_planes(&planes)
+            .map_err(|m| Error::Api(format!("clip group `{name}`: {m}")))?;
+        self.can_build(&format!("clip group `{name}`"))?;
+        let value = Spanned {
+            value: planes,
+            at: origin("<clip_planes>"),
+        };
+        match self.desc.clip_groups.iter_mut().find(|(n, _)| n == name) {
+            Some((_, g)) => *g = value,
+            None => self.desc.clip_groups.push((name.to_string(), value)),
+        }
+        self.dirty.build = true;
+        self.clip_group(name)
+            .ok_or_else(|| Error::Api(format!("clip group `{name}` was not defined")))
+    }
+
+    /// [`Scene::set_clip_group`] from RON text, the list a scene file's `clip_groups` map
+    /// holds after the name: `[(point: (0, 0, 0), normal: (0, 1, 0))]`; errors point into the
+    /// text as `<clip_planes>:line:col`.
+    pub fn set_clip_group_ron(&mut self, name: &str, text: &str) -> Result<ClipId, Error> {
+        let planes = fragment::clip_planes(text)?;
+        self.set_clip_group(name, planes)
+    }
+
     /// The clip group named `name`, if the scene has it.
     pub fn clip_group(&self, name: &str) -> Option<ClipId> {
         let index = self.desc.clip_groups.iter().position(|(n, _)| n == name)?;
@@ -716,24 +841,115 @@ impl Scene {
     /// their place).
     pub fn remove(&mut self, id: ObjectId) -> Result<(), Error> {
         let i = self.objects.position(id)?;
-        if !matches!(self.parts[i], Part::Plugin) {
-            // An array object or a volume: dropped from the built scene at the next commit,
-            // no build.
-            self.objects.remove(id)?;
-            self.parts.remove(i);
-            return Ok(());
+        match self.parts[i] {
+            Part::Plugin => {
+                self.objects_can_change()?;
+                self.not_animated("objects")?;
+            }
+            Part::PluginVolume => self.objects_can_change()?,
+            Part::Array(_) | Part::Volume(_) => {
+                // Dropped from the built scene at the next commit, no build.
+                self.objects.remove(id)?;
+                self.parts.remove(i);
+                return Ok(());
+            }
         }
-        self.objects_can_change()?;
-        self.not_animated("objects")?;
         let i = self.objects.remove(id)?;
-        self.parts.remove(i);
-        let plugin = i - self.parts[..i]
-            .iter()
-            .filter(|p| !matches!(p, Part::Plugin))
-            .count();
-        self.desc.objects.remove(plugin);
+        let part = self.parts.remove(i);
+        let before = |kind: fn(&Part) -> bool| self.parts[..i].iter().filter(|p| kind(p)).count();
+        match part {
+            Part::PluginVolume => {
+                // The scene's own volumes come first, then those added, in the parts' order.
+                let added = self.parts.iter().filter(|p| p.plugin_volume()).count() + 1;
+                let first = self.desc.volumes.len() - added;
+                self.desc
+                    .volumes
+                    .remove(first + before(Part::plugin_volume));
+            }
+            _ => {
+                let k = before(|p| matches!(p, Part::Plugin));
+                self.desc.objects.remove(k);
+            }
+        }
         self.dirty.build = true;
         Ok(())
+    }
+
+    /// Adds a volume read by the volume reader plugin `plugin` (`raw`, `vdb`... as a scene
+    /// file's `volumes` name them) from its parameters (RON text, as after `params:`), called
+    /// `name` (`None`: by its place among the volumes, as a scene file's unnamed ones) and drawn
+    /// as `look` says (`None`: data only, not drawn). The plugin reads the file at the next
+    /// commit: its errors point into the parameters as `<object N>:line:col` (N: the id's
+    /// number). Adding or removing one builds the scene again at the next commit.
+    pub fn add_plugin_volume(
+        &mut self,
+        plugin: &str,
+        params_ron: &str,
+        name: Option<&str>,
+        look: Option<VolumeRenderDesc>,
+    ) -> Result<ObjectId, Error> {
+        self.objects_can_change()?;
+        self.registry
+            .get(plugin, PluginKind::VolumeReader)
+            .map_err(|e| Error::Api(e.to_string()))?;
+        if let Some(n) = name {
+            if n.trim().is_empty() {
+                return Err(Error::Api(
+                    "the volume name is empty; expected a name such as \"head\" (or None)".into(),
+                ));
+            }
+            let taken = (self.desc.volumes.iter())
+                .any(|v| v.value.name.as_ref().is_some_and(|t| t.value == n));
+            if taken {
+                return Err(Error::Api(format!(
+                    "the scene has a volume named `{n}` already"
+                )));
+            }
+        }
+        if let Some(l) = &look {
+            fragment::check_volume_render(l)
+                .map_err(|m| Error::Api(format!("volume render settings: {m}")))?;
+            if let Some(c) = &l.clip {
+                if self.clip_group(&c.value).is_none() {
+                    return Err(Error::Api(format!("no clip group named `{}`", c.value)));
+                }
+            }
+        }
+        let id = self.objects.insert();
+        let at = origin(&format!("<{id}>"));
+        let named = |value: String| Spanned {
+            value,
+            at: at.clone(),
+        };
+        let entry = VolumeDescEntry {
+            call: PluginCall {
+                plugin: named(plugin.to_string()),
+                params: params_ron.to_string(),
+                params_at: at.clone(),
+            },
+            name: name.map(|n| named(n.to_string())),
+            render: look.map(|l| Spanned {
+                value: l,
+                at: at.clone(),
+            }),
+        };
+        self.desc.volumes.push(Spanned { value: entry, at });
+        self.parts.push(Part::PluginVolume);
+        self.dirty.build = true;
+        Ok(id)
+    }
+
+    /// [`Scene::add_plugin_volume`] drawn as RON text says (what follows `render:` in a scene
+    /// file's volume, see [`Scene::add_volume_ron`]).
+    pub fn add_plugin_volume_ron(
+        &mut self,
+        plugin: &str,
+        params_ron: &str,
+        name: Option<&str>,
+        look_ron: &str,
+    ) -> Result<ObjectId, Error> {
+        let look = fragment::volume_render(look_ron)?;
+        self.add_plugin_volume(plugin, params_ron, name, Some(look))
     }
 
     /// Adds spheres read from arrays (in place, or Luxon's copy: see [`crate::arrays`]). The
@@ -1004,7 +1220,7 @@ impl Scene {
     pub fn to_ron(&self) -> Result<String, Error> {
         let ids = self.objects.ids();
         let from_arrays = self.parts.iter().zip(&ids).find_map(|(p, id)| match p {
-            Part::Plugin => None,
+            Part::Plugin | Part::PluginVolume => None,
             Part::Array(a) => Some(a.label.clone()),
             Part::Volume(_) => Some(format!("{id} (volume)")),
         });
@@ -1085,15 +1301,16 @@ impl Scene {
         }
         let t0 = Instant::now();
         let offset = built.world_offset;
+        let budget = built.budget.clone();
         let mut previous: HashMap<u64, Object> = previous.into_iter().map(|o| (o.key, o)).collect();
         let mut list = Vec::new();
         for a in parts.iter().filter_map(Part::array) {
             let (object, outcome) = match previous.remove(&a.key) {
-                Some(o) => o.update(offset)?,
+                Some(o) => o.update(offset, &budget)?,
                 None => {
                     let (arrays, spec) = (a.arrays.clone(), a.spec);
                     let label = a.label.clone();
-                    let o = Object::build(a.key, label, arrays, spec, a.material, offset)?;
+                    let o = Object::build(a.key, label, arrays, spec, a.material, offset, &budget)?;
                     (o, Outcome::Built)
                 }
             };
@@ -1121,30 +1338,39 @@ impl Scene {
 
     /// Puts the volumes read from arrays into the built scene (which holds none of them now):
     /// each read from `grids` (its pinned values, in the order of the volumes in `parts`)
-    /// unless `previous` has it read at the same generation. Returns their keys and
-    /// generations, in order.
+    /// unless `previous` has it read at the same generation. Their bricks are charged to the
+    /// built scene's memory budget (a volume that does not fit is refused). Returns their keys
+    /// and generations, and their charges, in order.
     fn commit_volumes(
         parts: &[Part],
         grids: &[Pins],
-        mut previous: HashMap<(u64, u64), Volume>,
+        mut previous: ReadVolumes,
         desc: &SceneDesc,
         built: &mut Built,
         report: &mut CommitReport,
-    ) -> Result<Vec<(u64, u64)>, Error> {
+    ) -> Result<PutVolumes, Error> {
         let mut list = Vec::new();
         let mut keys = Vec::new();
+        let mut charges = Vec::new();
+        let budget = built.budget.clone();
         for (v, pins) in parts.iter().filter_map(Part::volume).zip(grids) {
             let key = (v.key, pins.generation(0));
-            let volume = match previous.remove(&key) {
-                Some(volume) => volume,
+            let (volume, charge) = match previous.remove(&key) {
+                Some((volume, charge)) => {
+                    let name = &v.name;
+                    let charge = charge.move_to(&budget, || format!("volume `{name}`"))?;
+                    (volume, charge)
+                }
                 None => {
                     report.volumes_read += 1;
-                    volumes::read(&v.grid, &v.name, pins.view(0)).map_err(|e| match e {
+                    let named = |e| match e {
                         Error::Api(m) => Error::Api(format!("{}: {m}", v.label)),
                         e => e,
-                    })?
+                    };
+                    volumes::read(&v.grid, &v.name, pins.view(0), &budget).map_err(named)?
                 }
             };
+            charges.push(charge);
             let clip = match v.look.as_ref().and_then(|l| l.clip.as_ref()) {
                 Some(c) => {
                     let i = desc.clip_groups.iter().position(|(n, _)| *n == c.value);
@@ -1165,7 +1391,7 @@ impl Scene {
         // Volumes removed since are dropped here.
         drop(previous);
         built.set_array_volumes(list, &desc.render)?;
-        Ok(keys)
+        Ok((keys, charges))
     }
 
     fn commit_here(&mut self, grids: &[Pins]) -> Result<CommitReport, Error> {
@@ -1204,7 +1430,9 @@ impl Scene {
         let mut previous_volumes = HashMap::new();
         if let (true, Some(b)) = (volumes_change, self.built.as_mut()) {
             let keys = std::mem::take(&mut self.volumes_built);
-            previous_volumes = keys.into_iter().zip(b.take_array_volumes()).collect();
+            let charges = std::mem::take(&mut self.volume_charges);
+            let volumes = b.take_array_volumes().into_iter().zip(charges);
+            previous_volumes = keys.into_iter().zip(volumes).collect();
         }
         if self.built.is_none() || self.dirty.build {
             if let Some(why) = self.consumed {
@@ -1243,7 +1471,7 @@ impl Scene {
         };
         Scene::commit_arrays(&self.parts, previous, built, &self.desc.render, &mut report)?;
         if volumes_change {
-            self.volumes_built = Scene::commit_volumes(
+            (self.volumes_built, self.volume_charges) = Scene::commit_volumes(
                 &self.parts,
                 grids,
                 previous_volumes,

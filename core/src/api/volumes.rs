@@ -5,8 +5,10 @@
 
 use super::objects::{expect_elem, VolumeGrid, VOXEL};
 use crate::arrays::{Elem, View};
+use crate::budget::{Budget, Charge, Use};
 use crate::error::Error;
 use crate::volume::{Volume, VolumeBuilder, BRICK_SIZE, MAX_VOXELS};
+use std::sync::Arc;
 
 /// Checks what can be checked before the values are read (`what`: `volume grid `name``):
 /// the element type, dims, origin, spacing and the span of the voxels over the array as long
@@ -81,13 +83,38 @@ fn layout(grid: &VolumeGrid, len: usize) -> Result<[i64; 3], String> {
 }
 
 /// Copies the grid's voxels (`view`: its values, pinned) into a volume the scene calls `name`,
-/// a slab of 8 z-slices at a time. A non-finite voxel is refused with its index.
-pub(super) fn read(grid: &VolumeGrid, name: &str, view: View<'_>) -> Result<Volume, Error> {
-    let fail = |m: String| Error::Api(format!("volume `{name}`: {m}"));
+/// a slab of 8 z-slices at a time. A non-finite voxel is refused with its index. Its bricks are
+/// charged to `budget` as they are made (one that does not fit is refused); the charge of the
+/// finished volume is returned with it (given back when it drops).
+pub(super) fn read(
+    grid: &VolumeGrid,
+    name: &str,
+    view: View<'_>,
+    budget: &Arc<Budget>,
+) -> Result<(Volume, Charge), Error> {
+    let before = budget.used(Use::Volumes);
+    let volume = read_charged(grid, name, view, budget)?;
+    // What the finished volume keeps charged (the builder charges and gives back as it goes).
+    let held = budget.used(Use::Volumes).saturating_sub(before);
+    Ok((volume, budget.guard(Use::Volumes, held)))
+}
+
+fn read_charged(
+    grid: &VolumeGrid,
+    name: &str,
+    view: View<'_>,
+    budget: &Arc<Budget>,
+) -> Result<Volume, Error> {
+    let fail = |m: String| match m.contains("memory budget") {
+        // The budget's message names the volume and says what to do.
+        true => Error::Render(m),
+        false => Error::Api(format!("volume `{name}`: {m}")),
+    };
     let strides = layout(grid, view.len()).map_err(fail)?;
     let [nx, ny, nz] = grid.dims;
     let (o, s) = (grid.origin, grid.spacing);
     let mut b = VolumeBuilder::new(name, "array");
+    b.charge_to(budget.clone());
     #[rustfmt::skip]
     let world_from_index = [
         s[0], 0.0, 0.0, o[0],

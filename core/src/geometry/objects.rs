@@ -5,14 +5,16 @@
 //! pinned (held still, writers waiting) from the commit that reads them to the end of the
 //! render after it, and released between renders ([`Objects::unpin`]).
 
-use super::array_set::{ArraySet, CapReader, CylinderReader, MeshReader, SphereReader};
+use super::array_set::{ArraySet, CapReader, CylinderReader, MeshReader, Reader, SphereReader};
 use super::Kind;
 use super::{Counters, Hit, Surface};
 use crate::arrays::{Array, Pins};
-use crate::bvh::{BoxRay, REBUILD_RATIO};
+use crate::budget::{Budget, Charge, Use};
+use crate::bvh::{BoxRay, BUILD_BYTES_PER_PRIM, REBUILD_RATIO};
 use crate::error::Error;
 use crate::math::{DVec3, Vec3A};
 use crate::ray::Ray;
+use std::sync::Arc;
 
 /// Array objects a scene can hold (their number is 16 bits of a hit).
 pub const MAX_OBJECTS: usize = u16::MAX as usize;
@@ -44,6 +46,15 @@ impl Spec {
         match self {
             Spec::Spheres(_) | Spec::Cylinders { .. } => None,
             Spec::Mesh(m) => m.indices,
+        }
+    }
+
+    /// The primitives its trees hold over `pins` (a cylinder's caps count).
+    fn prims(&self, pins: &Pins) -> usize {
+        match self {
+            Spec::Spheres(r) => r.len(pins),
+            Spec::Mesh(r) => r.len(pins),
+            Spec::Cylinders { reader, caps } => reader.len(pins) * (1 + *caps as usize),
         }
     }
 
@@ -100,11 +111,15 @@ pub struct Object {
     lens: Vec<usize>,
     generations: Vec<u64>,
     shapes: Shapes,
+    /// Its tree's bytes, charged to the memory budget of the build that holds it.
+    charge: Charge,
 }
 
 impl Object {
     /// Pins `arrays`, checks every element and builds the tree (in render space whose origin
-    /// is `offset`); the arrays stay pinned (see [`Objects::unpin`]).
+    /// is `offset`); the arrays stay pinned (see [`Objects::unpin`]). The build's working
+    /// memory is charged to `budget` first (refused with a message when it does not fit), and
+    /// the tree's bytes for the object's life.
     pub fn build(
         key: u64,
         label: String,
@@ -112,9 +127,15 @@ impl Object {
         spec: Spec,
         material: u32,
         offset: DVec3,
+        budget: &Arc<Budget>,
     ) -> Result<Object, Error> {
         let pins = Pins::new(&arrays)?;
         let spec = spec.at(offset);
+        let n = spec.prims(&pins);
+        let work = (n as u64).saturating_mul(BUILD_BYTES_PER_PRIM);
+        let work = budget.charge(Use::Bvh, work, || {
+            format!("building the BVH of {label} over {n} primitives")
+        })?;
         let shapes = match spec {
             Spec::Spheres(r) => ArraySet::build(r, &pins, material).map(Shapes::Spheres),
             Spec::Mesh(r) => ArraySet::build(r, &pins, material).map(Shapes::Mesh),
@@ -128,7 +149,10 @@ impl Object {
             }
         };
         let shapes = shapes.map_err(|m| Error::Api(format!("{label}: {m}")))?;
+        drop(work);
+        let charge = budget.charge(Use::Bvh, shapes.bytes(), || format!("the BVH of {label}"))?;
         Ok(Object {
+            charge,
             key,
             label,
             offset,
@@ -146,7 +170,8 @@ impl Object {
     /// changed, refitted when contents changed but not counts, built again when counts changed
     /// or render space's origin is now `offset`, or when the refitted tree degraded. On an
     /// error the object is unusable (unpinned and emptied) until a later update succeeds.
-    pub fn update(self, offset: DVec3) -> Result<(Object, Outcome), Error> {
+    /// Its tree stays charged to `budget` (the build's that holds it now).
+    pub fn update(self, offset: DVec3, budget: &Arc<Budget>) -> Result<(Object, Outcome), Error> {
         let Object {
             key,
             label,
@@ -156,7 +181,7 @@ impl Object {
             ..
         } = self;
         if offset != self.offset {
-            let o = Object::build(key, label, arrays, spec, material, offset)?;
+            let o = Object::build(key, label, arrays, spec, material, offset, budget)?;
             return Ok((o, Outcome::Built));
         }
         let pins = Pins::new(&arrays)?;
@@ -166,7 +191,7 @@ impl Object {
         let retopo = topology.is_some_and(|k| generations[k] != self.generations[k]);
         if lens != self.lens || retopo {
             drop(pins);
-            let o = Object::build(key, label, arrays, spec, material, offset)?;
+            let o = Object::build(key, label, arrays, spec, material, offset, budget)?;
             return Ok((o, Outcome::Built));
         }
         let mut object = Object {
@@ -180,7 +205,10 @@ impl Object {
             lens,
             generations: self.generations,
             shapes: self.shapes,
+            charge: self.charge,
         };
+        let label = &object.label;
+        object.charge = (object.charge).move_to(budget, || format!("the BVH of {label}"))?;
         if generations == object.generations {
             object.pins = Some(pins);
             return Ok((object, Outcome::Kept));
@@ -204,7 +232,7 @@ impl Object {
                 material,
                 ..
             } = object;
-            let o = Object::build(key, label, arrays, spec, material, offset)?;
+            let o = Object::build(key, label, arrays, spec, material, offset, budget)?;
             return Ok((o, Outcome::Degraded(ratio)));
         }
         object.generations = generations;
@@ -236,7 +264,13 @@ impl Object {
 
     /// Bytes of its tree and leaf order in use (the arrays are the caller's).
     pub fn bytes(&self) -> u64 {
-        match &self.shapes {
+        self.shapes.bytes()
+    }
+}
+
+impl Shapes {
+    fn bytes(&self) -> u64 {
+        match self {
             Shapes::Spheres(s) => s.bytes(),
             Shapes::Mesh(m) => m.bytes(),
             Shapes::Cylinders(tubes, caps) => {

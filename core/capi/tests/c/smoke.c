@@ -171,6 +171,12 @@ int main(int argc, char **argv) {
     EXPECT(strncmp(luxon_last_error(), "<camera>:1:2: ", 14) == 0);
     EXPECT(luxon_scene_add_object(scene, "no-such-plugin", "()", NULL, NULL, NULL) ==
            LUXON_ERROR_PLUGIN_NOT_FOUND);
+    EXPECT(luxon_scene_set_texture(scene, "t", "no-such-texture", NULL) ==
+           LUXON_ERROR_PLUGIN_NOT_FOUND);
+    EXPECT(luxon_scene_set_clip_group(scene, "g", "[(normal: (0, 0, 0))]") == LUXON_ERROR_SCENE);
+    EXPECT(strncmp(luxon_last_error(), "<clip_planes>:1:", 16) == 0);
+    EXPECT(luxon_scene_add_volume_plugin(scene, "no-such-reader", "()", NULL, NULL, NULL) ==
+           LUXON_ERROR_PLUGIN_NOT_FOUND);
     CHECK(luxon_scene_remove(scene, light));
     EXPECT(luxon_scene_remove(scene, light) == LUXON_ERROR_INVALID_HANDLE);
     EXPECT(luxon_scene_set_background(scene, 0, 0, 0) == LUXON_OK);

@@ -120,6 +120,10 @@ functions! {
     luxon_scene_set_frame(Handle, u32) -> i32;
     luxon_scene_objects(Handle, *mut Handle, usize, *mut usize) -> i32;
     luxon_set_log(LogFn, *mut c_void, i32) -> i32;
+    luxon_scene_set_material_ron(Handle, *const c_char, *const c_char) -> i32;
+    luxon_scene_set_texture(Handle, *const c_char, *const c_char, *const c_char) -> i32;
+    luxon_scene_set_clip_group(Handle, *const c_char, *const c_char) -> i32;
+    luxon_scene_add_volume_plugin(Handle, *const c_char, *const c_char, *const c_char, *const c_char, *mut Handle) -> i32;
 }
 
 /// The library, loaded once per test process.

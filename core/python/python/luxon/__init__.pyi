@@ -129,6 +129,31 @@ class Scene:
     def lights(self) -> list[Light]: ...
     def set_material(self, name: str, ron: str | None = None, /, **fields: Any) -> str: ...
     def has_material(self, name: str) -> bool: ...
+    def set_texture(
+        self, name: str, plugin: str, params: str | dict[str, Any] | None = None, /, **fields: Any
+    ) -> str:
+        """Defines or replaces the texture ``name`` made by the texture plugin ``plugin``
+        (``checker``, ``image``, or your own, e.g. examples/stripes) from its parameters (RON
+        text, a dict or keyword arguments); materials wear it by name. Bad parameters raise
+        ``SceneError`` at once (``<texture>:line:col: ...``). Returns ``name``."""
+    def set_clip_group(
+        self, name: str, planes: str | Sequence[tuple[_Vec3, _Vec3] | dict[str, _Vec3]]
+    ) -> str:
+        """Defines or replaces the clip group ``name``: ``(point, normal)`` planes (or RON
+        text); what lies on the side a normal points to is cut from the objects and volumes
+        that name the group. Returns ``name``."""
+    def add_volume(
+        self,
+        plugin: str,
+        params: str | dict[str, Any] | None = None,
+        /,
+        *,
+        name: str | None = None,
+        render: str | dict[str, Any] | None = None,
+        **fields: Any,
+    ) -> Object:
+        """Adds a volume read by the reader plugin ``plugin`` (``raw``, ``vdb``) from its
+        parameters, drawn as ``render`` says (None: data only). Returns its handle."""
     def add_object(
         self,
         plugin: str,

@@ -346,6 +346,57 @@ class Scene(_luxon.Scene):
         self._set_material_ron(name, _text(ron, fields, f"material {name!r}"))
         return name
 
+    def set_texture(self, name, plugin, params=None, /, **fields):
+        """Defines or replaces the texture ``name`` made by the texture plugin ``plugin``
+        (``checker``, ``image``, or one of your own such as examples/stripes) from its
+        parameters as RON text, a dict or keyword arguments: ``set_texture("bands",
+        "stripes", width=0.1, axis=(1, 0, 0))``. Materials wear it by name
+        (``set_material("wall", texture="bands")``). The plugin reads the parameters at once:
+        a bad one raises :class:`luxon.SceneError` pointing into them (``<texture>:1:9:
+        ...``). The next render builds the scene again. Returns ``name``."""
+        if isinstance(params, dict):
+            if fields:
+                raise TypeError("set_texture: give params or keyword arguments, not both")
+            params, fields = None, params
+        self._set_texture(name, plugin, _text(params, fields, f"texture {name!r}"))
+        return name
+
+    def set_clip_group(self, name, planes):
+        """Defines or replaces the clip group ``name``: objects (``add_object(...,
+        clip=name)``) and volumes (``render`` with ``clip=name``) in it lose what lies on the
+        side a plane's normal points to. ``planes``: a list of ``(point, normal)`` pairs or
+        ``dict(point=..., normal=...)``, or the RON text of a scene file's group:
+        ``set_clip_group("half", [((0, 0, 0), (1, 0, 0))])``. Returns ``name``."""
+        if not isinstance(planes, str):
+            rows = []
+            for p in planes:
+                if not isinstance(p, dict):
+                    point, normal = p
+                    p = dict(point=tuple(point), normal=tuple(normal))
+                rows.append(p)
+            planes = to_ron(rows)
+        self._set_clip_group_ron(name, planes)
+        return name
+
+    def add_volume(self, plugin, params=None, /, *, name=None, render=None, **fields):
+        """Adds a volume read by the volume reader plugin ``plugin`` (``raw``, ``vdb``),
+        from its parameters as RON text, a dict or keyword arguments, as a scene file's
+        ``volumes`` give them: ``add_volume("raw", file="head.raw", dims=(256, 256, 109),
+        name="head", render=dict(transfer=dict(preset="grayscale")))``. ``render``: how it is
+        drawn (RON text or a dict; None: data only, not drawn). The plugin reads the file at
+        the next render or commit. Returns the volume's :class:`Object` handle (for
+        :meth:`Object.remove`). For a volume in a numpy array, see :meth:`volume`."""
+        if isinstance(params, dict):
+            if fields:
+                raise TypeError("add_volume: give params or keyword arguments, not both")
+            params, fields = None, params
+        look = render
+        if isinstance(render, dict):
+            look = _text(None, render, "volume render")
+        return Object(
+            self, self._add_plugin_volume(plugin, _text(params, fields, plugin), name, look)
+        )
+
     def has_material(self, name):
         """Whether the scene has a material called ``name`` (``default`` always)."""
         return self._has_material(name)
