@@ -110,7 +110,7 @@ fn the_heat_example_renders_its_field_in_situ() {
         // The heaters: red to yellow pixels; the corners are the dark background.
         let hot = img
             .pixels()
-            .filter(|p| p.0[0] > 120 && p.0[0] > p.0[2] + 60)
+            .filter(|p| p.0[0] > 120 && p.0[0] > p.0[2].saturating_add(60))
             .count();
         assert!(hot > 300, "frame {k}: {hot} hot pixels");
         assert!(img.get_pixel(0, 0).0.iter().all(|&c| c < 70), "frame {k}");
