@@ -15,7 +15,7 @@ once() {
     rm -rf "$out"
     t0=$(date +%s.%N)
     mpirun --oversubscribe -np "$1" --bind-to none "$luxon" render scenes/carousel.ron \
-        --frames 0..47 --threads 1 --res 320x240 --force --frame-groups "$2" \
+        --frames 0..47 --threads 1 --res "${RES:-320x240}" --force --frame-groups "$2" \
         -o "$out/f%04d.png" 2>/dev/null
     t1=$(date +%s.%N)
     echo "$t0 $t1" | awk '{ printf "%.3f\n", $2 - $1 }'
