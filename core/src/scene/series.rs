@@ -282,14 +282,22 @@ fn store_mesh(
     let what = move || format!("{triangles} triangles");
     let attrs = !(m.normals.is_empty() && m.colors.is_empty() && m.uvs.is_empty());
     (sets.triangles).reserve_mesh(triangles, vertices, attrs, budget, &what)?;
+    with_mesh_input(g, |input| sets.triangles.push_mesh(input, offset, material))
+}
+
+/// A data frame's mesh as the triangle code reads it (colours and uvs in f32), lent to `with`.
+pub(super) fn with_mesh_input<R>(
+    g: &luxon_formats::InlineGeometry,
+    with: impl FnOnce(&MeshInput) -> R,
+) -> R {
+    let m = &g.mesh;
     let colors: Vec<f32> = m.colors.iter().flat_map(|c| c.map(|x| x as f32)).collect();
     let uvs: Vec<f32> = m.uvs.iter().flat_map(|u| u.map(|x| x as f32)).collect();
-    let input = MeshInput {
+    with(&MeshInput {
         positions: m.positions.as_flattened(),
         indices: m.indices.as_flattened(),
         normals: m.normals.as_flattened(),
         colors: &colors,
         uvs: &uvs,
-    };
-    sets.triangles.push_mesh(&input, offset, material)
+    })
 }

@@ -3,10 +3,11 @@
 //! at both ends. The data frames must hold the same things: as many atoms, and meshes with the
 //! same triangles over as many vertices (only where the vertices are changes).
 
+use super::series::with_mesh_input;
 use crate::budget::{Budget, Use};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::sweep::{Sweep, Swept};
-use crate::geometry::triangle::{corners, MeshInput, Triangle, VertexAttr, NO_ATTR};
+use crate::geometry::triangle::{corners, Triangle, VertexAttr, NO_ATTR};
 use crate::math::DVec3;
 use glam::Vec3;
 use luxon_formats::{InlineGeometry, SeriesFrame};
@@ -101,18 +102,7 @@ fn mesh(
 ) -> Result<(), String> {
     let mut ends: Vec<(Vec<Vec3>, Option<Vec<VertexAttr>>)> = Vec::new();
     for (g, (_, f)) in meshes.iter().zip(steps) {
-        let m = &g.mesh;
-        let colors: Vec<f32> = m.colors.iter().flat_map(|c| c.map(|x| x as f32)).collect();
-        let uvs: Vec<f32> = m.uvs.iter().flat_map(|u| u.map(|x| x as f32)).collect();
-        let input = MeshInput {
-            positions: m.positions.as_flattened(),
-            indices: m.indices.as_flattened(),
-            normals: m.normals.as_flattened(),
-            colors: &colors,
-            uvs: &uvs,
-        };
-        let end = input
-            .vertices(offset)
+        let end = with_mesh_input(g, |input| input.vertices(offset))
             .map_err(|e| format!("`{}`: {e}", f.file.display()))?;
         if end.1.is_some() != ends.first().map_or(end.1.is_some(), |e| e.1.is_some()) {
             return Err(format!(
