@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{bits, ensure_built, profile_dir, render_f32, rust_api};
+use common::{bits, ensure_built, profile_dir, render_f32, rust_api, temp_dir};
 use luxon_core::api::{Context, Mesh, Radius, Scene, Spheres, VolumeGrid};
 use luxon_core::arrays::{Array, SharedVec};
 use luxon_formats::{Attenuation, CameraDesc, LightDesc, MaterialDesc, Projection};
@@ -148,9 +148,7 @@ fn c99_arrays_render_what_rust_renders() {
     }
     ensure_built();
     let lib = profile_dir();
-    let dir = std::env::temp_dir().join(format!("luxon-capi-arrays-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("arrays");
     let exe = dir.join("arrays");
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let built = Command::new(&cc)

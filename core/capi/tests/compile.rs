@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bits, ensure_built, profile_dir, render_f32, render_rgba8, root, rust_api};
+use common::{bits, ensure_built, profile_dir, render_f32, render_rgba8, root, rust_api, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -31,13 +31,6 @@ fn run(cmd: &mut Command) -> Output {
         String::from_utf8_lossy(&out.stderr)
     );
     out
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("luxon-capi-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn floats(path: &Path) -> Vec<u32> {

@@ -8,27 +8,11 @@
 
 mod common;
 
-use common::{ensure_built, profile_dir, root};
+use common::{ensure_built, profile_dir, report, root, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 const ARGS: [&str; 6] = ["--size", "24", "--steps", "20", "--every", "5"];
-
-fn report(o: &Output) -> String {
-    format!(
-        "status {:?}\nstdout:\n{}\nstderr:\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("luxon-capi-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Compiles heat.c with `compiler` (`cc` or `mpicc`) and `defines` into `dir/heat-COMPILER`,
 /// or `None` when there is no such compiler.

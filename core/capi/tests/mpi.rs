@@ -38,7 +38,9 @@ fn a_communicator_is_refused_without_mpi_initialised_or_built_in() {
 
 #[cfg(feature = "mpi")]
 mod with_mpi {
-    use super::common::{bits, ensure_built, profile_dir, render_f32, root, rust_api};
+    use super::common::{
+        bits, ensure_built, profile_dir, render_f32, report, root, rust_api, temp_dir,
+    };
     use std::path::{Path, PathBuf};
     use std::process::{Command, Output, Stdio};
     use std::time::{Duration, Instant};
@@ -46,22 +48,6 @@ mod with_mpi {
     const DEADLINE: Duration = Duration::from_secs(90);
     const W: u32 = 97;
     const H: u32 = 61;
-
-    fn temp_dir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("luxon-capi-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
-    }
-
-    fn report(o: &Output) -> String {
-        format!(
-            "status {:?}\nstdout:\n{}\nstderr:\n{}",
-            o.status,
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        )
-    }
 
     /// `tests/c/mpi_split.c` compiled with mpicc against libluxon.so (with MPI).
     fn compile(dir: &Path) -> PathBuf {

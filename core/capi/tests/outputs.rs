@@ -3,21 +3,14 @@
 
 mod common;
 
-use common::bits;
 use common::capi::*;
+use common::{bits, temp_dir};
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::ptr::null_mut;
 use std::sync::Mutex;
 
 fn c(s: &str) -> CString {
     CString::new(s).unwrap()
-}
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("luxon-capi-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 #[test]
