@@ -408,6 +408,31 @@ mod tests {
     }
 
     #[test]
+    fn memory_refusals_are_told_apart_from_bad_data() {
+        // A dense brick (8³ f32) does not fit a 1000-byte budget.
+        let mut b = VolumeBuilder::new("v", "test");
+        b.charge_to(std::sync::Arc::new(crate::budget::Budget::new(
+            1000,
+            "test".into(),
+            None,
+        )));
+        b.begin(IDENTITY, 0.0, [0; 3], [7; 3], "g").unwrap();
+        assert!(!b.out_of_memory());
+        let e = b.add_dense([0; 3], [8; 3], &[0.5; 512]).unwrap_err();
+        assert!(e.contains("memory budget"), "{e}");
+        assert!(b.out_of_memory());
+        let (_, refused) = b.finish_or_refused().unwrap_err();
+        assert!(refused);
+
+        // A voxel outside the grid's box is the data's fault, with memory to spare.
+        let mut b = builder([0; 3], [3; 3]);
+        b.add_dense([2; 3], [4; 3], &[0.5; 64]).unwrap_err();
+        assert!(!b.out_of_memory());
+        let (_, refused) = b.finish_or_refused().unwrap_err();
+        assert!(!refused);
+    }
+
+    #[test]
     fn rejections() {
         let mut b = VolumeBuilder::new("v", "test");
         let e = b.add_dense([0; 3], [1; 3], &[0.0]).unwrap_err();

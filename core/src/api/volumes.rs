@@ -105,10 +105,12 @@ fn read_charged(
     view: View<'_>,
     budget: &Arc<Budget>,
 ) -> Result<Volume, Error> {
-    let fail = |m: String| match m.contains("memory budget") {
-        // The budget's message names the volume and says what to do.
+    let fail = |m: String| Error::Api(format!("volume `{name}`: {m}"));
+    // A builder error for want of memory is the budget's message: it names the volume and says
+    // what to do.
+    let built = |b: &VolumeBuilder, m: String| match b.out_of_memory() {
         true => Error::Render(m),
-        false => Error::Api(format!("volume `{name}`: {m}")),
+        false => fail(m),
     };
     let strides = layout(grid, view.len()).map_err(fail)?;
     let [nx, ny, nz] = grid.dims;
@@ -123,7 +125,7 @@ fn read_charged(
     ];
     let max = [nx, ny, nz].map(|n| n as i64 - 1);
     b.begin(world_from_index, 0.0, [0; 3], max, name)
-        .map_err(fail)?;
+        .map_err(|m| built(&b, m))?;
     let slab = BRICK_SIZE as u64;
     let per_slice = (nx * ny) as usize;
     let voxels = per_slice * slab.min(nz) as usize;
@@ -162,7 +164,7 @@ fn read_charged(
                     true => b.add_dense_u16(at, dims, &words, divisor(65535.0)),
                     false => b.add_dense_u8(at, dims, &bytes, divisor(255.0)),
                 }
-                .map_err(fail)?;
+                .map_err(|m| built(&b, m))?;
             }
         }
         _ => {
@@ -188,11 +190,15 @@ fn read_charged(
                     }
                 }
                 b.add_dense([0, 0, z0 as i64], [nx, ny, dz], &floats)
-                    .map_err(fail)?;
+                    .map_err(|m| built(&b, m))?;
             }
         }
     }
-    b.finish().map_err(fail)
+    b.finish_or_refused()
+        .map_err(|(m, out_of_memory)| match out_of_memory {
+            true => Error::Render(m),
+            false => fail(m),
+        })
 }
 
 /// Room for a slab of `n` voxels, or the error saying it does not fit.

@@ -103,6 +103,12 @@ impl VolumeBuilder {
         self.charger.budget()
     }
 
+    /// Whether an error came from memory refused (by the budget or the system) rather than
+    /// from the data, so a caller can report it as the budget's, not the volume's.
+    pub fn out_of_memory(&self) -> bool {
+        self.charger.was_refused()
+    }
+
     /// Records the first error; later calls fail with it.
     pub fn fail(&mut self, message: &str) {
         if self.failed.is_none() {
@@ -428,17 +434,21 @@ impl VolumeBuilder {
 
     /// The finished volume, or the first error. Dense bricks whose voxels all have one value
     /// (given or background) become constant bricks (complete bricks already are).
-    pub fn finish(mut self) -> Result<Volume, String> {
+    pub fn finish(self) -> Result<Volume, String> {
+        self.finish_or_refused().map_err(|(m, _)| m)
+    }
+
+    /// [`finish`](Self::finish), and with its error whether it came from memory refused (see
+    /// [`out_of_memory`](Self::out_of_memory)), sealing's own charges included.
+    pub fn finish_or_refused(mut self) -> Result<Volume, (String, bool)> {
+        let refused = |b: &Self, m: String| (m, b.out_of_memory());
         if let Some(first) = self.failed.take() {
-            return Err(format!(
-                "ignored an error from the host and returned success: {first}"
-            ));
+            let m = format!("ignored an error from the host and returned success: {first}");
+            return Err(refused(&self, m));
         }
         let Some(mut volume) = self.volume.take() else {
-            return Err(
-                "returned without reading a grid (it never called `begin` on the volume sink)"
-                    .into(),
-            );
+            let m = "returned without reading a grid (it never called `begin` on the volume sink)";
+            return Err(refused(&self, m.into()));
         };
         // Voxels nothing reached hold the background, so this keeps every value.
         let codes = &volume.codes;
@@ -448,7 +458,9 @@ impl VolumeBuilder {
                 *brick = Brick::Constant(v);
             }
         }
-        volume.seal(&mut self.charger)?;
+        if let Err(m) = volume.seal(&mut self.charger) {
+            return Err(refused(&self, m));
+        }
         self.charger.keep();
         Ok(volume)
     }

@@ -12,6 +12,8 @@ pub(super) struct Charger {
     name: String,
     /// Bytes charged for the volume so far.
     held: u64,
+    /// Whether a charge failed: the budget (or the system) refused memory, as opposed to bad data.
+    refused: bool,
 }
 
 /// Bytes a map entry of `T` takes (its key and value, and hashbrown's control byte).
@@ -25,6 +27,7 @@ impl Charger {
             budget,
             name: name.to_string(),
             held: 0,
+            refused: false,
         }
     }
 
@@ -35,9 +38,11 @@ impl Charger {
     /// Charges `n` more bytes for the volume, or says that it does not fit.
     pub(super) fn add(&mut self, n: u64) -> Result<(), String> {
         let (name, held) = (&self.name, self.held);
-        self.budget.reserve(Use::Volumes, n, || {
+        let charged = self.budget.reserve(Use::Volumes, n, || {
             format!("volume `{name}` (its storage so far: {})", bytes(held))
-        })?;
+        });
+        self.refused |= charged.is_err();
+        charged?;
         self.held += n;
         Ok(())
     }
@@ -50,8 +55,14 @@ impl Charger {
     }
 
     /// The error for `n` bytes the system refused.
-    pub(super) fn refused(&self, n: u64) -> String {
+    pub(super) fn refused(&mut self, n: u64) -> String {
+        self.refused = true;
         self.budget.refused(n, &format!("volume `{}`", self.name)).0
+    }
+
+    /// Whether the volume failed for want of memory (the budget's or the system's).
+    pub(super) fn was_refused(&self) -> bool {
+        self.refused
     }
 
     /// The bytes charged stay charged for the finished volume's life (its budget's).
