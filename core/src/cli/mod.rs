@@ -3,6 +3,7 @@
 pub mod check;
 pub mod convert;
 #[cfg(feature = "mpi")]
+pub mod frame_clock;
 pub mod frame_groups;
 pub mod job;
 pub mod new_plugin;
