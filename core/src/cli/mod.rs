@@ -2,8 +2,8 @@
 
 pub mod check;
 pub mod convert;
-#[cfg(feature = "mpi")]
 pub mod frame_clock;
+#[cfg(feature = "mpi")]
 pub mod frame_groups;
 pub mod job;
 pub mod new_plugin;
