@@ -386,6 +386,76 @@ mod with_mpi {
         }
     }
 
+    /// How many frames `--stats` says rank `r` of `ranks` rendered (its time line must be there,
+    /// with where the rest of its time went).
+    fn frames_of_rank(e: &str, r: usize, ranks: usize) -> usize {
+        let head = format!("luxon: rank {r} of {ranks}: ready after ");
+        let line = e
+            .lines()
+            .find(|l| l.starts_with(&head))
+            .unwrap_or_else(|| panic!("no time line of rank {r} of {ranks}: {e}"));
+        assert!(
+            line.contains(", waiting for frames ") && line.contains(", done after "),
+            "{line}"
+        );
+        let counted = line.split(", ").nth(1).unwrap_or_default();
+        counted
+            .split(" frames rendered in ")
+            .next()
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no frame count: {line}"))
+    }
+
+    /// With `--stats`, every rank of a sequence accounts for its time on one line: whole
+    /// frames are rendered by one rank each (the counts add up to the frames written), shared
+    /// frames by every rank; one process alone prints its line too.
+    #[test]
+    fn frame_stats_account_for_every_rank() {
+        let dir = temp_dir("mpi-frame-clock");
+        let s = root().join("scenes/carousel.ron").display().to_string();
+        for (ranks, groups) in [(0, "whole"), (3, "whole"), (3, "2"), (2, "shared")] {
+            let out = dir.join(format!("np{ranks}-{groups}"));
+            let pattern = out.join("f%d.ppm").display().to_string();
+            let args = [
+                "render",
+                &s,
+                "--frames",
+                "0..5",
+                "--res",
+                "24x18",
+                "--frame-groups",
+                groups,
+                "--stats",
+                "-o",
+                &pattern,
+            ];
+            let o = match ranks {
+                0 => run(&args),
+                _ => mpirun(ranks, &args, &[]).0,
+            };
+            let e = stderr(&o);
+            assert!(o.status.success(), "{ranks} {groups}: {e}");
+            assert_eq!(wrote(&o), 6, "{ranks} {groups}: {e}");
+            let (ranks, per_frame) = match (ranks, groups) {
+                (0, _) => (1, 1),
+                (_, "shared") => (ranks, ranks),
+                _ => (ranks, 1),
+            };
+            let leaders: usize = match groups {
+                "2" => [0, 2].iter().map(|&r| frames_of_rank(&e, r, ranks)).sum(),
+                _ => (0..ranks).map(|r| frames_of_rank(&e, r, ranks)).sum(),
+            };
+            assert_eq!(leaders, 6 * per_frame, "{ranks} {groups}: {e}");
+            if groups == "2" {
+                assert_eq!(
+                    frames_of_rank(&e, 1, ranks),
+                    frames_of_rank(&e, 0, ranks),
+                    "{e}"
+                );
+            }
+        }
+    }
+
     /// Ranks that cannot see the directory rank 0 writes the frame records to are refused
     /// before any frame: here the two ranks start in different directories and the output
     /// name is relative.

@@ -2,9 +2,11 @@
 //! Groups(n)))`, `--frame-groups`): consecutive ranks form groups of `n`; each group's leader
 //! takes frames from rank 0's queue ([`FrameQueue`]), the group renders each frame as one image
 //! is rendered (its pixels shared by the scene's decomposition, on the group's own
-//! communicator), and the leader writes it and reports it. Rank 0 keeps the frame records, as
-//! with one group, so a resumed run renders only the frames missing.
+//! communicator), and the leader writes it and reports it (with its request for the next
+//! frame). Rank 0 keeps the frame records, as with one group, so a resumed run renders only the
+//! frames missing.
 
+use super::frame_clock::FrameClock;
 use super::job::Job;
 use super::sequence::{Each, Tally, NO_FRAME};
 use luxon::api::Scene;
@@ -56,13 +58,13 @@ pub(super) fn run(
     world: &Cluster,
     n: usize,
     tally: Option<Tally>,
+    clock: &mut FrameClock,
 ) -> Result<Option<Tally>, Error> {
     let queue = FrameQueue::new(world);
     let group = match n {
         1 => Job::Local,
         _ => Job::Mpi(world.split(n)),
     };
-    let leader = group.rank() == 0;
     let result = match tally {
         Some(tally) => {
             let groups = world.size().div_ceil(n);
@@ -70,18 +72,35 @@ pub(super) fn run(
             let lock = || tally.lock().unwrap_or_else(PoisonError::into_inner);
             let next = || lock().next();
             let report = |r: FrameResult| lock().report(r);
+            // Rank 0's own frames are recorded by the dealer thread (recording syncs a file),
+            // so that rank 0 goes on to its next frame at once.
+            let own = Mutex::new(Vec::new());
+            let take_own =
+                || std::mem::take(&mut *own.lock().unwrap_or_else(PoisonError::into_inner));
+            let record_own = || take_own().into_iter().for_each(report);
+            let next_own = |done: Option<FrameResult>| {
+                let k = next();
+                if let Some(r) = done {
+                    own.lock().unwrap_or_else(PoisonError::into_inner).push(r);
+                }
+                k
+            };
             std::thread::scope(|sc| {
-                sc.spawn(|| queue.deal(groups - 1, &next, &report));
-                frames(each, scene, &group, next, report);
+                sc.spawn(|| queue.deal(groups - 1, &next, &report, &record_own));
+                frames(each, scene, &group, next_own, clock);
             });
+            record_own();
             Some(tally.into_inner().unwrap_or_else(PoisonError::into_inner))
         }
         None => {
-            let next = || match leader {
-                true => queue.request(),
-                false => None,
-            };
-            frames(each, scene, &group, next, |r| queue.report(&r));
+            // A frame's report goes with the request for the next one.
+            frames(
+                each,
+                scene,
+                &group,
+                |done| queue.request(done.as_ref()),
+                clock,
+            );
             None
         }
     };
@@ -90,32 +109,36 @@ pub(super) fn run(
     Ok(result)
 }
 
-/// One group's loop: its leader's `next` frame goes to every member, which renders it; the
-/// leader `report`s how it ended.
+/// One group's loop: its leader's `next(done)` reports how the group's previous frame ended
+/// (none before the first) and gives the next frame, which goes to every member, which renders
+/// it.
 fn frames(
     each: &Each,
     scene: &mut Scene,
     group: &Job,
-    next: impl Fn() -> Option<u32>,
-    report: impl Fn(FrameResult),
+    next: impl Fn(Option<FrameResult>) -> Option<u32>,
+    clock: &mut FrameClock,
 ) {
+    let mut done = None;
     loop {
-        let k = match group.rank() {
-            0 => next().map_or(NO_FRAME, u64::from),
-            _ => NO_FRAME,
-        };
-        let k = group.root_value(k);
+        let k = clock.wait(|| {
+            let k = match group.rank() {
+                0 => next(done.take()).map_or(NO_FRAME, u64::from),
+                _ => NO_FRAME,
+            };
+            group.root_value(k)
+        });
         if k == NO_FRAME {
             return;
         }
         let k = k as u32;
         let t = Instant::now();
-        if let Some(outcome) = each.frame(k, scene, group) {
-            report(FrameResult {
+        done = clock
+            .render(|| each.frame(k, scene, group))
+            .map(|outcome| FrameResult {
                 frame: k,
                 outcome,
                 seconds: t.elapsed().as_secs_f64(),
             });
-        }
     }
 }

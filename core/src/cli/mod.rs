@@ -2,6 +2,7 @@
 
 pub mod check;
 pub mod convert;
+pub mod frame_clock;
 #[cfg(feature = "mpi")]
 pub mod frame_groups;
 pub mod job;

@@ -322,7 +322,7 @@ pub fn run(path: &Path, o: &Overrides) -> Result<(), Error> {
     let load_time = t0.elapsed();
     let animated = desc.as_ref().is_ok_and(|d| d.animation.is_some());
     if animated || o.frames.is_some() || o.step.is_some() || o.force || o.preview.is_some() {
-        return super::sequence::run(o, desc, &read, &ctx, &renderer, job);
+        return super::sequence::run(o, desc, &read, &ctx, &renderer, job, t0);
     }
     let ready =
         desc.and_then(|desc| prepare(path, o, desc, cached, &ctx, &renderer, &job, &mut cache));

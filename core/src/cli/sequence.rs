@@ -12,6 +12,7 @@
 //! not rendered again (`--force` renders it anyway), and processes started on the same outputs
 //! share the frames by claiming them ([`super::resume`]).
 
+use super::frame_clock::FrameClock;
 use super::job::Job;
 use super::render::{
     built, plan, print_stats, scene_dir_of, warn_nan, write_image, Image, Overrides,
@@ -225,7 +226,7 @@ fn about(desc: &SceneDesc, frames: &[u32], hash: u64, o: &Overrides) -> String {
 }
 
 /// Renders the frames of an animated scene (`desc` is loaded with the command line's
-/// overrides); every rank runs this.
+/// overrides); every rank runs this. `start`: when the command started.
 pub fn run(
     o: &Overrides,
     desc: Result<SceneDesc, Error>,
@@ -233,6 +234,7 @@ pub fn run(
     ctx: &Context,
     renderer: &Renderer,
     job: Job,
+    start: Instant,
 ) -> Result<(), Error> {
     let t0 = Instant::now();
     let ready = desc.and_then(|d| prepare(o, d, read, ctx, renderer, &job));
@@ -279,6 +281,7 @@ pub fn run(
         // frame there would sweep it as stale.
         mpi_io: group >= job.size(),
     };
+    let mut clock = FrameClock::new(start);
     if group < job.size() {
         #[cfg(feature = "mpi")]
         if let Job::Mpi(cluster) = &job {
@@ -288,30 +291,39 @@ pub fn run(
                     None => job.exit_quietly(),
                 }
             }
-            tally = super::frame_groups::run(&each, &mut scene, cluster, group, tally)?;
+            tally = super::frame_groups::run(&each, &mut scene, cluster, group, tally, &mut clock)?;
         }
     } else {
-        // Rank 0 picks (and claims) the next frame; every rank renders it.
+        // Rank 0 picks (and claims) the next frame; every rank renders it. Rank 0 records the
+        // previous frame once the others have the next one: they need not wait for that.
+        let mut done = None;
         loop {
-            let next = tally
-                .as_mut()
-                .and_then(Tally::next)
-                .map_or(NO_FRAME, u64::from);
-            let next = job.root_value(next);
+            let next = clock.wait(|| {
+                let next = tally
+                    .as_mut()
+                    .and_then(Tally::next)
+                    .map_or(NO_FRAME, u64::from);
+                job.root_value(next)
+            });
+            if let (Some(tally), Some(r)) = (tally.as_mut(), done.take()) {
+                clock.report(|| tally.report(r));
+            }
             if next == NO_FRAME {
                 break;
             }
             let k = next as u32;
             let t = Instant::now();
-            let outcome = each.frame(k, &mut scene, &job);
-            if let (Some(tally), Some(outcome)) = (tally.as_mut(), outcome) {
-                tally.report(FrameResult {
+            done = clock
+                .render(|| each.frame(k, &mut scene, &job))
+                .map(|outcome| FrameResult {
                     frame: k,
                     outcome,
                     seconds: t.elapsed().as_secs_f64(),
                 });
-            }
         }
+    }
+    if o.stats {
+        clock.print(job.rank(), job.size());
     }
     let Some(tally) = tally else {
         return Ok(());
