@@ -4,15 +4,59 @@
 
 /// Appends the 8-bit sRGB RGB bytes of linear RGBA pixels, exactly as the `ppm` writer does.
 pub fn srgb8(rgba: &[f32], out: &mut Vec<u8>) {
+    let encode = |c: f32| (luxon_plugin::linear_to_srgb(c) * 255.0).round() as u8;
+    // A pixel with the same bits as the one before it (a background, a flat region) encodes
+    // the same: its bytes are copied rather than computed again (the curve is a `powf`).
+    let mut last: Option<([u32; 3], [u8; 3])> = None;
     for px in rgba.chunks_exact(4) {
-        out.extend(
-            px[..3]
-                .iter()
-                .map(|&c| (luxon_plugin::linear_to_srgb(c) * 255.0).round() as u8),
-        );
+        let bits = [px[0].to_bits(), px[1].to_bits(), px[2].to_bits()];
+        let rgb = match last {
+            Some((b, rgb)) if b == bits => rgb,
+            _ => {
+                let rgb = [encode(px[0]), encode(px[1]), encode(px[2])];
+                last = Some((bits, rgb));
+                rgb
+            }
+        };
+        out.extend_from_slice(&rgb);
     }
 }
 
 pub fn ppm_header(width: u32, height: u32) -> Vec<u8> {
     format!("P6\n{width} {height}\n255\n").into_bytes()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs of equal pixels (copied bytes) encode as every pixel computed on its own.
+    #[test]
+    fn repeated_pixels_encode_as_computed_alone() {
+        let values = [
+            0.0,
+            -0.0,
+            0.5,
+            0.5,
+            0.25,
+            f32::NAN,
+            f32::NAN,
+            1.5,
+            0.003,
+            0.0031,
+        ];
+        let mut rgba = Vec::new();
+        for (i, &v) in values.iter().enumerate() {
+            rgba.extend([v, 0.2, v, 1.0, v, 0.2, v, 0.5]);
+            rgba.extend([v, 0.2, values[(i + 3) % values.len()], 1.0]);
+        }
+        let mut all = Vec::new();
+        srgb8(&rgba, &mut all);
+        let mut alone = Vec::new();
+        for px in rgba.chunks_exact(4) {
+            srgb8(px, &mut alone);
+        }
+        assert_eq!(all, alone);
+        assert_eq!(&all[..3], &[0, 124, 0]);
+    }
 }

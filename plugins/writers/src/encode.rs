@@ -70,7 +70,7 @@ fn truncate(x: f32, max: f32) -> f32 {
 }
 
 /// Encoded samples, RGB or RGBA, one `T` per channel; alpha is stored linearly and rounded.
-fn encode_samples<T>(
+fn encode_samples<T: Copy + PartialEq>(
     image: &Image,
     alpha: bool,
     encoding: Encoding,
@@ -80,11 +80,24 @@ fn encode_samples<T>(
 ) -> Vec<T> {
     let channels = if alpha { 4 } else { 3 };
     let mut out = Vec::with_capacity(image.rgba.len() / 4 * channels);
+    let encode = |c: f32| match encoding {
+        Encoding::Srgb => quantize(linear_to_srgb(c)),
+        Encoding::Display => from_step(truncate(c, max)),
+    };
+    // A pixel with the same bits as the one before it (a background, a flat region) encodes
+    // the same: its samples are copied rather than computed again.
+    let mut last: Option<([u32; 3], [T; 3])> = None;
     for px in image.rgba.chunks_exact(4) {
-        match encoding {
-            Encoding::Srgb => out.extend(px[..3].iter().map(|&c| quantize(linear_to_srgb(c)))),
-            Encoding::Display => out.extend(px[..3].iter().map(|&c| from_step(truncate(c, max)))),
-        }
+        let bits = [px[0].to_bits(), px[1].to_bits(), px[2].to_bits()];
+        let rgb = match last {
+            Some((b, rgb)) if b == bits => rgb,
+            _ => {
+                let rgb = [encode(px[0]), encode(px[1]), encode(px[2])];
+                last = Some((bits, rgb));
+                rgb
+            }
+        };
+        out.extend_from_slice(&rgb);
         if alpha {
             out.push(quantize(linear_unit(px[3])));
         }
@@ -155,5 +168,58 @@ mod tests {
             [32767, 65469, 65535, 65535, 0, 0]
         );
         assert_eq!(samples8(&image, false, Encoding::Srgb)[0], 188);
+    }
+
+    /// Runs of equal pixels (copied samples) encode as every pixel computed on its own.
+    #[test]
+    fn repeated_pixels_encode_as_computed_alone() {
+        let values = [
+            0.0,
+            -0.0,
+            0.5,
+            0.5,
+            0.25,
+            f32::NAN,
+            f32::NAN,
+            1.5,
+            0.003,
+            0.0031,
+        ];
+        let mut rgba = Vec::new();
+        for (i, &v) in values.iter().enumerate() {
+            // Each colour twice, then once with only blue changed, and alpha varying.
+            for a in [1.0, 0.5] {
+                rgba.extend([v, 0.2, v, a]);
+            }
+            rgba.extend([v, 0.2, values[(i + 3) % values.len()], 0.25]);
+        }
+        let image = Image {
+            width: rgba.len() as u32 / 4,
+            height: 1,
+            rgba: &rgba,
+        };
+        for encoding in [Encoding::Srgb, Encoding::Display] {
+            for alpha in [false, true] {
+                let alone = |px: &[f32]| {
+                    let one = Image {
+                        width: 1,
+                        height: 1,
+                        rgba: px,
+                    };
+                    (
+                        samples8(&one, alpha, encoding),
+                        samples16(&one, alpha, encoding),
+                    )
+                };
+                let (mut want8, mut want16) = (Vec::new(), Vec::new());
+                for px in rgba.chunks_exact(4) {
+                    let (a, b) = alone(px);
+                    want8.extend(a);
+                    want16.extend(b);
+                }
+                assert_eq!(samples8(&image, alpha, encoding), want8, "{encoding:?}");
+                assert_eq!(samples16(&image, alpha, encoding), want16, "{encoding:?}");
+            }
+        }
     }
 }
