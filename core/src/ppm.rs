@@ -5,21 +5,7 @@
 /// Appends the 8-bit sRGB RGB bytes of linear RGBA pixels, exactly as the `ppm` writer does.
 pub fn srgb8(rgba: &[f32], out: &mut Vec<u8>) {
     let encode = |c: f32| (luxon_plugin::linear_to_srgb(c) * 255.0).round() as u8;
-    // A pixel with the same bits as the one before it (a background, a flat region) encodes
-    // the same: its bytes are copied rather than computed again (the curve is a `powf`).
-    let mut last: Option<([u32; 3], [u8; 3])> = None;
-    for px in rgba.chunks_exact(4) {
-        let bits = [px[0].to_bits(), px[1].to_bits(), px[2].to_bits()];
-        let rgb = match last {
-            Some((b, rgb)) if b == bits => rgb,
-            _ => {
-                let rgb = [encode(px[0]), encode(px[1]), encode(px[2])];
-                last = Some((bits, rgb));
-                rgb
-            }
-        };
-        out.extend_from_slice(&rgb);
-    }
+    luxon_plugin::encode_rgb(rgba, encode, |rgb, _| out.extend_from_slice(&rgb));
 }
 
 pub fn ppm_header(width: u32, height: u32) -> Vec<u8> {

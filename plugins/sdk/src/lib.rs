@@ -875,6 +875,30 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
+/// Encodes the RGB of each linear RGBA pixel of `rgba` with `encode` (one channel at a time)
+/// and hands `emit` the three samples with the pixel. A pixel whose colour has the same bits as
+/// the one before it (a background, a flat region) gets that pixel's samples again instead of
+/// being encoded anew: the same samples, without the transfer curve's `powf`.
+pub fn encode_rgb<T: Copy>(
+    rgba: &[f32],
+    mut encode: impl FnMut(f32) -> T,
+    mut emit: impl FnMut([T; 3], &[f32]),
+) {
+    let mut last: Option<([u32; 3], [T; 3])> = None;
+    for px in rgba.chunks_exact(4) {
+        let bits = [px[0].to_bits(), px[1].to_bits(), px[2].to_bits()];
+        let rgb = match last {
+            Some((b, rgb)) if b == bits => rgb,
+            _ => {
+                let rgb = [encode(px[0]), encode(px[1]), encode(px[2])];
+                last = Some((bits, rgb));
+                rgb
+            }
+        };
+        emit(rgb, px);
+    }
+}
+
 // ------------------------------------------------------------------------------------------------
 // Entry point shims (used by `export!`; not for direct use)
 // ------------------------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 //! What every integer format shares: the image checks, the encoding and quantisation of the
 //! samples (`encoding`), and the error of a failed encoder.
 
-use luxon_plugin::{invalid, linear_to_srgb, Error, Image};
+use luxon_plugin::{encode_rgb, invalid, linear_to_srgb, Error, Image};
 use serde::Deserialize;
 
 /// How colour values become integer samples (parameter `encoding`).
@@ -70,7 +70,7 @@ fn truncate(x: f32, max: f32) -> f32 {
 }
 
 /// Encoded samples, RGB or RGBA, one `T` per channel; alpha is stored linearly and rounded.
-fn encode_samples<T: Copy + PartialEq>(
+fn encode_samples<T: Copy>(
     image: &Image,
     alpha: bool,
     encoding: Encoding,
@@ -84,24 +84,12 @@ fn encode_samples<T: Copy + PartialEq>(
         Encoding::Srgb => quantize(linear_to_srgb(c)),
         Encoding::Display => from_step(truncate(c, max)),
     };
-    // A pixel with the same bits as the one before it (a background, a flat region) encodes
-    // the same: its samples are copied rather than computed again.
-    let mut last: Option<([u32; 3], [T; 3])> = None;
-    for px in image.rgba.chunks_exact(4) {
-        let bits = [px[0].to_bits(), px[1].to_bits(), px[2].to_bits()];
-        let rgb = match last {
-            Some((b, rgb)) if b == bits => rgb,
-            _ => {
-                let rgb = [encode(px[0]), encode(px[1]), encode(px[2])];
-                last = Some((bits, rgb));
-                rgb
-            }
-        };
+    encode_rgb(image.rgba, encode, |rgb, px| {
         out.extend_from_slice(&rgb);
         if alpha {
             out.push(quantize(linear_unit(px[3])));
         }
-    }
+    });
     out
 }
 
