@@ -19,6 +19,7 @@ use luxon_formats::{
     Decomposition, FrameGroups, InlineGeometry, MemorySize, Origin, OutputDesc, OutputIo,
     ParallelMode, RenderDesc, SceneDesc,
 };
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
@@ -694,15 +695,25 @@ pub(super) fn print_stats(
     write: Duration,
     total: Duration,
 ) {
+    // One write for the whole block: under mpirun, ranks' blocks would interleave line by line.
+    let mut o = String::new();
+    macro_rules! out {
+        ($($t:tt)*) => {
+            let _ = writeln!(o, $($t)*);
+        };
+    }
     let c = &s.counters;
     let set = &scene.settings;
     let secs = s.render_time.as_secs_f64();
-    eprintln!("luxon: statistics");
-    eprintln!(
+    out!("luxon: statistics");
+    out!(
         "  image            {}x{}, {} sample(s) per pixel, max depth {}",
-        set.width, set.height, set.samples, set.max_depth
+        set.width,
+        set.height,
+        set.samples,
+        set.max_depth
     );
-    eprintln!(
+    out!(
         "  primitives       {} ({} spheres, {} triangles, {} planes, {} custom)",
         scene.primitive_count(),
         scene.spheres.len(),
@@ -712,7 +723,7 @@ pub(super) fn print_stats(
     );
     if let Some(a) = &set.adaptive {
         let pixels = (set.width as u64 * set.height as u64).max(1);
-        eprintln!(
+        out!(
             "  adaptive         threshold {}, max depth {}: {} base sample(s) per pixel, {:.2} on average, at most {}",
             a.threshold,
             a.max_depth,
@@ -721,10 +732,10 @@ pub(super) fn print_stats(
             luxon::adaptive::max_samples(set.samples, a.max_depth)
         );
     }
-    eprintln!("  effects          {}", scene.features);
+    out!("  effects          {}", scene.features);
     if let Some((open, close)) = set.shutter {
         let moving = scene.instances.keyed_count();
-        eprintln!(
+        out!(
             "  motion blur      shutter {open}..{close} frames from the frame's time; {moving} \
              moving instance(s) placed per ray{}",
             if scene.camera_moves {
@@ -734,7 +745,7 @@ pub(super) fn print_stats(
             }
         );
     }
-    eprintln!(
+    out!(
         "  memory budget    {}; the scene holds {}",
         scene.budget.describe(),
         scene.budget.in_use()
@@ -756,18 +767,19 @@ pub(super) fn print_stats(
         OutputIo::Sync => "synchronous",
         OutputIo::MpiIo => "MPI-IO",
     };
-    eprintln!(
+    out!(
         "  parallel         {mode}, {how} ({} px), {io} output",
         set.tile_size
     );
-    eprintln!("  ranks            {}", job.size());
-    eprintln!(
+    out!("  ranks            {}", job.size());
+    out!(
         "  threads          {} per rank ({} {unit})",
-        s.threads, s.tiles
+        s.threads,
+        s.tiles
     );
     for r in &s.ranks {
         let t = r.total();
-        eprintln!(
+        out!(
             "    rank {:<3}       {} thread(s), {} {unit}, {} pixels, {} rays, busy {:.3} s of {:.3} s",
             r.rank,
             r.threads.len(),
@@ -778,7 +790,7 @@ pub(super) fn print_stats(
             r.time.as_secs_f64()
         );
         for (i, w) in r.threads.iter().enumerate() {
-            eprintln!(
+            out!(
                 "      thread {i:<3}   {} {unit}, {} pixels, {} rays, busy {:.3} s",
                 w.units,
                 w.pixels,
@@ -787,28 +799,29 @@ pub(super) fn print_stats(
             );
         }
     }
-    eprintln!(
+    out!(
         "  rays             {} ({:.2} M/s)",
         c.rays(),
         c.rays() as f64 / secs.max(1e-9) / 1e6
     );
-    eprintln!("    primary        {}", c.primary);
-    eprintln!("    shadow         {}", c.shadow);
-    eprintln!("    reflection     {}", c.reflection);
-    eprintln!("    refraction     {}", c.refraction);
-    eprintln!("    occlusion      {}", c.occlusion);
-    eprintln!("  intersection tests {}", c.tests);
+    out!("    primary        {}", c.primary);
+    out!("    shadow         {}", c.shadow);
+    out!("    reflection     {}", c.reflection);
+    out!("    refraction     {}", c.refraction);
+    out!("    occlusion      {}", c.occlusion);
+    out!("  intersection tests {}", c.tests);
     if scene.features.volumes {
-        eprintln!("  volume samples   {}", c.volume_samples);
+        out!("  volume samples   {}", c.volume_samples);
     }
-    eprintln!("  NaN pixels       {}", c.nan_pixels);
-    eprintln!(
+    out!("  NaN pixels       {}", c.nan_pixels);
+    out!(
         "  load + objects   {:.3} s (objects and geometry {:.3} s)",
         load.as_secs_f64() + scene.plugin_time.as_secs_f64(),
         scene.plugin_time.as_secs_f64()
     );
-    eprintln!("  BVH build        {:.3} s", scene.bvh_time.as_secs_f64());
-    eprintln!("  render           {:.3} s", secs);
-    eprintln!("  write            {:.3} s", write.as_secs_f64());
-    eprintln!("  total            {:.3} s", total.as_secs_f64());
+    out!("  BVH build        {:.3} s", scene.bvh_time.as_secs_f64());
+    out!("  render           {:.3} s", secs);
+    out!("  write            {:.3} s", write.as_secs_f64());
+    out!("  total            {:.3} s", total.as_secs_f64());
+    eprint!("{o}");
 }
