@@ -63,14 +63,20 @@ impl Framebuffer {
 
     /// Copies rendered pixels to where their spans say.
     pub fn put_chunk(&mut self, c: &Chunk) {
-        let mut src = c.rgba.chunks_exact(4);
+        let mut src = &c.rgba[..c.rgba.len() / 4 * 4];
         for s in &c.spans {
             let row = s.y as usize * self.width as usize;
-            for x in s.xs() {
+            let (here, rest) = src.split_at((s.count as usize * 4).min(src.len()));
+            src = rest;
+            if s.step == 1 {
+                // A run of the row (every tile's span): one copy.
+                let i = (row + s.x0 as usize) * 4;
+                self.rgba[i..i + here.len()].copy_from_slice(here);
+                continue;
+            }
+            for (x, px) in s.xs().zip(here.chunks_exact(4)) {
                 let i = (row + x as usize) * 4;
-                if let Some(px) = src.next() {
-                    self.rgba[i..i + 4].copy_from_slice(px);
-                }
+                self.rgba[i..i + 4].copy_from_slice(px);
             }
         }
     }
