@@ -390,6 +390,49 @@ mod tests {
     }
 
     #[test]
+    fn pinhole_rays_are_the_general_formula_bit_for_bit() {
+        let mut d = desc(Projection::PerspectiveZoom { zoom: 0.7 });
+        d.position = [1.0, 2.0, -3.0];
+        d.look_at = [0.3, -0.2, 0.9];
+        d.up = [0.1, 1.0, 0.0];
+        let plain = Camera::new(&d, Vec3A::new(0.5, -0.25, 2.0), 37, 23);
+        d.frustum = Some(Frustum {
+            left: -0.3,
+            right: 0.7,
+            bottom: -0.2,
+            top: 0.45,
+        });
+        let off_centre = Camera::new(&d, Vec3A::ZERO, 37, 23);
+        for cam in [plain, off_centre] {
+            assert!(cam.pinhole);
+            for y in 0..23 {
+                for x in 0..37 {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.25 * (x % 4) as f32);
+                    let a = cam.primary(px, py, 37, 23, 0.5).unwrap();
+                    let b = cam.primary_general(px, py, 37, 23, 0.5).unwrap();
+                    assert_eq!(
+                        a.origin.to_array().map(f32::to_bits),
+                        b.origin.to_array().map(f32::to_bits)
+                    );
+                    assert_eq!(
+                        a.dir.to_array().map(f32::to_bits),
+                        b.dir.to_array().map(f32::to_bits)
+                    );
+                    assert_eq!(a.time.to_bits(), b.time.to_bits());
+                }
+            }
+        }
+        // Stereo, a lens and the other projections take the general path.
+        let s = stereo(
+            Projection::Perspective { fov_deg: 60.0 },
+            StereoLayout::SideBySide,
+        );
+        assert!(!Camera::new(&s, Vec3A::ZERO, 20, 10).pinhole);
+        let o = desc(Projection::Orthographic { height: 2.0 });
+        assert!(!Camera::new(&o, Vec3A::ZERO, 20, 10).pinhole);
+    }
+
+    #[test]
     fn perspective_frustum_sets_an_off_centre_window_at_unit_distance() {
         let mut d = desc(Projection::Perspective { fov_deg: 45.0 });
         d.frustum = Some(Frustum {

@@ -238,3 +238,65 @@ pub fn rgba8(px: [f32; 4]) -> [u8; 4] {
         q(alpha),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn put_chunk_places_runs_and_strided_spans() {
+        let mut fb = Framebuffer::new(5, 3);
+        let px = |k: usize| [k as f32, 0.5, 0.25, 1.0];
+        let spans = vec![
+            Span {
+                y: 1,
+                x0: 1,
+                step: 1,
+                count: 3,
+            },
+            Span {
+                y: 2,
+                x0: 0,
+                step: 2,
+                count: 3,
+            },
+        ];
+        let rgba: Vec<f32> = (0..6).flat_map(px).collect();
+        fb.put_chunk(&Chunk {
+            spans,
+            rgba,
+            depth: Vec::new(),
+        });
+        let zero = [0.0; 4];
+        for (x, y, want) in [
+            (0, 1, zero),
+            (1, 1, px(0)),
+            (2, 1, px(1)),
+            (3, 1, px(2)),
+            (4, 1, zero),
+            (0, 2, px(3)),
+            (1, 2, zero),
+            (2, 2, px(4)),
+            (4, 2, px(5)),
+            (0, 0, zero),
+        ] {
+            assert_eq!(fb.pixel(x, y), want, "pixel ({x}, {y})");
+        }
+        // A chunk with fewer values than its spans name fills what it has.
+        let mut fb = Framebuffer::new(4, 1);
+        let spans = vec![Span {
+            y: 0,
+            x0: 0,
+            step: 1,
+            count: 4,
+        }];
+        let rgba: Vec<f32> = (0..2).flat_map(px).collect();
+        fb.put_chunk(&Chunk {
+            spans,
+            rgba,
+            depth: Vec::new(),
+        });
+        assert_eq!(fb.pixel(1, 0), px(1));
+        assert_eq!(fb.pixel(2, 0), zero);
+    }
+}
