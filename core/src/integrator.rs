@@ -713,7 +713,7 @@ impl Whitted<'_> {
                 color,
                 attenuation,
                 ..
-            } => self.from_point::<T>(
+            } => self.point_term::<T>(
                 sh,
                 mat,
                 rules,
@@ -738,7 +738,7 @@ impl Whitted<'_> {
                     return Vec3A::ZERO;
                 }
                 let w = Light::spot_weight(cos, *cos_inner, *cos_outer, *fade);
-                self.from_point::<T>(
+                self.point_term::<T>(
                     sh,
                     mat,
                     rules,
@@ -770,7 +770,7 @@ impl Whitted<'_> {
                     let (a, b) = square(seed, i, *samples);
                     let (r, phi) = (a.sqrt() * radius, b * std::f32::consts::TAU);
                     let q = *center + r * (phi.cos() * u + phi.sin() * v);
-                    sum += self.from_point::<T>(
+                    sum += self.point_term::<T>(
                         sh,
                         mat,
                         rules,
@@ -801,7 +801,7 @@ impl Whitted<'_> {
                 for i in 0..*samples {
                     let (a, b) = square(seed, i, *samples);
                     let q = *corner + a * *edge1 + b * *edge2;
-                    sum += self.from_point::<T>(
+                    sum += self.point_term::<T>(
                         sh,
                         mat,
                         rules,
@@ -821,7 +821,7 @@ impl Whitted<'_> {
     /// `raw`, `w`: see [`Whitted::term`].
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn from_point<const T: bool>(
+    fn point_term<const T: bool>(
         &self,
         sh: &Shade,
         mat: &Material,
