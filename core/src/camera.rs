@@ -84,6 +84,10 @@ pub struct Camera {
     lens: Option<Lens>,
     /// Texture footprint of a primary ray: width at the eye and growth per unit distance.
     footprint: (f32, f32),
+    /// A plain perspective camera (one eye, no lens), the per-pixel common case: its rays are
+    /// made inline from `centre` (`forward + shift`, the first sum of the general formula).
+    pinhole: bool,
+    centre: Vec3A,
 }
 
 impl Camera {
@@ -151,28 +155,33 @@ impl Camera {
             Kind::Orthographic => (per_pixel, 0.0),
             _ => (0.0, per_pixel),
         };
+        let eyes = desc.stereo.map(|s| Eyes {
+            layout: s.layout,
+            half_separation: (s.eye_separation * 0.5) as f32,
+            convergence: s.convergence as f32,
+        });
+        let lens = desc
+            .depth_of_field
+            .filter(|d| d.aperture > 0.0)
+            .map(|d| Lens {
+                radius: d.aperture as f32,
+                focal_distance: d.focal_distance as f32,
+            });
+        let shift = v(right * cx + up * cy);
         Camera {
             origin,
             forward: v(forward),
             right: v(right * half_w),
             up: v(up * half_h),
-            shift: v(right * cx + up * cy),
+            shift,
             right_unit: v(right),
             up_unit: v(up),
             kind,
-            eyes: desc.stereo.map(|s| Eyes {
-                layout: s.layout,
-                half_separation: (s.eye_separation * 0.5) as f32,
-                convergence: s.convergence as f32,
-            }),
-            lens: desc
-                .depth_of_field
-                .filter(|d| d.aperture > 0.0)
-                .map(|d| Lens {
-                    radius: d.aperture as f32,
-                    focal_distance: d.focal_distance as f32,
-                }),
+            eyes,
+            lens,
             footprint,
+            pinhole: kind == Kind::Perspective && eyes.is_none() && lens.is_none(),
+            centre: v(forward) + shift,
         }
     }
 
@@ -197,6 +206,19 @@ impl Camera {
     /// outside a fisheye's image circle (Tachyon draws those pixels black).
     #[inline]
     pub fn primary(&self, x: f32, y: f32, width: u32, height: u32, time: f32) -> Option<Ray> {
+        if self.pinhole {
+            // Step 1 alone, the same operations in the same order as below.
+            let sx = 2.0 * x / width as f32 - 1.0;
+            let sy = 1.0 - 2.0 * y / height as f32;
+            let d = (self.centre + sx * self.right + sy * self.up).normalize();
+            return Some(Ray::new(self.origin, d, time));
+        }
+        self.primary_general(x, y, width, height, time)
+    }
+
+    /// [`Camera::primary`] for every camera.
+    #[inline(never)]
+    fn primary_general(&self, x: f32, y: f32, width: u32, height: u32, time: f32) -> Option<Ray> {
         // Which eye, and the position in its half of the image.
         let (mut w, mut h) = (width as f32, height as f32);
         let (mut ex, mut ey, mut eye) = (x, y, 0.0);
@@ -365,6 +387,49 @@ mod tests {
         // `up` is the window's half-height at unit distance (the scene's pixel spread).
         assert!((cam.up.length() - 1.0).abs() < EPS);
         assert_eq!(cam.footprint(), (0.0, 2.0 / 100.0));
+    }
+
+    #[test]
+    fn pinhole_rays_are_the_general_formula_bit_for_bit() {
+        let mut d = desc(Projection::PerspectiveZoom { zoom: 0.7 });
+        d.position = [1.0, 2.0, -3.0];
+        d.look_at = [0.3, -0.2, 0.9];
+        d.up = [0.1, 1.0, 0.0];
+        let plain = Camera::new(&d, Vec3A::new(0.5, -0.25, 2.0), 37, 23);
+        d.frustum = Some(Frustum {
+            left: -0.3,
+            right: 0.7,
+            bottom: -0.2,
+            top: 0.45,
+        });
+        let off_centre = Camera::new(&d, Vec3A::ZERO, 37, 23);
+        for cam in [plain, off_centre] {
+            assert!(cam.pinhole);
+            for y in 0..23 {
+                for x in 0..37 {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.25 * (x % 4) as f32);
+                    let a = cam.primary(px, py, 37, 23, 0.5).unwrap();
+                    let b = cam.primary_general(px, py, 37, 23, 0.5).unwrap();
+                    assert_eq!(
+                        a.origin.to_array().map(f32::to_bits),
+                        b.origin.to_array().map(f32::to_bits)
+                    );
+                    assert_eq!(
+                        a.dir.to_array().map(f32::to_bits),
+                        b.dir.to_array().map(f32::to_bits)
+                    );
+                    assert_eq!(a.time.to_bits(), b.time.to_bits());
+                }
+            }
+        }
+        // Stereo, a lens and the other projections take the general path.
+        let s = stereo(
+            Projection::Perspective { fov_deg: 60.0 },
+            StereoLayout::SideBySide,
+        );
+        assert!(!Camera::new(&s, Vec3A::ZERO, 20, 10).pinhole);
+        let o = desc(Projection::Orthographic { height: 2.0 });
+        assert!(!Camera::new(&o, Vec3A::ZERO, 20, 10).pinhole);
     }
 
     #[test]

@@ -63,14 +63,20 @@ impl Framebuffer {
 
     /// Copies rendered pixels to where their spans say.
     pub fn put_chunk(&mut self, c: &Chunk) {
-        let mut src = c.rgba.chunks_exact(4);
+        let mut src = &c.rgba[..c.rgba.len() / 4 * 4];
         for s in &c.spans {
             let row = s.y as usize * self.width as usize;
-            for x in s.xs() {
+            let (here, rest) = src.split_at((s.count as usize * 4).min(src.len()));
+            src = rest;
+            if s.step == 1 {
+                // A run of the row (every tile's span): one copy.
+                let i = (row + s.x0 as usize) * 4;
+                self.rgba[i..i + here.len()].copy_from_slice(here);
+                continue;
+            }
+            for (x, px) in s.xs().zip(here.chunks_exact(4)) {
                 let i = (row + x as usize) * 4;
-                if let Some(px) = src.next() {
-                    self.rgba[i..i + 4].copy_from_slice(px);
-                }
+                self.rgba[i..i + 4].copy_from_slice(px);
             }
         }
     }
@@ -231,4 +237,66 @@ pub fn rgba8(px: [f32; 4]) -> [u8; 4] {
         q(luxon_plugin::linear_to_srgb(px[2])),
         q(alpha),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn put_chunk_places_runs_and_strided_spans() {
+        let mut fb = Framebuffer::new(5, 3);
+        let px = |k: usize| [k as f32, 0.5, 0.25, 1.0];
+        let spans = vec![
+            Span {
+                y: 1,
+                x0: 1,
+                step: 1,
+                count: 3,
+            },
+            Span {
+                y: 2,
+                x0: 0,
+                step: 2,
+                count: 3,
+            },
+        ];
+        let rgba: Vec<f32> = (0..6).flat_map(px).collect();
+        fb.put_chunk(&Chunk {
+            spans,
+            rgba,
+            depth: Vec::new(),
+        });
+        let zero = [0.0; 4];
+        for (x, y, want) in [
+            (0, 1, zero),
+            (1, 1, px(0)),
+            (2, 1, px(1)),
+            (3, 1, px(2)),
+            (4, 1, zero),
+            (0, 2, px(3)),
+            (1, 2, zero),
+            (2, 2, px(4)),
+            (4, 2, px(5)),
+            (0, 0, zero),
+        ] {
+            assert_eq!(fb.pixel(x, y), want, "pixel ({x}, {y})");
+        }
+        // A chunk with fewer values than its spans name fills what it has.
+        let mut fb = Framebuffer::new(4, 1);
+        let spans = vec![Span {
+            y: 0,
+            x0: 0,
+            step: 1,
+            count: 4,
+        }];
+        let rgba: Vec<f32> = (0..2).flat_map(px).collect();
+        fb.put_chunk(&Chunk {
+            spans,
+            rgba,
+            depth: Vec::new(),
+        });
+        assert_eq!(fb.pixel(1, 0), px(1));
+        assert_eq!(fb.pixel(2, 0), zero);
+    }
 }

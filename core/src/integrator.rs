@@ -85,6 +85,8 @@ pub struct Whitted<'a> {
     /// occlusion's `direct` when occlusion is on.
     term_scale: f32,
     compose: Compose,
+    /// The scene has no surface at all (Tachyon's empty scenes): no ray is worth intersecting.
+    blank: bool,
 }
 
 /// How a transparent surface's shading and what lies behind it combine (from the mode).
@@ -129,8 +131,18 @@ impl<'a> Whitted<'a> {
         if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
             term_scale *= ao.direct;
         }
+        let blank = scene.spheres.is_empty()
+            && scene.triangles.is_empty()
+            && scene.planes.planes.is_empty()
+            && scene.cones.is_empty()
+            && scene.discs.is_empty()
+            && scene.customs.is_empty()
+            && scene.moving.is_empty()
+            && scene.instances.is_empty()
+            && scene.objects.is_empty();
         Whitted {
             scene,
+            blank,
             draws,
             miss,
             sky,
@@ -191,7 +203,11 @@ impl Whitted<'_> {
         c: &mut Counters,
     ) -> Vec3A {
         let scene = self.scene;
-        let hit = scene.intersect(ray, f32::INFINITY, c);
+        let hit = if self.blank {
+            None
+        } else {
+            scene.intersect(ray, f32::INFINITY, c)
+        };
         if !scene.features.volumes {
             return match hit {
                 Some(hit) => self.shade(ray, &hit, depth, weight, media, width, c),
@@ -417,13 +433,16 @@ impl Whitted<'_> {
             time: ray.time,
         };
         let mut lit = Vec3A::ZERO;
+        // Each light's seed is mixed only by the lights that draw (see `direct`).
         if scene.features.tachyon_lights {
+            let rules = Rules::new::<true>(scene, mat);
             for (k, light) in scene.lights.iter().enumerate() {
-                lit += self.direct::<true>(&shade, mat, light, mix(seed ^ k as u32), c);
+                lit += self.direct::<true>(&shade, mat, &rules, light, seed ^ k as u32, c);
             }
         } else {
+            let rules = Rules::new::<false>(scene, mat);
             for (k, light) in scene.lights.iter().enumerate() {
-                lit += self.direct::<false>(&shade, mat, light, mix(seed ^ k as u32), c);
+                lit += self.direct::<false>(&shade, mat, &rules, light, seed ^ k as u32, c);
             }
         }
         if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
@@ -595,6 +614,38 @@ struct Shade {
     time: f32,
 }
 
+/// What every light's term at a shading point obeys, from the settings and the material (see
+/// `Whitted::direct`; `T`: Tachyon's lights).
+#[derive(Clone, Copy)]
+struct Rules {
+    /// Shadows are on (each light may still cast none).
+    shadows: bool,
+    /// Tachyon's threshold on a light's term and highlight, or 0.
+    floor: f32,
+    /// Tachyon's plain highlights.
+    plain: bool,
+    /// Tachyon's metal highlight needs no light colour: a black light still makes one.
+    colourless: bool,
+}
+
+impl Rules {
+    #[inline]
+    fn new<const T: bool>(scene: &Scene, mat: &Material) -> Rules {
+        let tachyon = scene.settings.tachyon;
+        let plain = T && tachyon.plain_highlights;
+        Rules {
+            shadows: scene.features.shadows,
+            floor: if T && tachyon.light_threshold {
+                TACHYON_FLOOR
+            } else {
+                0.0
+            },
+            plain,
+            colourless: plain && mat.highlight_surface && mat.specular > 0.0,
+        }
+    }
+}
+
 /// A transmit coefficient `kt` after `rule`, for a surface with normal `n` (facing the
 /// viewer) seen along `ray`.
 #[inline]
@@ -637,132 +688,41 @@ impl Whitted<'_> {
     /// shadow rays let through. Area lights average `samples` points on the light. With `T`
     /// (Tachyon's lights) the light's term must exceed Tachyon's threshold, and plain
     /// highlights take the light's colour before attenuation, spot fade and filtering (or, for
-    /// a surface-coloured highlight, the surface's colour in its place).
+    /// a surface-coloured highlight, the surface's colour in its place). `rules`: `mat`'s
+    /// (made once per shading point); `key`: the light's seed before mixing.
     fn direct<const T: bool>(
         &self,
         sh: &Shade,
         mat: &Material,
+        rules: &Rules,
         light: &Light,
-        seed: u32,
+        key: u32,
         c: &mut Counters,
     ) -> Vec3A {
-        let scene = self.scene;
-        let shadows = light.casts_shadows() && scene.features.shadows;
-        let tachyon = scene.settings.tachyon;
-        let floor = if T && tachyon.light_threshold {
-            TACHYON_FLOOR
-        } else {
-            0.0
+        // This light's rules: shadows only if it casts them.
+        let rules = &Rules {
+            shadows: rules.shadows && light.casts_shadows(),
+            ..*rules
         };
-        let plain = T && tachyon.plain_highlights;
-        // Tachyon's metal highlight needs no light colour: a black light still makes one.
-        let colourless = plain && mat.highlight_surface && mat.specular > 0.0;
-        // (point on the light or None for a direction, direction to it, radiance arriving;
-        // with `T`: the light's colour and its weight from attenuation and spot fade)
-        let one = |target: Option<Vec3A>,
-                   to_light: Vec3A,
-                   arriving: Vec3A,
-                   (raw, w): (Vec3A, f32),
-                   c: &mut Counters|
-         -> Vec3A {
-            let ndotl = sh.n.dot(to_light);
-            if ndotl <= 0.0 || (arriving == Vec3A::ZERO && !colourless) {
-                return Vec3A::ZERO;
-            }
-            if T && ndotl * w * self.term_scale <= floor {
-                return Vec3A::ZERO;
-            }
-            let mut arriving = arriving;
-            if shadows {
-                c.shadow += 1;
-                let (sray, t_max) = match target {
-                    Some(t) => spawn_to(sh.p, sh.p_error, sh.ng, t, sh.time),
-                    None => (
-                        spawn(sh.p, sh.p_error, sh.ng, to_light, sh.time),
-                        f32::INFINITY,
-                    ),
-                };
-                if colourless {
-                    // Blocked is what counts, not what arrives.
-                    let mut through =
-                        scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
-                    if scene.features.volumes && through != Vec3A::ZERO {
-                        through *= march::transmittance(scene, &sray, t_max, c);
-                    }
-                    if through == Vec3A::ZERO {
-                        return Vec3A::ZERO;
-                    }
-                    arriving *= through;
-                } else {
-                    arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
-                    if scene.features.volumes && arriving != Vec3A::ZERO {
-                        arriving *= march::transmittance(scene, &sray, t_max, c);
-                    }
-                    if arriving == Vec3A::ZERO {
-                        return Vec3A::ZERO;
-                    }
-                }
-            }
-            let mut lit = mat.diffuse * sh.opacity * ndotl * sh.base;
-            let mut highlight = Vec3A::ZERO;
-            if mat.specular > 0.0 {
-                let cos = match mat.highlight {
-                    Highlight::Phong => reflect(-to_light, sh.n).dot(sh.view),
-                    Highlight::Blinn | Highlight::BlinnFast => {
-                        sh.n.dot((to_light + sh.view).normalize())
-                    }
-                };
-                if cos > floor {
-                    let h = if mat.highlight == Highlight::BlinnFast {
-                        // Tachyon's cheap stand-in for cos^s.
-                        let s = mat.shininess;
-                        cos / (s - s * cos + cos)
-                    } else {
-                        cos.powf(mat.shininess)
-                    };
-                    if plain {
-                        highlight = Vec3A::splat(mat.specular * h);
-                    } else {
-                        // White, or the surface's colour (metal), times the light's.
-                        let tint = if mat.highlight_surface {
-                            sh.base
-                        } else {
-                            Vec3A::ONE
-                        };
-                        lit += (mat.specular * h) * tint;
-                    }
-                }
-            }
-            if plain {
-                // Tachyon's metal highlight takes the surface's colour in place of the light's.
-                let tint = if mat.highlight_surface {
-                    sh.base * self.scene.settings.light_scale
-                } else {
-                    raw
-                };
-                arriving * lit + tint * highlight
-            } else {
-                arriving * lit
-            }
-        };
-        // `color` arrives at the point attenuated; `raw`, `w`: see `one`.
-        let from_point =
-            |q: Vec3A, color: Vec3A, (raw, w): (Vec3A, f32), a: &[f32; 3], c: &mut Counters| {
-                let d = q - sh.p;
-                let dist = d.length();
-                let att = Light::attenuate(a, dist);
-                one(Some(q), d / dist, color * att, (raw, w * att), c)
-            };
         match light {
             Light::Directional {
                 to_light, color, ..
-            } => one(None, *to_light, *color, (*color, 1.0), c),
+            } => self.term::<T>(sh, mat, rules, None, *to_light, *color, (*color, 1.0), c),
             Light::Point {
                 position,
                 color,
                 attenuation,
                 ..
-            } => from_point(*position, *color, (*color, 1.0), attenuation, c),
+            } => self.point_term::<T>(
+                sh,
+                mat,
+                rules,
+                *position,
+                *color,
+                (*color, 1.0),
+                attenuation,
+                c,
+            ),
             Light::Spot {
                 position,
                 axis,
@@ -778,7 +738,16 @@ impl Whitted<'_> {
                     return Vec3A::ZERO;
                 }
                 let w = Light::spot_weight(cos, *cos_inner, *cos_outer, *fade);
-                from_point(*position, *color * w, (*color, w), attenuation, c)
+                self.point_term::<T>(
+                    sh,
+                    mat,
+                    rules,
+                    *position,
+                    *color * w,
+                    (*color, w),
+                    attenuation,
+                    c,
+                )
             }
             Light::Sphere {
                 center,
@@ -795,12 +764,22 @@ impl Whitted<'_> {
                 }
                 let u = crate::math::orthogonal(w);
                 let v = w.cross(u);
+                let seed = mix(key);
                 let mut sum = Vec3A::ZERO;
                 for i in 0..*samples {
                     let (a, b) = square(seed, i, *samples);
                     let (r, phi) = (a.sqrt() * radius, b * std::f32::consts::TAU);
                     let q = *center + r * (phi.cos() * u + phi.sin() * v);
-                    sum += from_point(q, *color, (*color, 1.0), attenuation, c);
+                    sum += self.point_term::<T>(
+                        sh,
+                        mat,
+                        rules,
+                        q,
+                        *color,
+                        (*color, 1.0),
+                        attenuation,
+                        c,
+                    );
                 }
                 sum / *samples as f32
             }
@@ -817,14 +796,156 @@ impl Whitted<'_> {
                 if (sh.p - *corner).dot(*normal) <= 0.0 {
                     return Vec3A::ZERO;
                 }
+                let seed = mix(key);
                 let mut sum = Vec3A::ZERO;
                 for i in 0..*samples {
                     let (a, b) = square(seed, i, *samples);
                     let q = *corner + a * *edge1 + b * *edge2;
-                    sum += from_point(q, *color, (*color, 1.0), attenuation, c);
+                    sum += self.point_term::<T>(
+                        sh,
+                        mat,
+                        rules,
+                        q,
+                        *color,
+                        (*color, 1.0),
+                        attenuation,
+                        c,
+                    );
                 }
                 sum / *samples as f32
             }
+        }
+    }
+
+    /// A point light's term at a shading point: `color` arrives at the point attenuated;
+    /// `raw`, `w`: see [`Whitted::term`].
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn point_term<const T: bool>(
+        &self,
+        sh: &Shade,
+        mat: &Material,
+        rules: &Rules,
+        q: Vec3A,
+        color: Vec3A,
+        (raw, w): (Vec3A, f32),
+        a: &[f32; 3],
+        c: &mut Counters,
+    ) -> Vec3A {
+        let d = q - sh.p;
+        let dist = d.length();
+        let att = Light::attenuate(a, dist);
+        self.term::<T>(
+            sh,
+            mat,
+            rules,
+            Some(q),
+            d / dist,
+            color * att,
+            (raw, w * att),
+            c,
+        )
+    }
+
+    /// One light term (see [`Whitted::direct`]): `target` is the point on the light or `None`
+    /// for a direction, `to_light` the direction to it, `arriving` the radiance arriving; with
+    /// `T`: `raw` is the light's colour and `w` its weight from attenuation and spot fade.
+    #[allow(clippy::too_many_arguments)]
+    fn term<const T: bool>(
+        &self,
+        sh: &Shade,
+        mat: &Material,
+        rules: &Rules,
+        target: Option<Vec3A>,
+        to_light: Vec3A,
+        arriving: Vec3A,
+        (raw, w): (Vec3A, f32),
+        c: &mut Counters,
+    ) -> Vec3A {
+        let scene = self.scene;
+        let Rules {
+            shadows,
+            floor,
+            plain,
+            colourless,
+        } = *rules;
+        let ndotl = sh.n.dot(to_light);
+        if ndotl <= 0.0 || (arriving == Vec3A::ZERO && !colourless) {
+            return Vec3A::ZERO;
+        }
+        if T && ndotl * w * self.term_scale <= floor {
+            return Vec3A::ZERO;
+        }
+        let mut arriving = arriving;
+        if shadows {
+            c.shadow += 1;
+            let (sray, t_max) = match target {
+                Some(t) => spawn_to(sh.p, sh.p_error, sh.ng, t, sh.time),
+                None => (
+                    spawn(sh.p, sh.p_error, sh.ng, to_light, sh.time),
+                    f32::INFINITY,
+                ),
+            };
+            if colourless {
+                // Blocked is what counts, not what arrives.
+                let mut through = scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                if scene.features.volumes && through != Vec3A::ZERO {
+                    through *= march::transmittance(scene, &sray, t_max, c);
+                }
+                if through == Vec3A::ZERO {
+                    return Vec3A::ZERO;
+                }
+                arriving *= through;
+            } else {
+                arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                if scene.features.volumes && arriving != Vec3A::ZERO {
+                    arriving *= march::transmittance(scene, &sray, t_max, c);
+                }
+                if arriving == Vec3A::ZERO {
+                    return Vec3A::ZERO;
+                }
+            }
+        }
+        let mut lit = mat.diffuse * sh.opacity * ndotl * sh.base;
+        let mut highlight = Vec3A::ZERO;
+        if mat.specular > 0.0 {
+            let cos = match mat.highlight {
+                Highlight::Phong => reflect(-to_light, sh.n).dot(sh.view),
+                Highlight::Blinn | Highlight::BlinnFast => {
+                    sh.n.dot((to_light + sh.view).normalize())
+                }
+            };
+            if cos > floor {
+                let h = if mat.highlight == Highlight::BlinnFast {
+                    // Tachyon's cheap stand-in for cos^s.
+                    let s = mat.shininess;
+                    cos / (s - s * cos + cos)
+                } else {
+                    cos.powf(mat.shininess)
+                };
+                if plain {
+                    highlight = Vec3A::splat(mat.specular * h);
+                } else {
+                    // White, or the surface's colour (metal), times the light's.
+                    let tint = if mat.highlight_surface {
+                        sh.base
+                    } else {
+                        Vec3A::ONE
+                    };
+                    lit += (mat.specular * h) * tint;
+                }
+            }
+        }
+        if plain {
+            // Tachyon's metal highlight takes the surface's colour in place of the light's.
+            let tint = if mat.highlight_surface {
+                sh.base * self.scene.settings.light_scale
+            } else {
+                raw
+            };
+            arriving * lit + tint * highlight
+        } else {
+            arriving * lit
         }
     }
 
