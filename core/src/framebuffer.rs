@@ -30,7 +30,7 @@ impl Framebuffer {
     ) -> Result<(Framebuffer, Charge), BudgetError> {
         let n = width as usize * height as usize * 4;
         let what = || format!("the image ({width}x{height}, 4 f32 channels)");
-        let (rgba, charge) = budget.alloc_vec(Use::Image, n, 0.0f32, what)?;
+        let (rgba, charge) = budget.alloc_zeroed_f32(Use::Image, n, what)?;
         Ok((
             Framebuffer {
                 width,

@@ -44,17 +44,16 @@ impl Writer for Ppm {
         check_image(image)?;
         // P6 is simple enough to write directly, and this pins the 16-bit byte order.
         let maxval = if bits == 8 { 255 } else { 65535 };
-        let mut bytes = format!("P6\n{} {}\n{maxval}\n", image.width, image.height).into_bytes();
+        // The header and the samples go out as they are: no copy of the image joins them.
+        let header = format!("P6\n{} {}\n{maxval}\n", image.width, image.height);
+        out.write_all(header.as_bytes())?;
         if bits == 8 {
-            bytes.extend(samples8(image, false, params.encoding));
+            out.write_all(&samples8(image, false, params.encoding))?;
         } else {
-            bytes.extend(
-                samples16(image, false, params.encoding)
-                    .iter()
-                    .flat_map(|s| s.to_be_bytes()),
-            );
+            let samples = samples16(image, false, params.encoding);
+            let bytes: Vec<u8> = samples.iter().flat_map(|s| s.to_be_bytes()).collect();
+            out.write_all(&bytes)?;
         }
-        out.write_all(&bytes)?;
         Ok(())
     }
 }
