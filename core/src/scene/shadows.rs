@@ -76,24 +76,29 @@ impl Casters {
             Some(s) => s.any_opaque(ray, b, t_max, clips, c),
             None => (scene.spheres).any_skipping(ray, b, t_max, clips, c, passes, |_, _| true),
         };
+        // Empty kinds are passed over here, not in a call each: a Tachyon scene uses two or
+        // three kinds of the seven.
         spheres
-            || if triangles {
-                tri.any_opaque(ray, b, t_max, clips, c)
-            } else {
-                tri.any_prepared(ray, b, t_max, clips, c, blocks)
-            }
+            || (!tri.is_empty()
+                && if triangles {
+                    tri.any_opaque(ray, b, t_max, clips, c)
+                } else {
+                    tri.any_prepared(ray, b, t_max, clips, c, blocks)
+                })
             || scene.planes.any(ray, t_max, clips, c, blocks)
-            || if cones {
-                (scene.cones).any_opaque(ray, b, t_max, clips, c)
-            } else {
-                (scene.cones).any_prepared(ray, b, t_max, clips, c, blocks)
-            }
-            || if discs {
-                (scene.discs).any_opaque(ray, b, t_max, clips, c)
-            } else {
-                (scene.discs).any_prepared(ray, b, t_max, clips, c, blocks)
-            }
-            || scene.customs.any(ray, t_max, clips, c, blocks)
+            || (!scene.cones.is_empty()
+                && if cones {
+                    (scene.cones).any_opaque(ray, b, t_max, clips, c)
+                } else {
+                    (scene.cones).any_prepared(ray, b, t_max, clips, c, blocks)
+                })
+            || (!scene.discs.is_empty()
+                && if discs {
+                    (scene.discs).any_opaque(ray, b, t_max, clips, c)
+                } else {
+                    (scene.discs).any_prepared(ray, b, t_max, clips, c, blocks)
+                })
+            || (!scene.customs.is_empty() && scene.customs.any(ray, t_max, clips, c, blocks))
             || (!scene.moving.is_empty() && scene.moving.any(ray, t_max, clips, c, &mut { blocks }))
     }
 }
