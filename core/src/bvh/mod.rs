@@ -24,7 +24,7 @@ mod traversal;
 mod wide;
 
 use crate::math::Aabb;
-use build::{build_node, BuildPrim, PARALLEL_CUTOFF};
+use build::{build_node, BuildPrim, LeafCost, PARALLEL_CUTOFF};
 use wide::Wide;
 
 pub use refit::REBUILD_RATIO;
@@ -87,6 +87,17 @@ impl Bvh {
     /// Builds over primitives `0..n` whose bounds `bound(i)` gives (no array of bounds is kept
     /// alongside the build's own).
     pub fn build_with(n: usize, bound: impl Fn(usize) -> Aabb + Sync) -> (Bvh, Vec<u64>) {
+        Bvh::build_blocks(n, LeafCost::PER_PRIM.block, bound)
+    }
+
+    /// [`Bvh::build_with`] for a kind whose leaves are tested `block` primitives at a time: the
+    /// SAH prices a leaf by its blocks (a leaf of up to `block` costs one test), so leaves fill
+    /// up and the tree is shallower. `block` 1 is `build_with`.
+    pub fn build_blocks(
+        n: usize,
+        block: usize,
+        bound: impl Fn(usize) -> Aabb + Sync,
+    ) -> (Bvh, Vec<u64>) {
         use rayon::prelude::*;
         if n == 0 {
             return (Bvh::default(), Vec::new());
@@ -104,7 +115,10 @@ impl Bvh {
                 .collect()
         };
         let mut binary = Vec::new();
-        build_node(&mut prims, 0, 0, &mut binary);
+        let cost = LeafCost {
+            block: block.clamp(1, MAX_LEAF),
+        };
+        build_node(&mut prims, cost, 0, 0, &mut binary);
         let order = prims.iter().map(|p| p.index).collect();
         drop(prims);
         (Bvh::collapse(&binary), order)
@@ -169,7 +183,7 @@ mod tests {
                 let mut prims: Vec<BuildPrim> =
                     (0..n).map(|i| BuildPrim::new(bounds[i], i)).collect();
                 let mut binary = Vec::new();
-                build_node(&mut prims, 0, 0, &mut binary);
+                build_node(&mut prims, LeafCost::PER_PRIM, 0, 0, &mut binary);
                 let wide = Bvh::collapse(&binary);
                 let peak = prims.capacity() * std::mem::size_of::<BuildPrim>()
                     + binary.capacity() * std::mem::size_of::<build::Node>()

@@ -15,6 +15,10 @@ pub trait Shape: Copy + Send + Sync {
     type Prep: Copy;
     fn prep(ray: &Ray) -> Self::Prep;
     fn bounds(&self) -> Aabb;
+    /// The SAH prices a leaf by blocks of this many primitives (see `Bvh::build_blocks`): more
+    /// than 1 for a kind whose leaf test takes a block at a time. Triangles stay at 1 until
+    /// such a test pays and ties are canonical (examples/BENCHMARKS.md, h9-tri).
+    const LEAF_BLOCK: usize = 1;
     /// The nearest hit in (0, t_max): t and two kind-specific values (triangle barycentrics).
     fn hit(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> Option<(f32, f32, f32)> {
         self.hit_after(ray, prep, 0.0, t_max)
@@ -128,7 +132,7 @@ impl<S: Shape> Set<S> {
     /// Builds the BVH and stores the primitives in leaf order.
     pub fn build(&mut self) {
         let data = &self.data;
-        let (bvh, order) = Bvh::build_with(data.len(), |i| data[i].bounds());
+        let (bvh, order) = Bvh::build_blocks(data.len(), S::LEAF_BLOCK, |i| data[i].bounds());
         if crate::bvh::serial(order.len()) {
             self.data = order.iter().map(|&i| self.data[i as usize]).collect();
             self.material = order.iter().map(|&i| self.material[i as usize]).collect();
