@@ -131,15 +131,8 @@ impl<'a> Whitted<'a> {
         if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
             term_scale *= ao.direct;
         }
-        let blank = scene.spheres.is_empty()
-            && scene.triangles.is_empty()
-            && scene.planes.planes.is_empty()
-            && scene.cones.is_empty()
-            && scene.discs.is_empty()
-            && scene.customs.is_empty()
-            && scene.moving.is_empty()
-            && scene.instances.is_empty()
-            && scene.objects.is_empty();
+        let blank =
+            scene.primitive_count() == 0 && scene.moving.is_empty() && scene.instances.is_empty();
         Whitted {
             scene,
             blank,
