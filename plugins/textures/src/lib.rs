@@ -248,6 +248,7 @@
 #[allow(unsafe_code)]
 mod cache;
 // Public for the `image_texture` fuzz target (tests/fuzz): probe, plan and decode from bytes.
+mod band;
 pub mod decode;
 mod image;
 mod mapping;
