@@ -94,6 +94,43 @@ fn a_single_image_is_written_under_tachyons_names_in_its_format() {
     assert_eq!(files(&dir), before);
 }
 
+/// A single image is written without `fsync` (as Tachyon writes) but still atomically: into a
+/// temporary file renamed over the target, never into the existing file, and nothing left
+/// behind. A second name for the old file (a hard link) keeps the old bytes; writing in place
+/// would change them.
+#[test]
+fn a_single_image_still_replaces_its_target_atomically() {
+    let dir = setup("atomic");
+    for (target, args) in [
+        ("outfile.tga", &["s.dat"][..]),
+        ("x.ppm", &["s.dat", "-format", "PPM", "-o", "x.ppm"][..]),
+    ] {
+        std::fs::write(dir.join(target), b"old").unwrap();
+        let keep = dir.join("keep");
+        std::fs::hard_link(dir.join(target), &keep).unwrap();
+        ok(&tachyon(&dir, args));
+        assert_eq!(
+            std::fs::read(&keep).unwrap(),
+            b"old",
+            "{target} written in place"
+        );
+        let new = std::fs::read(dir.join(target)).unwrap();
+        assert!(new.len() > 24 * 16 * 3, "{target}: {} bytes", new.len());
+        std::fs::remove_file(&keep).unwrap();
+    }
+    assert_eq!(
+        files(&dir),
+        ["outfile.tga", "s.dat", "x.ppm"],
+        "temporary files left"
+    );
+    // A scene that fails leaves the target as it was.
+    std::fs::write(dir.join("bad.dat"), "BEGIN_SCENE RESOLUTION 8 8 SPHERE\n").unwrap();
+    let before = std::fs::read(dir.join("outfile.tga")).unwrap();
+    error(&tachyon(&dir, &["bad.dat"]));
+    assert_eq!(std::fs::read(dir.join("outfile.tga")).unwrap(), before);
+    assert_eq!(files(&dir), ["bad.dat", "outfile.tga", "s.dat", "x.ppm"]);
+}
+
 /// A scene as VMD 1.9 exports it: its header, mixed-case keywords, `Shader_Mode` with
 /// `Trans_VMD` and `Fog_VMD`, `Raydepth 50`, directional lights, inline textures with `Phong
 /// Plastic`, a translucent sphere, `FCylinder`, `VCSTri` and a `VertexArray` strip.

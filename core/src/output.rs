@@ -16,7 +16,7 @@ pub mod manifest;
 pub mod preview;
 pub mod stream;
 
-pub use commit::OutputSet;
+pub use commit::{Durability, OutputSet};
 
 /// An output with its writer resolved.
 #[derive(Clone)]
@@ -64,16 +64,28 @@ pub fn resolve<'r>(
         .collect()
 }
 
-/// Encodes and writes every output, all or none; returns the paths written.
+/// Encodes and writes every output, all or none, synced before the commit; returns the paths
+/// written.
 pub fn write_all(
     outputs: &[Output],
     fb: &Framebuffer,
     registry: &Registry,
     scene_dir: &Path,
 ) -> Result<Vec<PathBuf>, Error> {
+    write_all_with(outputs, fb, registry, scene_dir, Durability::Synced)
+}
+
+/// [`write_all`] with the commit's [`Durability`] given.
+pub fn write_all_with(
+    outputs: &[Output],
+    fb: &Framebuffer,
+    registry: &Registry,
+    scene_dir: &Path,
+    durability: Durability,
+) -> Result<Vec<PathBuf>, Error> {
     let mut set = OutputSet::prepare(outputs, registry, scene_dir)?;
     for (i, o) in outputs.iter().enumerate() {
         set.encode(i, o, fb, registry, scene_dir)?;
     }
-    set.commit()
+    set.commit_with(durability)
 }

@@ -3,7 +3,7 @@
 
 use super::brick;
 use super::charge::Charger;
-use super::{local_index, Brick, BrickMap, Codes, Volume, BRICK_SHIFT, BRICK_SIZE};
+use super::{local_index, Brick, BrickMap, Codes, Volume, BRICK_SHIFT, BRICK_SIZE, BRICK_VOXELS};
 use super::{MAX_TABLE, MAX_VOXELS};
 use crate::budget::Budget;
 use std::sync::Arc;
@@ -566,6 +566,53 @@ fn uniform(values: impl IntoIterator<Item = f32>) -> Option<f32> {
     it.all(|v| v.to_bits() == first.to_bits()).then_some(first)
 }
 
+/// [`uniform`] of the voxels of `source` at `rows` (index ranges, the first not empty), row by
+/// row: integer codes are compared as codes (equal codes decode to equal values), and only
+/// when two differ are the values compared, as codes that differ may still decode to the same
+/// value (a tiny divisor).
+fn uniform_part(
+    source: Source,
+    codes: &Codes,
+    rows: impl Iterator<Item = std::ops::Range<usize>> + Clone,
+) -> Option<f32> {
+    /// The one element of `s` at every index of `rows`.
+    fn same<T: Copy + PartialEq>(
+        s: &[T],
+        mut rows: impl Iterator<Item = std::ops::Range<usize>> + Clone,
+    ) -> Option<T> {
+        let first = s[rows.clone().next()?.start];
+        rows.all(|r| s[r].iter().all(|&c| c == first))
+            .then_some(first)
+    }
+    let by_code = match source {
+        Source::Tile(v) => return Some(v),
+        Source::U8(s) => same(s, rows.clone()).map(|c| codes.u8(c)),
+        Source::U16(s) => same(s, rows.clone()).map(|c| codes.u16(c)),
+        // Values are compared by their bits.
+        Source::F32(s) => {
+            let bits = |v: &f32| v.to_bits();
+            let first = s[rows.clone().next()?.start].to_bits();
+            let mut rows = rows;
+            return rows
+                .all(|r| s[r].iter().map(bits).all(|b| b == first))
+                .then_some(f32::from_bits(first));
+        }
+    };
+    by_code.or_else(|| uniform(rows.flatten().map(|i| source.value(i, codes))))
+}
+
+/// Copies a whole brick's voxels from a u8 block of `dims` voxels whose voxel at the brick's
+/// first corner is `s[at]`: row `y` of slice `z` of the brick (eight bytes) is
+/// `s[at + (z * dims[1] + y) * dims[0]..]`, copied as a fixed-size array.
+fn copy_brick_u8(b: &mut [u8; BRICK_VOXELS], s: &[u8], at: usize, dims: [u64; 3]) {
+    const N: usize = BRICK_SIZE as usize;
+    let (dx, dy) = (dims[0] as usize, dims[1] as usize);
+    for (r, row) in b.chunks_exact_mut(N).enumerate() {
+        let from = at + ((r / N) * dy + r % N) * dx;
+        row.copy_from_slice(&s[from..from + N]);
+    }
+}
+
 /// Smallest and largest of a non-empty slice of codes.
 fn min_max<T: Copy + Ord>(values: &[T]) -> (T, T) {
     let first = values[0];
@@ -697,15 +744,10 @@ fn store(
                 let n = (hi[0] - lo[0] + 1) as usize;
                 if !existing {
                     if whole {
-                        let one = match source {
-                            Source::Tile(v) => Some(v),
-                            _ => uniform(
-                                (lo[2]..=hi[2])
-                                    .flat_map(|z| (lo[1]..=hi[1]).map(move |y| (y, z)))
-                                    .flat_map(|(y, z)| src_at(y, z)..src_at(y, z) + n)
-                                    .map(|i| source.value(i, codes)),
-                            ),
-                        };
+                        let rows = (lo[2]..=hi[2])
+                            .flat_map(|z| (lo[1]..=hi[1]).map(move |y| (y, z)))
+                            .map(|(y, z)| src_at(y, z)..src_at(y, z) + n);
+                        let one = uniform_part(source, codes, rows);
                         if let Some(v) = one {
                             store_uniform(bricks, (skipped, charger), background, key, v)?;
                             continue;
@@ -761,6 +803,12 @@ fn store(
                         return Err(charger.refused(Brick::BYTES[2]));
                     };
                     *brick = Brick::F32(values);
+                }
+                let fresh = whole && mask.is_none();
+                if let (true, Brick::U8(b), Source::U8(s)) = (fresh, &mut *brick, source) {
+                    // The common case of a u8 file (raw volumes): a whole brick of rows.
+                    copy_brick_u8(b, s, src_at(lo[1], lo[2]), dims);
+                    continue;
                 }
                 for z in lo[2]..=hi[2] {
                     for y in lo[1]..=hi[1] {

@@ -79,6 +79,28 @@ fn encode_samples<T: Copy>(
     from_step: impl Fn(f32) -> T,
 ) -> Vec<T> {
     let channels = if alpha { 4 } else { 3 };
+    if encoding == Encoding::Display {
+        // No curve to save here: every pixel is stepped, into a buffer of known size, without
+        // the repeated-pixel test (a pure function of the same bits: the same bytes).
+        let step = |c: f32| from_step(truncate(c, max));
+        let pixels = image.rgba.chunks_exact(4);
+        let mut out = vec![from_step(0.0); pixels.len() * channels];
+        if alpha {
+            for (o, p) in out.chunks_exact_mut(4).zip(pixels) {
+                o[0] = step(p[0]);
+                o[1] = step(p[1]);
+                o[2] = step(p[2]);
+                o[3] = quantize(linear_unit(p[3]));
+            }
+        } else {
+            for (o, p) in out.chunks_exact_mut(3).zip(pixels) {
+                o[0] = step(p[0]);
+                o[1] = step(p[1]);
+                o[2] = step(p[2]);
+            }
+        }
+        return out;
+    }
     let mut out = Vec::with_capacity(image.rgba.len() / 4 * channels);
     let encode = |c: f32| match encoding {
         Encoding::Srgb => quantize(linear_to_srgb(c)),

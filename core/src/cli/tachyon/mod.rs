@@ -20,6 +20,7 @@ pub mod post;
 use super::progress::Progress;
 use args::{split, usage};
 use luxon::budget::Budget;
+use luxon::output::Durability;
 use luxon::plugin::Registry;
 use luxon::{Error, Framebuffer, Scene};
 use luxon_formats::{Origin, OutputDesc, Spanned};
@@ -144,6 +145,21 @@ fn seconds(d: Duration) -> f64 {
 
 /// Loads, builds and renders one scene file (every frame of the camera file, if any).
 fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
+    // The plugins are loaded (dlopen, 5-25 ms) on a thread while the scene file is read: a
+    // Tachyon scene names no plugin places, so where to search is known before the file is.
+    std::thread::scope(|s| {
+        let plugins = s.spawn(|| Registry::discover(&[]));
+        render_loaded(path, plan, names, plugins)
+    })
+}
+
+/// [`render_scene`] with the plugins being loaded by `plugins`.
+fn render_loaded(
+    path: &Path,
+    plan: &Plan,
+    names: Names,
+    plugins: std::thread::ScopedJoinHandle<'_, Registry>,
+) -> Result<(), Error> {
     let t0 = Instant::now();
     // The scene's text within the machine's default budget (Tachyon's options set none).
     let mut options = plan.scene.clone();
@@ -158,7 +174,11 @@ fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
         None => None,
     };
     println!("Scene Parsing Time: {:10.4} seconds", seconds(t0.elapsed()));
-    let registry = Registry::discover(&desc.plugin_path);
+    let registry = match plugins.join() {
+        Ok(r) if desc.plugin_path.is_empty() => r,
+        Ok(_) => Registry::discover(&desc.plugin_path),
+        Err(panic) => std::panic::resume_unwind(panic),
+    };
     super::warn_skipped(&registry);
     // The writer is found before anything is built: a missing plugin fails at once.
     let probe = output(plan, PathBuf::from("probe"));
@@ -182,7 +202,8 @@ fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
         println!("  Ray Tracing Time: {:10.4} seconds", seconds(render_time));
         let t = Instant::now();
         if !plan.nosave {
-            write(plan, &fb, target, &registry, &dir)?;
+            // One image, as Tachyon writes it: atomic but not synced (see `output::commit`).
+            write(plan, &fb, target, &registry, &dir, Durability::Atomic)?;
         }
         println!("    Image I/O Time: {:10.4} seconds", seconds(t.elapsed()));
         return Ok(());
@@ -221,7 +242,8 @@ fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
             continue;
         }
         let name = pattern.name(k);
-        write(plan, &fb, name.clone(), &registry, &dir).map_err(in_frame)?;
+        // A sequence's frames are synced: a resumed sequence trusts a frame on disk.
+        write(plan, &fb, name.clone(), &registry, &dir, Durability::Synced).map_err(in_frame)?;
         println!(
             "Rendering Frame to {}   (ray tracing {:.4} s)",
             name.display(),
@@ -288,16 +310,17 @@ fn output(plan: &Plan, path: PathBuf) -> OutputDesc {
 }
 
 /// Writes `fb` to `path` (relative to the working directory, as Tachyon writes), whole or not
-/// at all.
+/// at all, synced before the rename or not as `durability` says.
 fn write(
     plan: &Plan,
     fb: &Framebuffer,
     path: PathBuf,
     registry: &Registry,
     scene_dir: &Path,
+    durability: Durability,
 ) -> Result<(), Error> {
     let outputs = luxon::output::resolve(&[output(plan, path)], registry)?;
-    luxon::output::write_all(&outputs, fb, registry, scene_dir)?;
+    luxon::output::write_all_with(&outputs, fb, registry, scene_dir, durability)?;
     Ok(())
 }
 
