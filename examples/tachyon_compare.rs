@@ -2,7 +2,7 @@
 //! pair (luma, `luxon::metrics::ssim`) and both programs' times, in one run.
 //!
 //! ```sh
-//! cargo build --release --example tachyon_compare
+//! cargo build --release && cargo build --release --example tachyon_compare
 //! target/release/examples/tachyon_compare [--runs N] [--threads T] SCENE_DIR OUT_DIR [NAME.dat ...]
 //! ```
 //!
@@ -10,7 +10,8 @@
 //! `/usr/share/doc/tachyon/examples/scenes`, copied somewhere writable; Tachyon opens relative
 //! paths from the working directory, so both programs run there). Without names every `.dat`
 //! file is rendered. `tachyon-nox` (Debian's `tachyon-bin-nox`) must be on the path, and
-//! Luxon's release binary beside this example's directory (`target/release/luxon`).
+//! Luxon's release binary beside this example's directory (`target/release/luxon`, with its
+//! plugins: `--example` alone rebuilds neither, so build both as above).
 //!
 //! Each scene is rendered `N` times (default 3) by each program, alternating, with the same
 //! thread count (`-numthreads T`, default 2), each as the whole command a user runs:
