@@ -1,40 +1,13 @@
 //! `include`: merge order, nesting, relative paths, cycles, missing files, error positions.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::TempDir;
+
+use std::path::Path;
 
 use luxon_formats::*;
 
 /// A fresh directory under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap()
-            .as_nanos();
-        let dir = std::env::temp_dir().join(format!(
-            "luxon-formats-{name}-{}-{nanos}",
-            std::process::id()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, text: &str) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, text).unwrap();
-        path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn intensities(scene: &SceneDesc) -> Vec<f64> {
     scene
         .lights
@@ -96,7 +69,7 @@ fn includes_merge_in_order() {
 )"#,
     );
     let scene = load(&main).unwrap();
-    let d = &dir.0;
+    let d: &Path = &dir;
 
     // Lists: included files first (depth first, in include order), then this file.
     assert_eq!(intensities(&scene), [1.0, 3.0, 2.0, 4.0]);
@@ -154,7 +127,7 @@ fn positions_in_included_content_name_that_file() {
     );
     let scene = load(&main).unwrap();
     let sphere = &scene.objects[0];
-    assert_eq!(*sphere.at.file, dir.0.join("common.ron"));
+    assert_eq!(*sphere.at.file, dir.join("common.ron"));
     assert_eq!((sphere.at.line, sphere.at.col), (3, 9));
     assert_eq!(sphere.value.call.params, "(radius: 2)");
     assert_eq!(
@@ -173,11 +146,11 @@ fn positions_in_included_content_name_that_file() {
     );
     let error = load(&main).unwrap_err();
     let at = error.origin().unwrap();
-    assert_eq!(*at.file, dir.0.join("common.ron"));
+    assert_eq!(*at.file, dir.join("common.ron"));
     assert_eq!((at.line, at.col), (3, 45));
     let prefix = format!(
         "{}:3:45: NaN is not allowed",
-        dir.0.join("common.ron").display()
+        dir.join("common.ron").display()
     );
     assert!(error.to_string().starts_with(&prefix), "{error}");
 
@@ -190,7 +163,7 @@ fn positions_in_included_content_name_that_file() {
     let at = error.origin().unwrap();
     assert_eq!(
         (&**at.file, at.line, at.col),
-        (dir.0.join("common.ron").as_path(), 2, 14)
+        (dir.join("common.ron").as_path(), 2, 14)
     );
     assert!(
         error.to_string().contains("did you mean `Point`?"),
@@ -220,7 +193,7 @@ fn names_defined_in_the_including_file_resolve_in_included_content() {
     let at = error.origin().unwrap();
     assert_eq!(
         (&**at.file, at.line, at.col),
-        (dir.0.join("objects.ron").as_path(), 1, 41)
+        (dir.join("objects.ron").as_path(), 1, 41)
     );
     assert!(
         error.to_string().contains("did you mean `gold`?"),
@@ -241,16 +214,16 @@ fn include_cycle_is_an_error_naming_the_chain() {
     let at = error.origin().unwrap();
     assert_eq!(
         (&**at.file, at.line, at.col),
-        (dir.0.join("b.ron").as_path(), 3, 5)
+        (dir.join("b.ron").as_path(), 3, 5)
     );
     let message = error.to_string();
     assert!(message.contains("include cycle"), "{message}");
     let chain = format!(
         "{} -> {} -> {} -> {}",
         main.display(),
-        dir.0.join("a.ron").display(),
-        dir.0.join("b.ron").display(),
-        dir.0.join("main.ron").display()
+        dir.join("a.ron").display(),
+        dir.join("b.ron").display(),
+        dir.join("main.ron").display()
     );
     assert!(message.contains(&chain), "{message}");
 
@@ -260,7 +233,7 @@ fn include_cycle_is_an_error_naming_the_chain() {
     let at = error.origin().unwrap();
     assert_eq!(
         (&**at.file, at.line, at.col),
-        (dir.0.join("a.ron").as_path(), 1, 12)
+        (dir.join("a.ron").as_path(), 1, 12)
     );
     assert!(error.to_string().contains("include cycle"), "{error}");
 }
@@ -354,14 +327,14 @@ fn a_long_include_chain_needs_no_stack() {
     for i in 0..n {
         dir.write(
             &format!("c{i}.ron"),
-            &format!("(include: [\"c{}.ron\"])", i + 1),
+            format!("(include: [\"c{}.ron\"])", i + 1),
         );
     }
     dir.write(
         &format!("c{n}.ron"),
         "(camera: (position: (0, 0, -7), look_at: (0, 0, 0)))",
     );
-    let root = dir.0.join("c0.ron");
+    let root = dir.join("c0.ron");
     let scene = std::thread::Builder::new()
         .stack_size(256 << 10)
         .spawn(move || load(&root).map(|s| s.camera.value.position))
@@ -453,14 +426,14 @@ fn an_include_diamond_on_disk_loads() {
     for i in 0..n {
         dir.write(
             &format!("d{i}.ron"),
-            &format!("(include: [\"d{}.ron\", \"d{}.ron\"])", i + 1, i + 1),
+            format!("(include: [\"d{}.ron\", \"d{}.ron\"])", i + 1, i + 1),
         );
     }
     dir.write(
         &format!("d{n}.ron"),
         "(camera: (position: (0, 0, -5), look_at: (0, 0, 0)), lights: [Point(position: (0, 0, 0))])",
     );
-    let scene = load(&dir.0.join("d0.ron")).unwrap();
+    let scene = load(&dir.join("d0.ron")).unwrap();
     assert_eq!(scene.lights.len(), 1);
 }
 

@@ -3,6 +3,9 @@
 //! blocking, lines without end bounded, one UTF-8 byte-order mark skipped, UTF-16 and binary
 //! data refused with a message that is safe to print.
 
+mod common;
+use common::TempDir;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -11,38 +14,14 @@ use std::time::Duration;
 use luxon_formats::{load, SceneDesc, SceneError};
 
 /// A fresh directory under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("luxon-formats-input-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::write(&path, bytes).unwrap();
-        path
-    }
-
-    fn fifo(&self, name: &str) -> PathBuf {
-        let path = self.0.join(name);
-        let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
-        // SAFETY: `c` is a valid NUL-terminated path.
-        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
-        path
-    }
+/// A named pipe `name` in `dir`.
+fn fifo(dir: &Path, name: &str) -> PathBuf {
+    let path = dir.join(name);
+    let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: `c` is a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+    path
 }
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 const CAMERA: &str = "camera: (position: (0, 0, -5), look_at: (0, 0, 0))";
 const NFF: &str = "v\nfrom 0 -10 0\nat 0 0 0\nup 0 0 1\nangle 45\ns 0 0 0 1\n";
 const OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -68,7 +47,7 @@ fn error_text(path: &Path) -> String {
 fn devices_and_directories_are_refused_by_type() {
     let dir = TempDir::new("devices");
     for ext in ["ron", "nff", "obj"] {
-        let link = dir.0.join(format!("z.{ext}"));
+        let link = dir.join(format!("z.{ext}"));
         std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
         let what = match ext {
             "ron" => "a scene file",
@@ -97,7 +76,7 @@ fn devices_and_directories_are_refused_by_type() {
         ),
         "{e}"
     );
-    std::fs::create_dir(dir.0.join("sub.ron")).unwrap();
+    std::fs::create_dir(dir.join("sub.ron")).unwrap();
     dir.write(
         "main.ron",
         format!("Scene(include: [\"sub.ron\"], {CAMERA})"),
@@ -126,7 +105,7 @@ fn devices_and_directories_are_refused_by_type() {
 fn fifos_are_refused_without_blocking() {
     let dir = TempDir::new("fifos");
     for name in ["f.ron", "f.nff", "f.obj"] {
-        let fifo = dir.fifo(name);
+        let fifo = fifo(&dir, name);
         let e = error_text(&fifo);
         assert!(e.contains("is a FIFO (named pipe); expected"), "{e}");
     }
@@ -140,7 +119,7 @@ fn fifos_are_refused_without_blocking() {
     );
     assert!(error_text(&main).contains("is a FIFO (named pipe)"));
     // An MTL library on a FIFO: a warning, like any library that cannot be read.
-    dir.fifo("m.mtl");
+    fifo(&dir, "m.mtl");
     let obj = dir.write("m.obj", format!("mtllib m.mtl\n{OBJ}"));
     let scene = load_within_seconds(&obj).unwrap();
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);

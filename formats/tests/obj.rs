@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 use luxon_formats::obj::load_obj;
 use luxon_formats::{load, InlineGeometry, SceneError};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("luxon-obj-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+mod common;
+use common::TempDir;
+
+fn temp_dir(name: &str) -> TempDir {
+    TempDir::new(&format!("obj-{name}"))
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

@@ -3,6 +3,9 @@
 //! `file:line:col` with what was expected and found, INCLUDE, paths, warnings; and, when
 //! Debian's `tachyon-doc` is installed, every example scene.
 
+mod common;
+use common::TempDir;
+
 use std::path::{Path, PathBuf};
 
 use luxon_formats::tachyon::{parse_file, syntax, Highlights, Options, ShadeLevel, Skylight};
@@ -12,39 +15,13 @@ use luxon_formats::{
     TransparencyAngle, TransparencyMode, TransparentShadows,
 };
 
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let d = std::env::temp_dir().join(format!("luxon-tachyon-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        TempDir(d)
-    }
-
-    fn write(&self, name: &str, text: &str) -> PathBuf {
-        let p = self.0.join(name);
-        if let Some(parent) = p.parent() {
-            std::fs::create_dir_all(parent).unwrap();
-        }
-        std::fs::write(&p, text).unwrap();
-        p
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 const HEAD: &str = "BEGIN_SCENE\nRESOLUTION 64 32\n";
 const TEX: &str = "TEXTURE AMBIENT 0.1 DIFFUSE 0.9 SPECULAR 0 OPACITY 1 COLOR 1 0 0 TEXFUNC 0";
 
 /// Loads scene `body` (statements after the header).
 fn scene(name: &str, body: &str) -> SceneDesc {
     let dir = TempDir::new(name);
-    let p = dir.write("s.dat", &format!("{HEAD}{body}\nEND_SCENE\n"));
+    let p = dir.write("s.dat", format!("{HEAD}{body}\nEND_SCENE\n"));
     load(&p).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -283,7 +260,7 @@ fn sky_light_and_ambient_occlusion() {
 /// Loads scene `body` with command-line `options` (their origin is filled in).
 fn scene_with(name: &str, body: &str, options: impl FnOnce(&mut Options)) -> SceneDesc {
     let dir = TempDir::new(name);
-    let p = dir.write("s.dat", &format!("{HEAD}{body}\nEND_SCENE\n"));
+    let p = dir.write("s.dat", format!("{HEAD}{body}\nEND_SCENE\n"));
     let mut o = Options::new(Origin {
         file: std::sync::Arc::new(PathBuf::from("<command line>")),
         line: 1,
@@ -557,7 +534,7 @@ fn background_and_gradient() {
         let dir = TempDir::new("bgtree");
         let p = dir.write(
             "s.dat",
-            &format!(
+            format!(
                 "{HEAD}BACKGROUND_GRADIENT SKY_ORTHO_PLANE UPDIR 0 1 0 TOPVAL 1 BOTTOMVAL -1 \
                  TOPCOLOR 1 1 1 BOTTOMCOLOR 0 0 0\n"
             ),
@@ -599,7 +576,7 @@ fn optional_surface_parts_are_kept_in_the_tree() {
     let dir = TempDir::new("surface");
     let p = dir.write(
         "s.dat",
-        &format!(
+        format!(
             "{HEAD}TEXDEF glass AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0.2 OPACITY 0.4\n\
              TRANSMODE R3D OUTLINE 0.5 OUTLINE_WIDTH 0.3 PHONG shiny 0.6 PHONG_SIZE 12\n\
              COLOR 1 1 1 TEXFUNC 0\nSHADER_MODE medium TRANS_VMD END_SHADER_MODE\n\
@@ -718,7 +695,7 @@ const PPM: &[u8] = b"P6\n4 2\n255\n\xff\x00\x00\x00\xff\x00\x00\x00\xff\xff\xff\
 #[test]
 fn texture_functions() {
     let dir = TempDir::new("texfunc");
-    std::fs::write(dir.0.join("img.ppm"), PPM).unwrap();
+    std::fs::write(dir.join("img.ppm"), PPM).unwrap();
     let frame = "CENTER 1 2 3 ROTATE 0.25 0.5 0 SCALE 2 -4 1";
     // Sphere i has the colour 0.1·(i + 1), so that no two bodies share a material.
     let funcs = [
@@ -824,7 +801,7 @@ fn imagedef_and_volume_textures() {
     let dir = TempDir::new("imagedef");
     let p = dir.write(
         "s.dat",
-        &format!(
+        format!(
             "{HEAD}IMAGEDEF ::pic FORMAT RGB24 RESOLUTION 2 1 1 ENCODING HEX f00 00ff00\n\
              SPHERE CENTER 0 0 5 RAD 1 TEXTURE AMBIENT 1 DIFFUSE 0 SPECULAR 0 OPACITY 1 \
              COLOR 0.5 0.5 0.5 TEXFUNC 10 ::pic CENTER 0 0 0 ROTATE 0 0 0 SCALE 1 1 1 \
@@ -1018,7 +995,7 @@ fn tpolyfile_reads_its_triangles_through_tachyons_transform() {
     );
     let p = dir.write(
         "s.dat",
-        &format!("{HEAD}TPOLYFILE SCALE 1 1 1 ROT 0 90 0 CENTER 0 0 0 FILE m/ship.tpoly {TEX}\n"),
+        format!("{HEAD}TPOLYFILE SCALE 1 1 1 ROT 0 90 0 CENTER 0 0 0 FILE m/ship.tpoly {TEX}\n"),
     );
     let d = load(&p).unwrap_or_else(|e| panic!("{e}"));
     let g = only(&d);
@@ -1031,7 +1008,7 @@ fn tpolyfile_reads_its_triangles_through_tachyons_transform() {
     // A missing file is an error at its name.
     let p = dir.write(
         "t.dat",
-        &format!("{HEAD}TPOLYFILE SCALE 1 1 1 ROT 0 0 0 CENTER 0 0 0 FILE nope.tpoly {TEX}\n"),
+        format!("{HEAD}TPOLYFILE SCALE 1 1 1 ROT 0 0 0 CENTER 0 0 0 FILE nope.tpoly {TEX}\n"),
     );
     let e = load(&p).unwrap_err().to_string();
     assert!(
@@ -1043,11 +1020,11 @@ fn tpolyfile_reads_its_triangles_through_tachyons_transform() {
 #[test]
 fn scalarvol_becomes_a_raw_volume_or_a_box() {
     let dir = TempDir::new("vol");
-    std::fs::write(dir.0.join("v.raw"), vec![128u8; 2 * 2 * 3]).unwrap();
+    std::fs::write(dir.join("v.raw"), vec![128u8; 2 * 2 * 3]).unwrap();
     let body = "TEXTURE AMBIENT 1 DIFFUSE 0 SPECULAR 0 OPACITY 4 COLOR 0.2 0.4 0.6 TEXFUNC 0";
     let p = dir.write(
         "s.dat",
-        &format!(
+        format!(
             "{HEAD}SCALARVOL MIN -1 -1 1 MAX 1 1 3 DIM 2 2 2 FILE v.raw {body}\n\
              SCALARVOL MIN -1 -1 1 MAX 1 1 3 DIM 2 2 2 FILE none.raw {body}\n"
         ),
@@ -1125,7 +1102,7 @@ fn include_reads_statements_in_place() {
     );
     let p = dir.write(
         "s.dat",
-        &format!("{HEAD}INCLUDE parts/lights.dat\nSPHERE CENTER 0 0 5 RAD 1 {TEX}\nEND_SCENE\n"),
+        format!("{HEAD}INCLUDE parts/lights.dat\nSPHERE CENTER 0 0 5 RAD 1 {TEX}\nEND_SCENE\n"),
     );
     let d = load(&p).unwrap_or_else(|e| panic!("{e}"));
     // The included END_SCENE ends only that file: its second light is not read, the sphere is.
@@ -1145,11 +1122,11 @@ fn include_cycles_and_missing_files_are_errors() {
     let dir = TempDir::new("cycle");
     dir.write("a.dat", "INCLUDE b.dat\n");
     dir.write("b.dat", "SPHERE CENTER 0 0 0 RAD 1 t\nINCLUDE a.dat\n");
-    let p = dir.write("s.dat", &format!("{HEAD}INCLUDE a.dat\n"));
+    let p = dir.write("s.dat", format!("{HEAD}INCLUDE a.dat\n"));
     let e = load(&p).unwrap_err().to_string();
     assert!(e.contains("b.dat:2:9: INCLUDE cycle:"), "{e}");
     assert!(e.contains("a.dat -> ") && e.contains("b.dat -> "), "{e}");
-    let p = dir.write("m.dat", &format!("{HEAD}INCLUDE\tnothere.dat\n"));
+    let p = dir.write("m.dat", format!("{HEAD}INCLUDE\tnothere.dat\n"));
     let e = load(&p).unwrap_err().to_string();
     assert!(
         e.contains("m.dat:3:9: INCLUDE: `nothere.dat` was found neither in the working directory"),
@@ -1161,14 +1138,13 @@ fn include_cycles_and_missing_files_are_errors() {
 #[test]
 fn relative_paths_look_in_the_working_directory_first() {
     let dir = TempDir::new("paths");
-    std::fs::write(dir.0.join("img.ppm"), PPM).unwrap();
+    std::fs::write(dir.join("img.ppm"), PPM).unwrap();
     // The same name relative to the working directory (the test's, not changed here).
     let cwd = std::env::current_dir().unwrap();
     let up = "../".repeat(cwd.components().count() - 1);
     let from_cwd = format!(
         "{up}{}",
-        dir.0
-            .join("img.ppm")
+        dir.join("img.ppm")
             .display()
             .to_string()
             .trim_start_matches('/')
@@ -1181,7 +1157,7 @@ fn relative_paths_look_in_the_working_directory_first() {
     };
     let p = dir.write(
         "s.dat",
-        &format!(
+        format!(
             "{HEAD}PLANE CENTER 0 0 5 NORMAL 0 0 1 {}\nPLANE CENTER 0 0 6 NORMAL 0 0 1 {}\n",
             tex(&from_cwd),
             tex("img.ppm")
@@ -1193,7 +1169,7 @@ fn relative_paths_look_in_the_working_directory_first() {
         "{:?}",
         d.warnings
     );
-    let file = std::fs::canonicalize(dir.0.join("img.ppm")).unwrap();
+    let file = std::fs::canonicalize(dir.join("img.ppm")).unwrap();
     for (_, t) in &d.textures {
         let params = &t.value.params;
         let start = params.find("file: \"").unwrap() + 7;
@@ -1369,8 +1345,8 @@ fn every_debian_example_loads_except_the_one_tachyon_rejects() {
         return;
     }
     let dir = TempDir::new("examples");
-    copy_examples(from, &dir.0);
-    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir.0)
+    copy_examples(from, &dir);
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&*dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "dat"))
@@ -1408,7 +1384,7 @@ fn every_debian_example_loads_except_the_one_tachyon_rejects() {
         }
     }
     // A few that need every part: SCAPE, TPOLYFILE, VERTEXARRAY, volumes, clip groups.
-    let get = |n: &str| load(&dir.0.join(n)).unwrap();
+    let get = |n: &str| load(&dir.join(n)).unwrap();
     assert_eq!(
         get("island.dat")
             .inline
@@ -1440,7 +1416,7 @@ fn every_debian_example_loads_except_the_one_tachyon_rejects() {
 #[test]
 fn special_files_are_refused_by_type_and_a_bom_is_skipped() {
     let dir = TempDir::new("special");
-    let d = dir.0.join("dir.dat");
+    let d = dir.join("dir.dat");
     std::fs::create_dir_all(&d).unwrap();
     let e = load(&d)
         .expect_err("a directory is not a scene")
@@ -1449,12 +1425,12 @@ fn special_files_are_refused_by_type_and_a_bom_is_skipped() {
     // An INCLUDE of a directory names it too.
     let p = dir.write(
         "inc.dat",
-        &format!("{HEAD}INCLUDE {}\nEND_SCENE\n", d.display()),
+        format!("{HEAD}INCLUDE {}\nEND_SCENE\n", d.display()),
     );
     let e = load(&p)
         .expect_err("a directory is not an include")
         .to_string();
     assert!(e.contains("is a directory"), "{e}");
-    let p = dir.write("bom.dat", &format!("\u{feff}{HEAD}END_SCENE\n"));
+    let p = dir.write("bom.dat", format!("\u{feff}{HEAD}END_SCENE\n"));
     load(&p).unwrap_or_else(|e| panic!("{e}"));
 }

@@ -1,5 +1,8 @@
 //! `volumes: [...]`: parsing with positions, merging across includes, and its errors.
 
+mod common;
+use common::TempDir;
+
 use std::path::{Path, PathBuf};
 
 use luxon_formats::*;
@@ -158,35 +161,6 @@ fn wrong_type_for_volumes() {
 }
 
 /// A fresh directory under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap()
-            .as_nanos();
-        let dir = std::env::temp_dir().join(format!(
-            "luxon-formats-volumes-{name}-{}-{nanos}",
-            std::process::id()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, text: &str) -> PathBuf {
-        let path = self.0.join(name);
-        std::fs::write(&path, text).unwrap();
-        path
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 #[test]
 fn volumes_merge_across_includes_in_order() {
     let dir = TempDir::new("merge");
@@ -221,9 +195,9 @@ fn volumes_merge_across_includes_in_order() {
         "main2.ron",
         "(\n    include: [\"data.ron\"],\n    camera: (position: (0, 0, -1), look_at: (0, 0, 0)),\n    volumes: [(plugin: \"raw\", name: \"a\")],\n)",
     );
-    let e = luxon_formats::load(&dir.0.join("main2.ron")).unwrap_err();
+    let e = luxon_formats::load(&dir.join("main2.ron")).unwrap_err();
     let at = e.origin().unwrap();
-    assert_eq!(*at.file, dir.0.join("main2.ron"));
+    assert_eq!(*at.file, dir.join("main2.ron"));
     assert_eq!((at.line, at.col), (4, 37));
     assert!(e.to_string().contains("already used at"), "{e}");
 }

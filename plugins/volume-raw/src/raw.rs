@@ -903,13 +903,29 @@ mod tests {
         }
     }
 
-    /// A fresh directory for one test.
-    fn temp_dir(name: &str) -> PathBuf {
+    /// A fresh directory for one test, removed when dropped.
+    struct TempDir(PathBuf);
+
+    impl std::ops::Deref for TempDir {
+        type Target = Path;
+
+        fn deref(&self) -> &Path {
+            &self.0
+        }
+    }
+
+    impl Drop for TempDir {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn temp_dir(name: &str) -> TempDir {
         let d =
             std::env::temp_dir().join(format!("luxon-volume-raw-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
-        d
+        TempDir(d)
     }
 
     fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
@@ -1154,7 +1170,6 @@ mod tests {
         .unwrap();
         let want: Vec<f32> = bytes.iter().map(|&b| b as f32).collect();
         assert!(got.values == want, "values differ");
-        let _ = std::fs::remove_dir_all(&dir);
         got
     }
 
