@@ -274,6 +274,31 @@ mod tests {
         );
     }
 
+    /// Lanes left free by the inner children take leaves' primitives one each: up to eight
+    /// primitives make one node of one-primitive lanes, and a leaf split this way keeps its
+    /// primitives in reverse lane order (the any-hit loops take lanes last to first).
+    #[test]
+    fn free_lanes_take_leaves_primitives_one_each() {
+        for n in 1..=LANES {
+            let (bvh, _) = Bvh::build(&boxes(n));
+            assert_eq!(bvh.nodes.len(), 1, "{n} primitives");
+            assert_eq!(bvh.leaf_sizes().count(), n, "{n} primitives");
+            assert!(bvh.leaf_sizes().all(|c| c == 1));
+        }
+        // Two coincident boxes make one leaf of two at the root: now two lanes, the first
+        // primitive in the higher one.
+        let same = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 2];
+        let (bvh, _) = Bvh::build(&same);
+        let root = &bvh.nodes[0];
+        assert_eq!(
+            (root.link[0], root.link[1]),
+            (
+                1 | 1 << super::super::OFFSET_BITS,
+                1 << super::super::OFFSET_BITS
+            )
+        );
+    }
+
     #[test]
     fn wide_nodes_are_four_cache_lines() {
         assert_eq!(std::mem::size_of::<Wide>(), 256);
