@@ -99,7 +99,7 @@ impl BuildPrim {
     }
 
     #[inline(always)]
-    fn bounds(&self) -> Aabb {
+    pub(super) fn bounds(&self) -> Aabb {
         Aabb::new(self.min.into(), self.max.into())
     }
 

@@ -120,8 +120,8 @@ impl Bvh {
         };
         build_node(&mut prims, cost, 0, 0, &mut binary);
         let order = prims.iter().map(|p| p.index).collect();
-        drop(prims);
-        (Bvh::collapse(&binary), order)
+        let bvh = Bvh::collapse(&binary, &|i| prims[i].bounds());
+        (bvh, order)
     }
 
     pub fn node_count(&self) -> usize {
@@ -184,7 +184,7 @@ mod tests {
                     (0..n).map(|i| BuildPrim::new(bounds[i], i)).collect();
                 let mut binary = Vec::new();
                 build_node(&mut prims, LeafCost::PER_PRIM, 0, 0, &mut binary);
-                let wide = Bvh::collapse(&binary);
+                let wide = Bvh::collapse(&binary, &|i| prims[i].bounds());
                 let peak = prims.capacity() * std::mem::size_of::<BuildPrim>()
                     + binary.capacity() * std::mem::size_of::<build::Node>()
                     + binary.len() * 2

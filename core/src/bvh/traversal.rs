@@ -558,7 +558,7 @@ mod tests {
         }
         assert!(flat_trees >= 8, "only {flat_trees} one-node trees");
         assert!(
-            visits > 1000,
+            visits > 500,
             "the rays should meet many boxes, met {visits}"
         );
     }

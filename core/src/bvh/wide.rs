@@ -66,15 +66,20 @@ const LINK_WORDS: usize = 6 * LANES;
 
 impl Bvh {
     /// The wide tree of a binary one: each wide node takes the two children of a binary node
-    /// and keeps opening the largest inner one among them until it has `LANES`.
-    pub(super) fn collapse(binary: &[Node]) -> Bvh {
+    /// and keeps opening the largest inner one among them until it has `LANES`; lanes still
+    /// free then take leaves' primitives one per lane (see `fill_lanes`). `bound(i)` is the
+    /// box of the i-th primitive in leaf order.
+    pub(super) fn collapse(binary: &[Node], bound: &impl Fn(usize) -> Aabb) -> Bvh {
         let mut nodes = Vec::with_capacity(binary.len() / 3 + 1);
         if binary[0].count() > 0 {
             let mut root = Wide::NONE;
-            root.set(0, &binary[0].bounds(), binary[0].link);
+            let (lanes, n) = fill_lanes(binary, &[0], 1);
+            for (lane, &(k, p)) in lanes[..n].iter().enumerate() {
+                set_leaf_lane(&mut root, lane, &binary[k], p, bound);
+            }
             nodes.push(root);
         } else {
-            collapse_node(binary, 0, &mut nodes);
+            collapse_node(binary, 0, &mut nodes, bound);
         }
         Bvh { nodes }
     }
@@ -176,19 +181,71 @@ fn leaf_link(node: &Node) -> u64 {
     node.link & !(3 << 56)
 }
 
+/// A lane per child when there is room for it: the children `kids[..len]` (binary nodes), each
+/// leaf among them, in order, given a lane per primitive while the lanes last (a box test of
+/// the node is one vector pass whatever its lanes hold; a lane per primitive spares the
+/// primitive tests of the boxes a ray misses). Each entry is (binary node, primitive): `NONE`
+/// for the whole child. A split leaf's primitives take its place in reverse order, so the
+/// any-hit loops, which take a node's lanes from the last to the first, test them in the same
+/// order as before (a shadow ray through filters multiplies them in that order).
+fn fill_lanes(binary: &[Node], kids: &[usize], len: usize) -> ([(usize, usize); LANES], usize) {
+    let mut free = LANES - len;
+    let mut lanes = [(0, NONE); LANES];
+    let mut n = 0;
+    for &k in &kids[..len] {
+        let count = binary[k].count();
+        if count > 1 && count - 1 <= free {
+            free -= count - 1;
+            for p in (0..count).rev() {
+                lanes[n] = (k, binary[k].offset() + p);
+                n += 1;
+            }
+        } else {
+            lanes[n] = (k, NONE);
+            n += 1;
+        }
+    }
+    (lanes, n)
+}
+
+/// No single primitive: the lane holds the whole child.
+const NONE: usize = usize::MAX;
+
+/// Lane `lane` of `wide` set to leaf `node`, or to its primitive `p` alone.
+fn set_leaf_lane(
+    wide: &mut Wide,
+    lane: usize,
+    node: &Node,
+    p: usize,
+    bound: &impl Fn(usize) -> Aabb,
+) {
+    if p == NONE {
+        wide.set(lane, &node.bounds(), leaf_link(node));
+    } else {
+        let link = p as u64 | 1 << super::OFFSET_BITS;
+        wide.set(lane, &bound(p), link);
+    }
+}
+
 /// Emits the wide node for binary inner node `i` and, after it, its inner descendants;
 /// returns its index.
-fn collapse_node(binary: &[Node], i: usize, out: &mut Vec<Wide>) -> usize {
+fn collapse_node(
+    binary: &[Node],
+    i: usize,
+    out: &mut Vec<Wide>,
+    bound: &impl Fn(usize) -> Aabb,
+) -> usize {
     let index = out.len();
     out.push(Wide::NONE);
     let (kids, len) = open_kids(binary, i);
-    for (lane, &k) in kids[..len].iter().enumerate() {
-        let link = if binary[k].count() > 0 {
-            leaf_link(&binary[k])
+    let (lanes, n) = fill_lanes(binary, &kids, len);
+    for (lane, &(k, p)) in lanes[..n].iter().enumerate() {
+        if binary[k].count() > 0 {
+            set_leaf_lane(&mut out[index], lane, &binary[k], p, bound);
         } else {
-            collapse_node(binary, k, out) as u64
-        };
-        out[index].set(lane, &binary[k].bounds(), link);
+            let link = collapse_node(binary, k, out, bound) as u64;
+            out[index].set(lane, &binary[k].bounds(), link);
+        }
     }
     index
 }
@@ -214,6 +271,31 @@ mod tests {
             bvh.nodes.len() * 2 < leaves,
             "{} nodes, {leaves} leaves",
             bvh.nodes.len()
+        );
+    }
+
+    /// Lanes left free by the inner children take leaves' primitives one each: up to eight
+    /// primitives make one node of one-primitive lanes, and a leaf split this way keeps its
+    /// primitives in reverse lane order (the any-hit loops take lanes last to first).
+    #[test]
+    fn free_lanes_take_leaves_primitives_one_each() {
+        for n in 1..=LANES {
+            let (bvh, _) = Bvh::build(&boxes(n));
+            assert_eq!(bvh.nodes.len(), 1, "{n} primitives");
+            assert_eq!(bvh.leaf_sizes().count(), n, "{n} primitives");
+            assert!(bvh.leaf_sizes().all(|c| c == 1));
+        }
+        // Two coincident boxes make one leaf of two at the root: now two lanes, the first
+        // primitive in the higher one.
+        let same = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 2];
+        let (bvh, _) = Bvh::build(&same);
+        let root = &bvh.nodes[0];
+        assert_eq!(
+            (root.link[0], root.link[1]),
+            (
+                1 | 1 << super::super::OFFSET_BITS,
+                1 << super::super::OFFSET_BITS
+            )
         );
     }
 

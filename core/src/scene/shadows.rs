@@ -11,10 +11,12 @@ use crate::geometry::{material_of, Counters};
 use crate::math::Vec3A;
 use crate::ray::Ray;
 
-/// Most spheres copied into [`Casters`] (a few kilobytes, not charged to the memory budget):
-/// more would take a second BVH build for little (a shadow ray rarely comes near a light's
-/// sphere), so those pass the light spheres over one by one as before.
-const MAX_COPIED: usize = 64;
+/// Most spheres copied into [`Casters`] (tens of kilobytes, not charged to the memory
+/// budget): more would take a second BVH build; those pass the light spheres over one by one
+/// as before. Worth the copy: a shadow ray towards a point light drawn as a sphere ends inside
+/// that sphere's box, so the shared tree leads every such ray down to it (820spheres: 1.15
+/// light spheres passed over per shadow ray).
+const MAX_COPIED: usize = 1024;
 
 /// What shadow rays test in such a scene.
 pub struct Casters {
