@@ -757,24 +757,11 @@ impl Whitted<'_> {
                 }
                 let u = crate::math::orthogonal(w);
                 let v = w.cross(u);
-                let seed = mix(key);
-                let mut sum = Vec3A::ZERO;
-                for i in 0..*samples {
-                    let (a, b) = square(seed, i, *samples);
+                let at = |a: f32, b: f32| {
                     let (r, phi) = (a.sqrt() * radius, b * std::f32::consts::TAU);
-                    let q = *center + r * (phi.cos() * u + phi.sin() * v);
-                    sum += self.point_term::<T>(
-                        sh,
-                        mat,
-                        rules,
-                        q,
-                        *color,
-                        (*color, 1.0),
-                        attenuation,
-                        c,
-                    );
-                }
-                sum / *samples as f32
+                    *center + r * (phi.cos() * u + phi.sin() * v)
+                };
+                self.area_term::<T>(sh, mat, rules, key, *samples, at, *color, attenuation, c)
             }
             Light::Rect {
                 corner,
@@ -789,25 +776,44 @@ impl Whitted<'_> {
                 if (sh.p - *corner).dot(*normal) <= 0.0 {
                     return Vec3A::ZERO;
                 }
-                let seed = mix(key);
-                let mut sum = Vec3A::ZERO;
-                for i in 0..*samples {
-                    let (a, b) = square(seed, i, *samples);
-                    let q = *corner + a * *edge1 + b * *edge2;
-                    sum += self.point_term::<T>(
-                        sh,
-                        mat,
-                        rules,
-                        q,
-                        *color,
-                        (*color, 1.0),
-                        attenuation,
-                        c,
-                    );
-                }
-                sum / *samples as f32
+                let at = |a: f32, b: f32| *corner + a * *edge1 + b * *edge2;
+                self.area_term::<T>(sh, mat, rules, key, *samples, at, *color, attenuation, c)
             }
         }
+    }
+
+    /// An area light's term: the mean of `samples` point terms at `at(a, b)`, the light's point
+    /// for the stratified sample `(a, b)` of the unit square (seeded by `key`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn area_term<const T: bool>(
+        &self,
+        sh: &Shade,
+        mat: &Material,
+        rules: &Rules,
+        key: u32,
+        samples: u32,
+        at: impl Fn(f32, f32) -> Vec3A,
+        color: Vec3A,
+        attenuation: &[f32; 3],
+        c: &mut Counters,
+    ) -> Vec3A {
+        let seed = mix(key);
+        let mut sum = Vec3A::ZERO;
+        for i in 0..samples {
+            let (a, b) = square(seed, i, samples);
+            sum += self.point_term::<T>(
+                sh,
+                mat,
+                rules,
+                at(a, b),
+                color,
+                (color, 1.0),
+                attenuation,
+                c,
+            );
+        }
+        sum / samples as f32
     }
 
     /// A point light's term at a shading point: `color` arrives at the point attenuated;
