@@ -427,15 +427,18 @@ impl Whitted<'_> {
         };
         let mut lit = Vec3A::ZERO;
         // Each light's seed is mixed only by the lights that draw (see `direct`).
+        // A light's rules: shadows only if it casts them (both made once per point).
         if scene.features.tachyon_lights {
-            let rules = Rules::new::<true>(scene, mat);
+            let rules = Rules::new::<true>(scene, mat).per_light();
             for (k, light) in scene.lights.iter().enumerate() {
-                lit += self.direct::<true>(&shade, mat, &rules, light, seed ^ k as u32, c);
+                let rules = &rules[light.casts_shadows() as usize];
+                lit += self.direct::<true>(&shade, mat, rules, light, seed ^ k as u32, c);
             }
         } else {
-            let rules = Rules::new::<false>(scene, mat);
+            let rules = Rules::new::<false>(scene, mat).per_light();
             for (k, light) in scene.lights.iter().enumerate() {
-                lit += self.direct::<false>(&shade, mat, &rules, light, seed ^ k as u32, c);
+                let rules = &rules[light.casts_shadows() as usize];
+                lit += self.direct::<false>(&shade, mat, rules, light, seed ^ k as u32, c);
             }
         }
         if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
@@ -637,6 +640,18 @@ impl Rules {
             colourless: plain && mat.highlight_surface && mat.specular > 0.0,
         }
     }
+
+    /// These rules for a light that casts no shadow (first) and one that does.
+    #[inline]
+    fn per_light(self) -> [Rules; 2] {
+        [
+            Rules {
+                shadows: false,
+                ..self
+            },
+            self,
+        ]
+    }
 }
 
 /// A transmit coefficient `kt` after `rule`, for a surface with normal `n` (facing the
@@ -682,7 +697,8 @@ impl Whitted<'_> {
     /// (Tachyon's lights) the light's term must exceed Tachyon's threshold, and plain
     /// highlights take the light's colour before attenuation, spot fade and filtering (or, for
     /// a surface-coloured highlight, the surface's colour in its place). `rules`: `mat`'s
-    /// (made once per shading point); `key`: the light's seed before mixing.
+    /// (made once per shading point), shadows already off for a light that casts none; `key`: the
+    /// light's seed before mixing.
     fn direct<const T: bool>(
         &self,
         sh: &Shade,
@@ -692,11 +708,6 @@ impl Whitted<'_> {
         key: u32,
         c: &mut Counters,
     ) -> Vec3A {
-        // This light's rules: shadows only if it casts them.
-        let rules = &Rules {
-            shadows: rules.shadows && light.casts_shadows(),
-            ..*rules
-        };
         match light {
             Light::Directional {
                 to_light, color, ..
