@@ -427,15 +427,18 @@ impl Whitted<'_> {
         };
         let mut lit = Vec3A::ZERO;
         // Each light's seed is mixed only by the lights that draw (see `direct`).
+        // A light's rules: shadows only if it casts them (both made once per point).
         if scene.features.tachyon_lights {
-            let rules = Rules::new::<true>(scene, mat);
+            let rules = Rules::new::<true>(scene, mat).per_light();
             for (k, light) in scene.lights.iter().enumerate() {
-                lit += self.direct::<true>(&shade, mat, &rules, light, seed ^ k as u32, c);
+                let rules = &rules[light.casts_shadows() as usize];
+                lit += self.direct::<true>(&shade, mat, rules, light, seed ^ k as u32, c);
             }
         } else {
-            let rules = Rules::new::<false>(scene, mat);
+            let rules = Rules::new::<false>(scene, mat).per_light();
             for (k, light) in scene.lights.iter().enumerate() {
-                lit += self.direct::<false>(&shade, mat, &rules, light, seed ^ k as u32, c);
+                let rules = &rules[light.casts_shadows() as usize];
+                lit += self.direct::<false>(&shade, mat, rules, light, seed ^ k as u32, c);
             }
         }
         if let (true, Some(ao)) = (scene.features.ambient_occlusion, &scene.ao) {
@@ -637,6 +640,18 @@ impl Rules {
             colourless: plain && mat.highlight_surface && mat.specular > 0.0,
         }
     }
+
+    /// These rules for a light that casts no shadow (first) and one that does.
+    #[inline]
+    fn per_light(self) -> [Rules; 2] {
+        [
+            Rules {
+                shadows: false,
+                ..self
+            },
+            self,
+        ]
+    }
 }
 
 /// A transmit coefficient `kt` after `rule`, for a surface with normal `n` (facing the
@@ -682,7 +697,8 @@ impl Whitted<'_> {
     /// (Tachyon's lights) the light's term must exceed Tachyon's threshold, and plain
     /// highlights take the light's colour before attenuation, spot fade and filtering (or, for
     /// a surface-coloured highlight, the surface's colour in its place). `rules`: `mat`'s
-    /// (made once per shading point); `key`: the light's seed before mixing.
+    /// (made once per shading point), shadows already off for a light that casts none; `key`: the
+    /// light's seed before mixing.
     fn direct<const T: bool>(
         &self,
         sh: &Shade,
@@ -692,11 +708,6 @@ impl Whitted<'_> {
         key: u32,
         c: &mut Counters,
     ) -> Vec3A {
-        // This light's rules: shadows only if it casts them.
-        let rules = &Rules {
-            shadows: rules.shadows && light.casts_shadows(),
-            ..*rules
-        };
         match light {
             Light::Directional {
                 to_light, color, ..
@@ -757,24 +768,11 @@ impl Whitted<'_> {
                 }
                 let u = crate::math::orthogonal(w);
                 let v = w.cross(u);
-                let seed = mix(key);
-                let mut sum = Vec3A::ZERO;
-                for i in 0..*samples {
-                    let (a, b) = square(seed, i, *samples);
+                let at = |a: f32, b: f32| {
                     let (r, phi) = (a.sqrt() * radius, b * std::f32::consts::TAU);
-                    let q = *center + r * (phi.cos() * u + phi.sin() * v);
-                    sum += self.point_term::<T>(
-                        sh,
-                        mat,
-                        rules,
-                        q,
-                        *color,
-                        (*color, 1.0),
-                        attenuation,
-                        c,
-                    );
-                }
-                sum / *samples as f32
+                    *center + r * (phi.cos() * u + phi.sin() * v)
+                };
+                self.area_term::<T>(sh, mat, rules, key, *samples, at, *color, attenuation, c)
             }
             Light::Rect {
                 corner,
@@ -789,25 +787,44 @@ impl Whitted<'_> {
                 if (sh.p - *corner).dot(*normal) <= 0.0 {
                     return Vec3A::ZERO;
                 }
-                let seed = mix(key);
-                let mut sum = Vec3A::ZERO;
-                for i in 0..*samples {
-                    let (a, b) = square(seed, i, *samples);
-                    let q = *corner + a * *edge1 + b * *edge2;
-                    sum += self.point_term::<T>(
-                        sh,
-                        mat,
-                        rules,
-                        q,
-                        *color,
-                        (*color, 1.0),
-                        attenuation,
-                        c,
-                    );
-                }
-                sum / *samples as f32
+                let at = |a: f32, b: f32| *corner + a * *edge1 + b * *edge2;
+                self.area_term::<T>(sh, mat, rules, key, *samples, at, *color, attenuation, c)
             }
         }
+    }
+
+    /// An area light's term: the mean of `samples` point terms at `at(a, b)`, the light's point
+    /// for the stratified sample `(a, b)` of the unit square (seeded by `key`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn area_term<const T: bool>(
+        &self,
+        sh: &Shade,
+        mat: &Material,
+        rules: &Rules,
+        key: u32,
+        samples: u32,
+        at: impl Fn(f32, f32) -> Vec3A,
+        color: Vec3A,
+        attenuation: &[f32; 3],
+        c: &mut Counters,
+    ) -> Vec3A {
+        let seed = mix(key);
+        let mut sum = Vec3A::ZERO;
+        for i in 0..samples {
+            let (a, b) = square(seed, i, samples);
+            sum += self.point_term::<T>(
+                sh,
+                mat,
+                rules,
+                at(a, b),
+                color,
+                (color, 1.0),
+                attenuation,
+                c,
+            );
+        }
+        sum / samples as f32
     }
 
     /// A point light's term at a shading point: `color` arrives at the point attenuated;

@@ -68,6 +68,7 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
         }
         return out;
     }
+    let still = s.shutter.is_none().then_some(s.time);
     for span in spans {
         let y = span.y;
         for x in span.xs() {
@@ -91,7 +92,12 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
                     let seed = sampler.pixel_seed(x, y);
                     for i in 0..n {
                         let (jx, jy) = sampler.sample(x, y, seed, i);
-                        sum += shade(jx, jy, sample_time(scene, x, y, i, n, None));
+                        // Without a shutter every sample is at the frame's time.
+                        let time = match still {
+                            Some(t) => t,
+                            None => sample_time(scene, x, y, i, n, None),
+                        };
+                        sum += shade(jx, jy, time);
                     }
                     sum * inv_n
                 }

@@ -245,6 +245,7 @@ impl Scene {
             animation: None,
             budget: b.budget,
             casters: None,
+            more_kinds: true,
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
@@ -280,6 +281,7 @@ impl Scene {
             scene.set_frame_with(a.value.first, true)?;
         }
         scene.casters = Casters::of(&scene);
+        scene.more_kinds = scene.has_more_kinds();
         Ok(scene)
     }
 }

@@ -399,6 +399,9 @@ pub struct Scene {
     /// What shadow rays test when every surface blocks them or lets them through unchanged
     /// (refreshed with the features).
     pub casters: Option<Casters>,
+    /// Some triangle, cone, disc or plugin object: closest hits ask those kinds too
+    /// (refreshed with the features; spheres and planes are asked anyway).
+    pub more_kinds: bool,
 }
 
 impl Scene {
@@ -446,6 +449,14 @@ impl Scene {
         out
     }
 
+    /// Whether any kind besides spheres and planes has primitives (see `more_kinds`).
+    pub(crate) fn has_more_kinds(&self) -> bool {
+        !self.triangles.set.is_empty()
+            || !self.cones.is_empty()
+            || !self.discs.is_empty()
+            || !self.customs.is_empty()
+    }
+
     /// The closest hit along `ray` before `t_max`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
@@ -454,14 +465,20 @@ impl Scene {
         let boxes = BoxRay::new(ray.origin, ray.dir);
         let (t, h, clips) = (&mut t_max, &mut hit, &self.clips);
         (self.spheres).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
-        (self.triangles.set).intersect_noting(ray, &boxes, t, h, clips, c, |i| {
-            self.triangles.prefetch_shading(i)
-        });
-        self.planes.intersect(ray, t, h, clips, c);
-        (self.cones).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
-        (self.discs).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
-        self.customs
-            .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        if !self.more_kinds {
+            // Tachyon's usual scenes: spheres and planes only, one test for the kinds they
+            // lack (same order of kinds, so ties go as below).
+            self.planes.intersect(ray, t, h, clips, c);
+        } else {
+            (self.triangles.set).intersect_noting(ray, &boxes, t, h, clips, c, |i| {
+                self.triangles.prefetch_shading(i)
+            });
+            self.planes.intersect(ray, t, h, clips, c);
+            (self.cones).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
+            (self.discs).intersect_noting(ray, &boxes, t, h, clips, c, |_| {});
+            self.customs
+                .intersect(ray, &mut t_max, &mut hit, &self.clips, c);
+        }
         if !self.moving.is_empty() {
             self.moving
                 .intersect(ray, &mut t_max, &mut hit, &self.clips, c);

@@ -179,5 +179,6 @@ impl Scene {
         // Set by the build from the animation, which `features` does not see.
         self.features.motion_blur = self.settings.shutter.is_some();
         self.casters = Casters::of(self);
+        self.more_kinds = self.has_more_kinds();
     }
 }
