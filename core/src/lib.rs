@@ -81,6 +81,8 @@ pub mod output;
 #[allow(unsafe_code)]
 pub mod plugin;
 pub mod ppm;
+// SSE2 lane arithmetic on float bits (the offset of a spawned ray's origin).
+#[allow(unsafe_code)]
 pub mod ray;
 pub mod render;
 pub mod sampler;

@@ -285,19 +285,37 @@ impl<S: Shape> Set<S> {
         clips: &Clips,
         c: &mut Counters,
     ) -> bool {
-        if self.data.len() <= const { tiny(S::KIND) } && !self.clipped {
+        if self.few() {
             // A ray with a NaN or infinite coordinate, or a NaN length, meets nothing, as in
             // the trees.
             if self.data.is_empty() || !boxes.finite() || t_max.is_nan() {
                 return false;
             }
-            let prep = S::prep(ray);
-            return self.data.iter().any(|s| {
-                c.tests += 1;
-                s.crossings(ray, &prep, t_max) > 0
-            });
+            return self.any_few(ray, t_max, c);
         }
         self.any_with::<false>(ray, boxes, t_max, clips, c, |_| false, |_, _| true)
+    }
+
+    /// Whether [`Set::any_few`] may answer for this set: a handful of primitives, none clipped.
+    #[inline(always)]
+    pub fn few(&self) -> bool {
+        self.data.len() <= const { tiny(S::KIND) } && !self.clipped
+    }
+
+    /// [`Set::any_opaque`] for a set that is [`Set::few`], tested one by one without a box
+    /// set-up; the caller has checked that the ray is finite and `t_max` not NaN (the tree
+    /// meets nothing otherwise).
+    #[inline(always)]
+    pub fn any_few(&self, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
+        // No set-up for an empty kind (a triangle ray's shear is some 70 instructions).
+        if self.data.is_empty() {
+            return false;
+        }
+        let prep = S::prep(ray);
+        self.data.iter().any(|s| {
+            c.tests += 1;
+            s.crossings(ray, &prep, t_max) > 0
+        })
     }
 
     /// [`Set::any_prepared`] passing over, untested, the primitives whose material `skip`

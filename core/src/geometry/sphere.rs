@@ -47,6 +47,12 @@ pub fn intersect_sphere(
         return (None, 0);
     }
     let cc = f.dot(f) - r * r;
+    // Outside (cc > 0) and moving away (b < 0): q < 0, so both roots below are negative and
+    // neither lies past t_min >= 0. Answered without the square root and the division (a
+    // shadow ray leaving the sphere it starts on).
+    if cc > 0.0 && b < 0.0 && t_min >= 0.0 {
+        return (None, 0);
+    }
     let q = b + disc.sqrt().copysign(b);
     if q == 0.0 {
         return (None, 0);

@@ -521,13 +521,26 @@ impl Scene {
     /// the product of the filters (`Material::shadow`) of the surfaces it crosses.
     #[inline]
     pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
+        if let (Some(casters), true) = (&self.casters, min_weight <= 1.0) {
+            let blocked = casters.blocked(self, ray, t_max, c);
+            return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
+        }
+        self.transmittance_filtered(ray, t_max, min_weight, c)
+    }
+
+    /// [`Scene::transmittance`] of a scene without [`Casters`] (or asked with a `min_weight`
+    /// above 1).
+    #[inline(never)]
+    fn transmittance_filtered(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        min_weight: f32,
+        c: &mut Counters,
+    ) -> Vec3A {
         // The box tests' set-up, once for every kind.
         let boxes = BoxRay::new(ray.origin, ray.dir);
         let b = &boxes;
-        if let (Some(casters), true) = (&self.casters, min_weight <= 1.0) {
-            let blocked = casters.blocked(self, ray, b, t_max, c);
-            return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
-        }
         if !self.features.shadow_filters {
             // Opaque world: the first hit anywhere ends the query.
             let clips = &self.clips;

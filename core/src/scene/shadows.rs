@@ -25,6 +25,9 @@ pub struct Casters {
     /// Per kind (triangles, cones, discs): every primitive blocks, so the kind is asked
     /// without looking at materials.
     all_block: [bool; 3],
+    /// Every kind is a handful of spheres or triangles tested one by one, or planes (fog,
+    /// spotlight, model2): a shadow ray needs no box tests, so their set-up is not made.
+    few: bool,
 }
 
 impl Casters {
@@ -49,27 +52,60 @@ impl Casters {
                 .is_none()
         };
         let all = |m: &[u32]| m.iter().all(|&p| blocks(p));
+        let spheres = (scene.spheres.len() <= MAX_COPIED).then(|| scene.spheres.filtered(blocks));
+        let all_block = [
+            all(&scene.triangles.set.material),
+            all(&scene.cones.material),
+            all(&scene.discs.material),
+        ];
+        let tri = &scene.triangles.set;
+        let few = spheres.as_ref().is_some_and(|s| s.few())
+            && (tri.is_empty() || (tri.few() && all_block[0]))
+            && scene.cones.is_empty()
+            && scene.discs.is_empty()
+            && scene.customs.is_empty()
+            && scene.moving.is_empty();
         Some(Casters {
-            spheres: (scene.spheres.len() <= MAX_COPIED).then(|| scene.spheres.filtered(blocks)),
-            all_block: [
-                all(&scene.triangles.set.material),
-                all(&scene.cones.material),
-                all(&scene.discs.material),
-            ],
+            spheres,
+            all_block,
+            few,
         })
     }
 
-    /// Whether something blocks `ray` before `t_max` (`boxes`: its box tests' set-up).
-    #[inline]
-    pub(super) fn blocked(
-        &self,
+    /// Whether something blocks `ray` before `t_max`.
+    #[inline(always)]
+    pub(super) fn blocked(&self, scene: &Scene, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
+        match (&self.spheres, self.few) {
+            (Some(spheres), true) => Self::blocked_few(spheres, scene, ray, t_max, c),
+            _ => self.blocked_tree(scene, ray, t_max, c),
+        }
+    }
+
+    /// [`Casters::blocked`] when `few` holds: the same tests in the same order
+    /// (so the same answer and test count) as [`Casters::blocked_tree`].
+    #[inline(never)]
+    fn blocked_few(
+        spheres: &Spheres,
         scene: &Scene,
         ray: &Ray,
-        boxes: &BoxRay,
         t_max: f32,
         c: &mut Counters,
     ) -> bool {
-        let (b, clips) = (boxes, &scene.clips);
+        // A ray with a NaN or infinite coordinate, or a NaN length, meets no sphere or
+        // triangle, as in the trees; planes answer for themselves.
+        let meets = ray.finite() && !t_max.is_nan();
+        let tri = &scene.triangles.set;
+        let blocks = |m: u32, _: u32| scene.materials[m as usize].shadow.is_none();
+        (meets && (spheres.any_few(ray, t_max, c) || tri.any_few(ray, t_max, c)))
+            || scene.planes.any(ray, t_max, &scene.clips, c, blocks)
+    }
+
+    /// [`Casters::blocked`] through the kinds' trees.
+    #[inline(never)]
+    fn blocked_tree(&self, scene: &Scene, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
+        // The box tests' set-up, once for every kind.
+        let boxes = BoxRay::new(ray.origin, ray.dir);
+        let (b, clips) = (&boxes, &scene.clips);
         let blocks = |m: u32, _: u32| scene.materials[m as usize].shadow.is_none();
         let [triangles, cones, discs] = self.all_block;
         let tri = &scene.triangles.set;
