@@ -9,7 +9,7 @@ use super::frame::{self, Animation, Keyed};
 use super::instances::{self, PrototypeUse};
 use super::place::Sets;
 use super::series::SeriesSet;
-use super::{AngleRule, Ao, Casters, Fade, Features, Fog, Light, Material, Scene, Settings, Sky};
+use super::{AngleRule, Ao, Casters, Fade, Features, Few, Fog, Light, Material, Scene, Settings, Sky};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
@@ -246,6 +246,7 @@ impl Scene {
             budget: b.budget,
             casters: None,
             more_kinds: true,
+            few: None,
         };
         if let Some(a) = &desc.animation {
             // An animated scene starts at its first frame.
@@ -282,6 +283,7 @@ impl Scene {
         }
         scene.casters = Casters::of(&scene);
         scene.more_kinds = scene.has_more_kinds();
+        scene.few = Few::of(&scene);
         Ok(scene)
     }
 }

@@ -8,6 +8,7 @@
 //! (for both) in `place`.
 
 mod build;
+mod few;
 mod frame;
 mod instances;
 mod place;
@@ -19,6 +20,7 @@ pub(crate) mod update;
 
 pub(crate) use build::shadowless_groups;
 pub use build::Prebuilt;
+pub use few::Few;
 pub use frame::Animation;
 pub use instances::PrototypeUse;
 pub use series::DataFiles;
@@ -402,6 +404,9 @@ pub struct Scene {
     /// Some triangle, cone, disc or plugin object: closest hits ask those kinds too
     /// (refreshed with the features; spheres and planes are asked anyway).
     pub more_kinds: bool,
+    /// A scene of a few spheres, at most one triangle and planes: closest hits test them
+    /// without the trees (refreshed with `more_kinds`).
+    pub few: Option<Few>,
 }
 
 impl Scene {
@@ -459,7 +464,18 @@ impl Scene {
 
     /// The closest hit along `ray` before `t_max`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
+    pub fn intersect(&self, ray: &Ray, t_max: f32, c: &mut Counters) -> Option<Hit> {
+        if let Some(few) = &self.few {
+            if let Some(hit) = few.closest(self, ray, t_max, c) {
+                return hit;
+            }
+        }
+        self.intersect_trees(ray, t_max, c)
+    }
+
+    /// [`Scene::intersect`] through the kinds' trees.
+    #[inline]
+    fn intersect_trees(&self, ray: &Ray, mut t_max: f32, c: &mut Counters) -> Option<Hit> {
         let mut hit = None;
         // The box tests' set-up, once for every kind.
         let boxes = BoxRay::new(ray.origin, ray.dir);

@@ -5,7 +5,7 @@
 //! stage on the description's part, so the scene is what a build would make of it.
 
 use super::build::{self, features, settings, Build};
-use super::{Casters, Scene};
+use super::{Casters, Few, Scene};
 use crate::error::Error;
 use crate::geometry::material_of;
 use crate::geometry::objects::Objects;
@@ -180,5 +180,6 @@ impl Scene {
         self.features.motion_blur = self.settings.shutter.is_some();
         self.casters = Casters::of(self);
         self.more_kinds = self.has_more_kinds();
+        self.few = Few::of(self);
     }
 }
