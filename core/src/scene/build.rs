@@ -9,7 +9,9 @@ use super::frame::{self, Animation, Keyed};
 use super::instances::{self, PrototypeUse};
 use super::place::Sets;
 use super::series::SeriesSet;
-use super::{AngleRule, Ao, Casters, Fade, Features, Few, Fog, Light, Material, Scene, Settings, Sky};
+use super::{
+    AngleRule, Ao, Casters, Fade, Features, Few, Fog, Light, Material, Scene, Settings, Sky,
+};
 use crate::budget::{Budget, Use};
 use crate::bvh::BUILD_BYTES_PER_PRIM;
 use crate::camera::Camera;
