@@ -47,11 +47,14 @@ struct Ball {
 impl Ball {
     fn around(v: &[glam::Vec3; 3]) -> Ball {
         let v = v.map(|p| p.as_dvec3());
-        let c = (v[0] + v[1] + v[2]) / 3.0;
+        // The radius from the centre as stored: its rounding (up to half a float step of
+        // the coordinates, more than a small triangle far out) must not shrink the ball.
+        let center = ((v[0] + v[1] + v[2]) / 3.0).as_vec3a();
+        let c = center.as_dvec3();
         let r = v.iter().map(|p| p.distance(c)).fold(0.0, f64::max);
         // A vertex that is not finite makes `r2` infinite or NaN: the ball never rejects.
         Ball {
-            center: c.as_vec3a(),
+            center,
             r2: (r * 1.01 * (r * 1.01)) as f32,
         }
     }
@@ -199,5 +202,68 @@ impl Casters {
                 })
             || (!scene.customs.is_empty() && scene.customs.any(ray, t_max, clips, c, blocks))
             || (!scene.moving.is_empty() && scene.moving.any(ray, t_max, clips, c, &mut { blocks }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::triangle::{intersect_triangle, TriRay};
+    use glam::Vec3;
+
+    /// No ray the watertight test takes is rejected by the triangle's ball: rays from near
+    /// and far origins (also far from the world's origin) aimed at the corners, the edges
+    /// and just outside them, where rounding decides. And rays well away are rejected.
+    #[test]
+    fn balls_keep_every_hit() {
+        let triangles = [
+            [(0.0, -4.0, 12.0), (4.0, -4.0, 8.0), (-4.0, -4.0, 8.0)],
+            [
+                (1e4, 2e4, -3e4),
+                (1e4 + 0.01, 2e4, -3e4),
+                (1e4, 2e4 + 1e-3, -3e4),
+            ],
+            [(-1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1e-4, 30.0)],
+        ];
+        let (mut hits, mut rejected) = (0, 0);
+        for t in triangles {
+            let v = t.map(|(x, y, z)| Vec3::new(x, y, z));
+            let ball = Ball::around(&v);
+            let w = v.map(Vec3A::from);
+            let size = (w[1] - w[0]).length().max((w[2] - w[0]).length());
+            for i in 0..40 {
+                let a = i as f32 * 0.61;
+                let dir = Vec3A::new(a.cos(), (0.8 * a).sin(), 0.5 - (1.7 * a).cos());
+                for far in [0.01, 1.0, 1e3, 1e6] {
+                    let origin = w[0] + far * size * dir.normalize();
+                    for k in 0..3 {
+                        for s in [0.0, 0.5, 1.0] {
+                            for nudge in [-1e-4, 0.0, 1e-4] {
+                                // Along edge k, at its ends and middle, nudged across.
+                                let edge = w[(k + 1) % 3] - w[k];
+                                let inward = w[(k + 2) % 3] - w[k];
+                                let q = w[k] + s * edge + nudge * inward;
+                                let ray = Ray::new(origin, (q - origin).normalize(), 0.0);
+                                if !ray.finite() {
+                                    continue;
+                                }
+                                let r = TriRay::new(&ray);
+                                if intersect_triangle(&v, &r, f32::INFINITY).is_some() {
+                                    hits += 1;
+                                    assert!(!ball.missed_by(&ray), "{t:?} {ray:?}");
+                                }
+                                // The same ray moved aside by ten sizes misses the ball.
+                                let aside =
+                                    w[0] + 10.0 * size * Vec3A::Y.cross(ray.dir).normalize();
+                                let away = Ray::new(origin + aside - w[0], ray.dir, 0.0);
+                                rejected += usize::from(ball.missed_by(&away));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(hits > 1000, "{hits}");
+        assert!(rejected > 1000, "{rejected}");
     }
 }
