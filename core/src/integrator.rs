@@ -928,7 +928,13 @@ impl Whitted<'_> {
                 }
                 arriving *= through;
             } else {
-                arriving *= scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
+                // Blocked or not needs no product: `arriving` times one is `arriving`.
+                let min_weight = scene.settings.min_weight;
+                match scene.blocked(&sray, t_max, min_weight, c) {
+                    Some(true) => return Vec3A::ZERO,
+                    Some(false) => {}
+                    None => arriving *= scene.transmittance(&sray, t_max, min_weight, c),
+                }
                 if scene.features.volumes && arriving != Vec3A::ZERO {
                     arriving *= march::transmittance(scene, &sray, t_max, c);
                 }
