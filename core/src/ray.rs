@@ -47,6 +47,14 @@ pub fn offset_origin(p: Vec3A, p_error: Vec3A, ng: Vec3A, w: Vec3A) -> Vec3A {
     away(p + offset, offset)
 }
 
+/// [`offset_origin`] for any `w` that does not leave against `ng` (`w · ng` not below 0,
+/// or NaN): the same origin for all of them, so a shading point's shadow rays can share it.
+#[inline]
+pub fn offset_up(p: Vec3A, p_error: Vec3A, ng: Vec3A) -> Vec3A {
+    let offset = ng.abs().dot(p_error) * ng;
+    away(p + offset, offset)
+}
+
 /// `po` rounded one float further along the sign of `offset`, per coordinate: `next_up`
 /// where it is positive, `next_down` where negative, unchanged where zero or NaN.
 #[cfg(not(target_arch = "x86_64"))]
@@ -112,6 +120,50 @@ pub fn spawn(p: Vec3A, p_error: Vec3A, ng: Vec3A, dir: Vec3A, time: f32) -> Ray 
 pub fn spawn_to(p: Vec3A, p_error: Vec3A, ng: Vec3A, target: Vec3A, time: f32) -> (Ray, f32) {
     let d = target - p;
     let o = offset_origin(p, p_error, ng, d);
+    ray_to(o, target, time)
+}
+
+/// [`spawn_to`] bit for bit, given `up()`, the point's [`offset_up`] (made once per point
+/// by the caller): only a target behind the geometric normal pays for its own offset.
+#[inline(always)]
+pub fn spawn_to_or(
+    p: Vec3A,
+    p_error: Vec3A,
+    ng: Vec3A,
+    target: Vec3A,
+    time: f32,
+    up: impl FnOnce() -> Vec3A,
+) -> (Ray, f32) {
+    let d = target - p;
+    let o = if d.dot(ng) < 0.0 {
+        offset_origin(p, p_error, ng, d)
+    } else {
+        up()
+    };
+    ray_to(o, target, time)
+}
+
+/// [`spawn`] bit for bit, given the point's [`offset_up`] as `up()` (see [`spawn_to_or`]).
+#[inline(always)]
+pub fn spawn_or(
+    p: Vec3A,
+    p_error: Vec3A,
+    ng: Vec3A,
+    dir: Vec3A,
+    time: f32,
+    up: impl FnOnce() -> Vec3A,
+) -> Ray {
+    let o = if dir.dot(ng) < 0.0 {
+        offset_origin(p, p_error, ng, dir)
+    } else {
+        up()
+    };
+    Ray::new(o, dir, time)
+}
+
+/// The ray from `o` toward `target` and the distance to just short of it.
+#[inline(always)]
+fn ray_to(o: Vec3A, target: Vec3A, time: f32) -> (Ray, f32) {
     let to = target - o;
     let dist = to.length();
     (Ray::new(o, to / dist, time), dist * (1.0 - 1e-4))
@@ -168,5 +220,42 @@ mod tests {
             }
         }
         assert!(n > 10_000);
+    }
+
+    /// The shared origin's spawns are `spawn_to` and `spawn` bit for bit, on either side of
+    /// the normal, along it and across it.
+    #[test]
+    fn shared_offset_spawns_match() {
+        let bits = |r: &Ray| {
+            (
+                r.origin.to_array().map(f32::to_bits),
+                r.dir.to_array().map(f32::to_bits),
+            )
+        };
+        let ng = Vec3A::new(0.3, -0.8, 0.52).normalize();
+        let mut n = 0;
+        for p in [
+            Vec3A::new(1.5, -2.25, 7.0),
+            Vec3A::new(-1e4, 0.0, 3e-3),
+            Vec3A::ZERO,
+        ] {
+            let p_error = 3e-7 * (p.abs() + Vec3A::ONE);
+            let up = offset_up(p, p_error, ng);
+            for k in 0..64 {
+                let a = k as f32 * 0.37;
+                let w = Vec3A::new(a.cos(), (1.3 * a).sin(), (0.7 * a).cos() - 0.2);
+                let w = if k % 5 == 0 { ng.cross(w) } else { w };
+                let target = p + 3.0 * w;
+                let (want, wt) = spawn_to(p, p_error, ng, target, 0.5);
+                let (got, gt) = spawn_to_or(p, p_error, ng, target, 0.5, || up);
+                assert_eq!((bits(&got), gt.to_bits()), (bits(&want), wt.to_bits()));
+                let dir = w.normalize();
+                let want = spawn(p, p_error, ng, dir, 0.5);
+                let got = spawn_or(p, p_error, ng, dir, 0.5, || up);
+                assert_eq!(bits(&got), bits(&want));
+                n += 1;
+            }
+        }
+        assert_eq!(n, 192);
     }
 }

@@ -537,11 +537,28 @@ impl Scene {
     /// the product of the filters (`Material::shadow`) of the surfaces it crosses.
     #[inline]
     pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
-        if let (Some(casters), true) = (&self.casters, min_weight <= 1.0) {
-            let blocked = casters.blocked(self, ray, t_max, c);
-            return if blocked { Vec3A::ZERO } else { Vec3A::ONE };
+        match self.blocked(ray, t_max, min_weight, c) {
+            Some(true) => Vec3A::ZERO,
+            Some(false) => Vec3A::ONE,
+            None => self.transmittance_filtered(ray, t_max, min_weight, c),
         }
-        self.transmittance_filtered(ray, t_max, min_weight, c)
+    }
+
+    /// In a scene whose shadow rays are blocked or pass unchanged ([`Casters`]): whether
+    /// `ray` is blocked ([`Scene::transmittance`] zero or one). `None` elsewhere, asking
+    /// nothing: the caller asks [`Scene::transmittance`].
+    #[inline(always)]
+    pub fn blocked(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        min_weight: f32,
+        c: &mut Counters,
+    ) -> Option<bool> {
+        match (&self.casters, min_weight <= 1.0) {
+            (Some(casters), true) => Some(casters.blocked(self, ray, t_max, c)),
+            _ => None,
+        }
     }
 
     /// [`Scene::transmittance`] of a scene without [`Casters`] (or asked with a `min_weight`
