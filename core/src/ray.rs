@@ -39,12 +39,9 @@ impl Ray {
 /// work at any scale and far from the origin (Wächter & Binder, Ray Tracing Gems ch. 6; pbrt-v4).
 #[inline]
 pub fn offset_origin(p: Vec3A, p_error: Vec3A, ng: Vec3A, w: Vec3A) -> Vec3A {
-    let d = ng.abs().dot(p_error);
-    let mut offset = d * ng;
-    if w.dot(ng) < 0.0 {
-        offset = -offset;
-    }
-    away(p + offset, offset)
+    // |−ng| = |ng| and d·(−ng) = −(d·ng) exactly, so this is the offset negated.
+    let side = if w.dot(ng) < 0.0 { -ng } else { ng };
+    offset_up(p, p_error, side)
 }
 
 /// [`offset_origin`] for any `w` that does not leave against `ng` (`w · ng` not below 0,
