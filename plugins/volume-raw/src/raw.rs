@@ -634,15 +634,24 @@ fn stream(
     if slab_bytes <= max_slab {
         let (bx, by) = block_size(layout.dims, block_voxels);
         let mut raw: Vec<u8> = Vec::new();
+        // One slab buffer for the whole file: a fresh one per slab was zeroed and, above
+        // malloc's mmap threshold, mapped and faulted in again every time.
+        let full = SLAB.min(nz);
+        let mut buf = buffer(nx * ny * full * bpv, || {
+            format!(
+                "a slab of {full} slices of {nx}x{ny} {} voxels",
+                layout.format.name()
+            )
+        })?;
         for z0 in (0..nz).step_by(SLAB as usize) {
             let dz = SLAB.min(nz - z0);
-            let mut slab = buffer(nx * ny * dz * bpv, || {
-                format!(
-                    "a slab of {dz} slices of {nx}x{ny} {} voxels",
-                    layout.format.name()
-                )
-            })?;
-            input.fill(&mut slab)?;
+            let slab = &mut buf[..(nx * ny * dz * bpv) as usize];
+            input.fill(slab)?;
+            if bx == nx && by == ny {
+                // One block is the whole slab, in file order already: no copy.
+                send(slab, [0, 0, z0], [nx, ny, dz])?;
+                continue;
+            }
             for y0 in (0..ny).step_by(by as usize) {
                 let dy = by.min(ny - y0);
                 for x0 in (0..nx).step_by(bx as usize) {
