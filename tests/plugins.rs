@@ -403,10 +403,10 @@ fn plugins_command_lists_every_plugin_and_its_parameters() {
         "texture `checker`",
         "writer `png` [.png]",
         "writer `exr` [.exr]",
-        "plugin ABI 2",
+        "plugin ABI 3",
         "radius",
         "skipped",
-        "built for plugin ABI 1 (luxon-plugin 0.1.0)",
+        "built for plugin ABI 2 (luxon-plugin 0.2.0)",
     ] {
         assert!(s.contains(want), "missing `{want}` in:\n{s}");
     }
