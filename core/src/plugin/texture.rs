@@ -18,6 +18,8 @@ pub struct TextureInstance {
     /// The scene's name for the texture, and where its parameters are.
     pub name: String,
     pub at: Origin,
+    /// Which fields of the query `eval` reads (`abi::READS_*`, the plugin's declaration).
+    pub reads: u32,
     /// Evaluations that gave NaN or an infinity, for the warning after the render.
     pub nan_results: AtomicU64,
 }
@@ -125,6 +127,7 @@ pub fn create_texture(
     let mut out = abi::TextureObject {
         object: std::ptr::null_mut(),
         vtable: std::ptr::null(),
+        reads: abi::READS_ALL,
     };
     call_plugin(registry, entry, params_at, |err| {
         // SAFETY: the calling contract: `params`, `ctx`, `out` and `err` live across the call,
@@ -145,6 +148,7 @@ pub fn create_texture(
         plugin: entry.name.clone(),
         name: instance.to_string(),
         at: params_at.clone(),
+        reads: out.reads,
         nan_results: AtomicU64::new(0),
     })
 }

@@ -150,7 +150,8 @@ impl Scene {
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
-        let palette = Build::materials(desc, &texture_names, &shadowless)?;
+        let mut palette = Build::materials(desc, &texture_names, &shadowless)?;
+        declare_uv(&mut palette.materials, &textures);
         let clips = b.clips()?;
         let render_volumes = b.render_volumes(&volumes)?;
         let mut stored = Stored::new(b.world_offset, palette.materials.len());
@@ -1158,6 +1159,18 @@ fn material(
         outline: m.outline as f32,
         outline_power: 32.0 * (1.0 - m.outline_width as f32),
         fog: m.fog,
+        // Any texture until the textures' declarations are known (`declare_uv`).
+        uv: textures.iter().any(Option::is_some),
+    }
+}
+
+/// Sets each material's [`Material::uv`] from what its textures declare they read.
+pub(super) fn declare_uv(materials: &mut [Material], textures: &[TextureInstance]) {
+    let reads_uv = |t: Option<u32>| {
+        t.is_some_and(|t| textures[t as usize].reads & luxon_plugin::abi::READS_UV != 0)
+    };
+    for m in materials {
+        m.uv = reads_uv(m.texture) || reads_uv(m.reflect_texture) || reads_uv(m.transmit_texture);
     }
 }
 

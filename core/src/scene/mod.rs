@@ -76,6 +76,8 @@ pub struct Material {
     pub outline_power: f32,
     /// Whether fog covers the surface.
     pub fog: bool,
+    /// Whether one of its textures reads texture coordinates (see [`Material::reads_uv`]).
+    pub uv: bool,
 }
 
 /// How a material's transmit coefficient t changes with the angle θ it is seen at.
@@ -89,11 +91,12 @@ pub enum AngleRule {
 }
 
 impl Material {
-    /// Whether shading reads the texture coordinates at this material's points (a texture
-    /// of any kind: the texture query carries them).
+    /// Whether shading reads the texture coordinates at this material's points: one of its
+    /// textures declares it reads them (`abi::READS_UV`; an image projected from the point
+    /// does not).
     #[inline]
     pub fn reads_uv(&self) -> bool {
-        self.texture.is_some() || self.reflect_texture.is_some() || self.transmit_texture.is_some()
+        self.uv
     }
 
     /// The outline factor on the diffuse light where the view direction makes cosine `cos`

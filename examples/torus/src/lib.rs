@@ -39,7 +39,7 @@
 //! through `LUXON_PLUGIN_PATH=DIR luxon render scene.ron`, or a scene names the directory (or
 //! the `.so` itself), relative to the scene file: `plugin_path: ["../target/release"]`.
 //!
-//! The library records the plugin ABI it was built for (ABI 2: `luxon-plugin` 0.2); Luxon
+//! The library records the plugin ABI it was built for (ABI 3: `luxon-plugin` 0.3); Luxon
 //! skips a library built for another and says so, naming both versions: rebuild it against the
 //! SDK of the Luxon that loads it. A shape that builds big arrays (a tessellated mesh) should
 //! allocate them with `ctx.alloc_vec`, which keeps to the memory budget the host gives the call

@@ -43,8 +43,8 @@ use std::ffi::c_void;
 
 /// Bumped on every incompatible change to this file. Version 2 added
 /// [`CallContext::memory_budget`], [`VolumeSink::add_dense_typed`] and the error sink of
-/// [`TextureInstanceVTable::eval`].
-pub const ABI_VERSION: u32 = 2;
+/// [`TextureInstanceVTable::eval`]; version 3 [`TextureObject::reads`].
+pub const ABI_VERSION: u32 = 3;
 /// First eight bytes of every [`PluginHeader`].
 pub const MAGIC: [u8; 8] = *b"LUXONPLG";
 /// The one symbol a plugin library exports (NUL-terminated for `dlsym`).
@@ -379,7 +379,25 @@ pub struct TextureObject {
     pub object: *mut c_void,
     /// A table that stays valid while the library is loaded (a static).
     pub vtable: *const TextureInstanceVTable,
+    /// Which fields of [`TexQuery`] the object's `eval` reads: `READS_*` bits
+    /// ([`READS_ALL`] when unsure). The host may skip working out the others (it leaves them
+    /// 0): a sphere's `uv` costs an `atan2` and an `acos` that a projected image never reads.
+    pub reads: u32,
 }
+
+/// [`TextureObject::reads`]: the hit point [`TexQuery::p`].
+pub const READS_POINT: u32 = 1;
+/// [`TextureObject::reads`]: the shading normal [`TexQuery::n`].
+pub const READS_NORMAL: u32 = 1 << 1;
+/// [`TextureObject::reads`]: the texture coordinates [`TexQuery::uv`] and
+/// [`TexQuery::uv_footprint`].
+pub const READS_UV: u32 = 1 << 2;
+/// [`TextureObject::reads`]: the world footprint [`TexQuery::footprint`].
+pub const READS_FOOTPRINT: u32 = 1 << 3;
+/// [`TextureObject::reads`]: the ray's time [`TexQuery::time`].
+pub const READS_TIME: u32 = 1 << 4;
+/// [`TextureObject::reads`]: every field.
+pub const READS_ALL: u32 = READS_POINT | READS_NORMAL | READS_UV | READS_FOOTPRINT | READS_TIME;
 
 /// Where and how a texture is looked up: one shading point (the SDK re-exports it at its
 /// root: `luxon_plugin::TexQuery`).

@@ -619,6 +619,12 @@ pub trait Texture: Describe + Send + Sync + Sized + 'static {
     fn try_eval(&self, query: &abi::TexQuery) -> Result<[f32; 4], Error> {
         Ok(self.eval(query))
     }
+    /// Which fields of the query `eval` reads (`abi::READS_*` bits), asked once after
+    /// `create`: the host may leave the others 0 and skip working them out. The default, every
+    /// field, is always correct; a texture that declares too few sees zeros.
+    fn reads(&self) -> u32 {
+        abi::READS_ALL
+    }
 }
 
 fn texture_instance_vtable<T: Texture>() -> &'static abi::TextureInstanceVTable {
@@ -1015,9 +1021,11 @@ pub mod shim {
             let out = out.ok_or_else(|| Error::new("no place for the texture"))?;
             with_params::<T, T::Params>(text, |p| {
                 let tex = T::create(p, &context(ctx))?;
+                let reads = tex.reads();
                 *out = abi::TextureObject {
                     object: Box::into_raw(Box::new(tex)) as *mut c_void,
                     vtable: texture_instance_vtable::<T>(),
+                    reads,
                 };
                 Ok(())
             })
@@ -1401,6 +1409,7 @@ mod tests {
             let mut out = abi::TextureObject {
                 object: std::ptr::null_mut(),
                 vtable: std::ptr::null(),
+                reads: abi::READS_ALL,
             };
             let mut slot = SinkError(None);
             let err = abi::ErrorSink {

@@ -45,7 +45,7 @@ use std::time::SystemTime;
 /// The budget when the render settings give none (0): 1 GiB.
 pub const DEFAULT_BUDGET: u64 = 1 << 30;
 
-/// Reader counters per image; threads are spread over them round-robin.
+/// Reader counters per image; threads are spread over them by where their stacks lie.
 const STRIPES: usize = 16;
 
 /// Where log messages go: `(level, message)`, level 0 error, 1 warning.
@@ -55,11 +55,15 @@ pub type Log = Box<dyn Fn(u32, &str) + Send + Sync>;
 #[derive(Default)]
 struct Stripe(AtomicUsize);
 
-/// This thread's reader counter index.
+/// This thread's reader counter index, from the address of its stack: threads' stacks lie at
+/// least a megabyte apart, so they mostly differ in the bits above 2^20. Any index is correct
+/// (a guard leaves the counter it entered); distinct ones only spare the threads contention.
+/// A thread-local index costs a `__tls_get_addr` call per lookup in a plugin library.
+#[inline(always)]
 fn stripe() -> usize {
-    static NEXT: AtomicUsize = AtomicUsize::new(0);
-    thread_local!(static MINE: usize = NEXT.fetch_add(1, Relaxed) % STRIPES);
-    MINE.with(|m| *m)
+    let marker = 0u8;
+    let a = std::ptr::addr_of!(marker) as usize;
+    ((a >> 20) ^ (a >> 24)) % STRIPES
 }
 
 /// One MIP level of one image.
@@ -374,6 +378,27 @@ impl Cache {
         }
         let (la, lb) = self.load(img, a, b)?;
         Ok(f(&la, &lb))
+    }
+
+    /// [`Self::with_levels`] of one level (`a == b`): one pointer to check and stamp.
+    #[inline]
+    pub fn with_level<R>(
+        &self,
+        img: &CachedImage,
+        a: usize,
+        f: impl FnOnce(&Level) -> R,
+    ) -> Result<R, String> {
+        {
+            let _reading = img.enter();
+            let slot = &img.slots[a];
+            let pa = slot.data.load(SeqCst);
+            if !pa.is_null() {
+                self.touch(slot);
+                // SAFETY: as in `with_levels`.
+                return Ok(f(unsafe { &*pa }));
+            }
+        }
+        self.with_levels(img, a, a, |l, _| f(l))
     }
 
     fn load(

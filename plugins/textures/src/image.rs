@@ -5,7 +5,7 @@ use crate::decode::{plan, probe, Plan};
 use crate::mapping::{Kind, Mapping};
 use crate::mipmap::{bilinear, level_pair, mip_level, nearest, trilinear, Wrap};
 use crate::params::{up, yes, Factors};
-use luxon_plugin::abi::TexQuery;
+use luxon_plugin::abi::{TexQuery, READS_FOOTPRINT, READS_POINT, READS_UV};
 use luxon_plugin::{invalid, Context, Describe, Error, Texture};
 use serde::Deserialize;
 use std::sync::Arc;
@@ -152,6 +152,16 @@ impl Texture for ImageTexture {
         Self::create_in(p, ctx, cache)
     }
 
+    /// uv mapping reads the coordinates (and their footprint); the projections the point,
+    /// and MIP filtering the world footprint too.
+    fn reads(&self) -> u32 {
+        match (self.mapping.kind(), self.filter) {
+            (Kind::Uv, _) => READS_UV,
+            (_, Filter::Mip) => READS_POINT | READS_FOOTPRINT,
+            _ => READS_POINT,
+        }
+    }
+
     /// Magenta where the image cannot be decoded (the host calls `try_eval`, which fails).
     fn eval(&self, q: &TexQuery) -> [f32; 4] {
         self.try_eval(q).unwrap_or(MAGENTA)
@@ -162,11 +172,11 @@ impl Texture for ImageTexture {
         let got = match self.filter {
             Filter::Nearest => {
                 let (s, t) = self.mapping.point(q);
-                (self.cache).with_levels(img, 0, 0, |a, _| nearest(a, s, t, wrap))
+                (self.cache).with_level(img, 0, |a| nearest(a, s, t, wrap))
             }
             Filter::Bilinear => {
                 let (s, t) = self.mapping.point(q);
-                (self.cache).with_levels(img, 0, 0, |a, _| bilinear(a, s, t, wrap))
+                (self.cache).with_level(img, 0, |a| bilinear(a, s, t, wrap))
             }
             Filter::Mip => {
                 let l = self.mapping.lookup(q);
@@ -245,6 +255,21 @@ mod tests {
         // srgb: false reads the bytes as linear.
         let raw = tex(&dir, r#"(file: "ramp.png", filter: nearest, srgb: false)"#);
         assert_eq!(at_uv(&raw, centre(1, 0), 0.0), grey(40.0 / 255.0));
+    }
+
+    #[test]
+    fn declares_what_its_mapping_reads() {
+        use luxon_plugin::abi::{READS_FOOTPRINT, READS_POINT, READS_UV};
+        let dir = TempDir::new("img-reads");
+        fixture(&dir);
+        let reads = |p: &str| tex(&dir, &format!(r#"(file: "ramp.png", {p})"#)).reads();
+        // A projection reads the point (and the world footprint under MIP filtering), never
+        // uv: the host then skips a sphere's uv. uv mapping reads uv and its footprint.
+        assert_eq!(reads("mapping: spherical, filter: bilinear"), READS_POINT);
+        assert_eq!(reads("mapping: planar, filter: nearest"), READS_POINT);
+        assert_eq!(reads("mapping: cylindrical"), READS_POINT | READS_FOOTPRINT);
+        assert_eq!(reads("filter: bilinear"), READS_UV);
+        assert_eq!(reads(""), READS_UV);
     }
 
     #[test]

@@ -172,6 +172,11 @@ impl Mapping {
         self.resolve::<true>(q)
     }
 
+    /// What the mapping projects from (uv: the surface's coordinates; else the point).
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
+
     /// Image coordinates `(s, t)` alone, as [`Self::lookup`] gives them (for the filters that
     /// read no footprint).
     pub fn point(&self, q: &TexQuery) -> (f64, f64) {

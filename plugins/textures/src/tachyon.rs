@@ -12,7 +12,7 @@
 
 use crate::band::{cos_band, sin_band};
 use crate::params::{color, Factors};
-use luxon_plugin::abi::TexQuery;
+use luxon_plugin::abi::{TexQuery, READS_POINT};
 use luxon_plugin::{finite, invalid, Context, Describe, Error, Texture};
 use serde::Deserialize;
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -103,6 +103,11 @@ impl Describe for TachyonMarble {
 impl Texture for TachyonMarble {
     type Params = NoParams;
 
+    /// The point alone.
+    fn reads(&self) -> u32 {
+        READS_POINT
+    }
+
     fn create(_p: NoParams, _ctx: &Context) -> Result<Self, Error> {
         Ok(TachyonMarble)
     }
@@ -168,6 +173,11 @@ impl Describe for TachyonWood {
 
 impl Texture for TachyonWood {
     type Params = WoodParams;
+
+    /// The point alone.
+    fn reads(&self) -> u32 {
+        READS_POINT
+    }
 
     fn create(p: WoodParams, _ctx: &Context) -> Result<Self, Error> {
         Ok(TachyonWood {
@@ -237,6 +247,11 @@ impl Describe for TachyonCylinderChecker {
 
 impl Texture for TachyonCylinderChecker {
     type Params = CylinderCheckerParams;
+
+    /// The point alone.
+    fn reads(&self) -> u32 {
+        READS_POINT
+    }
 
     fn create(p: CylinderCheckerParams, _ctx: &Context) -> Result<Self, Error> {
         Ok(TachyonCylinderChecker {
@@ -327,6 +342,11 @@ impl Describe for TachyonVolumeImage {
 
 impl Texture for TachyonVolumeImage {
     type Params = VolumeImageParams;
+
+    /// The point alone.
+    fn reads(&self) -> u32 {
+        READS_POINT
+    }
 
     fn create(p: VolumeImageParams, _ctx: &Context) -> Result<Self, Error> {
         let size = p.size.map(|n| n as usize);
