@@ -150,8 +150,7 @@ impl Scene {
         let t0 = Instant::now();
         let (textures, texture_names) = b.textures()?;
         let volumes = b.volumes()?;
-        let mut palette = Build::materials(desc, &texture_names, &shadowless)?;
-        declare_uv(&mut palette.materials, &textures);
+        let palette = Build::materials(desc, &texture_names, &textures, &shadowless)?;
         let clips = b.clips()?;
         let render_volumes = b.render_volumes(&volumes)?;
         let mut stored = Stored::new(b.world_offset, palette.materials.len());
@@ -454,11 +453,12 @@ impl<'a> Build<'a> {
     pub(super) fn materials(
         desc: &SceneDesc,
         texture_names: &[String],
+        textures: &[TextureInstance],
         shadowless_groups: &[Option<Spanned<String>>],
     ) -> Result<Palette, Error> {
         let t = &desc.render.transparency;
         let mut material_names = vec!["default".to_string()];
-        let mut materials = vec![material(&Default::default(), [None; 3], t)];
+        let mut materials = vec![material(&Default::default(), [None; 3], false, t)];
         for (name, m) in &desc.materials {
             let find = |t: &Option<Spanned<String>>| -> Result<Option<u32>, Error> {
                 match t {
@@ -475,7 +475,12 @@ impl<'a> Build<'a> {
                 find(&m.value.reflect_texture)?,
                 find(&m.value.transmit_texture)?,
             ];
-            let mat = material(&m.value, tex, t);
+            // Whether shading must work out uv: one of its textures declares it reads them.
+            let uv = tex
+                .iter()
+                .flatten()
+                .any(|&i| textures[i as usize].reads & luxon_plugin::abi::READS_UV != 0);
+            let mat = material(&m.value, tex, uv, t);
             if let Some(i) = material_names.iter().position(|n| n == name) {
                 materials[i] = mat;
             } else {
@@ -1128,6 +1133,7 @@ pub(super) fn shadow_filter(
 fn material(
     m: &luxon_formats::MaterialDesc,
     textures: [Option<u32>; 3],
+    uv: bool,
     t: &TransparencyDesc,
 ) -> Material {
     let color = v3(m.color);
@@ -1159,18 +1165,7 @@ fn material(
         outline: m.outline as f32,
         outline_power: 32.0 * (1.0 - m.outline_width as f32),
         fog: m.fog,
-        // Any texture until the textures' declarations are known (`declare_uv`).
-        uv: textures.iter().any(Option::is_some),
-    }
-}
-
-/// Sets each material's [`Material::uv`] from what its textures declare they read.
-pub(super) fn declare_uv(materials: &mut [Material], textures: &[TextureInstance]) {
-    let reads_uv = |t: Option<u32>| {
-        t.is_some_and(|t| textures[t as usize].reads & luxon_plugin::abi::READS_UV != 0)
-    };
-    for m in materials {
-        m.uv = reads_uv(m.texture) || reads_uv(m.reflect_texture) || reads_uv(m.transmit_texture);
+        uv,
     }
 }
 

@@ -87,8 +87,7 @@ impl Scene {
         desc: &SceneDesc,
         shadowless_groups: &[Option<Spanned<String>>],
     ) -> Result<bool, Error> {
-        let mut p = Build::materials(desc, &self.texture_names, shadowless_groups)?;
-        build::declare_uv(&mut p.materials, &self.textures);
+        let p = Build::materials(desc, &self.texture_names, &self.textures, shadowless_groups)?;
         let copies = self.materials.len() - self.material_names.len();
         let appended = copies == 0
             && p.materials.len() == p.names.len()

@@ -1,8 +1,8 @@
 //! Test plugin: the handshake of a plugin built for plugin ABI 2 with luxon-plugin 0.2.0 (the
 //! version before the current one: its `TextureObject` had no `reads`), which the host must
-//! refuse. The header's leading fields
-//! keep their layout in every ABI version, so this is what such a library really declares; the
-//! host must stop after reading `abi_version` and never touch `declaration` (null here).
+//! refuse. The header's leading fields keep their layout in every ABI version, so this is what
+//! such a library really declares; the host must stop after reading `abi_version` and never
+//! touch `declaration` (null here).
 
 use luxon_plugin::abi::{DeclareFn, HostTable, PluginHeader, Str, MAGIC};
 
