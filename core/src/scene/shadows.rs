@@ -8,7 +8,7 @@ use super::few::Few;
 use super::Scene;
 use crate::bvh::BoxRay;
 use crate::geometry::set::Set;
-use crate::geometry::sphere::{solve_sphere, Spheres};
+use crate::geometry::sphere::{solve_sphere, Sphere, Spheres};
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{material_of, Counters};
 use crate::math::Vec3A;
@@ -32,8 +32,16 @@ pub struct Casters {
     balls: Vec<Ball>,
     /// `Some` when every kind is a handful of spheres or triangles tested one by one, or
     /// planes (fog, spotlight, model2: `few`): a shadow ray needs no box tests, so their
-    /// set-up is not made. The blocking spheres in lanes, for their first test four at a time.
-    lanes: Option<Few>,
+    /// set-up is not made. The blocking spheres again, as that query reads them.
+    few: Option<FewSpheres>,
+}
+
+/// The blocking spheres of a `few` scene: in lanes for their first test, four at a time,
+/// and as they are for the rest (one `match` and a register's worth of arguments per
+/// shadow ray, not two `Option`s).
+struct FewSpheres {
+    lanes: Few,
+    data: Vec<Sphere>,
 }
 
 /// A ball holding a triangle, with room to spare: a ray whose line passes outside it cannot
@@ -109,10 +117,13 @@ impl Casters {
             && scene.discs.is_empty()
             && scene.customs.is_empty()
             && scene.moving.is_empty();
-        let (balls, lanes) = match (&spheres, few) {
+        let (balls, few) = match (&spheres, few) {
             (Some(spheres), true) => (
                 tri.data.iter().map(|t| Ball::around(&t.v)).collect(),
-                Some(Few::new(&spheres.data)),
+                Some(FewSpheres {
+                    lanes: Few::new(&spheres.data),
+                    data: spheres.data.clone(),
+                }),
             ),
             _ => (Vec::new(), None),
         };
@@ -120,26 +131,25 @@ impl Casters {
             spheres,
             all_block,
             balls,
-            lanes,
+            few,
         })
     }
 
     /// Whether something blocks `ray` before `t_max`.
     #[inline(always)]
     pub(super) fn blocked(&self, scene: &Scene, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
-        match (&self.spheres, &self.lanes) {
-            (Some(spheres), Some(lanes)) => self.blocked_few(spheres, lanes, scene, ray, t_max, c),
-            _ => self.blocked_tree(scene, ray, t_max, c),
+        match &self.few {
+            Some(few) => self.blocked_few(few, scene, ray, t_max, c),
+            None => self.blocked_tree(scene, ray, t_max, c),
         }
     }
 
-    /// [`Casters::blocked`] with `lanes` (`few`): the same answer and test count as
+    /// [`Casters::blocked`] with `few`: the same answer and test count as
     /// [`Casters::blocked_tree`].
     #[inline(never)]
     fn blocked_few(
         &self,
-        spheres: &Spheres,
-        lanes: &Few,
+        spheres: &FewSpheres,
         scene: &Scene,
         ray: &Ray,
         t_max: f32,
@@ -153,22 +163,16 @@ impl Casters {
         // No triangle, no ball: asked before the call (fog and spotlight have none).
         let triangles =
             |c: &mut Counters| !self.balls.is_empty() && self.triangles_few(tri, ray, t_max, c);
-        (meets && (Self::spheres_few(spheres, lanes, ray, t_max, c) || triangles(c)))
+        (meets && (Self::spheres_few(spheres, ray, t_max, c) || triangles(c)))
             || scene.planes.any(ray, t_max, &scene.clips, c, blocks)
     }
 
-    /// `spheres.any_few` (the copy, `lanes` made of it): the same answer and test count, with
+    /// `any_few` of the copy's spheres: the same answer and test count, with
     /// `intersect_sphere`'s first test made for all of them at once (`Few::near`, bit for bit
     /// the same) and the rest for those it keeps, in order.
     #[inline(always)]
-    fn spheres_few(
-        spheres: &Spheres,
-        lanes: &Few,
-        ray: &Ray,
-        t_max: f32,
-        c: &mut Counters,
-    ) -> bool {
-        let mut near = lanes.near(ray);
+    fn spheres_few(spheres: &FewSpheres, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
+        let mut near = spheres.lanes.near(ray);
         while near != 0 {
             let i = near.trailing_zeros() as usize;
             near &= near - 1;
@@ -262,7 +266,7 @@ mod tests {
                 let s = if k == 3 {
                     made[0]
                 } else {
-                    crate::geometry::sphere::Sphere {
+                    Sphere {
                         center: Vec3::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0, r() * 4.0 - 2.0),
                         radius: 0.1 + r() * (k as f32 + 1.0) * 0.5,
                     }
@@ -271,7 +275,10 @@ mod tests {
                 set.push(s, k as u32);
             }
             set.build();
-            let lanes = Few::new(&set.data);
+            let few = FewSpheres {
+                lanes: Few::new(&set.data),
+                data: set.data.clone(),
+            };
             for i in 0..4000 {
                 let dir = Vec3A::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize();
                 let origin = match (i % 2, made.len()) {
@@ -287,7 +294,7 @@ mod tests {
                 let t_max = if r() < 0.5 { r() * 3.0 } else { f32::INFINITY };
                 let (a, b) = (&mut Counters::default(), &mut Counters::default());
                 let want = set.any_few(&ray, t_max, a);
-                let got = Casters::spheres_few(&set, &lanes, &ray, t_max, b);
+                let got = Casters::spheres_few(&few, &ray, t_max, b);
                 assert_eq!(
                     (got, b.tests),
                     (want, a.tests),
