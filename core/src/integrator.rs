@@ -16,7 +16,6 @@ use crate::sampler::{mix, pixel_sample};
 use crate::scene::{AngleRule, Ao, Light, Material, Scene, Sky};
 use luxon_formats::{BeyondMax, Highlight, TransparencyMode};
 use luxon_plugin::abi::TexQuery;
-use std::cell::Cell;
 
 /// Tachyon's threshold on light terms and coefficients (`TachyonDesc::light_threshold`).
 const TACHYON_FLOOR: f32 = 1.0 / 510.0;
@@ -89,6 +88,9 @@ pub struct Whitted<'a> {
     compose: Compose,
     /// The scene has no surface at all (Tachyon's empty scenes): no ray is worth intersecting.
     blank: bool,
+    /// Every light is a point light (most of Tachyon's scenes): `lighting` runs their terms
+    /// inline, without the dispatch per light.
+    points: bool,
 }
 
 /// How a transparent surface's shading and what lies behind it combine (from the mode).
@@ -138,6 +140,7 @@ impl<'a> Whitted<'a> {
         Whitted {
             scene,
             blank,
+            points: (scene.lights.iter()).all(|l| matches!(l, Light::Point { .. })),
             draws,
             miss,
             sky,
@@ -436,12 +439,32 @@ impl Whitted<'_> {
             base,
             opacity,
             time: ray.time,
-            up: Cell::new(None),
+            up: if scene.features.shadows {
+                offset_up(light_p, light_error, side.ng)
+            } else {
+                light_p
+            },
         };
         let mut lit = Vec3A::ZERO;
         // Each light's seed is mixed only by the lights that draw (see `direct`).
         // A light's rules: shadows only if it casts them (both made once per point).
-        if scene.features.tachyon_lights {
+        if scene.features.tachyon_lights && self.points {
+            // `direct`'s point-light arm, its term inline (no seed: a point light draws none).
+            let rules = Rules::new::<true>(scene, mat).per_light();
+            for light in &scene.lights {
+                if let Light::Point {
+                    position,
+                    color,
+                    attenuation,
+                    shadows,
+                } = light
+                {
+                    let (rules, raw) = (&rules[*shadows as usize], (*color, 1.0));
+                    let (q, a) = (*position, attenuation);
+                    lit += self.point_term::<true, true>(&shade, mat, rules, q, *color, raw, a, c);
+                }
+            }
+        } else if scene.features.tachyon_lights {
             let rules = Rules::new::<true>(scene, mat).per_light();
             for (k, light) in scene.lights.iter().enumerate() {
                 let rules = &rules[light.casts_shadows() as usize];
@@ -621,24 +644,10 @@ struct Shade {
     base: Vec3A,
     opacity: f32,
     time: f32,
-    /// `p`'s shadow-ray origin for lights on `ng`'s side, once a light has needed it.
-    up: Cell<Option<Vec3A>>,
-}
-
-impl Shade {
-    /// The origin of shadow rays toward lights on `ng`'s side (`offset_up`): made at the
-    /// first such ray, shared by the point's others (~40 instructions each).
-    #[inline(always)]
-    fn up(&self) -> Vec3A {
-        match self.up.get() {
-            Some(o) => o,
-            None => {
-                let o = offset_up(self.p, self.p_error, self.ng);
-                self.up.set(Some(o));
-                o
-            }
-        }
-    }
+    /// With shadows on: the origin of shadow rays toward lights on `ng`'s side
+    /// (`offset_up`, ~40 instructions), made once for the point's lights (nearly every
+    /// shading point casts one; a lazy `Cell` cost more per shadow ray than it saved).
+    up: Vec3A,
 }
 
 /// What every light's term at a shading point obeys, from the settings and the material (see
@@ -742,13 +751,22 @@ impl Whitted<'_> {
         match light {
             Light::Directional {
                 to_light, color, ..
-            } => self.term::<T>(sh, mat, rules, None, *to_light, *color, (*color, 1.0), c),
+            } => self.term::<T, false>(
+                sh,
+                mat,
+                rules,
+                Vec3A::ZERO,
+                *to_light,
+                *color,
+                (*color, 1.0),
+                c,
+            ),
             Light::Point {
                 position,
                 color,
                 attenuation,
                 ..
-            } => self.point_term::<T>(
+            } => self.point_term::<T, false>(
                 sh,
                 mat,
                 rules,
@@ -773,7 +791,7 @@ impl Whitted<'_> {
                     return Vec3A::ZERO;
                 }
                 let w = Light::spot_weight(cos, *cos_inner, *cos_outer, *fade);
-                self.point_term::<T>(
+                self.point_term::<T, false>(
                     sh,
                     mat,
                     rules,
@@ -844,7 +862,7 @@ impl Whitted<'_> {
         let mut sum = Vec3A::ZERO;
         for i in 0..samples {
             let (a, b) = square(seed, i, samples);
-            sum += self.point_term::<T>(
+            sum += self.point_term::<T, false>(
                 sh,
                 mat,
                 rules,
@@ -859,10 +877,11 @@ impl Whitted<'_> {
     }
 
     /// A point light's term at a shading point: `color` arrives at the point attenuated;
-    /// `raw`, `w`: see [`Whitted::term`].
+    /// `raw`, `w`: see [`Whitted::term_body`]. With `I` the term is inlined (`lighting`'s loop
+    /// over point lights), else called.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn point_term<const T: bool>(
+    fn point_term<const T: bool, const I: bool>(
         &self,
         sh: &Shade,
         mat: &Material,
@@ -876,28 +895,43 @@ impl Whitted<'_> {
         let d = q - sh.p;
         let dist = d.length();
         let att = Light::attenuate(a, dist);
-        self.term::<T>(
-            sh,
-            mat,
-            rules,
-            Some(q),
-            d / dist,
-            color * att,
-            (raw, w * att),
-            c,
-        )
+        let (to_light, arriving, raw) = (d / dist, color * att, (raw, w * att));
+        if I {
+            self.term_body::<T, true>(sh, mat, rules, q, to_light, arriving, raw, c)
+        } else {
+            self.term::<T, true>(sh, mat, rules, q, to_light, arriving, raw, c)
+        }
     }
 
-    /// One light term (see [`Whitted::direct`]): `target` is the point on the light or `None`
-    /// for a direction, `to_light` the direction to it, `arriving` the radiance arriving; with
-    /// `T`: `raw` is the light's colour and `w` its weight from attenuation and spot fade.
+    /// [`Whitted::term_body`] out of line, for `direct`'s lights.
     #[allow(clippy::too_many_arguments)]
-    fn term<const T: bool>(
+    #[inline(never)]
+    fn term<const T: bool, const P: bool>(
         &self,
         sh: &Shade,
         mat: &Material,
         rules: &Rules,
-        target: Option<Vec3A>,
+        target: Vec3A,
+        to_light: Vec3A,
+        arriving: Vec3A,
+        raw: (Vec3A, f32),
+        c: &mut Counters,
+    ) -> Vec3A {
+        self.term_body::<T, P>(sh, mat, rules, target, to_light, arriving, raw, c)
+    }
+
+    /// One light term (see [`Whitted::direct`]): with `P`, `target` is the point on the light
+    /// (unused for a direction), `to_light` the direction to it, `arriving` the radiance
+    /// arriving; with `T`: `raw` is the light's colour and `w` its weight from attenuation and
+    /// spot fade.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn term_body<const T: bool, const P: bool>(
+        &self,
+        sh: &Shade,
+        mat: &Material,
+        rules: &Rules,
+        target: Vec3A,
         to_light: Vec3A,
         arriving: Vec3A,
         (raw, w): (Vec3A, f32),
@@ -920,13 +954,12 @@ impl Whitted<'_> {
         let mut arriving = arriving;
         if shadows {
             c.shadow += 1;
-            let up = || sh.up();
-            let (sray, t_max) = match target {
-                Some(t) => spawn_to_or(sh.p, sh.p_error, sh.ng, t, sh.time, up),
-                None => (
-                    spawn_or(sh.p, sh.p_error, sh.ng, to_light, sh.time, up),
-                    f32::INFINITY,
-                ),
+            let up = || sh.up;
+            let (sray, t_max) = if P {
+                spawn_to_or(sh.p, sh.p_error, sh.ng, target, sh.time, up)
+            } else {
+                let r = spawn_or(sh.p, sh.p_error, sh.ng, to_light, sh.time, up);
+                (r, f32::INFINITY)
             };
             if colourless {
                 // Blocked is what counts, not what arrives.

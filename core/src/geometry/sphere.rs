@@ -37,6 +37,20 @@ pub fn intersect_sphere(
     if r2 - l.dot(l) < -r2 * 1e-4 {
         return (None, 0);
     }
+    solve_sphere(c, r, o, d, t_min, t_max)
+}
+
+/// [`intersect_sphere`] past its f32 rejection (which `scene::few` also makes four spheres
+/// at a time): the roots in f64.
+#[inline(always)]
+pub fn solve_sphere(
+    c: Vec3A,
+    r: f32,
+    o: Vec3A,
+    d: Vec3A,
+    t_min: f32,
+    t_max: f32,
+) -> (Option<f32>, u32) {
     let f = o.as_dvec3() - c.as_dvec3();
     let d = d.as_dvec3();
     let r = r as f64;

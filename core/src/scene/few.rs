@@ -50,8 +50,8 @@ impl Few {
         Some(Few::new(&spheres.data))
     }
 
-    /// The lanes of up to eight spheres.
-    fn new(spheres: &[Sphere]) -> Few {
+    /// The lanes of up to eight spheres (also `Casters`' copy of the blocking ones).
+    pub(super) fn new(spheres: &[Sphere]) -> Few {
         assert!(
             spheres.len() <= 4 * GROUPS,
             "at most {} spheres",
@@ -81,7 +81,7 @@ impl Few {
     /// in f32) does not reject, a bit each: the same operations in the same order, lane by
     /// lane, so the same answers.
     #[inline(always)]
-    fn near(&self, ray: &Ray) -> u32 {
+    pub(super) fn near(&self, ray: &Ray) -> u32 {
         let (o, d) = (ray.origin, ray.dir);
         let (dx, dy, dz) = (Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z));
         let mut near = 0;

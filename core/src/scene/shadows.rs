@@ -4,10 +4,11 @@
 //! it is asked of the spheres that block only (the light spheres left out at build time, not
 //! passed over one by one on every ray), and of small sets one primitive after another.
 
+use super::few::Few;
 use super::Scene;
 use crate::bvh::BoxRay;
 use crate::geometry::set::Set;
-use crate::geometry::sphere::Spheres;
+use crate::geometry::sphere::{solve_sphere, Sphere, Spheres};
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{material_of, Counters};
 use crate::math::Vec3A;
@@ -27,11 +28,20 @@ pub struct Casters {
     /// Per kind (triangles, cones, discs): every primitive blocks, so the kind is asked
     /// without looking at materials.
     all_block: [bool; 3],
-    /// Every kind is a handful of spheres or triangles tested one by one, or planes (fog,
-    /// spotlight, model2): a shadow ray needs no box tests, so their set-up is not made.
-    few: bool,
     /// With `few`: a ball around each triangle, in the set's order (empty otherwise).
     balls: Vec<Ball>,
+    /// `Some` when every kind is a handful of spheres or triangles tested one by one, or
+    /// planes (fog, spotlight, model2: `few`): a shadow ray needs no box tests, so their
+    /// set-up is not made. The blocking spheres again, as that query reads them.
+    few: Option<FewSpheres>,
+}
+
+/// The blocking spheres of a `few` scene: in lanes for their first test, four at a time,
+/// and as they are for the rest (one `match` and a register's worth of arguments per
+/// shadow ray, not two `Option`s).
+struct FewSpheres {
+    lanes: Few,
+    data: Vec<Sphere>,
 }
 
 /// A ball holding a triangle, with room to spare: a ray whose line passes outside it cannot
@@ -107,34 +117,39 @@ impl Casters {
             && scene.discs.is_empty()
             && scene.customs.is_empty()
             && scene.moving.is_empty();
-        let balls = if few {
-            tri.data.iter().map(|t| Ball::around(&t.v)).collect()
-        } else {
-            Vec::new()
+        let (balls, few) = match (&spheres, few) {
+            (Some(spheres), true) => (
+                tri.data.iter().map(|t| Ball::around(&t.v)).collect(),
+                Some(FewSpheres {
+                    lanes: Few::new(&spheres.data),
+                    data: spheres.data.clone(),
+                }),
+            ),
+            _ => (Vec::new(), None),
         };
         Some(Casters {
             spheres,
             all_block,
-            few,
             balls,
+            few,
         })
     }
 
     /// Whether something blocks `ray` before `t_max`.
     #[inline(always)]
     pub(super) fn blocked(&self, scene: &Scene, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
-        match (&self.spheres, self.few) {
-            (Some(spheres), true) => self.blocked_few(spheres, scene, ray, t_max, c),
-            _ => self.blocked_tree(scene, ray, t_max, c),
+        match &self.few {
+            Some(few) => self.blocked_few(few, scene, ray, t_max, c),
+            None => self.blocked_tree(scene, ray, t_max, c),
         }
     }
 
-    /// [`Casters::blocked`] when `few` holds: the same tests in the same order
-    /// (so the same answer and test count) as [`Casters::blocked_tree`].
+    /// [`Casters::blocked`] with `few`: the same answer and test count as
+    /// [`Casters::blocked_tree`].
     #[inline(never)]
     fn blocked_few(
         &self,
-        spheres: &Spheres,
+        spheres: &FewSpheres,
         scene: &Scene,
         ray: &Ray,
         t_max: f32,
@@ -148,8 +163,28 @@ impl Casters {
         // No triangle, no ball: asked before the call (fog and spotlight have none).
         let triangles =
             |c: &mut Counters| !self.balls.is_empty() && self.triangles_few(tri, ray, t_max, c);
-        (meets && (spheres.any_few(ray, t_max, c) || triangles(c)))
+        (meets && (Self::spheres_few(spheres, ray, t_max, c) || triangles(c)))
             || scene.planes.any(ray, t_max, &scene.clips, c, blocks)
+    }
+
+    /// `any_few` of the copy's spheres: the same answer and test count, with
+    /// `intersect_sphere`'s first test made for all of them at once (`Few::near`, bit for bit
+    /// the same) and the rest for those it keeps, in order.
+    #[inline(always)]
+    fn spheres_few(spheres: &FewSpheres, ray: &Ray, t_max: f32, c: &mut Counters) -> bool {
+        let mut near = spheres.lanes.near(ray);
+        while near != 0 {
+            let i = near.trailing_zeros() as usize;
+            near &= near - 1;
+            let s = &spheres.data[i];
+            if solve_sphere(s.center.into(), s.radius, ray.origin, ray.dir, 0.0, t_max).1 > 0 {
+                // `any_few` stops at the first blocker, having tested those before it.
+                c.tests += i as u64 + 1;
+                return true;
+            }
+        }
+        c.tests += spheres.data.len() as u64;
+        false
     }
 
     /// `tri.any_few` (`tri`: the scene's triangles, [`Set::few`], all blocking) that first
@@ -210,6 +245,70 @@ mod tests {
     use super::*;
     use crate::geometry::triangle::{intersect_triangle, TriRay};
     use glam::Vec3;
+
+    /// The lanes' sphere query gives `any_few`'s answer and test count: rays from the
+    /// spheres' surfaces (shadow rays) and from around them, short and unbounded, with
+    /// copies and spheres inside one another.
+    #[test]
+    fn lanes_answer_as_any_few() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut r = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut blocked, mut open) = (0, 0);
+        for n in 0..=4 {
+            let mut set = Spheres::default();
+            let mut made = Vec::new();
+            for k in 0..n {
+                let s = if k == 3 {
+                    made[0]
+                } else {
+                    Sphere {
+                        center: Vec3::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0, r() * 4.0 - 2.0),
+                        radius: 0.1 + r() * (k as f32 + 1.0) * 0.5,
+                    }
+                };
+                made.push(s);
+                set.push(s, k as u32);
+            }
+            set.build();
+            let few = FewSpheres {
+                lanes: Few::new(&set.data),
+                data: set.data.clone(),
+            };
+            for i in 0..4000 {
+                let dir = Vec3A::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize();
+                let origin = match (i % 2, made.len()) {
+                    (1, m) if m > 0 => {
+                        // On a sphere, leaving it or going through it.
+                        let s = made[i % m];
+                        let w = Vec3A::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize();
+                        Vec3A::from(s.center) + s.radius * w
+                    }
+                    _ => Vec3A::new(r() * 6.0 - 3.0, r() * 6.0 - 3.0, r() * 6.0 - 3.0),
+                };
+                let ray = Ray::new(origin, dir, 0.0);
+                let t_max = if r() < 0.5 { r() * 3.0 } else { f32::INFINITY };
+                let (a, b) = (&mut Counters::default(), &mut Counters::default());
+                let want = set.any_few(&ray, t_max, a);
+                let got = Casters::spheres_few(&few, &ray, t_max, b);
+                assert_eq!(
+                    (got, b.tests),
+                    (want, a.tests),
+                    "{n} spheres, {ray:?} {t_max}"
+                );
+                (blocked, open) = if want {
+                    (blocked + 1, open)
+                } else {
+                    (blocked, open + 1)
+                };
+            }
+        }
+        assert!(blocked > 1000 && open > 1000, "{blocked} {open}");
+    }
 
     /// No ray the watertight test takes is rejected by the triangle's ball: rays from near
     /// and far origins (also far from the world's origin) aimed at the corners, the edges
