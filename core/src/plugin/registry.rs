@@ -599,6 +599,23 @@ impl Registry {
             .collect()
     }
 
+    /// Every name a scene can use (the first library's of each), with its kind and library
+    /// file, in search order; known without loading the libraries.
+    pub fn provided(&self) -> Vec<(PluginKind, &str, &Path)> {
+        self.names
+            .iter()
+            .enumerate()
+            .filter(|(i, n)| self.by_name.get(&n.name) == Some(i))
+            .map(|(_, n)| {
+                (
+                    n.kind,
+                    n.name.as_str(),
+                    self.slots[n.library].path.as_path(),
+                )
+            })
+            .collect()
+    }
+
     /// How many library files were found usable (loaded or not yet).
     pub fn library_count(&self) -> usize {
         self.slots.len()
