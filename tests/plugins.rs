@@ -521,7 +521,7 @@ fn a_lookup_loads_only_the_library_that_provides_the_name() {
     use luxon::plugin::{PluginKind, Registry};
     let dir = temp_dir("lazy");
     install_plugin(&dir, "luxon_shapes", "luxon_myshapes");
-    let r = Registry::discover(&[dir.clone()]);
+    let r = Registry::discover(std::slice::from_ref(&dir));
     assert!(r.library_count() >= 4, "{}", r.library_count());
     assert!(r.loaded_libraries().is_empty());
     let sphere = r.get("sphere", PluginKind::Primitive).unwrap();
@@ -582,7 +582,7 @@ fn a_library_with_a_damaged_name_table_is_loaded_at_once() {
             .unwrap()[0],
         b'X'
     );
-    let r = Registry::discover(&[dir.clone()]);
+    let r = Registry::discover(std::slice::from_ref(&dir));
     let loaded = r.loaded_libraries();
     assert_eq!(loaded.len(), 1);
     assert_eq!(loaded[0].0.path, lib.canonicalize().unwrap());
@@ -603,7 +603,7 @@ fn a_listed_name_the_library_does_not_declare_is_an_error_naming_both() {
     let mut file = std::fs::read(&lib).unwrap();
     file[at + name + 5] = b'a';
     std::fs::write(&lib, &file).unwrap();
-    let r = Registry::discover(&[dir.clone()]);
+    let r = Registry::discover(std::slice::from_ref(&dir));
     assert!(r.loaded_libraries().is_empty());
     let e = r
         .get("sphera", PluginKind::Primitive)
