@@ -513,3 +513,118 @@ fn special_files_named_like_plugins_are_refused_by_type() {
         "{listed}"
     );
 }
+
+/// The workspace's libraries carry name tables: finding them loads none, a lookup loads the
+/// one library that provides the name, and `load_all` the rest.
+#[test]
+fn a_lookup_loads_only_the_library_that_provides_the_name() {
+    use luxon::plugin::{PluginKind, Registry};
+    let dir = temp_dir("lazy");
+    install_plugin(&dir, "luxon_shapes", "luxon_myshapes");
+    let r = Registry::discover(std::slice::from_ref(&dir));
+    assert!(r.library_count() >= 4, "{}", r.library_count());
+    assert!(r.loaded_libraries().is_empty());
+    let sphere = r.get("sphere", PluginKind::Primitive).unwrap();
+    let loaded = r.loaded_libraries();
+    assert_eq!(loaded.len(), 1);
+    // The first library on the search path provides it: the copy in `dir`.
+    assert_eq!(
+        loaded[0].0.path,
+        dir.join("libluxon_myshapes.so").canonicalize().unwrap()
+    );
+    assert_eq!(r.library_of(sphere).name, "luxon-shapes");
+    let png = r.writer_for_extension("PNG").unwrap().unwrap();
+    assert_eq!(r.loaded_libraries().len(), 2);
+    assert_eq!(r.library_of(png).name, "luxon-writers");
+    // The names are known without loading: the other writers' extensions, a wrong kind.
+    assert!(r.writer_extensions().contains(&"ppm".to_string()));
+    assert!(r.get("png", PluginKind::Texture).is_err());
+    assert_eq!(r.loaded_libraries().len(), 2);
+    assert!(r.load_all().is_empty());
+    assert_eq!(r.loaded_libraries().len(), r.library_count());
+    // The copy's entries shadow the executable directory's shapes.
+    let shadowed: Vec<_> = r
+        .loaded_libraries()
+        .into_iter()
+        .filter(|(l, _)| l.name == "luxon-shapes")
+        .map(|(_, e)| e.iter().all(|e| e.shadowed))
+        .collect();
+    assert!(shadowed.len() >= 2 && !shadowed[0], "{shadowed:?}");
+    assert!(shadowed[1..].iter().all(|&s| s), "{shadowed:?}");
+}
+
+/// The bytes of a library's name table and where they are in its file.
+fn name_table(lib: &Path) -> (Vec<u8>, usize) {
+    let table = luxon::plugin::elf::check_library(lib)
+        .unwrap()
+        .names
+        .expect("a name table");
+    let file = std::fs::read(lib).unwrap();
+    let at = file.windows(table.len()).position(|w| w == table).unwrap();
+    (table, at)
+}
+
+/// A library whose table cannot be read is loaded at once to learn its names, as one built
+/// before tables existed.
+#[test]
+fn a_library_with_a_damaged_name_table_is_loaded_at_once() {
+    use luxon::plugin::{PluginKind, Registry};
+    let dir = temp_dir("damaged-table");
+    let lib = install_plugin(&dir, "luxon_shapes", "luxon_damaged");
+    let (_, at) = name_table(&lib);
+    let mut file = std::fs::read(&lib).unwrap();
+    file[at] = b'X';
+    std::fs::write(&lib, &file).unwrap();
+    assert_eq!(
+        luxon::plugin::elf::check_library(&lib)
+            .unwrap()
+            .names
+            .unwrap()[0],
+        b'X'
+    );
+    let r = Registry::discover(std::slice::from_ref(&dir));
+    let loaded = r.loaded_libraries();
+    assert_eq!(loaded.len(), 1);
+    assert_eq!(loaded[0].0.path, lib.canonicalize().unwrap());
+    let sphere = r.get("sphere", PluginKind::Primitive).unwrap();
+    assert_eq!(r.library_of(sphere).path, lib.canonicalize().unwrap());
+    assert!(r.problems.is_empty(), "{:?}", r.problems);
+}
+
+/// A table that lists a name the library does not declare (a file that does not match its
+/// code): a lookup of that name is an error naming the name and the library.
+#[test]
+fn a_listed_name_the_library_does_not_declare_is_an_error_naming_both() {
+    use luxon::plugin::{PluginKind, Registry};
+    let dir = temp_dir("mismatched-table");
+    let lib = install_plugin(&dir, "luxon_shapes", "luxon_mismatch");
+    let (table, at) = name_table(&lib);
+    let name = table.windows(6).position(|w| w == b"sphere").unwrap();
+    let mut file = std::fs::read(&lib).unwrap();
+    file[at + name + 5] = b'a';
+    std::fs::write(&lib, &file).unwrap();
+    let r = Registry::discover(std::slice::from_ref(&dir));
+    assert!(r.loaded_libraries().is_empty());
+    let e = r
+        .get("sphera", PluginKind::Primitive)
+        .unwrap_err()
+        .to_string();
+    let want = format!(
+        "plugin `sphera` is provided by {}, which cannot be used: its name table lists \
+         primitive `sphera`, but its declaration does not (it declares primitive `sphere`, \
+         primitive `spheres`, ",
+        lib.canonicalize().unwrap().display()
+    );
+    assert!(e.starts_with(&want), "{e}");
+    assert!(
+        e.ends_with("the library's file does not match its code"),
+        "{e}"
+    );
+    // `luxon plugins` loads every library: it lists this one as skipped, with the reason.
+    let failed = r.load_all();
+    assert_eq!(failed.len(), 1, "{failed:?}");
+    assert_eq!(failed[0].path, lib.canonicalize().unwrap());
+    // The real sphere comes from the executable's directory.
+    let sphere = r.get("sphere", PluginKind::Primitive).unwrap();
+    assert_ne!(r.library_of(sphere).path, lib.canonicalize().unwrap());
+}

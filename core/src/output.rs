@@ -39,7 +39,10 @@ pub fn resolve<'r>(
                     .map_err(|e| Error::at(&name.at, e.to_string()))?,
                 None => {
                     let ext = o.path.extension().and_then(|e| e.to_str()).unwrap_or("");
-                    registry.writer_for_extension(ext).ok_or_else(|| {
+                    let found = registry
+                        .writer_for_extension(ext)
+                        .map_err(|e| Error::at(&o.params_at, e.to_string()))?;
+                    found.ok_or_else(|| {
                         let known = registry.writer_extensions();
                         Error::at(
                             &o.params_at,

@@ -35,14 +35,11 @@ impl PyContext {
 
     /// The plugins found: `(kind, name, library path)` tuples, in search order.
     fn plugins(&self) -> Vec<(String, String, PathBuf)> {
+        // From the libraries' name tables: listing them loads none.
         let r = self.ctx.registry();
-        r.entries
-            .iter()
-            .filter(|e| !e.shadowed)
-            .map(|e| {
-                let lib = &r.libraries[e.library];
-                (e.kind.to_string(), e.name.clone(), lib.path.clone())
-            })
+        r.provided()
+            .into_iter()
+            .map(|(kind, name, path)| (kind.to_string(), name.to_string(), path.to_path_buf()))
             .collect()
     }
 

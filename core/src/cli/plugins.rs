@@ -5,7 +5,10 @@ use std::path::PathBuf;
 
 pub fn run(extra: &[PathBuf]) {
     let registry = Registry::discover(extra);
-    for (i, lib) in registry.libraries.iter().enumerate() {
+    // Every library is loaded here, not only those a scene would use.
+    let failed = registry.load_all();
+    let loaded = registry.loaded_libraries();
+    for (lib, entries) in &loaded {
         println!(
             "{} (library `{}`, plugin ABI {}, luxon-plugin {})",
             lib.path.display(),
@@ -13,7 +16,7 @@ pub fn run(extra: &[PathBuf]) {
             lib.abi_version,
             lib.sdk_version
         );
-        for e in registry.entries.iter().filter(|e| e.library == i) {
+        for e in entries.iter() {
             let ext = if e.kind == PluginKind::Writer {
                 format!(" [.{}]", e.extensions.join(", ."))
             } else {
@@ -30,11 +33,16 @@ pub fn run(extra: &[PathBuf]) {
             }
         }
     }
-    if registry.libraries.is_empty() {
+    if loaded.is_empty() {
         println!("no plugins found");
     }
     // Files that could not be used, then places named on the search path that gave nothing.
-    for p in registry.problems.iter().chain(&registry.notes) {
+    for p in registry
+        .problems
+        .iter()
+        .chain(&failed)
+        .chain(&registry.notes)
+    {
         println!("skipped {p}");
     }
     let dirs: Vec<String> = registry

@@ -5,19 +5,30 @@
 //! and the process dies without a word, even when the scene never uses that library. So the
 //! loader reads the ELF header and the program headers first (two reads, no mapping) and refuses
 //! a file whose segments or section headers lie beyond its end, or that was built for another
-//! machine. What stays out of reach: a library rewritten while it is mapped, a truncated
-//! dependency of a plugin (`ld.so` loads it), and a library whose initialisers crash.
+//! machine. The same pass finds the library's name table (`luxon_plugin::names`): the section
+//! headers, their string table and the section, three small reads more. What stays out of
+//! reach: a library rewritten while it is mapped, a truncated dependency of a plugin (`ld.so`
+//! loads it), and a library whose initialisers crash.
 //!
 //! On platforms whose libraries are not ELF (macOS, Windows) the check passes everything.
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-/// Checks the library at `path` (a regular file) before it is loaded; the error says why it
-/// cannot be, in words that follow its path.
-pub fn check_library(path: &Path) -> Result<(), String> {
+/// What the check read beside its verdict.
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct Checked {
+    /// The bytes of the library's name table section (`luxon_plugin::names::SECTION`), if it
+    /// has one that lies in the file; `None` for a library built without it, or whose section
+    /// headers this reader does not follow (it is then loaded to learn its names).
+    pub names: Option<Vec<u8>>,
+}
+
+/// Checks the library at `path` (a regular file) before it is loaded, and reads its name table;
+/// the error says why it cannot be loaded, in words that follow its path.
+pub fn check_library(path: &Path) -> Result<Checked, String> {
     if !cfg!(all(unix, not(target_vendor = "apple"))) {
-        return Ok(());
+        return Ok(Checked::default());
     }
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read: {e}"))?;
     let len = file
@@ -127,7 +138,7 @@ fn truncated(what: &str, start: u64, end: u64, len: u64) -> String {
 }
 
 /// The check itself, on any seekable bytes of length `len`.
-fn check(file: &mut (impl Read + Seek), len: u64, host: &Host) -> Result<(), String> {
+fn check(file: &mut (impl Read + Seek), len: u64, host: &Host) -> Result<Checked, String> {
     let io = |e: std::io::Error| format!("cannot be read: {e}");
     let mut ident = [0u8; 64];
     let head_len = len.min(64) as usize;
@@ -217,13 +228,118 @@ fn check(file: &mut (impl Read + Seek), len: u64, host: &Host) -> Result<(), Str
         }
     }
     // The loader does not need the section headers, but a file cut short of them is broken.
-    if shoff != 0 {
-        let end = shoff.saturating_add(u64::from(shnum) * u64::from(shentsize));
-        if end > len {
-            return Err(truncated("its section header table", shoff, end, len));
-        }
+    if shoff == 0 {
+        return Ok(Checked::default());
     }
-    Ok(())
+    let end = shoff.saturating_add(u64::from(shnum) * u64::from(shentsize));
+    if end > len {
+        return Err(truncated("its section header table", shoff, end, len));
+    }
+    let shstrndx = f_u16(&ident, little, if wide { 62 } else { 50 });
+    let sections = Sections {
+        wide,
+        little,
+        shoff,
+        shnum,
+        shentsize,
+        shstrndx,
+        len,
+    };
+    Ok(Checked {
+        names: sections.find(file, luxon_plugin::names::SECTION)?,
+    })
+}
+
+fn f_u16(bytes: &[u8], little: bool, at: usize) -> u16 {
+    Fields { bytes, little }.u16(at)
+}
+
+/// Undefined section index, and `e_shstrndx`'s escape to a larger index (not followed here).
+const SHN_UNDEF: u16 = 0;
+const SHN_XINDEX: u16 = 0xffff;
+/// A section that occupies no bytes in the file.
+const SHT_NOBITS: u32 = 8;
+/// Section names longer than this are not looked at (`.shstrtab` is a few hundred bytes).
+const MAX_SHSTRTAB: u64 = 1 << 20;
+
+/// The section header table of a checked file (which lies inside it).
+struct Sections {
+    wide: bool,
+    little: bool,
+    shoff: u64,
+    shnum: u16,
+    shentsize: u16,
+    shstrndx: u16,
+    len: u64,
+}
+
+impl Sections {
+    /// The bytes of the section named `name`: `None` when there is none, or when the table is
+    /// laid out in a way not followed here (so the library is loaded as one without it); an
+    /// error when the section's bytes lie past the end of the file.
+    fn find(&self, file: &mut (impl Read + Seek), name: &str) -> Result<Option<Vec<u8>>, String> {
+        let io = |e: std::io::Error| format!("cannot be read: {e}");
+        let want = if self.wide { 64 } else { 40 };
+        if self.shentsize != want
+            || self.shnum == 0
+            || matches!(self.shstrndx, SHN_UNDEF | SHN_XINDEX)
+            || self.shstrndx >= self.shnum
+        {
+            return Ok(None);
+        }
+        let mut table = vec![0u8; usize::from(self.shnum) * usize::from(want)];
+        file.seek(SeekFrom::Start(self.shoff)).map_err(io)?;
+        file.read_exact(&mut table).map_err(io)?;
+        let f = Fields {
+            bytes: &table,
+            little: self.little,
+        };
+        let w = self.wide;
+        // (name offset, type, file offset, size) of section `k`.
+        let header = |k: usize| {
+            let at = k * usize::from(want);
+            (
+                f.u32(at),
+                f.u32(at + 4),
+                f.word(w, at + 24, at + 16),
+                f.word(w, at + 32, at + 20),
+            )
+        };
+        let (_, _, str_off, str_size) = header(usize::from(self.shstrndx));
+        if str_size > MAX_SHSTRTAB || str_off.saturating_add(str_size) > self.len {
+            return Ok(None);
+        }
+        let mut names = vec![0u8; str_size as usize];
+        file.seek(SeekFrom::Start(str_off)).map_err(io)?;
+        file.read_exact(&mut names).map_err(io)?;
+        let named = |at: u32| {
+            let rest = names.get(at as usize..).unwrap_or_default();
+            let end = rest.iter().position(|&b| b == 0).unwrap_or(rest.len());
+            &rest[..end]
+        };
+        let Some((_, kind, offset, size)) = (0..usize::from(self.shnum))
+            .map(header)
+            .find(|h| named(h.0) == name.as_bytes())
+        else {
+            return Ok(None);
+        };
+        if kind == SHT_NOBITS || size > luxon_plugin::names::MAX_TABLE as u64 {
+            return Ok(None);
+        }
+        let end = offset.saturating_add(size);
+        if end > self.len {
+            return Err(truncated(
+                &format!("its section {name}"),
+                offset,
+                end,
+                self.len,
+            ));
+        }
+        let mut bytes = vec![0u8; size as usize];
+        file.seek(SeekFrom::Start(offset)).map_err(io)?;
+        file.read_exact(&mut bytes).map_err(io)?;
+        Ok(Some(bytes))
+    }
 }
 
 #[cfg(test)]
@@ -263,13 +379,65 @@ mod tests {
         b
     }
 
-    fn run(b: &[u8]) -> Result<(), String> {
+    /// [`image`] of one program header whose sections are the null one, `.shstrtab` and a
+    /// section named `name` holding `data`.
+    fn with_section(name: &str, data: &[u8]) -> Vec<u8> {
+        let mut b = image(1);
+        b.truncate(64 + 56);
+        let strtab_at = b.len();
+        let strtab = format!("\0.shstrtab\0{name}\0");
+        b.extend_from_slice(strtab.as_bytes());
+        let data_at = b.len();
+        b.extend_from_slice(data);
+        let shoff = b.len();
+        b.extend_from_slice(&[0u8; 64]);
+        for (name_at, at, size) in [(1u32, strtab_at, strtab.len()), (11, data_at, data.len())] {
+            let mut h = [0u8; 64];
+            h[..4].copy_from_slice(&name_at.to_le_bytes());
+            h[4..8].copy_from_slice(&1u32.to_le_bytes());
+            h[24..32].copy_from_slice(&(at as u64).to_le_bytes());
+            h[32..40].copy_from_slice(&(size as u64).to_le_bytes());
+            b.extend_from_slice(&h);
+        }
+        b[40..48].copy_from_slice(&(shoff as u64).to_le_bytes());
+        b[60..62].copy_from_slice(&3u16.to_le_bytes());
+        b[62..64].copy_from_slice(&1u16.to_le_bytes());
+        let len = b.len() as u64;
+        b[64 + 32..64 + 40].copy_from_slice(&len.to_le_bytes());
+        b
+    }
+
+    #[test]
+    fn the_name_table_section_is_read_by_its_name() {
+        let table = b"LUXNAMES-and-the-rest";
+        let b = with_section(luxon_plugin::names::SECTION, table);
+        assert_eq!(run(&b).unwrap().names.as_deref(), Some(&table[..]));
+        // Another section's name: no table, the library will be loaded to learn its names.
+        let b = with_section(".luxon_namez", table);
+        assert_eq!(run(&b), Ok(Checked::default()));
+        // The section's bytes past the end of the file.
+        let mut b = with_section(luxon_plugin::names::SECTION, table);
+        let shoff = u64::from_le_bytes(b[40..48].try_into().unwrap()) as usize;
+        let size_at = shoff + 2 * 64 + 32;
+        b[size_at..size_at + 8].copy_from_slice(&1000u64.to_le_bytes());
+        let e = run(&b).unwrap_err();
+        assert!(
+            e.starts_with("is a truncated ELF file: its section .luxon_names needs bytes"),
+            "{e}"
+        );
+        // A string table index out of range: followed no further.
+        let mut b = with_section(luxon_plugin::names::SECTION, table);
+        b[62..64].copy_from_slice(&7u16.to_le_bytes());
+        assert_eq!(run(&b), Ok(Checked::default()));
+    }
+
+    fn run(b: &[u8]) -> Result<Checked, String> {
         check(&mut Cursor::new(b), b.len() as u64, &X86_64)
     }
 
     #[test]
     fn a_complete_library_passes() {
-        assert_eq!(run(&image(3)), Ok(()));
+        assert_eq!(run(&image(3)), Ok(Checked::default()));
     }
 
     #[test]

@@ -3,6 +3,12 @@
 //! Libraries are never unloaded: objects created by a plugin may live anywhere in the process,
 //! and unloading libraries that have thread-local destructors crashes.
 //!
+//! A library is loaded when a scene first uses one of its names (`get`,
+//! `writer_for_extension`; `load_all` for `luxon plugins`): the names, kinds and extensions
+//! come from its name table section ([`luxon_plugin::names`]), read from the file with the
+//! ELF check, and its handshake must declare exactly those entries. A library without a
+//! readable table (an older SDK) is loaded while searching, as every library once was.
+//!
 //! Plugins are trusted code: loading one runs its initialisers. What Luxon checks first is the
 //! file: a special file (FIFO, device, directory) named like a plugin is refused by its type, and
 //! a library's ELF headers must fit in its file ([`super::elf`]), so a truncated copy is skipped
@@ -15,10 +21,12 @@
 //! hold other libraries on purpose), but `luxon plugins` and a lookup that misses list them.
 
 use luxon_plugin::abi;
+use luxon_plugin::names;
 use std::collections::HashMap;
 use std::ffi::c_void;
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PluginKind {
@@ -151,6 +159,13 @@ pub enum LookupError {
         expected: PluginKind,
         library: PathBuf,
     },
+    /// The library whose name table lists `name` failed its handshake when it was loaded.
+    #[error("plugin `{name}` is provided by {}, which cannot be used: {message}", .library.display())]
+    Unusable {
+        name: String,
+        library: PathBuf,
+        message: String,
+    },
 }
 
 fn not_found_message(
@@ -181,16 +196,48 @@ fn not_found_message(
     m
 }
 
+/// A library file on the search path that passed the file check, loaded now (no name table,
+/// or `load_all`) or when a scene first uses one of its names.
+struct Slot {
+    path: PathBuf,
+    /// Set once: the handshake's result.
+    loaded: OnceLock<Result<Loaded, String>>,
+    /// The names its section lists, checked against the declaration when it is loaded; `None`
+    /// when it was loaded for want of a section.
+    listed: Option<Vec<names::Named>>,
+}
+
+/// A library after its handshake.
+struct Loaded {
+    library: Library,
+    entries: Vec<Entry>,
+}
+
+/// A name some library provides, known before (or without) loading it.
+struct Named {
+    kind: PluginKind,
+    name: String,
+    extensions: Vec<String>,
+    /// Index into `Registry::slots`.
+    library: usize,
+}
+
 #[derive(Default)]
 pub struct Registry {
-    pub libraries: Vec<Library>,
-    pub entries: Vec<Entry>,
+    /// Every usable library file, in search order.
+    slots: Vec<Slot>,
+    /// Every name of every library, in search order.
+    names: Vec<Named>,
     /// Every directory (or file) searched, in order.
     pub searched: Vec<PathBuf>,
+    /// Files that could not be used, found while searching (a library whose name table
+    /// brought it in unloaded reports a failed handshake when it is first used, or by
+    /// [`Registry::load_all`]).
     pub problems: Vec<Problem>,
     /// Places the user named that gave nothing, and why: a missing directory, a library not
     /// loaded for its name (see the module comment).
     pub notes: Vec<Problem>,
+    /// The first of `names` for each name.
     by_name: HashMap<String, usize>,
     /// The libraries whose entries were looked up (by `get` or `writer_for_extension`).
     used: std::sync::Mutex<std::collections::BTreeSet<usize>>,
@@ -373,152 +420,139 @@ impl Registry {
         });
     }
 
+    /// Takes a library file into the registry: its names from its name table when it has a
+    /// readable one (it is loaded on first use), else by loading it now.
     fn load(&mut self, path: &Path) {
         let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        if self.libraries.iter().any(|l| l.path == canonical) {
+        if self.slots.iter().any(|l| l.path == canonical) {
             return;
         }
-        if let Err(e) = regular_file(path).and_then(|()| super::elf::check_library(&canonical)) {
-            return self.problem(path, e);
-        }
-        // SAFETY: loading runs the library's initialisers, and from here on its code runs in
-        // this process. Nothing here can check that code: plugin files are trusted by design
-        // (the user put them on the search path), as is everything below that relies on a
-        // library keeping the ABI's promises.
-        let lib = match unsafe { libloading::Library::new(&canonical) } {
-            Ok(l) => l,
-            Err(e) => return self.problem(path, format!("cannot be loaded: {e}")),
+        let checked = match regular_file(path).and_then(|()| super::elf::check_library(&canonical))
+        {
+            Ok(c) => c,
+            Err(e) => return self.problem(path, e),
         };
-        // SAFETY: `DeclareFn` is the type the ABI gives this symbol; the function pointer is
-        // used while `lib` is loaded, which is forever (see the module comment).
-        let declare: libloading::Symbol<abi::DeclareFn> =
-            match unsafe { lib.get(abi::DECLARE_SYMBOL) } {
-                Ok(s) => s,
-                Err(_) => {
-                    return self.problem(
-                        path,
-                        "not a Luxon plugin (it does not export `luxon_plugin_declare`)".into(),
-                    )
-                }
-            };
-        // SAFETY: the handshake's one argument is the host table, valid for the process (a
-        // static here).
-        let header = unsafe { declare(&HOST) };
-        if header.is_null() {
-            return self.problem(path, "not a Luxon plugin (its declaration is null)".into());
-        }
-        // SAFETY: a non-null header is the library's static, valid for the process. Its leading
-        // `magic`, `abi_version` and `sdk_version` keep their layout in every ABI version, so
-        // they are read on their own, before the version says what follows them; the version
-        // string is only read (and copied) once the magic says this is a Luxon header.
-        let (magic, abi_version) = unsafe { ((*header).magic, (*header).abi_version) };
-        if magic != abi::MAGIC {
-            return self.problem(
-                path,
-                "not a Luxon plugin (bad magic in its declaration)".into(),
-            );
-        }
-        // SAFETY: as above; the string is a static of the library.
-        let sdk = unsafe { (*header).sdk_version.as_str() }
-            .unwrap_or("?")
-            .to_string();
-        if abi_version != abi::ABI_VERSION {
-            return self.problem(
-                path,
-                format!(
-                    "built for plugin ABI {} (luxon-plugin {sdk}), but this Luxon uses ABI {} \
-                     (luxon-plugin {}); rebuild it against luxon-plugin {}",
-                    abi_version,
-                    abi::ABI_VERSION,
-                    luxon_plugin::SDK_VERSION,
-                    luxon_plugin::SDK_VERSION
-                ),
-            );
-        }
-        // From here on the library speaks this ABI version: its header, declaration, entries
-        // and strings are statics of the library laid out as `abi` says, valid for the process.
-        // SAFETY: see above.
-        let Some(decl) = (unsafe { (*header).declaration.as_ref() }) else {
-            return self.problem(path, "plugin declares nothing (null declaration)".into());
-        };
-        // SAFETY: see above.
-        let text = |s: &abi::Str| unsafe { s.as_str() }.unwrap_or("").to_string();
-        let name = text(&decl.library);
-        let raw: &[abi::Entry] = if decl.entry_count == 0 || decl.entries.is_null() {
-            &[]
-        } else {
-            // SAFETY: see above; `entries` points to `entry_count` entries.
-            unsafe { std::slice::from_raw_parts(decl.entries, decl.entry_count) }
-        };
-        let index = self.libraries.len();
-        let mut entries = Vec::new();
-        for e in raw {
-            let Some(kind) = PluginKind::from_abi(e.kind) else {
-                return self.problem(path, format!("declares an unknown plugin kind {}", e.kind));
-            };
-            if e.vtable.is_null() {
-                return self.problem(
-                    path,
-                    format!("entry `{}` has no function table", text(&e.name)),
-                );
-            }
-            entries.push(Entry {
-                kind,
-                name: text(&e.name),
-                description: text(&e.description),
-                params_doc: text(&e.params_doc),
-                extensions: text(&e.extensions)
-                    .split(',')
-                    .map(|s| s.trim().to_ascii_lowercase())
-                    .filter(|s| !s.is_empty())
-                    .collect(),
+        let index = self.slots.len();
+        // A table that cannot be read is as good as none: the library is loaded to learn its
+        // names, as one built before tables existed.
+        let listed = checked.names.and_then(|b| names::parse(&b).ok());
+        let listed = listed.filter(|l| l.iter().all(|n| PluginKind::from_abi(n.kind).is_some()));
+        if let Some(listed) = listed {
+            let named = listed.iter().map(|n| Named {
+                kind: PluginKind::from_abi(n.kind).unwrap_or(PluginKind::Primitive),
+                name: n.name.clone(),
+                extensions: extension_list(&n.extensions),
                 library: index,
-                // SAFETY: a non-null `vtable` points to the table of the entry's kind, a static
-                // of the library (see above).
-                table: unsafe { Table::new(kind, e.vtable) },
-                shadowed: false,
             });
+            self.add_names(named.collect());
+            self.slots.push(Slot {
+                path: canonical,
+                loaded: OnceLock::new(),
+                listed: Some(listed),
+            });
+            return;
         }
-        self.libraries.push(Library {
-            path: canonical,
-            name,
-            sdk_version: sdk,
-            abi_version,
+        let mut loaded = match handshake(&canonical, index) {
+            Ok(l) => l,
+            Err(e) => return self.problem(path, e),
+        };
+        let named = loaded.entries.iter().map(|e| Named {
+            kind: e.kind,
+            name: e.name.clone(),
+            extensions: e.extensions.clone(),
+            library: index,
         });
-        for mut e in entries {
-            if self.by_name.contains_key(&e.name) {
-                e.shadowed = true;
-            } else {
-                self.by_name.insert(e.name.clone(), self.entries.len());
-            }
-            self.entries.push(e);
-        }
-        // Never unload (see the module comment).
-        std::mem::forget(lib);
+        self.add_names(named.collect());
+        self.mark_shadowed(index, &mut loaded.entries);
+        self.slots.push(Slot {
+            path: canonical,
+            loaded: OnceLock::from(Ok(loaded)),
+            listed: None,
+        });
     }
 
-    /// The entry a scene means by `name`, which must be of `kind`.
+    /// Adds a library's names after those of the libraries before it: the first of a name wins.
+    fn add_names(&mut self, named: Vec<Named>) {
+        for n in named {
+            if !self.by_name.contains_key(&n.name) {
+                self.by_name.insert(n.name.clone(), self.names.len());
+            }
+            self.names.push(n);
+        }
+    }
+
+    /// Marks the entries of library `index` whose names an earlier library (or an earlier
+    /// entry of the same library) provides.
+    fn mark_shadowed(&self, index: usize, entries: &mut [Entry]) {
+        for k in 0..entries.len() {
+            let first = self
+                .by_name
+                .get(&entries[k].name)
+                .map(|&i| self.names[i].library);
+            let again = entries[..k].iter().any(|e| e.name == entries[k].name);
+            entries[k].shadowed = first != Some(index) || again;
+        }
+    }
+
+    /// Library `index` after its handshake, which runs on the first call (from any thread):
+    /// the error says why it cannot be used.
+    fn loaded(&self, index: usize) -> Result<&Loaded, &str> {
+        let slot = &self.slots[index];
+        let r = slot.loaded.get_or_init(|| {
+            let mut loaded = handshake(&slot.path, index)?;
+            if let Some(listed) = &slot.listed {
+                same_entries(listed, &loaded.entries)?;
+            }
+            self.mark_shadowed(index, &mut loaded.entries);
+            Ok(loaded)
+        });
+        r.as_ref().map_err(String::as_str)
+    }
+
+    /// The entry named by `names[i]`, its library loaded.
+    fn entry(&self, i: usize) -> Result<&Entry, LookupError> {
+        let n = &self.names[i];
+        let unusable = |message: String| LookupError::Unusable {
+            name: n.name.clone(),
+            library: self.slots[n.library].path.clone(),
+            message,
+        };
+        let loaded = self
+            .loaded(n.library)
+            .map_err(|m| unusable(m.to_string()))?;
+        let e = loaded
+            .entries
+            .iter()
+            .find(|e| e.name == n.name && e.kind == n.kind)
+            .ok_or_else(|| unusable(format!("it does not declare {} `{}`", n.kind, n.name)))?;
+        let mut used = self.used.lock().unwrap_or_else(|e| e.into_inner());
+        used.insert(n.library);
+        Ok(e)
+    }
+
+    /// The entry a scene means by `name`, which must be of `kind`. Loads the library that
+    /// provides it, if it is not loaded yet.
     pub fn get(&self, name: &str, kind: PluginKind) -> Result<&Entry, LookupError> {
         match self.by_name.get(name) {
             Some(&i) => {
-                let e = &self.entries[i];
-                if e.kind != kind {
+                let n = &self.names[i];
+                if n.kind != kind {
                     return Err(LookupError::WrongKind {
                         name: name.to_string(),
-                        found: e.kind,
+                        found: n.kind,
                         expected: kind,
-                        library: self.libraries[e.library].path.clone(),
+                        library: self.slots[n.library].path.clone(),
                     });
                 }
-                self.mark_used(e);
-                Ok(e)
+                self.entry(i)
             }
             None => {
                 let candidates = self
-                    .entries
+                    .names
                     .iter()
-                    .filter(|e| e.kind == kind && !e.shadowed)
-                    .map(|e| e.name.as_str());
+                    .enumerate()
+                    .filter(|(i, n)| n.kind == kind && self.by_name.get(&n.name) == Some(i))
+                    .map(|(_, n)| n.name.as_str());
                 Err(LookupError::NotFound {
                     name: name.to_string(),
                     kind,
@@ -530,38 +564,77 @@ impl Registry {
         }
     }
 
-    /// The writer claiming a file extension (first in search order).
-    pub fn writer_for_extension(&self, ext: &str) -> Option<&Entry> {
+    /// The writer claiming a file extension (first in search order), its library loaded.
+    pub fn writer_for_extension(&self, ext: &str) -> Result<Option<&Entry>, LookupError> {
         let ext = ext.to_ascii_lowercase();
-        let e = self
-            .entries
+        let found = self
+            .names
             .iter()
-            .find(|e| e.kind == PluginKind::Writer && e.extensions.contains(&ext));
-        if let Some(e) = e {
-            self.mark_used(e);
-        }
-        e
+            .position(|n| n.kind == PluginKind::Writer && n.extensions.contains(&ext));
+        found.map(|i| self.entry(i)).transpose()
     }
 
-    fn mark_used(&self, e: &Entry) {
-        let mut used = self.used.lock().unwrap_or_else(|e| e.into_inner());
-        used.insert(e.library);
+    /// Loads every library not loaded yet (what `luxon plugins` lists): the problems are those
+    /// whose handshake failed, in search order (they are also what a lookup of their names
+    /// reports).
+    pub fn load_all(&self) -> Vec<Problem> {
+        (0..self.slots.len())
+            .filter_map(|i| {
+                self.loaded(i).err().map(|m| Problem {
+                    path: self.slots[i].path.clone(),
+                    message: m.to_string(),
+                })
+            })
+            .collect()
+    }
+
+    /// The libraries loaded so far, with their entries, in search order.
+    pub fn loaded_libraries(&self) -> Vec<(&Library, &[Entry])> {
+        self.slots
+            .iter()
+            .filter_map(|s| match s.loaded.get() {
+                Some(Ok(l)) => Some((&l.library, &l.entries[..])),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Every name a scene can use (the first library's of each), with its kind and library
+    /// file, in search order; known without loading the libraries.
+    pub fn provided(&self) -> Vec<(PluginKind, &str, &Path)> {
+        self.names
+            .iter()
+            .enumerate()
+            .filter(|(i, n)| self.by_name.get(&n.name) == Some(i))
+            .map(|(_, n)| {
+                (
+                    n.kind,
+                    n.name.as_str(),
+                    self.slots[n.library].path.as_path(),
+                )
+            })
+            .collect()
+    }
+
+    /// How many library files were found usable (loaded or not yet).
+    pub fn library_count(&self) -> usize {
+        self.slots.len()
     }
 
     /// The libraries a scene used so far (whose entries were looked up), in search order:
     /// what a frame's completion record stamps.
     pub fn used_libraries(&self) -> Vec<&Library> {
         let used = self.used.lock().unwrap_or_else(|e| e.into_inner());
-        used.iter().map(|&i| &self.libraries[i]).collect()
+        used.iter().map(|&i| self.library(i)).collect()
     }
 
     /// Every extension some writer claims.
     pub fn writer_extensions(&self) -> Vec<String> {
         let mut v: Vec<String> = self
-            .entries
+            .names
             .iter()
-            .filter(|e| e.kind == PluginKind::Writer)
-            .flat_map(|e| e.extensions.iter().cloned())
+            .filter(|n| n.kind == PluginKind::Writer)
+            .flat_map(|n| n.extensions.iter().cloned())
             .collect();
         v.sort();
         v.dedup();
@@ -569,8 +642,183 @@ impl Registry {
     }
 
     pub fn library_of(&self, e: &Entry) -> &Library {
-        &self.libraries[e.library]
+        self.library(e.library)
     }
+
+    /// Library `index`, which is loaded (an entry of it or a use of it exists).
+    fn library(&self, index: usize) -> &Library {
+        match self.slots[index].loaded.get() {
+            Some(Ok(l)) => &l.library,
+            _ => unreachable!("entries exist only of loaded libraries"),
+        }
+    }
+
+    /// A registry of one loaded library with `entries` (whose `library` is 0), for tests of
+    /// the calls with tables of their own.
+    #[cfg(test)]
+    pub(crate) fn with_library(library: Library, entries: Vec<Entry>) -> Registry {
+        let mut r = Registry::default();
+        let named = entries.iter().map(|e| Named {
+            kind: e.kind,
+            name: e.name.clone(),
+            extensions: e.extensions.clone(),
+            library: 0,
+        });
+        r.add_names(named.collect());
+        r.slots.push(Slot {
+            path: library.path.clone(),
+            loaded: OnceLock::from(Ok(Loaded { library, entries })),
+            listed: None,
+        });
+        r
+    }
+}
+
+/// A writer's extension list as entries keep it: lower case, no blanks or empty items.
+fn extension_list(s: &str) -> Vec<String> {
+    s.split(',')
+        .map(|s| s.trim().to_ascii_lowercase())
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+/// The declaration's entries are those its name table listed, kind, name and extensions: a
+/// scene was matched to this library by the table.
+fn same_entries(listed: &[names::Named], entries: &[Entry]) -> Result<(), String> {
+    let declared = |e: &Entry| format!("{} `{}`", e.kind, e.name);
+    let all: Vec<String> = entries.iter().map(declared).collect();
+    let all = if all.is_empty() {
+        "nothing".to_string()
+    } else {
+        all.join(", ")
+    };
+    for n in listed {
+        let kind = PluginKind::from_abi(n.kind);
+        let ext = extension_list(&n.extensions);
+        let found = entries
+            .iter()
+            .any(|e| Some(e.kind) == kind && e.name == n.name && e.extensions == ext);
+        if !found {
+            let what = kind.map_or_else(|| format!("kind {}", n.kind), |k| k.to_string());
+            return Err(format!(
+                "its name table lists {what} `{}`{}, but its declaration does not (it declares \
+                 {all}); the library's file does not match its code",
+                n.name,
+                if ext.is_empty() {
+                    String::new()
+                } else {
+                    format!(" [.{}]", ext.join(", ."))
+                }
+            ));
+        }
+    }
+    for e in entries {
+        let listed_too = listed.iter().any(|n| {
+            PluginKind::from_abi(n.kind) == Some(e.kind)
+                && n.name == e.name
+                && extension_list(&n.extensions) == e.extensions
+        });
+        if !listed_too {
+            return Err(format!(
+                "its declaration has {} that its name table does not list; the library's file \
+                 does not match its code",
+                declared(e)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The handshake with the library at `path` (checked, canonical): loads it and reads its
+/// declaration. Its entries' `library` is `index`; none is marked shadowed yet.
+fn handshake(path: &Path, index: usize) -> Result<Loaded, String> {
+    // SAFETY: loading runs the library's initialisers, and from here on its code runs in
+    // this process. Nothing here can check that code: plugin files are trusted by design
+    // (the user put them on the search path), as is everything below that relies on a
+    // library keeping the ABI's promises.
+    let lib =
+        unsafe { libloading::Library::new(path) }.map_err(|e| format!("cannot be loaded: {e}"))?;
+    // SAFETY: `DeclareFn` is the type the ABI gives this symbol; the function pointer is
+    // used while `lib` is loaded, which is forever (see the module comment).
+    let declare: abi::DeclareFn = *unsafe { lib.get::<abi::DeclareFn>(abi::DECLARE_SYMBOL) }
+        .map_err(|_| {
+            "not a Luxon plugin (it does not export `luxon_plugin_declare`)".to_string()
+        })?;
+    // SAFETY: the handshake's one argument is the host table, valid for the process (a
+    // static here).
+    let header = unsafe { declare(&HOST) };
+    // Never unload (see the module comment): the library stays whatever the checks below say.
+    std::mem::forget(lib);
+    if header.is_null() {
+        return Err("not a Luxon plugin (its declaration is null)".into());
+    }
+    // SAFETY: a non-null header is the library's static, valid for the process. Its leading
+    // `magic`, `abi_version` and `sdk_version` keep their layout in every ABI version, so
+    // they are read on their own, before the version says what follows them; the version
+    // string is only read (and copied) once the magic says this is a Luxon header.
+    let (magic, abi_version) = unsafe { ((*header).magic, (*header).abi_version) };
+    if magic != abi::MAGIC {
+        return Err("not a Luxon plugin (bad magic in its declaration)".into());
+    }
+    // SAFETY: as above; the string is a static of the library.
+    let sdk = unsafe { (*header).sdk_version.as_str() }
+        .unwrap_or("?")
+        .to_string();
+    if abi_version != abi::ABI_VERSION {
+        return Err(format!(
+            "built for plugin ABI {} (luxon-plugin {sdk}), but this Luxon uses ABI {} \
+             (luxon-plugin {}); rebuild it against luxon-plugin {}",
+            abi_version,
+            abi::ABI_VERSION,
+            luxon_plugin::SDK_VERSION,
+            luxon_plugin::SDK_VERSION
+        ));
+    }
+    // From here on the library speaks this ABI version: its header, declaration, entries
+    // and strings are statics of the library laid out as `abi` says, valid for the process.
+    // SAFETY: see above.
+    let Some(decl) = (unsafe { (*header).declaration.as_ref() }) else {
+        return Err("plugin declares nothing (null declaration)".into());
+    };
+    // SAFETY: see above.
+    let text = |s: &abi::Str| unsafe { s.as_str() }.unwrap_or("").to_string();
+    let name = text(&decl.library);
+    let raw: &[abi::Entry] = if decl.entry_count == 0 || decl.entries.is_null() {
+        &[]
+    } else {
+        // SAFETY: see above; `entries` points to `entry_count` entries.
+        unsafe { std::slice::from_raw_parts(decl.entries, decl.entry_count) }
+    };
+    let mut entries = Vec::new();
+    for e in raw {
+        let Some(kind) = PluginKind::from_abi(e.kind) else {
+            return Err(format!("declares an unknown plugin kind {}", e.kind));
+        };
+        if e.vtable.is_null() {
+            return Err(format!("entry `{}` has no function table", text(&e.name)));
+        }
+        entries.push(Entry {
+            kind,
+            name: text(&e.name),
+            description: text(&e.description),
+            params_doc: text(&e.params_doc),
+            extensions: extension_list(&text(&e.extensions)),
+            library: index,
+            // SAFETY: a non-null `vtable` points to the table of the entry's kind, a static
+            // of the library (see above).
+            table: unsafe { Table::new(kind, e.vtable) },
+            shadowed: false,
+        });
+    }
+    Ok(Loaded {
+        library: Library {
+            path: path.to_path_buf(),
+            name,
+            sdk_version: sdk,
+            abi_version,
+        },
+        entries,
+    })
 }
 
 #[cfg(test)]

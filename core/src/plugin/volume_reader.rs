@@ -418,14 +418,13 @@ mod tests {
     static SLOPPY: abi::VolumeReaderVTable = abi::VolumeReaderVTable { read: sloppy_read };
 
     fn sloppy_registry() -> Registry {
-        let mut r = Registry::default();
-        r.libraries.push(crate::plugin::Library {
+        let library = crate::plugin::Library {
             path: "/plugins/libluxon_sloppy.so".into(),
             name: "sloppy".into(),
             sdk_version: luxon_plugin::SDK_VERSION.into(),
             abi_version: abi::ABI_VERSION,
-        });
-        r.entries.push(Entry {
+        };
+        let entry = Entry {
             kind: PluginKind::VolumeReader,
             name: "sloppy".into(),
             description: String::new(),
@@ -434,8 +433,8 @@ mod tests {
             library: 0,
             table: Table::VolumeReader(&SLOPPY),
             shadowed: false,
-        });
-        r
+        };
+        Registry::with_library(library, vec![entry])
     }
 
     /// A volume's storage is charged to the budget: one that does not fit is an error naming
@@ -443,7 +442,7 @@ mod tests {
     #[test]
     fn a_volume_over_the_budget_is_an_error_naming_it() {
         let reg = sloppy_registry();
-        let entry = &reg.entries[0];
+        let entry = reg.get("sloppy", PluginKind::VolumeReader).unwrap();
         let at = Origin {
             file: std::sync::Arc::new("scene.ron".into()),
             line: 4,
@@ -470,7 +469,7 @@ mod tests {
     #[test]
     fn sink_errors_reach_the_scene_position_and_stick() {
         let reg = sloppy_registry();
-        let entry = &reg.entries[0];
+        let entry = reg.get("sloppy", PluginKind::VolumeReader).unwrap();
         let at = Origin {
             file: std::sync::Arc::new("scene.ron".into()),
             line: 4,
@@ -509,7 +508,7 @@ mod tests {
     #[test]
     fn typed_blocks_keep_their_values_and_are_checked() {
         let reg = sloppy_registry();
-        let entry = &reg.entries[0];
+        let entry = reg.get("sloppy", PluginKind::VolumeReader).unwrap();
         let at = Origin {
             file: std::sync::Arc::new("scene.ron".into()),
             line: 4,

@@ -41,6 +41,7 @@
 
 pub mod abi;
 pub mod files;
+pub mod names;
 mod params;
 
 use std::ffi::c_void;
@@ -1281,6 +1282,35 @@ macro_rules! export {
                 entries: ENTRIES.0.as_ptr(),
                 entry_count: ENTRIES.0.len(),
             });
+            // The same entries' names, read from the file by a host that loads only the
+            // libraries a scene uses (see `names`).
+            const ITEMS: &[$crate::names::Item] = &[
+                $($($crate::names::Item {
+                    kind: abi::KIND_PRIMITIVE,
+                    name: <$prim as $crate::Describe>::NAME,
+                    extensions: "",
+                },)*)?
+                $($($crate::names::Item {
+                    kind: abi::KIND_TEXTURE,
+                    name: <$tex as $crate::Describe>::NAME,
+                    extensions: "",
+                },)*)?
+                $($($crate::names::Item {
+                    kind: abi::KIND_VOLUME_READER,
+                    name: <$vol as $crate::Describe>::NAME,
+                    extensions: "",
+                },)*)?
+                $($($crate::names::Item {
+                    kind: abi::KIND_WRITER,
+                    name: <$wr as $crate::Describe>::NAME,
+                    extensions: <$wr as $crate::Writer>::EXTENSIONS,
+                },)*)?
+            ];
+            // Placing a static in a named section is unsafe only if the section's other
+            // contents clash; this one holds this table alone.
+            #[unsafe(link_section = ".luxon_names")]
+            #[used]
+            static NAMES: [u8; $crate::names::table_len(ITEMS)] = $crate::names::table(ITEMS);
             static HEADER: SyncWrap<abi::PluginHeader> = SyncWrap(abi::PluginHeader {
                 magic: abi::MAGIC,
                 abi_version: abi::ABI_VERSION,
@@ -1300,6 +1330,8 @@ macro_rules! export {
             ) -> *const abi::PluginHeader {
                 // SAFETY: the caller's promise, which is `init`'s contract.
                 unsafe { $crate::shim::init(host, $lib) };
+                // A use of the table, so that no linker drops its section as unreferenced.
+                ::core::hint::black_box(&NAMES);
                 &HEADER.0
             }
         };
