@@ -1285,26 +1285,13 @@ macro_rules! export {
             // The same entries' names, read from the file by a host that loads only the
             // libraries a scene uses (see `names`).
             const ITEMS: &[$crate::names::Item] = &[
-                $($($crate::names::Item {
-                    kind: abi::KIND_PRIMITIVE,
-                    name: <$prim as $crate::Describe>::NAME,
-                    extensions: "",
-                },)*)?
-                $($($crate::names::Item {
-                    kind: abi::KIND_TEXTURE,
-                    name: <$tex as $crate::Describe>::NAME,
-                    extensions: "",
-                },)*)?
-                $($($crate::names::Item {
-                    kind: abi::KIND_VOLUME_READER,
-                    name: <$vol as $crate::Describe>::NAME,
-                    extensions: "",
-                },)*)?
-                $($($crate::names::Item {
-                    kind: abi::KIND_WRITER,
-                    name: <$wr as $crate::Describe>::NAME,
-                    extensions: <$wr as $crate::Writer>::EXTENSIONS,
-                },)*)?
+                $($($crate::names::Item::of::<$prim>(abi::KIND_PRIMITIVE, ""),)*)?
+                $($($crate::names::Item::of::<$tex>(abi::KIND_TEXTURE, ""),)*)?
+                $($($crate::names::Item::of::<$vol>(abi::KIND_VOLUME_READER, ""),)*)?
+                $($($crate::names::Item::of::<$wr>(
+                    abi::KIND_WRITER,
+                    <$wr as $crate::Writer>::EXTENSIONS,
+                ),)*)?
             ];
             // Placing a static in a named section is unsafe only if the section's other
             // contents clash; this one holds this table alone.

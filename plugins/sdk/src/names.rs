@@ -31,6 +31,18 @@ pub struct Item {
     pub extensions: &'static str,
 }
 
+impl Item {
+    /// The item of entry `D` of kind `kind` (`abi::KIND_*`), with a writer's `extensions`
+    /// (empty for other kinds): what `export!` lists beside each handshake entry.
+    pub const fn of<D: crate::Describe>(kind: u32, extensions: &'static str) -> Item {
+        Item {
+            kind,
+            name: D::NAME,
+            extensions,
+        }
+    }
+}
+
 /// Bytes of the table of `items`.
 pub const fn table_len(items: &[Item]) -> usize {
     let mut n = 16;
