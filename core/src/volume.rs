@@ -699,6 +699,50 @@ mod tests {
         assert!(e.contains("non-finite value inf at voxel [1, 0, 0]"), "{e}");
     }
 
+    /// A block not aligned to bricks: its whole bricks (copied and tested as one array) and its
+    /// partial ones read back every voxel; whole bricks of one code become constants (or
+    /// nothing, for the background's), in any position of the block.
+    #[test]
+    fn whole_u8_bricks_of_an_unaligned_block_read_back() {
+        let (origin, dims) = ([3i64, 0, 5], [21u64, 16, 11]);
+        let mut b = VolumeBuilder::new("v", "test");
+        b.begin(IDENTITY, 0.0, [0; 3], [31, 15, 15], "g").unwrap();
+        let at = |i: usize| {
+            let (x, y, z) = (
+                i as u64 % dims[0],
+                i as u64 / dims[0] % dims[1],
+                i as u64 / 336,
+            );
+            [x, y, z].map(|c| c as i64)
+        };
+        // Brick [1, 0, 1] (x 8..15, z 8..15) all 9; brick [1, 1, 1] all 0 (the background);
+        // the rest a pattern.
+        let code = |ijk: [i64; 3]| match (ijk[0] >> 3, ijk[1] >> 3, ijk[2] >> 3) {
+            (1, 0, 1) => 9,
+            (1, 1, 1) => 0,
+            _ => byte(ijk) | 1,
+        };
+        let bytes: Vec<u8> = (0..(21 * 16 * 11))
+            .map(|i| code([0, 1, 2].map(|a| at(i)[a] + origin[a])))
+            .collect();
+        b.add_dense_u8(origin, dims, &bytes, 2.0).unwrap();
+        let v = b.finish().unwrap();
+        assert_eq!(v.brick([1, 0, 1]), Some(&Brick::Constant(4.5)));
+        assert_eq!(v.brick([1, 1, 1]), None);
+        for (i, &c) in bytes.iter().enumerate() {
+            let ijk = [0, 1, 2].map(|a| at(i)[a] + origin[a]);
+            assert_eq!(
+                v.value(ijk).to_bits(),
+                (f32::from(c) / 2.0).to_bits(),
+                "{ijk:?}"
+            );
+        }
+        assert_eq!(v.value([0, 0, 0]), 0.0);
+        // Whole bricks: x 8..=23, y 0..=15, z 8..=15 (four, two of them collapsed); partial:
+        // the eight others the block reaches, kept as u8 (the background has a code).
+        assert_eq!(v.dense_counts(), [2 + 8, 0, 0]);
+    }
+
     #[test]
     fn index_to_world_applies_the_affine_map() {
         let mut b = VolumeBuilder::new("v", "test");

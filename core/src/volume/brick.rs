@@ -75,7 +75,11 @@ impl Brick {
         match self {
             Brick::Constant(v) => Some(*v),
             Brick::F32(v) => same_bits(v.iter().copied()),
-            Brick::U8(v) => same_bits(v.iter().map(|&c| codes.u8(c))),
+            Brick::U8(v) => {
+                let first = v[0];
+                // No early exit, so that the 512 comparisons vectorise.
+                codes.u8_uniform(v, v.iter().fold(0, |d, &c| d | (c ^ first)) == 0)
+            }
             Brick::U16(v) => same_bits(v.iter().map(|&c| codes.u16(c))),
         }
     }
@@ -121,12 +125,22 @@ pub fn array<T: Copy>(fill: T) -> Option<Box<[T; BRICK_VOXELS]>> {
         .ok()
 }
 
+/// A copy of a brick's array, or `None` when the system refuses the memory (never an abort).
+pub fn copy_of<T: Copy>(values: &[T; BRICK_VOXELS]) -> Option<Box<[T; BRICK_VOXELS]>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(BRICK_VOXELS).ok()?;
+    v.extend_from_slice(values);
+    v.into_boxed_slice().try_into().ok()
+}
+
 /// How the codes of u8 and u16 bricks become values: `code as f32 / divisor`, one divisor per
 /// format for the whole volume (the reader's, checked by the builder).
 #[derive(Clone, Debug)]
 pub struct Codes {
     /// The value of every byte.
     u8_values: Box<[f32; 256]>,
+    /// Whether no two bytes have the same value (only a tiny or huge divisor makes some alike).
+    u8_distinct: bool,
     u8_divisor: f32,
     u16_divisor: f32,
 }
@@ -136,6 +150,7 @@ impl Default for Codes {
     fn default() -> Codes {
         Codes {
             u8_values: Box::new(std::array::from_fn(|i| i as f32)),
+            u8_distinct: true,
             u8_divisor: 1.0,
             u16_divisor: 1.0,
         }
@@ -149,6 +164,21 @@ impl Codes {
         self.u8_values[usize::from(c)]
     }
 
+    /// The one value of u8 codes `b` when all decode to the same bits: equal codes decode
+    /// alike, and only when two differ (and some codes decode alike) are the values compared.
+    pub fn u8_uniform(&self, b: &[u8; BRICK_VOXELS], all_equal: bool) -> Option<f32> {
+        if all_equal {
+            return Some(self.u8(b[0]));
+        }
+        if self.u8_distinct {
+            return None;
+        }
+        let first = self.u8(b[0]).to_bits();
+        b.iter()
+            .all(|&c| self.u8(c).to_bits() == first)
+            .then(|| self.u8(b[0]))
+    }
+
     /// The value of word `c`.
     #[inline]
     pub fn u16(&self, c: u16) -> f32 {
@@ -160,6 +190,9 @@ impl Codes {
         if divisor.to_bits() != self.u8_divisor.to_bits() {
             self.u8_divisor = divisor;
             *self.u8_values = std::array::from_fn(|i| i as f32 / divisor);
+            // Division by a positive divisor keeps the order, so alike values are neighbours.
+            let bits = self.u8_values.map(f32::to_bits);
+            self.u8_distinct = bits.windows(2).all(|w| w[0] != w[1]);
         }
     }
 
@@ -233,6 +266,16 @@ mod tests {
         assert_eq!(brick.value(7, &c), 4.5);
         assert_eq!(brick.to_f32(&c).unwrap()[9], 0.5);
         assert_eq!(brick.heap_bytes(), 512);
+        // Codes that differ but decode alike (a divisor so small that both overflow) are
+        // one value, as the values are compared.
+        let mut c = Codes::default();
+        c.set_u8_divisor(1e-38);
+        let mut b = [200u8; BRICK_VOXELS];
+        b[100] = 201;
+        assert_eq!(c.u8_uniform(&b, false), Some(f32::INFINITY));
+        b[3] = 0;
+        assert_eq!(c.u8_uniform(&b, false), None);
+        assert_eq!(Brick::U8(Box::new(b)).uniform(&c), None);
         let w = Brick::U16(Box::new([3; BRICK_VOXELS]));
         assert_eq!((w.uniform(&c), w.heap_bytes()), (Some(3.0), 1024));
     }

@@ -450,9 +450,13 @@ impl VolumeBuilder {
             let m = "returned without reading a grid (it never called `begin` on the volume sink)";
             return Err(refused(&self, m.into()));
         };
-        // Voxels nothing reached hold the background, so this keeps every value.
+        // Voxels nothing reached hold the background, so this keeps every value. Only bricks
+        // still partly given can be dense and uniform: a complete one was tested when it was.
         let codes = &volume.codes;
-        for brick in volume.bricks.values_mut() {
+        for key in self.partial.keys() {
+            let Some(brick) = volume.bricks.get_mut(key) else {
+                continue;
+            };
             if let Some(v) = brick.uniform(codes) {
                 self.charger.sub(brick.heap_bytes() as u64);
                 *brick = Brick::Constant(v);
@@ -602,15 +606,24 @@ fn uniform_part(
 }
 
 /// Copies a whole brick's voxels from a u8 block of `dims` voxels whose voxel at the brick's
-/// first corner is `s[at]`: row `y` of slice `z` of the brick (eight bytes) is
-/// `s[at + (z * dims[1] + y) * dims[0]..]`, copied as a fixed-size array.
-fn copy_brick_u8(b: &mut [u8; BRICK_VOXELS], s: &[u8], at: usize, dims: [u64; 3]) {
+/// first corner is `s[at]` (row `y` of slice `z` of the brick, eight bytes, is
+/// `s[at + (z * dims[1] + y) * dims[0]..]`), and says whether they all hold the same code.
+fn copy_brick_u8(b: &mut [u8; BRICK_VOXELS], s: &[u8], at: usize, dims: [u64; 3]) -> bool {
     const N: usize = BRICK_SIZE as usize;
-    let (dx, dy) = (dims[0] as usize, dims[1] as usize);
-    for (r, row) in b.chunks_exact_mut(N).enumerate() {
-        let from = at + ((r / N) * dy + r % N) * dx;
-        row.copy_from_slice(&s[from..from + N]);
+    let (dx, slab) = (dims[0] as usize, (dims[0] * dims[1]) as usize);
+    let splat = u64::from(s[at]) * 0x0101_0101_0101_0101;
+    let mut differ = 0;
+    for (z, plane) in b.chunks_exact_mut(N * N).enumerate() {
+        let s = &s[at + z * slab..];
+        for (y, row) in plane.chunks_exact_mut(N).enumerate() {
+            // One eight-byte word per row: copied, and compared with the first code.
+            let mut word = [0; N];
+            word.copy_from_slice(&s[y * dx..y * dx + N]);
+            row.copy_from_slice(&word);
+            differ |= u64::from_ne_bytes(word) ^ splat;
+        }
     }
+    differ == 0
 }
 
 /// Smallest and largest of a non-empty slice of codes.
@@ -742,6 +755,21 @@ fn store(
                         + (lo[0] - origin[0]) as u64) as usize
                 };
                 let n = (hi[0] - lo[0] + 1) as usize;
+                if let (false, true, Source::U8(s)) = (existing, whole, source) {
+                    // The common case of a u8 file (raw volumes): a whole new brick, copied
+                    // once and tested as one contiguous array.
+                    let mut b = [0; BRICK_VOXELS];
+                    let all_equal = copy_brick_u8(&mut b, s, src_at(lo[1], lo[2]), dims);
+                    if let Some(v) = codes.u8_uniform(&b, all_equal) {
+                        store_uniform(bricks, (skipped, charger), background, key, v)?;
+                    } else {
+                        let brick =
+                            charger.brick(|| brick::copy_of(&b).map(Brick::U8), Brick::BYTES[0])?;
+                        charger.room_for_one(bricks)?;
+                        bricks.insert(key, brick);
+                    }
+                    continue;
+                }
                 if !existing {
                     if whole {
                         let rows = (lo[2]..=hi[2])
@@ -803,12 +831,6 @@ fn store(
                         return Err(charger.refused(Brick::BYTES[2]));
                     };
                     *brick = Brick::F32(values);
-                }
-                let fresh = whole && mask.is_none();
-                if let (true, Brick::U8(b), Source::U8(s)) = (fresh, &mut *brick, source) {
-                    // The common case of a u8 file (raw volumes): a whole brick of rows.
-                    copy_brick_u8(b, s, src_at(lo[1], lo[2]), dims);
-                    continue;
                 }
                 for z in lo[2]..=hi[2] {
                     for y in lo[1]..=hi[1] {

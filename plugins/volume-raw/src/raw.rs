@@ -399,7 +399,7 @@ impl Checked {
 /// The file's bytes (decompressed when it is gzip), read in order, with the size rules: a
 /// stream that ends early or goes on too long is an error stating both sizes.
 struct Input<'a> {
-    reader: Box<dyn Read + 'a>,
+    reader: Box<dyn Read + Send + 'a>,
     path: &'a Path,
     checked: &'a Checked,
     gzip: bool,
@@ -408,8 +408,13 @@ struct Input<'a> {
 }
 
 impl<'a> Input<'a> {
-    fn new(source: impl Read + 'a, gzip: bool, path: &'a Path, checked: &'a Checked) -> Self {
-        let reader: Box<dyn Read + 'a> = if gzip {
+    fn new(
+        source: impl Read + Send + 'a,
+        gzip: bool,
+        path: &'a Path,
+        checked: &'a Checked,
+    ) -> Self {
+        let reader: Box<dyn Read + Send + 'a> = if gzip {
             Box::new(flate2::read::MultiGzDecoder::new(std::io::BufReader::new(
                 source,
             )))
@@ -634,23 +639,26 @@ fn stream(
     if slab_bytes <= max_slab {
         let (bx, by) = block_size(layout.dims, block_voxels);
         let mut raw: Vec<u8> = Vec::new();
-        // One slab buffer for the whole file: a fresh one per slab was zeroed and, above
-        // malloc's mmap threshold, mapped and faulted in again every time.
+        // One slab buffer for the whole file (two when the next slab is read ahead): a fresh
+        // one per slab was zeroed and, above malloc's mmap threshold, mapped and faulted in
+        // again every time.
         let full = SLAB.min(nz);
-        let mut buf = buffer(nx * ny * full * bpv, || {
-            format!(
-                "a slab of {full} slices of {nx}x{ny} {} voxels",
-                layout.format.name()
-            )
-        })?;
-        for z0 in (0..nz).step_by(SLAB as usize) {
+        let slab_buffer = || {
+            buffer(nx * ny * full * bpv, || {
+                format!(
+                    "a slab of {full} slices of {nx}x{ny} {} voxels",
+                    layout.format.name()
+                )
+            })
+        };
+        let slabs = (0..nz).step_by(SLAB as usize).map(|z0| {
             let dz = SLAB.min(nz - z0);
-            let slab = &mut buf[..(nx * ny * dz * bpv) as usize];
-            input.fill(slab)?;
+            (z0, dz, (nx * ny * dz * bpv) as usize)
+        });
+        let mut each = |(z0, dz): (u64, u64), slab: &[u8]| -> Result<(), Error> {
             if bx == nx && by == ny {
                 // One block is the whole slab, in file order already: no copy.
-                send(slab, [0, 0, z0], [nx, ny, dz])?;
-                continue;
+                return send(slab, [0, 0, z0], [nx, ny, dz]);
             }
             for y0 in (0..ny).step_by(by as usize) {
                 let dy = by.min(ny - y0);
@@ -665,6 +673,16 @@ fn stream(
                     }
                     send(&raw, [x0, y0, z0], [dx, dy, dz])?;
                 }
+            }
+            Ok(())
+        };
+        if nz > SLAB && slab_bytes.saturating_mul(2) <= max_slab {
+            read_ahead(input, slabs, [slab_buffer()?, slab_buffer()?], each)?;
+        } else {
+            let mut buf = slab_buffer()?;
+            for (z0, dz, n) in slabs {
+                input.fill(&mut buf[..n])?;
+                each((z0, dz), &buf[..n])?;
             }
         }
     } else if nx <= block_voxels {
@@ -694,6 +712,48 @@ fn stream(
         }
     }
     Ok(())
+}
+
+/// Reads the slabs `(z0, dz, bytes)` of `slabs` in order on a second thread, each into whichever
+/// of `buffers` the host has done with, while `each` hands the one before to the host: the
+/// file's reading (or decompression) overlaps the host's bricking. Slabs reach `each` in file
+/// order, and the first error (reading or the host's) is returned.
+fn read_ahead(
+    input: &mut Input,
+    slabs: impl Iterator<Item = (u64, u64, usize)> + Clone + Send,
+    buffers: [Vec<u8>; 2],
+    mut each: impl FnMut((u64, u64), &[u8]) -> Result<(), Error>,
+) -> Result<(), Error> {
+    use std::sync::mpsc::sync_channel;
+    std::thread::scope(|s| {
+        let (full_tx, full_rx) = sync_channel::<Result<Vec<u8>, Error>>(1);
+        let (empty_tx, empty_rx) = sync_channel::<Vec<u8>>(2);
+        for b in buffers {
+            // The receiver lives until the reading thread ends, which needs a buffer first.
+            let _ = empty_tx.send(b);
+        }
+        let sizes = slabs.clone().map(|(_, _, n)| n);
+        s.spawn(move || {
+            for n in sizes {
+                // The host stopped (an error): nothing more to read.
+                let Ok(mut b) = empty_rx.recv() else { return };
+                let read = input.fill(&mut b[..n]).map(|()| b);
+                let failed = read.is_err();
+                if full_tx.send(read).is_err() || failed {
+                    return;
+                }
+            }
+        });
+        for (z0, dz, n) in slabs {
+            let b = full_rx
+                .recv()
+                .map_err(|_| invalid("the thread reading the volume file stopped"))??;
+            each((z0, dz), &b[..n])?;
+            // The reading thread may have stopped after its last slab.
+            let _ = empty_tx.send(b);
+        }
+        Ok(())
+    })
 }
 
 /// f32 files may hold NaN or infinities: the first one is an error naming its voxel and byte.
@@ -1384,6 +1444,33 @@ mod tests {
             "{}",
             e.message
         );
+    }
+
+    /// A host that refuses a block while the next slab is being read ahead: its error is the
+    /// reader's, nothing after it reaches the host, and nothing hangs (plain and gzip).
+    #[test]
+    fn a_host_error_stops_the_read_ahead() {
+        struct Refuses(Vec<[i64; 3]>);
+        impl Blocks for Refuses {
+            fn begin(&mut self, _: &GridInfo) -> Result<(), Error> {
+                Ok(())
+            }
+            fn dense(&mut self, origin: [i64; 3], _: [u64; 3], _: &[f32]) -> Result<(), Error> {
+                self.0.push(origin);
+                if origin[2] == 8 {
+                    return Err(invalid("the host refuses slab 8"));
+                }
+                Ok(())
+            }
+        }
+        let bytes: Vec<u8> = (0..16 * 16 * 40).map(|i| i as u8).collect();
+        let params = r#"(file: "h.raw", dims: (16, 16, 40))"#;
+        for file in [bytes.clone(), gzip(&bytes)] {
+            let mut host = Refuses(Vec::new());
+            let e = read_bytes(params, &file, &mut host).unwrap_err();
+            assert_eq!(e.message, "the host refuses slab 8");
+            assert_eq!(host.0, [[0, 0, 0], [0, 0, 8]]);
+        }
     }
 
     #[test]

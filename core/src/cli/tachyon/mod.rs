@@ -97,7 +97,7 @@ pub fn run(words: &[OsString]) -> Result<(), Error> {
             Some(_) => Names::Sequence(sequence_names(&plan, "cam")?),
             None => Names::One(names::single(plan.output.as_deref(), ext)),
         };
-        return render_scene(&line.scenes[0], &plan, names);
+        return render_scene(&line.scenes[0], &plan, names, true);
     }
     // Several scenes: Tachyon numbers them (outfile.0000.tga...) and goes on after a failure.
     let pattern = sequence_names(&plan, "outfile")?;
@@ -110,7 +110,8 @@ pub fn run(words: &[OsString]) -> Result<(), Error> {
             line.scenes.len(),
             s.display()
         );
-        if let Err(e) = render_scene(s, &plan, Names::One(pattern.name(k))) {
+        let last = k + 1 == line.scenes.len();
+        if let Err(e) = render_scene(s, &plan, Names::One(pattern.name(k)), last) {
             luxon::error::print_error(&e.to_string());
             failed += 1;
         }
@@ -143,13 +144,14 @@ fn seconds(d: Duration) -> f64 {
     d.as_secs_f64()
 }
 
-/// Loads, builds and renders one scene file (every frame of the camera file, if any).
-fn render_scene(path: &Path, plan: &Plan, names: Names) -> Result<(), Error> {
+/// Loads, builds and renders one scene file (every frame of the camera file, if any); `last`:
+/// the process ends after it.
+fn render_scene(path: &Path, plan: &Plan, names: Names, last: bool) -> Result<(), Error> {
     // The plugins are loaded (dlopen, 5-25 ms) on a thread while the scene file is read: a
     // Tachyon scene names no plugin places, so where to search is known before the file is.
     std::thread::scope(|s| {
         let plugins = s.spawn(|| Registry::discover(&[]));
-        render_loaded(path, plan, names, plugins)
+        render_loaded(path, plan, names, plugins, last)
     })
 }
 
@@ -159,6 +161,7 @@ fn render_loaded(
     plan: &Plan,
     names: Names,
     plugins: std::thread::ScopedJoinHandle<'_, Registry>,
+    last: bool,
 ) -> Result<(), Error> {
     let t0 = Instant::now();
     // The scene's text within the machine's default budget (Tachyon's options set none).
@@ -206,6 +209,11 @@ fn render_loaded(
             write(plan, &fb, target, &registry, &dir, Durability::Atomic)?;
         }
         println!("    Image I/O Time: {:10.4} seconds", seconds(t.elapsed()));
+        if last {
+            // The process ends now: the system takes the memory back at once, where freeing a
+            // volume's bricks one by one took milliseconds (voltest: 2.6 M instructions).
+            std::mem::forget(scene);
+        }
         return Ok(());
     };
     let Names::Sequence(pattern) = names else {
