@@ -139,7 +139,8 @@ pub fn copy_of<T: Copy>(values: &[T; BRICK_VOXELS]) -> Option<Box<[T; BRICK_VOXE
 pub struct Codes {
     /// The value of every byte.
     u8_values: Box<[f32; 256]>,
-    /// Whether no two bytes have the same value (only a tiny or huge divisor makes some alike).
+    /// Whether no two bytes have the same value (only a divisor so small that codes overflow to
+    /// infinity makes some alike).
     u8_distinct: bool,
     u8_divisor: f32,
     u16_divisor: f32,
