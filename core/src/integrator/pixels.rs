@@ -6,6 +6,7 @@ use crate::adaptive;
 use crate::framebuffer::Span;
 use crate::geometry::Counters;
 use crate::math::Vec3A;
+use crate::ray::Ray;
 use crate::sampler::{time_at, time_sample, PixelSampler};
 use crate::scene::Scene;
 
@@ -28,6 +29,49 @@ fn sample_time(scene: &Scene, x: u32, y: u32, i: u32, n: u32, at: Option<(f32, f
     }
 }
 
+/// Camera rays made at a time.
+const BATCH_RAYS: usize = 64;
+
+/// Image points and times whose camera rays are made together ([`Scene::primaries`]) before
+/// any of them is traced, so that no ray waits on the arithmetic that made it.
+struct Batch {
+    len: usize,
+    xs: [f32; BATCH_RAYS],
+    ys: [f32; BATCH_RAYS],
+    times: [f32; BATCH_RAYS],
+    rays: [Option<Ray>; BATCH_RAYS],
+}
+
+impl Batch {
+    fn new() -> Batch {
+        Batch {
+            len: 0,
+            xs: [0.0; BATCH_RAYS],
+            ys: [0.0; BATCH_RAYS],
+            times: [0.0; BATCH_RAYS],
+            rays: [None; BATCH_RAYS],
+        }
+    }
+
+    fn is_full(&self) -> bool {
+        self.len == BATCH_RAYS
+    }
+
+    fn push(&mut self, x: f32, y: f32, time: f32) {
+        let k = self.len;
+        (self.xs[k], self.ys[k], self.times[k]) = (x, y, time);
+        self.len += 1;
+    }
+
+    /// The rays of the points pushed since the last call, in their order; forgets the points.
+    fn rays(&mut self, scene: &Scene) -> &[Option<Ray>] {
+        let k = std::mem::take(&mut self.len);
+        let (xs, ys, times) = (&self.xs[..k], &self.ys[..k], &self.times[..k]);
+        scene.primaries(xs, ys, times, &mut self.rays[..k]);
+        &self.rays[..k]
+    }
+}
+
 /// Renders the pixels of `spans`, returning their RGBA values span after span.
 pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32> {
     let s = &scene.settings;
@@ -39,72 +83,77 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     let media = IorStack::default();
     let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
     let sampler = PixelSampler::new(n, s.frame);
-    if plan.is_none() && n == 1 && s.shutter.is_none() {
-        // One sample at each pixel's centre at the scene's time: the loop below without its
-        // sampler, sample time and sum (bit for bit the same values).
-        out.resize(count * 4, 1.0);
-        let mut px = out.chunks_exact_mut(4);
+    if let Some(plan) = &plan {
         for span in spans {
-            let py = span.y as f32 + 0.5;
+            let y = span.y;
             for x in span.xs() {
-                let v = match scene.primary(x as f32 + 0.5, py, s.time) {
-                    Some(ray) => {
-                        c.primary += 1;
-                        // `ZERO +` as the sum below: a -0.0 comes out +0.0.
-                        Vec3A::ZERO + integrator.radiance(&ray, 0, 1.0, &media, c)
+                let v = plan.pixel(x, y, s.frame, &mut |jx, jy| {
+                    let time = sample_time(scene, x, y, 0, n, Some((jx, jy)));
+                    // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
+                    match scene.primary(x as f32 + jx, y as f32 + jy, time) {
+                        Some(ray) => {
+                            c.primary += 1;
+                            integrator.radiance(&ray, 0, 1.0, &media, c)
+                        }
+                        None => Vec3A::ZERO,
                     }
-                    None => Vec3A::ZERO,
-                };
-                let v = if v.is_finite() {
-                    v
-                } else {
-                    c.nan_pixels += 1;
-                    Vec3A::ZERO
-                };
-                if let Some(p) = px.next() {
-                    p[..3].copy_from_slice(&v.to_array());
-                }
+                });
+                push_pixel(&mut out, v, c);
             }
         }
         return out;
     }
+    // Each span's samples, pixel after pixel, are made into rays a batch at a time; the rays
+    // are then traced in the same order, each pixel's sum complete after its `n`th.
+    let mut batch = Batch::new();
     for span in spans {
         let y = span.y;
-        for x in span.xs() {
-            let mut shade = |jx: f32, jy: f32, time: f32| {
-                let (px, py) = (x as f32 + jx, y as f32 + jy);
+        let (mut made, mut i, mut seed) = (0, 0, 0);
+        let (mut traced, mut sum) = (0, Vec3A::ZERO);
+        while made < span.count {
+            while made < span.count && !batch.is_full() {
+                let x = span.x0 + made * span.step;
+                if i == 0 && n > 1 {
+                    seed = sampler.pixel_seed(x, y);
+                }
+                let (jx, jy) = sampler.sample(x, y, seed, i);
+                let time = sample_time(scene, x, y, i, n, None);
+                batch.push(x as f32 + jx, y as f32 + jy, time);
+                i += 1;
+                if i == n {
+                    (i, made) = (0, made + 1);
+                }
+            }
+            for ray in batch.rays(scene) {
                 // Outside a fisheye's image circle there is no ray: black, as in Tachyon.
-                match scene.primary(px, py, time) {
+                sum += match ray {
                     Some(ray) => {
                         c.primary += 1;
-                        integrator.radiance(&ray, 0, 1.0, &media, c)
+                        integrator.radiance(ray, 0, 1.0, &media, c)
                     }
                     None => Vec3A::ZERO,
+                };
+                traced += 1;
+                if traced == n {
+                    // From `ZERO`: a -0.0 comes out +0.0; times 1.0 for one sample is exact.
+                    push_pixel(&mut out, sum * inv_n, c);
+                    (traced, sum) = (0, Vec3A::ZERO);
                 }
-            };
-            let mut v = match &plan {
-                Some(p) => p.pixel(x, y, s.frame, &mut |jx, jy| {
-                    shade(jx, jy, sample_time(scene, x, y, 0, n, Some((jx, jy))))
-                }),
-                None => {
-                    let mut sum = Vec3A::ZERO;
-                    let seed = sampler.pixel_seed(x, y);
-                    for i in 0..n {
-                        let (jx, jy) = sampler.sample(x, y, seed, i);
-                        sum += shade(jx, jy, sample_time(scene, x, y, i, n, None));
-                    }
-                    sum * inv_n
-                }
-            };
-            if !v.is_finite() {
-                // A NaN never aborts a render: count it and clamp the pixel.
-                c.nan_pixels += 1;
-                v = Vec3A::ZERO;
             }
-            out.extend_from_slice(&[v.x, v.y, v.z, 1.0]);
         }
     }
     out
+}
+
+/// Appends a pixel's value; a NaN never aborts a render: it is counted and the pixel clamped.
+fn push_pixel(out: &mut Vec<f32>, v: Vec3A, c: &mut Counters) {
+    let v = if v.is_finite() {
+        v
+    } else {
+        c.nan_pixels += 1;
+        Vec3A::ZERO
+    };
+    out.extend_from_slice(&[v.x, v.y, v.z, 1.0]);
 }
 
 /// The depth of the pixels of `spans`, span after span: for each pixel, the smallest distance

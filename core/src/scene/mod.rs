@@ -646,7 +646,7 @@ impl Scene {
     /// The camera ray through image point (`px`, `py`) at frame-relative time `time`: from
     /// the camera at that time when the camera moves during the shutter, else the frame's.
     #[inline]
-    pub fn primary(&self, px: f32, py: f32, time: f32) -> Option<crate::ray::Ray> {
+    pub fn primary(&self, px: f32, py: f32, time: f32) -> Option<Ray> {
         let s = &self.settings;
         if self.camera_moves {
             let moved = self
@@ -658,6 +658,20 @@ impl Scene {
             }
         }
         self.camera.primary(px, py, s.width, s.height, time)
+    }
+
+    /// The camera rays through the image points (`xs[i]`, `ys[i]`) at times `times[i]`, into
+    /// `out` (as long as `xs`): [`Scene::primary`]'s, bit for bit, made side by side when the
+    /// camera holds still ([`Camera::primaries`]).
+    pub fn primaries(&self, xs: &[f32], ys: &[f32], times: &[f32], out: &mut [Option<Ray>]) {
+        if self.camera_moves {
+            for (((o, &x), &y), &t) in out.iter_mut().zip(xs).zip(ys).zip(times) {
+                *o = self.primary(x, y, t);
+            }
+            return;
+        }
+        let size = (self.settings.width, self.settings.height);
+        self.camera.primaries(xs, ys, times, size, out);
     }
 
     pub fn set_camera(&mut self, desc: &luxon_formats::CameraDesc) {
