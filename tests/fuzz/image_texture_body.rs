@@ -29,7 +29,7 @@ pub fn run(data: &[u8]) -> Result<Vec<Level>, String> {
     assert!(
         levels
             .iter()
-            .all(|l| l.texels.iter().flatten().all(|v| v.is_finite())),
+            .all(|l| l.texels().iter().flatten().all(|v| v.is_finite())),
         "non-finite texels"
     );
     Ok(levels)

@@ -18,8 +18,10 @@
 //! never used, so they are the first to go. The missing thread samples through `Arc`s it
 //! holds itself, so it makes progress even if its levels are evicted again at once.
 //!
-//! **Eviction.** After each install, while the resident texel bytes exceed the budget, the
-//! least recently used level (ties: the largest) is evicted: its pointer is swapped to null,
+//! **Eviction.** After each install, while the resident texel bytes exceed the budget (each
+//! level counted as float texels, 16 bytes each, also an 8-bit level 0 that holds 4: the count
+//! is known before the file is read, and errs on the safe side), the least recently used
+//! level (ties: the largest) is evicted: its pointer is swapped to null,
 //! then the evicting thread waits until each of the image's reader counters has been seen at
 //! zero (readers that saw the old pointer have finished; new ones see null and take the miss
 //! path), and frees it. Recency is a clock that advances on every miss; a hit stamps its
@@ -560,7 +562,7 @@ mod tests {
     }
 
     fn level0(cache: &Cache, img: &CachedImage) -> Result<f32, String> {
-        cache.with_levels(img, 0, 0, |l, _| l.texels[0][0])
+        cache.with_levels(img, 0, 0, |l, _| l.texels()[0][0])
     }
 
     #[test]
@@ -750,7 +752,7 @@ mod tests {
                         let lv = (i + t) % 4;
                         let got = cache
                             .with_levels(img, lv, (lv + 1).min(3), |a, b| {
-                                (a.texels[0][1], b.texels[0][2])
+                                (a.texels()[0][1], b.texels()[0][2])
                             })
                             .unwrap();
                         assert_eq!(got, (*want, *want));

@@ -376,6 +376,89 @@ fn texel_row(n: usize) -> Result<Vec<[f32; 4]>, String> {
     Ok(v)
 }
 
+/// Where an image's rows of samples go: converted into the MIP pyramid, except that an 8-bit
+/// image's level 0, when kept, is kept as its samples ([`Level::from_bytes`]) and only the
+/// coarser levels are built from the converted rows.
+struct Rows {
+    convert: Converter,
+    size: (usize, usize),
+    /// Level 0's texels as bytes, when it is kept so.
+    codes: Option<Vec<[u8; 4]>>,
+    /// The float levels; none when level 0 alone is kept as bytes.
+    pyramid: Option<Pyramid>,
+    row: Vec<[f32; 4]>,
+}
+
+impl Rows {
+    fn new(convert: Converter, w: usize, h: usize, plan: &Plan) -> Result<Rows, String> {
+        let bytes = convert.is_u8() && plan.first_level == 0;
+        let codes = if bytes {
+            let mut v = Vec::new();
+            v.try_reserve_exact(w * h)
+                .map_err(|_| format!("cannot allocate {w}x{h} texels"))?;
+            Some(v)
+        } else {
+            None
+        };
+        let coarser = plan.mip && level_sizes(w, h).len() > 1;
+        let pyramid = match (bytes, coarser) {
+            (false, _) => Some(Pyramid::new(w, h, plan.first_level, plan.mip)),
+            (true, true) => Some(Pyramid::new(w, h, 1, true)),
+            (true, false) => None,
+        };
+        let row = if pyramid.is_some() {
+            texel_row(w)?
+        } else {
+            Vec::new()
+        };
+        Ok(Rows {
+            convert,
+            size: (w, h),
+            codes,
+            pyramid,
+            row,
+        })
+    }
+
+    /// Takes the next row's samples (exactly a row's).
+    fn push(&mut self, samples: &[u8]) -> Result<(), String> {
+        let (w, h) = self.size;
+        if let Some(codes) = &mut self.codes {
+            if codes.len() == w * h {
+                return Err(format!(
+                    "the image has more rows than its header says ({w}x{h})"
+                ));
+            }
+            self.convert.codes(samples, codes);
+        }
+        if let Some(pyramid) = &mut self.pyramid {
+            self.convert.row(samples, &mut self.row);
+            pyramid.push_row(&self.row)?;
+        }
+        Ok(())
+    }
+
+    /// The kept levels, finest first; an error if rows are missing.
+    fn finish(self) -> Result<Vec<Level>, String> {
+        let Some(codes) = self.codes else {
+            return self.pyramid.expect("a pyramid without bytes").finish();
+        };
+        let (w, h) = self.size;
+        if codes.len() != w * h {
+            return Err(format!(
+                "the image ends after {} of its {h} rows ({w}x{h})",
+                codes.len() / w
+            ));
+        }
+        let table = self.convert.decode_table();
+        let mut levels = vec![Level::from_bytes(w, h, codes, table)];
+        if let Some(pyramid) = self.pyramid {
+            levels.extend(pyramid.finish()?);
+        }
+        Ok(levels)
+    }
+}
+
 /// Non-interlaced PNG, row by row into the reducers.
 fn decode_png_rows<R: BufRead + Seek>(
     r: R,
@@ -394,17 +477,14 @@ fn decode_png_rows<R: BufRead + Seek>(
     let (colour, depth) = reader.output_color_type();
     let format = RowFormat::of_png(colour, depth)
         .ok_or_else(|| format!("unsupported PNG sample layout {colour:?} {depth:?}"))?;
-    let convert = Converter::new(format, srgb);
-    let mut pyramid = Pyramid::new(w, h, plan.first_level, plan.mip);
-    let mut row = texel_row(w)?;
+    let mut rows = Rows::new(Converter::new(format, srgb), w, h, plan)?;
     while let Some(r) = reader.next_row().map_err(|e| e.to_string())? {
         if r.data().len() != w * format.bytes_per_texel() {
             return Err("a PNG row has the wrong length".into());
         }
-        convert.row(r.data(), &mut row);
-        pyramid.push_row(&row)?;
+        rows.push(r.data())?;
     }
-    pyramid.finish()
+    rows.finish()
 }
 
 /// Formats decoded whole by the `image` crate into their own buffer, then reduced row by row.
@@ -449,14 +529,11 @@ fn decode_whole<R: BufRead + Seek>(
         .map_err(|_| format!("cannot allocate {} to decode the image", size(bytes)))?;
     buf.resize(len, 0u8);
     decoder.read_image(&mut buf).map_err(|e| e.to_string())?;
-    let convert = Converter::new(format, srgb);
-    let mut pyramid = Pyramid::new(w, h, plan.first_level, plan.mip);
-    let mut row = texel_row(w)?;
+    let mut rows = Rows::new(Converter::new(format, srgb), w, h, plan)?;
     for samples in buf.chunks_exact(w * format.bytes_per_texel()) {
-        convert.row(samples, &mut row);
-        pyramid.push_row(&row)?;
+        rows.push(samples)?;
     }
-    pyramid.finish()
+    rows.finish()
 }
 
 /// OpenEXR: read whole as float RGBA (the `exr` crate calls back per texel, in block order),
@@ -630,6 +707,16 @@ mod tests {
             |_| {},
             &bytes(n * 4, 4),
         );
+        write_png_with(
+            &add("greya8.png"),
+            w,
+            h,
+            GrayscaleAlpha,
+            Eight,
+            |_| {},
+            &bytes(n * 2, 9),
+        );
+        write_png_with(&add("one8.png"), 1, 1, Rgb, Eight, |_| {}, &[7, 200, 255]);
         let grey2: Vec<u8> = bytes(h as usize * 10, 5);
         write_png_with(&add("grey2.png"), 40, h, Grayscale, Two, |_| {}, &grey2);
         let palette = bytes(16 * 3, 6);
@@ -687,7 +774,7 @@ mod tests {
     }
 
     fn bits(l: &Level) -> Vec<[u32; 4]> {
-        l.texels.iter().map(|t| t.map(f32::to_bits)).collect()
+        l.texels().iter().map(|t| t.map(f32::to_bits)).collect()
     }
 
     #[test]
@@ -702,6 +789,11 @@ mod tests {
                 let want = build_pyramid(reference(&path, srgb));
                 let got = decoded(&path, srgb, 0);
                 assert_eq!(got.len(), want.len(), "{name}");
+                // 8-bit samples (also 2-bit grey and palettes, expanded to 8) keep level 0
+                // as bytes; the coarser levels are floats.
+                let bytes = !name.contains("16") && !name.ends_with(".exr");
+                assert_eq!(got[0].is_bytes(), bytes, "{name}");
+                assert!(got[1..].iter().all(|l| !l.is_bytes()), "{name}");
                 for (k, (g, l)) in got.iter().zip(&want).enumerate() {
                     assert!(bits(g) == bits(l), "{name}, srgb {srgb}: level {k} differs");
                 }

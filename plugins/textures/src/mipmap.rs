@@ -1,9 +1,10 @@
 //! Texel storage, MIP pyramids and filtered lookups.
 //!
-//! A [`Level`] is linear RGBA `f32`, rows top to bottom. Texture coordinates `(s, t)` put
-//! `(0, 0)` at the bottom-left corner of the image and `(1, 1)` at the top-right, so texel
-//! `(x, y)` (column, row from the top) covers `s ∈ [x/w, (x+1)/w)`, `t ∈ (1 - (y+1)/h, 1 - y/h]`
-//! and its centre is `((x + 0.5)/w, 1 - (y + 0.5)/h)`.
+//! A [`Level`] is linear RGBA `f32`, rows top to bottom (an 8-bit image's level 0 is held as
+//! its bytes and decoded through a table on each read, to the same floats). Texture
+//! coordinates `(s, t)` put `(0, 0)` at the bottom-left corner of the image and `(1, 1)` at the
+//! top-right, so texel `(x, y)` (column, row from the top) covers `s ∈ [x/w, (x+1)/w)`,
+//! `t ∈ (1 - (y+1)/h, 1 - y/h]` and its centre is `((x + 0.5)/w, 1 - (y + 0.5)/h)`.
 //!
 //! Level `i + 1` has `max(1, ⌊w/2⌋) × max(1, ⌊h/2⌋)` texels. Each of its texels is the exact
 //! area average of the texels of level `i` it covers: for an even size that is a 2×2 box; for
@@ -17,31 +18,95 @@ use serde::Deserialize;
 pub struct Level {
     pub width: usize,
     pub height: usize,
-    pub texels: Vec<[f32; 4]>,
+    store: Store,
     /// `width` and `height` as f64, converted once (a lookup scales by them).
     size: (f64, f64),
 }
 
+/// How a level's texels are held.
+#[derive(Clone, Debug, PartialEq)]
+enum Store {
+    Floats(Vec<[f32; 4]>),
+    /// An 8-bit image's level 0 as its samples (RGBA: grey repeated, a missing alpha 255),
+    /// read through `decode` (`[0]` colour, `[1]` alpha): the float texels the converter
+    /// makes of them, bit for bit, in a quarter of the memory and of the cache lines a
+    /// lookup touches (fog's two maps: 1.5 MB each as floats).
+    Bytes {
+        codes: Vec<[u8; 4]>,
+        decode: Box<[[f32; 256]; 2]>,
+    },
+}
+
 impl Level {
     pub fn new(width: usize, height: usize, texels: Vec<[f32; 4]>) -> Level {
-        assert_eq!(texels.len(), width * height, "texel count");
+        Level::with(width, height, texels.len(), Store::Floats(texels))
+    }
+
+    /// A level of 8-bit texels: channel `c < 3` of texel `i` is `decode[0][codes[i][c]]`,
+    /// its alpha `decode[1][codes[i][3]]`.
+    pub fn from_bytes(
+        width: usize,
+        height: usize,
+        codes: Vec<[u8; 4]>,
+        decode: [[f32; 256]; 2],
+    ) -> Level {
+        let n = codes.len();
+        let decode = Box::new(decode);
+        Level::with(width, height, n, Store::Bytes { codes, decode })
+    }
+
+    fn with(width: usize, height: usize, n: usize, store: Store) -> Level {
+        assert_eq!(n, width * height, "texel count");
         assert!(width > 0 && height > 0, "empty level");
         Level {
             width,
             height,
-            texels,
+            store,
             size: (width as f64, height as f64),
         }
     }
 
     /// Bytes of texel data.
     pub fn bytes(&self) -> usize {
-        self.texels.len() * std::mem::size_of::<[f32; 4]>()
+        match &self.store {
+            Store::Floats(t) => std::mem::size_of_val(t.as_slice()),
+            Store::Bytes { codes, decode } => {
+                std::mem::size_of_val(codes.as_slice()) + std::mem::size_of_val(&**decode)
+            }
+        }
+    }
+
+    /// Whether the texels are held as 8-bit samples.
+    pub fn is_bytes(&self) -> bool {
+        matches!(self.store, Store::Bytes { .. })
+    }
+
+    /// Every texel's value, rows top to bottom.
+    pub fn texels(&self) -> std::borrow::Cow<'_, [[f32; 4]]> {
+        match &self.store {
+            Store::Floats(t) => t.into(),
+            Store::Bytes { codes, decode } => codes.iter().map(|&c| decoded(decode, c)).collect(),
+        }
     }
 
     fn at(&self, x: usize, y: usize) -> [f32; 4] {
-        self.texels[y * self.width + x]
+        let i = y * self.width + x;
+        match &self.store {
+            Store::Floats(t) => t[i],
+            Store::Bytes { codes, decode } => decoded(decode, codes[i]),
+        }
     }
+}
+
+#[inline(always)]
+fn decoded(decode: &[[f32; 256]; 2], c: [u8; 4]) -> [f32; 4] {
+    let [colour, alpha] = decode;
+    [
+        colour[c[0] as usize],
+        colour[c[1] as usize],
+        colour[c[2] as usize],
+        alpha[c[3] as usize],
+    ]
 }
 
 /// Sizes of every level of a `width × height` image, finest first, down to 1×1.
@@ -222,6 +287,23 @@ pub fn bilinear(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
 
 #[inline(always)]
 fn bilinear_with(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
+    // The store decided once, outside the texel reads.
+    match &level.store {
+        Store::Floats(texels) => bilinear_in(level, s, t, wrap, |i| texels[i]),
+        Store::Bytes { codes, decode } => {
+            bilinear_in(level, s, t, wrap, |i| decoded(decode, codes[i]))
+        }
+    }
+}
+
+#[inline(always)]
+fn bilinear_in(
+    level: &Level,
+    s: f64,
+    t: f64,
+    wrap: Wrap,
+    texel: impl Fn(usize) -> [f32; 4],
+) -> [f32; 4] {
     let (x, y) = texel_coords(level, s, t);
     let (x, y) = (x - 0.5, y - 0.5);
     let (x0, y0) = (x.floor(), y.floor());
@@ -229,11 +311,12 @@ fn bilinear_with(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
     let (x0, y0) = (x0 as i64, y0 as i64);
     let (xa, xb) = wrap_pair(x0, level.width, wrap);
     let (ya, yb) = wrap_pair(y0, level.height, wrap);
+    let w = level.width;
     let (p00, p10, p01, p11) = (
-        level.at(xa, ya),
-        level.at(xb, ya),
-        level.at(xa, yb),
-        level.at(xb, yb),
+        texel(ya * w + xa),
+        texel(ya * w + xb),
+        texel(yb * w + xa),
+        texel(yb * w + xb),
     );
     std::array::from_fn(|c| {
         let top = p00[c] + (p10[c] - p00[c]) * fx;
@@ -297,7 +380,7 @@ mod tests {
     }
 
     fn mean(l: &Level) -> f64 {
-        l.texels.iter().map(|t| t[0] as f64).sum::<f64>() / l.texels.len() as f64
+        l.texels().iter().map(|t| t[0] as f64).sum::<f64>() / l.texels().len() as f64
     }
 
     #[test]
@@ -321,7 +404,7 @@ mod tests {
         let l1 = downsample(&ramp(4, 2));
         assert_eq!((l1.width, l1.height), (2, 1));
         // (0 + 1 + 10 + 11) / 4 and (2 + 3 + 12 + 13) / 4.
-        assert_eq!(l1.texels, [grey(5.5), grey(7.5)]);
+        assert_eq!(*l1.texels(), [grey(5.5), grey(7.5)]);
     }
 
     #[test]
@@ -334,15 +417,23 @@ mod tests {
         assert_eq!((p[2].width, p[2].height), (1, 1));
         // Level 1, texel 0: columns 0, 1, 2 weighted 2/5, 2/5, 1/5, of rows averaged 1/3 each.
         // Row means of column x are x + 10; so (0.4·10 + 0.4·11 + 0.2·12) = 10.8.
-        assert!((p[1].texels[0][0] - 10.8).abs() < 1e-5, "{:?}", p[1].texels);
+        assert!(
+            (p[1].texels()[0][0] - 10.8).abs() < 1e-5,
+            "{:?}",
+            p[1].texels()
+        );
         // Texel 1: columns 2, 3, 4 weighted 1/5, 2/5, 2/5: 0.2·12 + 0.4·13 + 0.4·14 = 13.2.
-        assert!((p[1].texels[1][0] - 13.2).abs() < 1e-5, "{:?}", p[1].texels);
+        assert!(
+            (p[1].texels()[1][0] - 13.2).abs() < 1e-5,
+            "{:?}",
+            p[1].texels()
+        );
         // The mean survives every level; the last texel is the image's mean.
         for l in &p {
             assert!((mean(l) - m0).abs() < 1e-4, "{} vs {m0}", mean(l));
         }
-        assert!((p[2].texels[0][0] as f64 - m0).abs() < 1e-4);
-        assert!(p.iter().all(|l| l.texels.iter().all(|t| t[3] == 1.0)));
+        assert!((p[2].texels()[0][0] as f64 - m0).abs() < 1e-4);
+        assert!(p.iter().all(|l| l.texels().iter().all(|t| t[3] == 1.0)));
     }
 
     #[test]
@@ -367,6 +458,39 @@ mod tests {
         assert!((v - 14.0).abs() < 1e-5, "{v}");
         assert_eq!(nearest(&l, 0.01, 0.99, Wrap::Clamp), grey(0.0));
         assert_eq!(nearest(&l, 0.99, 0.01, Wrap::Clamp), grey(23.0));
+    }
+
+    #[test]
+    fn byte_texels_look_up_as_their_floats() {
+        let (w, h) = (7, 5);
+        let codes: Vec<[u8; 4]> = (0..w * h)
+            .map(|i| std::array::from_fn(|c| ((i * 37 + c * 101) % 256) as u8))
+            .collect();
+        let decode = [
+            std::array::from_fn(|i| crate::texels::srgb_to_linear(i as f32 / 255.0)),
+            std::array::from_fn(|i| i as f32 / 255.0),
+        ];
+        let bytes = Level::from_bytes(w, h, codes.clone(), decode);
+        let floats = Level::new(w, h, bytes.texels().into_owned());
+        assert!(bytes.is_bytes() && !floats.is_bytes());
+        assert_eq!(bytes.texels()[8], floats.texels()[8]);
+        let c = codes[8];
+        assert_eq!(bytes.texels()[8][3], c[3] as f32 / 255.0, "alpha is linear");
+        assert_eq!(bytes.bytes(), w * h * 4 + 2 * 256 * 4);
+        let bits = |v: [f32; 4]| v.map(f32::to_bits);
+        for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror] {
+            for k in 0..200 {
+                let (s, t) = (k as f64 * 0.0137 - 0.7, k as f64 * 0.0291 - 1.3);
+                assert_eq!(
+                    bits(bilinear(&bytes, s, t, wrap)),
+                    bits(bilinear(&floats, s, t, wrap))
+                );
+                assert_eq!(
+                    bits(nearest(&bytes, s, t, wrap)),
+                    bits(nearest(&floats, s, t, wrap))
+                );
+            }
+        }
     }
 
     #[test]

@@ -215,14 +215,14 @@ mod tests {
 
     fn streamed(base: &Level, first: usize) -> Vec<Level> {
         let mut p = Pyramid::new(base.width, base.height, first, true);
-        for row in base.texels.chunks(base.width) {
+        for row in base.texels().chunks(base.width) {
             p.push_row(row).unwrap();
         }
         p.finish().unwrap()
     }
 
     fn bits(l: &Level) -> Vec<[u32; 4]> {
-        l.texels.iter().map(|t| t.map(f32::to_bits)).collect()
+        l.texels().iter().map(|t| t.map(f32::to_bits)).collect()
     }
 
     #[test]
@@ -269,7 +269,7 @@ mod tests {
             for first in 0..want.len() + 1 {
                 let mut p = Pyramid::new(w, h, first, false);
                 assert_eq!(p.reducers.len(), first.min(want.len() - 1));
-                for row in base.texels.chunks(w) {
+                for row in base.texels().chunks(w) {
                     p.push_row(row).unwrap();
                 }
                 let got = p.finish().unwrap();
@@ -285,7 +285,7 @@ mod tests {
     fn only_the_kept_levels_are_held() {
         let base = noise(1024, 1024, 9);
         let mut p = Pyramid::new(1024, 1024, 2, true);
-        for row in base.texels.chunks(1024) {
+        for row in base.texels().chunks(1024) {
             p.push_row(row).unwrap();
             // Each reducer holds at most three rows.
             assert!(p.reducers.iter().all(|r| r.window.len() <= 3));
@@ -302,14 +302,14 @@ mod tests {
     fn missing_and_extra_rows_are_errors() {
         let base = noise(4, 3, 3);
         let mut p = Pyramid::new(4, 3, 0, true);
-        p.push_row(&base.texels[..4]).unwrap();
+        p.push_row(&base.texels()[..4]).unwrap();
         let e = p.finish().unwrap_err();
         assert!(e.contains("ends after 1 of its 3 rows"), "{e}");
         let mut p = Pyramid::new(4, 1, 0, true);
-        p.push_row(&base.texels[..4]).unwrap();
-        assert!(p.push_row(&base.texels[4..8]).is_err());
+        p.push_row(&base.texels()[..4]).unwrap();
+        assert!(p.push_row(&base.texels()[4..8]).is_err());
         assert!(Pyramid::new(4, 1, 0, true)
-            .push_row(&base.texels[..3])
+            .push_row(&base.texels()[..3])
             .is_err());
     }
 }

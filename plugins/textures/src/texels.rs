@@ -140,6 +140,30 @@ impl Converter {
         }
     }
 
+    /// Whether rows are 8-bit samples, which [`Converter::codes`] keeps as they are.
+    pub fn is_u8(&self) -> bool {
+        self.format.sample == Sample::U8
+    }
+
+    /// What [`Converter::codes`]'s bytes decode to: `[0]` a colour sample's value, `[1]` an
+    /// alpha sample's (the values [`Converter::row`] gives them).
+    pub fn decode_table(&self) -> [[f32; 256]; 2] {
+        [self.table, std::array::from_fn(|i| i as f32 / 255.0)]
+    }
+
+    /// Appends the texels of a row of 8-bit samples as RGBA bytes (grey repeated, a missing
+    /// alpha 255, which decodes to 1): [`Converter::row`]'s texels through
+    /// [`Converter::decode_table`].
+    pub fn codes(&self, row: &[u8], out: &mut Vec<[u8; 4]>) {
+        debug_assert!(self.is_u8());
+        match self.format.channels {
+            1 => out.extend(row.iter().map(|&l| [l, l, l, 255])),
+            2 => out.extend(row.chunks_exact(2).map(|p| [p[0], p[0], p[0], p[1]])),
+            3 => out.extend(row.chunks_exact(3).map(|p| [p[0], p[1], p[2], 255])),
+            _ => out.extend(row.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]])),
+        }
+    }
+
     /// Converts `row` (at least `out.len()` texels of samples) into `out`.
     pub fn row(&self, row: &[u8], out: &mut [[f32; 4]]) {
         if self.format.sample == Sample::U8 {
