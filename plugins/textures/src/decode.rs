@@ -392,14 +392,8 @@ struct Rows {
 impl Rows {
     fn new(convert: Converter, w: usize, h: usize, plan: &Plan) -> Result<Rows, String> {
         let bytes = convert.is_u8() && plan.first_level == 0;
-        let codes = if bytes {
-            let mut v = Vec::new();
-            v.try_reserve_exact(w * h)
-                .map_err(|_| format!("cannot allocate {w}x{h} texels"))?;
-            Some(v)
-        } else {
-            None
-        };
+        // Allocated at the first row, as the levels are.
+        let codes = bytes.then(Vec::new);
         let coarser = plan.mip && level_sizes(w, h).len() > 1;
         let pyramid = match (bytes, coarser) {
             (false, _) => Some(Pyramid::new(w, h, plan.first_level, plan.mip)),
@@ -428,6 +422,10 @@ impl Rows {
                 return Err(format!(
                     "the image has more rows than its header says ({w}x{h})"
                 ));
+            }
+            if codes.capacity() == 0 {
+                let e = |_| format!("cannot allocate level 0 ({w}x{h}, 4 bytes a texel)");
+                codes.try_reserve_exact(w * h).map_err(e)?;
             }
             self.convert.codes(samples, codes);
         }
