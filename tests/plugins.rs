@@ -75,15 +75,15 @@ fn wrong_abi_version_names_both_versions() {
     install_plugin(&dir, "testplug_bad_abi", "luxon_old");
     let e = build_error(&dir, r#"(plugin: "old_thing")"#);
     assert!(e.contains("no primitive plugin named `old_thing`"), "{e}");
-    // A plugin built for the previous ABI, as every plugin built before the bump to 3 is.
+    // A plugin built for the previous ABI, as every plugin built before the bump to 4 is.
     assert!(
         e.contains(
-            "libluxon_old.so: built for plugin ABI 2 (luxon-plugin 0.2.0), but this Luxon uses \
-             ABI 3 (luxon-plugin 0.3.0); rebuild it against luxon-plugin 0.3.0"
+            "libluxon_old.so: built for plugin ABI 3 (luxon-plugin 0.3.0), but this Luxon uses \
+             ABI 4 (luxon-plugin 0.4.0); rebuild it against luxon-plugin 0.4.0"
         ),
         "{e}"
     );
-    assert_eq!(luxon_plugin::ABI_VERSION, 3);
+    assert_eq!(luxon_plugin::ABI_VERSION, 4);
 }
 
 #[test]
@@ -403,10 +403,10 @@ fn plugins_command_lists_every_plugin_and_its_parameters() {
         "texture `checker`",
         "writer `png` [.png]",
         "writer `exr` [.exr]",
-        "plugin ABI 3",
+        "plugin ABI 4",
         "radius",
         "skipped",
-        "built for plugin ABI 2 (luxon-plugin 0.2.0)",
+        "built for plugin ABI 3 (luxon-plugin 0.3.0)",
     ] {
         assert!(s.contains(want), "missing `{want}` in:\n{s}");
     }

@@ -171,12 +171,15 @@ impl Whitted<'_> {
         media: &IorStack,
         c: &mut Counters,
     ) -> Vec3A {
-        let width = if depth == 0 {
-            self.scene.primary_width
-        } else {
-            0.0
+        let cone = Cone {
+            width: if depth == 0 {
+                self.scene.primary_width
+            } else {
+                0.0
+            },
+            travelled: 0.0,
         };
-        self.trace(ray, depth, weight, media, width, c)
+        self.trace(ray, depth, weight, media, cone, c)
     }
 
     /// Texture `t` at a surface point; a texture that fails or panics raises the scene's fault.
@@ -198,16 +201,16 @@ impl Whitted<'_> {
         [0.0; 4]
     }
 
-    /// `width` is the width of the ray's footprint at its origin: rays are traced as thin cones
-    /// (a pixel wide at the camera, widening by the pixel angle per unit of distance) so textures
-    /// know how much of them a pixel covers and can filter (MIP mapping).
+    /// `cone` is the ray's footprint at its origin and the path's length so far: rays are traced
+    /// as thin cones (a pixel wide at the camera, widening by the pixel angle per unit of
+    /// distance) so textures know how much of them a pixel covers and can filter (MIP mapping).
     fn trace(
         &self,
         ray: &Ray,
         depth: u32,
         weight: f32,
         media: &IorStack,
-        width: f32,
+        cone: Cone,
         c: &mut Counters,
     ) -> Vec3A {
         let scene = self.scene;
@@ -218,20 +221,28 @@ impl Whitted<'_> {
         };
         if !scene.features.volumes {
             return match hit {
-                Some(hit) => self.shade(ray, &hit, depth, weight, media, width, c),
+                Some(hit) => self.shade(ray, &hit, depth, weight, media, cone, c),
                 None => self.missed(ray, depth),
             };
         }
         // Volumes in front of the first surface (or the background), composited over it.
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         let cutoff = scene.settings.min_weight / weight.max(f32::MIN_POSITIVE);
-        let (color, through) = march::march(scene, ray, t_hit, cutoff, c);
+        let (color, through) = if scene.settings.tachyon.additive_volumes {
+            // Tachyon shades a SCALARVOL's box at its front face, then, through it, at its
+            // back face from inside: the same march twice, C + (1 − S)(C + (1 − S) behind).
+            let (color, sum) = march::march_additive(scene, ray, t_hit, c);
+            let through = 1.0 - sum;
+            (color * (1.0 + through), through * through)
+        } else {
+            march::march(scene, ray, t_hit, cutoff, c)
+        };
         if through < cutoff {
             // Early ray termination: what lies behind cannot show.
             return color;
         }
         let behind = match hit {
-            Some(hit) => self.shade(ray, &hit, depth, weight * through, media, width, c),
+            Some(hit) => self.shade(ray, &hit, depth, weight * through, media, cone, c),
             None => self.missed(ray, depth),
         };
         color + through * behind
@@ -267,7 +278,7 @@ impl Whitted<'_> {
         depth: u32,
         weight: f32,
         media: &IorStack,
-        width: f32,
+        cone: Cone,
         c: &mut Counters,
     ) -> Vec3A {
         let scene = self.scene;
@@ -275,16 +286,16 @@ impl Whitted<'_> {
         let s = scene.surface(&hit, ray);
         let mat = &scene.materials[s.material as usize];
         let features = scene.features;
-        let footprint = width + scene.pixel_spread * hit.t;
+        let cone = cone.at(hit.t, scene.pixel_spread);
         let side = Side::of(&s, ray);
-        let (base, kr, kt) = self.material_at(&s, mat, side.n, footprint, ray.time);
+        let (base, kr, kt) = self.material_at(&s, mat, side.n, cone, ray.time);
         let mut kt = kt;
         if kt > 0.0 {
             let t = scene.settings.transparency;
             if t.max_surfaces.is_some_and(|n| media.surfaces >= n) {
                 if t.beyond_max == BeyondMax::Skip {
                     // Not shown at all: the ray goes on as if the surface were not there.
-                    return self.pass_through(ray, &s, &side, depth, weight, media, footprint, c);
+                    return self.pass_through(ray, &s, &side, depth, weight, media, cone, c);
                 }
                 kt = 0.0;
             } else {
@@ -316,7 +327,7 @@ impl Whitted<'_> {
             let bounce = Bounce {
                 depth: next,
                 weight: weight * kr,
-                footprint,
+                cone,
             };
             self.reflection(&mut color, ray, &s, &side, kr, &bounce, media, c);
         }
@@ -324,7 +335,7 @@ impl Whitted<'_> {
             let bounce = Bounce {
                 depth: next,
                 weight: weight * kt,
-                footprint,
+                cone,
             };
             let filter = kt * filter;
             self.transmission(&mut color, ray, &s, &side, mat, filter, &bounce, media, c);
@@ -346,7 +357,7 @@ impl Whitted<'_> {
         depth: u32,
         weight: f32,
         media: &IorStack,
-        footprint: f32,
+        cone: Cone,
         c: &mut Counters,
     ) -> Vec3A {
         let next = depth + 1;
@@ -356,7 +367,7 @@ impl Whitted<'_> {
         }
         c.refraction += 1;
         let r = spawn(s.p, s.p_error, side.ng, ray.dir, ray.time);
-        self.trace(&r, next, weight, media, footprint, c)
+        self.trace(&r, next, weight, media, cone, c)
     }
 
     /// The material's colour and reflect and transmit coefficients at a surface point, with
@@ -367,7 +378,7 @@ impl Whitted<'_> {
         s: &Surface,
         mat: &Material,
         n: Vec3A,
-        footprint: f32,
+        cone: Cone,
         time: f32,
     ) -> (Vec3A, f32, f32) {
         let scene = self.scene;
@@ -378,9 +389,10 @@ impl Whitted<'_> {
                 p: (s.p.as_dvec3() + scene.world_offset).into(),
                 n: n.into(),
                 uv: s.uv,
-                footprint,
-                uv_footprint: footprint * s.uv_scale,
+                footprint: cone.width,
+                uv_footprint: cone.width * s.uv_scale,
                 time,
+                distance: cone.travelled,
             };
             let mean = |c: [f32; 4]| (c[0] + c[1] + c[2]) / 3.0;
             if let Some(t) = mat.texture {
@@ -544,7 +556,7 @@ impl Whitted<'_> {
         } else if bounce.weight >= settings.min_weight {
             c.reflection += 1;
             let r = spawn(s.p, s.p_error, side.ng, reflect(ray.dir, side.n), ray.time);
-            *color += kr * self.trace(&r, bounce.depth, bounce.weight, media, bounce.footprint, c);
+            *color += kr * self.trace(&r, bounce.depth, bounce.weight, media, bounce.cone, c);
         }
     }
 
@@ -595,7 +607,7 @@ impl Whitted<'_> {
             outside.surfaces += 1;
             let stack = if through { &inside } else { &outside };
             let (depth, weight) = (bounce.depth, bounce.weight);
-            *color += filter * self.trace(&r, depth, weight, stack, bounce.footprint, c);
+            *color += filter * self.trace(&r, depth, weight, stack, bounce.cone, c);
         }
     }
 }
@@ -625,11 +637,31 @@ impl Side {
 }
 
 /// The ray a reflection or refraction spawns: its depth, its weight (the most it can add to the
-/// pixel), and the width of its footprint at its origin.
+/// pixel), and its cone at its origin.
 struct Bounce {
     depth: u32,
     weight: f32,
-    footprint: f32,
+    cone: Cone,
+}
+
+/// A ray's footprint and the length of its path from the camera, at a point of the path.
+#[derive(Clone, Copy)]
+struct Cone {
+    /// How wide the pixel's share of the scene is here (world units).
+    width: f32,
+    /// How far the path has come from the camera (world units).
+    travelled: f32,
+}
+
+impl Cone {
+    /// The cone `t` further along a ray, widening by `spread` per unit of distance.
+    #[inline]
+    fn at(self, t: f32, spread: f32) -> Cone {
+        Cone {
+            width: self.width + spread * t,
+            travelled: self.travelled + t,
+        }
+    }
 }
 
 /// What lighting needs to know about a shading point.

@@ -86,9 +86,11 @@ pub fn time_at(jx: f32, jy: f32, px: u32, py: u32, frame: u32) -> f32 {
 /// [`pixel_sample`] for every pixel of one render (one sample count, one frame): what does not
 /// depend on the pixel is computed once, not per sample (the inner half of each `hash`, the
 /// square root, the grid cell's division), so a sample costs two hashes of two rounds. Same
-/// values, bit for bit.
+/// values, bit for bit. Or, `centred`, Tachyon's antialiasing: sample 0 at the pixel's centre,
+/// the others at the same jitter alone, anywhere in the pixel (no strata).
 pub struct PixelSampler {
     n: u32,
+    centred: bool,
     /// Side of the jittered grid when `n` is a square, else 0 (N-rooks).
     grid: u32,
     /// Per sample: `mix(frame ^ mix(dim))` of its two jitter dimensions, and its grid cell
@@ -99,7 +101,7 @@ pub struct PixelSampler {
 }
 
 impl PixelSampler {
-    pub fn new(n: u32, frame: u32) -> PixelSampler {
+    pub fn new(n: u32, frame: u32, centred: bool) -> PixelSampler {
         let inner = |dim: u32| mix(frame ^ mix(dim));
         let m = (n as f64).sqrt() as u32;
         let grid = if m * m == n { m } else { 0 };
@@ -116,6 +118,7 @@ impl PixelSampler {
         };
         PixelSampler {
             n,
+            centred,
             grid,
             per_sample,
             seed_inner: inner(0xffff_fff0),
@@ -125,7 +128,7 @@ impl PixelSampler {
     /// The N-rooks permutation seed of pixel (`px`, `py`) (unused for square counts).
     #[inline]
     pub fn pixel_seed(&self, px: u32, py: u32) -> u32 {
-        if self.n <= 1 || self.grid != 0 {
+        if self.n <= 1 || self.grid != 0 || self.centred {
             return 0;
         }
         mix(px ^ mix(py ^ self.seed_inner))
@@ -136,12 +139,15 @@ impl PixelSampler {
     #[inline]
     pub fn sample(&self, px: u32, py: u32, seed: u32, i: u32) -> (f32, f32) {
         let n = self.n;
-        if n <= 1 {
+        if n <= 1 || (self.centred && i == 0) {
             return (0.5, 0.5);
         }
         let (inner, [sx, sy]) = self.per_sample[i as usize];
         let jx = to_unit(mix(px ^ mix(py ^ inner[0])));
         let jy = to_unit(mix(px ^ mix(py ^ inner[1])));
+        if self.centred {
+            return (jx, jy);
+        }
         match self.grid {
             0 => {
                 let sy = permute(i, n, seed) as f32;
@@ -160,7 +166,7 @@ mod tests {
     fn pixel_sampler_equals_pixel_sample() {
         for n in [0u32, 1, 2, 3, 4, 5, 9, 16, 33] {
             for frame in [0u32, 7] {
-                let s = PixelSampler::new(n, frame);
+                let s = PixelSampler::new(n, frame, false);
                 for (px, py) in [(0u32, 0u32), (3, 7), (511, 200)] {
                     let seed = s.pixel_seed(px, py);
                     for i in 0..n.max(1) {
@@ -171,6 +177,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Tachyon's antialiasing: the centre first, then positions spread over the whole pixel
+    /// (not one per stratum), the same for every thread count (a function of the pixel).
+    #[test]
+    fn centred_sampling_starts_at_the_centre_and_spreads_over_the_pixel() {
+        let n = 5;
+        let s = PixelSampler::new(n, 0, true);
+        let mut quadrants = [0; 4];
+        for (px, py) in (0..40u32).flat_map(|y| (0..40u32).map(move |x| (x, y))) {
+            let seed = s.pixel_seed(px, py);
+            assert_eq!(s.sample(px, py, seed, 0), (0.5, 0.5));
+            for i in 1..n {
+                let (x, y) = s.sample(px, py, seed, i);
+                assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                assert_eq!(s.sample(px, py, seed, i), (x, y));
+                quadrants[(x >= 0.5) as usize + 2 * (y >= 0.5) as usize] += 1;
+            }
+        }
+        // 6400 positions: each quadrant near a quarter (not the strata's fixed shares).
+        assert!(
+            quadrants.iter().all(|&q| (1400..1800).contains(&q)),
+            "{quadrants:?}"
+        );
     }
 
     /// One sample per stratum of the shutter, in [0, 1), and not in the image-plane order.

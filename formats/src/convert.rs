@@ -462,6 +462,8 @@ impl Checker<'_> {
                     light_threshold: t.light_threshold.unwrap_or(false),
                     plain_highlights: t.plain_highlights.unwrap_or(false),
                     depth_limit_background: t.depth_limit_background.unwrap_or(false),
+                    centre_sample: t.centre_sample.unwrap_or(false),
+                    additive_volumes: t.additive_volumes.unwrap_or(false),
                 },
                 None => d.tachyon,
             },

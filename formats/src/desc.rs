@@ -732,6 +732,14 @@ pub struct TachyonDesc {
     /// A reflected or transmitted ray past `max_depth` adds the background colour unscaled
     /// (not times the mirror or transmission coefficient).
     pub depth_limit_background: bool,
+    /// A pixel's first sample is its centre and the others fall anywhere in it, uniformly
+    /// (Tachyon's antialiasing, whose pixels weight the centre by 1/samples), not stratified.
+    pub centre_sample: bool,
+    /// Volumes composite as Tachyon's SCALARVOL: each sample adds its opacity σ·dt and its
+    /// colour times that, without attenuation, until the sum S reaches 1, and the volume
+    /// counts twice (Tachyon shades its box's front face, then through it the back face from
+    /// inside): C·(2 − S) + (1 − S)² × what lies behind. Shadow rays are as before.
+    pub additive_volumes: bool,
 }
 
 /// A memory size as a scene (`render: (memory: ...)`) or the command line (`--memory`) gives it.

@@ -599,6 +599,8 @@ pub(crate) struct Tachyon {
     pub light_threshold: Option<bool>,
     pub plain_highlights: Option<bool>,
     pub depth_limit_background: Option<bool>,
+    pub centre_sample: Option<bool>,
+    pub additive_volumes: Option<bool>,
 }
 
 #[derive(Deserialize)]

@@ -1194,13 +1194,16 @@ pub(crate) fn render_fields(
         light_threshold,
         plain_highlights,
         depth_limit_background,
+        centre_sample,
+        additive_volumes,
     } = tachyon;
     f.push(("light_scale", format!("light_scale: {}", num(*light_scale))));
     f.push((
         "tachyon",
         format!(
             "tachyon: (light_threshold: {light_threshold}, plain_highlights: \
-             {plain_highlights}, depth_limit_background: {depth_limit_background})"
+             {plain_highlights}, depth_limit_background: {depth_limit_background}, \
+             centre_sample: {centre_sample}, additive_volumes: {additive_volumes})"
         ),
     ));
     f.push(("volume_step", format!("volume_step: {}", num(*volume_step))));

@@ -101,7 +101,7 @@ fn toml_string(s: &str) -> String {
     out
 }
 
-/// The version requirement that matches this build's SDK: "0.3" for 0.3.x (its ABI).
+/// The version requirement that matches this build's SDK: "0.4" for 0.4.x (its ABI).
 fn sdk_version_req() -> String {
     let v = luxon_plugin::SDK_VERSION;
     let mut parts = v.split('.');
@@ -378,7 +378,7 @@ mod tests {
 
     #[test]
     fn the_sdk_version_requirement_is_this_builds() {
-        assert_eq!(sdk_version_req(), "0.3");
+        assert_eq!(sdk_version_req(), "0.4");
         assert_eq!(parse_sdk("0.2").unwrap(), Sdk::Version("0.2".into()));
         assert_eq!(parse_sdk("=0.2.0").unwrap(), Sdk::Version("=0.2.0".into()));
         let e = parse_sdk("/no/such/dir").unwrap_err().to_string();

@@ -283,6 +283,47 @@ pub fn march(scene: &Scene, ray: &Ray, t_end: f32, cutoff: f32, c: &mut Counters
     })
 }
 
+/// Tachyon's SCALARVOL compositing along `ray` before `t_end`: (colour, summed opacity S).
+/// Each sample adds its opacity σ·dt, and its colour times that, until the sum reaches 1; no
+/// attenuation in between (Tachyon's `scalar_volume_texture`).
+pub fn march_additive(scene: &Scene, ray: &Ray, t_end: f32, c: &mut Counters) -> (Vec3A, f32) {
+    let mut m = Additive {
+        color: Vec3A::ZERO,
+        sum: 0.0,
+    };
+    walk(scene, ray, t_end, c, &mut m);
+    (m.color, m.sum)
+}
+
+/// Additive compositing (see [`march_additive`]).
+struct Additive {
+    color: Vec3A,
+    sum: f32,
+}
+
+impl<'a> Visit<'a> for Additive {
+    #[inline(always)]
+    fn visit(&mut self, t: f32, dt: f32, tracks: &mut [Track<'a>], c: &mut Counters) -> bool {
+        for tr in active(tracks) {
+            c.volume_samples += 1;
+            tr.at(t);
+            let [r, g, b, s] = tr.classify();
+            let a = s * dt;
+            if a <= 0.0 {
+                continue;
+            }
+            self.sum += a;
+            if self.sum >= 1.0 {
+                // Opaque: nothing further adds.
+                self.sum = 1.0;
+                return false;
+            }
+            self.color += a * Vec3A::new(r, g, b);
+        }
+        true
+    }
+}
+
 /// Slots of the alpha cache (a power of two).
 const ALPHA_SLOTS: usize = 1024;
 

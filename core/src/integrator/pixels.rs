@@ -82,7 +82,7 @@ pub fn render_spans(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     let inv_n = 1.0 / n as f32;
     let media = IorStack::default();
     let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
-    let sampler = PixelSampler::new(n, s.frame);
+    let sampler = PixelSampler::new(n, s.frame, s.tachyon.centre_sample);
     if let Some(plan) = &plan {
         for span in spans {
             let y = span.y;
@@ -167,7 +167,7 @@ pub fn render_depth(scene: &Scene, spans: &[Span], c: &mut Counters) -> Vec<f32>
     let mut out = Vec::with_capacity(count);
     let n = s.samples.max(1);
     let plan = s.adaptive.as_ref().map(|a| adaptive::Plan::new(n, a));
-    let sampler = PixelSampler::new(n, s.frame);
+    let sampler = PixelSampler::new(n, s.frame, s.tachyon.centre_sample);
     for span in spans {
         let y = span.y;
         for x in span.xs() {

@@ -321,9 +321,10 @@ impl Mapper {
                     Ok((p, n)) => {
                         self.notes.add(
                             "SCALARVOL",
-                            "is drawn by Luxon's emission-absorption ray casting with Tachyon's \
-                             colour ramp (Tachyon sums the samples' opacity and marches the box \
-                             twice)",
+                            "is drawn by Luxon's volume ray casting with Tachyon's colour ramp \
+                             and compositing; nearest-voxel edges may sit up to a voxel apart, \
+                             and shadows pass through it as through a volume (Tachyon's box \
+                             blocks light wholly while its shadow filter is on)",
                             at,
                         );
                         self.shapes.volume(*min, *max, *dim, p, n, density, at)?;
@@ -627,6 +628,8 @@ impl Mapper {
                     light_threshold: true,
                     plain_highlights: true,
                     depth_limit_background: true,
+                    centre_sample: true,
+                    additive_volumes: true,
                 },
                 ..RenderDesc::default()
             },

@@ -695,6 +695,8 @@ fn image(
         .is_some_and(|e| e.eq_ignore_ascii_case("tga"));
     let (su, sv) = (frame.scale[0], frame.scale[1]);
     let (ru, rv) = (frame.rotate[0], frame.rotate[1]);
+    // Tachyon's blur: 0.05 × the distance travelled × its larger scale (see the filter's doc).
+    let filter = format!("tachyon({})", float(0.05 * su.abs().max(sv.abs())));
     // v' = v·sv + rv, flipped to 1 - v' for top-row-first images.
     let (sv, rv) = if tga { (sv, rv) } else { (-sv, 1.0 - rv) };
     let file = string(&path.to_string_lossy());
@@ -704,7 +706,7 @@ fn image(
             let [ua, va] = axes.copied().unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
             let u = mirror(ua).map(|x| x * su);
             let v = mirror(va).map(|x| x * sv);
-            planar(&file, c, u, v, ru, rv)
+            planar(&file, &filter, c, u, v, ru, rv)
         }
         ImageKind::Cylindrical | ImageKind::Spherical => {
             // Luxon's longitude about +y from +x toward Tachyon's +z (Luxon's -z) is Tachyon's
@@ -719,7 +721,7 @@ fn image(
                 "spherical"
             };
             Ok(format!(
-                "(file: {file}, srgb: false, filter: bilinear, mapping: {mapping}, center: {}, axis: (0.0, 1.0, 0.0), \
+                "(file: {file}, srgb: false, filter: {filter}, mapping: {mapping}, center: {}, axis: (0.0, 1.0, 0.0), \
                  scale: {}, offset: {})",
                 vec3(c),
                 vec2([1.0 / su, 1.0 / sv]),
@@ -735,6 +737,7 @@ fn image(
 /// lengths of `u` and `v` become the scale. `u` and `v` must be perpendicular.
 fn planar(
     file: &str,
+    filter: &str,
     c: V3,
     u: V3,
     v: V3,
@@ -783,7 +786,7 @@ fn planar(
     let (s, co) = theta.sin_cos();
     let offset = [co * p - s * q, s * p + co * q];
     Ok(format!(
-        "(file: {file}, srgb: false, filter: bilinear, mapping: planar, center: {}, axis: {}, scale: {}, \
+        "(file: {file}, srgb: false, filter: {filter}, mapping: planar, center: {}, axis: {}, scale: {}, \
          rotate: {}, offset: {})",
         vec3(c),
         vec3(n),

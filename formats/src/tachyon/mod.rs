@@ -57,7 +57,7 @@
 //! | `ZOOM z`, `ASPECTRATIO a` | a window `1/z` high and `(x/y)/(a·z)` wide at unit distance (perspective) or in world units (orthographic), given as a `frustum` |
 //! | `FRUSTUM l r b t` | that window instead (Tachyon's order: left right bottom top) |
 //! | pixel sampling | Tachyon samples pixel (i, j) at ((i+1)/x, (j+1)/y) of the window, half a pixel right of and above the centre Luxon samples: the window is moved by half a pixel right and up |
-//! | `ANTIALIASING n` | `samples: n + 1` (Tachyon: one sample at that point plus n jittered; the noise differs) |
+//! | `ANTIALIASING n` | `samples: n + 1` with `centre_sample` (Tachyon: one sample at the pixel's centre plus n anywhere in it; the noise differs) |
 //! | `RAYDEPTH n` | `max_depth: n - 1` (Tachyon's primary ray counts as one level) |
 //! | `PROJECTION ORTHOGRAPHIC` | `Orthographic` with the same window |
 //! | `PROJECTION FISHEYE` | not a circular fisheye: Tachyon's window (zoom, aspect or FRUSTUM) in radians of longitude and latitude around VIEWDIR, so `Equirectangular` with that `frustum` in degrees, half a pixel moved like the others |
@@ -159,7 +159,7 @@
 //! | 5 gradient noise | the colour (Tachyon's noise value is clamped to 1 almost everywhere) |
 //! | 6 cylindrical checker | the `tachyon_cylinder_checker` texture: 18 sectors about the z axis through CENTER (the angle from +x toward +y) by bands 0.1 high along it, counted from CENTER by \|height\|, odd cells (1, 0.2, 0), even (0, 0.2, 1); CENTER mirrored; ROTATE, SCALE and COLOR ignored, as in Tachyon |
 //! | 10 volume image | the `tachyon_volume_image` texture with the IMAGEDEF's texels: u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x, likewise v (VAXIS, y) and w (WAXIS, z), wrapped into [0, 1), trilinear with the first and last texels' centres at 0 and 1 (measured against `tachyon-nox`: within 2 codes); CENTER and the axes mirrored; an undefined IMAGEDEF is white with a warning, as in Tachyon; blocks over a million texels show COLOR with a note |
-//! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: bilinear` (Tachyon's MIP blur grows with the distance travelled, not with the pixel's footprint: plain bilinear lookups look closer to it than Luxon's footprint MIP) |
+//! | 7, 8, 9 image maps | the `image` texture (`srgb: false`: texels are display values like colours), mappings `cylindrical`, `spherical` (both about +y, longitude from +x toward Tachyon's +z, as Tachyon's) and `planar` (axis UAXIS × VAXIS, turned and scaled so that u = UAXIS·(p − CENTER)·SCALE.x + ROTATE.x); v runs from the image's first row in memory (PPM: the top row, so it is flipped; TGA: the bottom row); a negative SCALE mirrors; `filter: tachyon(k)`, k = 0.05 × the larger \|SCALE\|: Tachyon's MIP blur, which grows with the distance the ray travelled from the camera (through mirrors and glass), not with the pixel's footprint, divided by 8 × the point's distance from CENTER for cylindrical and spherical maps |
 //!
 //! ## Geometry
 //!
@@ -178,18 +178,18 @@
 //! | `VERTEXARRAY ... COLORS` | the meshes after it take those vertex `colors`, interpolated as VCSTRI's, in their TEXTURE's material in white and without its TEXFUNC: Tachyon's vertex colours replace the texture's colour and pattern (measured) |
 //! | `SCAPE` | Tachyon's terrain generator reproduced (its random sequence and midpoint subdivision), an inline mesh with its normals |
 //! | `TPOLYFILE` | the `.tpoly` file's triangles through Tachyon's SCALE/ROT/CENTER transform (its "rotation" matrix included, which mirrors when ROT.y ≠ 0), as TRI (v1, v0, v2) |
-//! | `SCALARVOL` | a `raw` u8 volume, voxel 0 at MIN and the last at MAX, nearest-voxel samples every \|MAX − MIN\| / \|DIM\|, emitting Tachyon's red-yellow-white ramp with extinction OPACITY·s / \|MAX − MIN\| (s the voxel / 255); a file with extra whole slices is read and cropped to the box (Tachyon reads the first DIM voxels) |
+//! | `SCALARVOL` | a `raw` u8 volume, voxel 0 at MIN and the last at MAX, nearest-voxel samples every \|MAX − MIN\| / \|DIM\|, emitting Tachyon's red-yellow-white ramp with opacity OPACITY·s / \|MAX − MIN\| per unit length (s the voxel / 255), composited as Tachyon's (`additive_volumes`: opacities summed without attenuation up to 1, the box counted twice); a file with extra whole slices is read and cropped to the box (Tachyon reads the first DIM voxels) |
 //! | `START_CLIPGROUP NUMPLANES n a b c d ...` | clip group `clip-N` of planes with normal (a, b, c) through d·(a, b, c)/\|(a, b, c)\|² cutting away a·x + b·y + c·z > d, on every object up to END_CLIPGROUP (a new group replaces the one in effect) |
 //!
 //! ## Not yet
 //!
 //! Read into the syntax tree and reported with one warning each, but not rendered as Tachyon
 //! renders them: image maps whose placement the image texture cannot express (skewed planar
-//! axes, a SCALE that mirrors); Tachyon's two-pass volume compositing. Also different in
+//! axes, a SCALE that mirrors); a SCALARVOL's box as a shadow caster. Also different in
 //! small ways: the lens shape of PERSPECTIVE_DOF (a disc, Tachyon's is a rectangle: wider
-//! windows blur more sideways in Tachyon), image texel centres (Tachyon puts u = 0 and 1 on
-//! the first and last texel centres), MIP level choice, and the noise of antialiasing, depth of
-//! field and occlusion.
+//! windows blur more sideways in Tachyon), the coarse MIP levels of an image map (Tachyon
+//! averages 2 × 2 bytes and drops an odd last row or column; Luxon's levels are exact area
+//! averages), and the noise of antialiasing, depth of field and occlusion.
 
 mod files;
 mod lex;

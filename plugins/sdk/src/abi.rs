@@ -43,8 +43,9 @@ use std::ffi::c_void;
 
 /// Bumped on every incompatible change to this file. Version 2 added
 /// [`CallContext::memory_budget`], [`VolumeSink::add_dense_typed`] and the error sink of
-/// [`TextureInstanceVTable::eval`]; version 3 [`TextureObject::reads`].
-pub const ABI_VERSION: u32 = 3;
+/// [`TextureInstanceVTable::eval`]; version 3 [`TextureObject::reads`]; version 4
+/// [`TexQuery::distance`].
+pub const ABI_VERSION: u32 = 4;
 /// First eight bytes of every [`PluginHeader`].
 pub const MAGIC: [u8; 8] = *b"LUXONPLG";
 /// The one symbol a plugin library exports (NUL-terminated for `dlsym`).
@@ -396,8 +397,11 @@ pub const READS_UV: u32 = 1 << 2;
 pub const READS_FOOTPRINT: u32 = 1 << 3;
 /// [`TextureObject::reads`]: the ray's time [`TexQuery::time`].
 pub const READS_TIME: u32 = 1 << 4;
+/// [`TextureObject::reads`]: how far the ray travelled [`TexQuery::distance`].
+pub const READS_DISTANCE: u32 = 1 << 5;
 /// [`TextureObject::reads`]: every field.
-pub const READS_ALL: u32 = READS_POINT | READS_NORMAL | READS_UV | READS_FOOTPRINT | READS_TIME;
+pub const READS_ALL: u32 =
+    READS_POINT | READS_NORMAL | READS_UV | READS_FOOTPRINT | READS_TIME | READS_DISTANCE;
 
 /// Where and how a texture is looked up: one shading point (the SDK re-exports it at its
 /// root: `luxon_plugin::TexQuery`).
@@ -428,6 +432,10 @@ pub struct TexQuery {
     pub uv_footprint: f32,
     /// The ray's time within the frame's shutter, for textures that change over time.
     pub time: f32,
+    /// How far light travels from `p` to the camera along this path, in world units: the
+    /// camera ray's length plus every mirror and glass segment before it (an orthographic
+    /// camera's rays start on its image plane). Tachyon's image maps blur with it.
+    pub distance: f32,
 }
 
 #[repr(C)]

@@ -3,9 +3,11 @@
 use crate::cache::{self, Cache, CachedImage};
 use crate::decode::{plan, probe, Plan};
 use crate::mapping::{Kind, Mapping};
-use crate::mipmap::{bilinear, level_pair, mip_level, nearest, trilinear, Wrap};
+use crate::mipmap::{
+    bilinear, bilinear_inside, level_pair, mip_level, nearest, trilinear, Level, Wrap,
+};
 use crate::params::{up, yes, Factors};
-use luxon_plugin::abi::{TexQuery, READS_FOOTPRINT, READS_POINT, READS_UV};
+use luxon_plugin::abi::{TexQuery, READS_DISTANCE, READS_FOOTPRINT, READS_POINT, READS_UV};
 use luxon_plugin::{invalid, Context, Describe, Error, Texture};
 use serde::Deserialize;
 use std::sync::Arc;
@@ -13,7 +15,7 @@ use std::sync::Arc;
 /// What an image that cannot be decoded looks like.
 pub const MAGENTA: [f32; 4] = [1.0, 0.0, 1.0, 1.0];
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize)]
 pub enum Filter {
     /// The texel under the point, full resolution.
     #[serde(rename = "nearest", alias = "Nearest")]
@@ -25,6 +27,53 @@ pub enum Filter {
     #[default]
     #[serde(rename = "mip", alias = "Mip")]
     Mip,
+    /// Tachyon's MIP blur, which grows with the distance the ray travelled rather than with
+    /// the pixel's footprint: `tachyon(k)` blends levels `d (L − 0.9999)` of `L`, with
+    /// `d = k × distance` (planar), or that over `8 ×` the point's distance from `center`
+    /// (cylindrical, spherical), clamped to [0, 1]; from level `L − 2` on, the 1×1 level alone.
+    /// Texels are placed as Tachyon places them (the first and last texel centres at 0 and 1,
+    /// wrapping by the fractional part; `wrap` is not read). The Tachyon importer writes
+    /// `k = 0.05 × |SCALE|` (the larger of its two).
+    #[serde(rename = "tachyon", alias = "Tachyon")]
+    Tachyon(f64),
+}
+
+/// Tachyon's level count for a `w × h` image: the bit length of the larger side (256: 9
+/// levels, 256² down to 1²).
+fn tachyon_levels(w: usize, h: usize) -> usize {
+    (usize::BITS - w.max(h).leading_zeros()) as usize
+}
+
+/// `x`'s fractional part, in [0, 1).
+fn fract(x: f64) -> f64 {
+    let f = x - x.floor();
+    if f < 1.0 {
+        f
+    } else {
+        0.0
+    }
+}
+
+/// Bilinear as Tachyon's `ImageMap` places texels: `u` = 0 and 1 on the first and last texel
+/// centres of a row (`x = (w − 1) u`), `v` from the top row likewise.
+fn tachyon_bilinear(level: &Level, u: f64, v: f64) -> [f32; 4] {
+    let (w, h) = (level.width as f64, level.height as f64);
+    bilinear_inside(level, (w - 1.0) * u, (h - 1.0) * v)
+}
+
+/// The two levels and the weight of the second that Tachyon's MIP lookup blends for blur `d`
+/// on a pyramid of `levels`, as its `MIPMap` does: `d` clamped to [0, 1] is spread over
+/// `levels − 0.9999`, and past the second-coarsest level the coarsest is used alone.
+fn tachyon_pair(d: f64, levels: usize) -> (usize, usize, f32) {
+    let d = if d.is_nan() { 1.0 } else { d.clamp(0.0, 1.0) };
+    let at = d * (levels as f64 - 0.9999);
+    let lo = at as usize;
+    if lo + 2 < levels {
+        (lo, lo + 1, (at - lo as f64) as f32)
+    } else {
+        let last = levels.saturating_sub(1);
+        (last, last, 0.0)
+    }
 }
 
 #[derive(Deserialize)]
@@ -70,7 +119,7 @@ scale: f64 or (u, v) = 1.0  size of one copy of the image in mapping units (not 
 rotate: f64 = 0.0  turns the image counter-clockwise, degrees
 offset: (u, v) = (0, 0)  where the image's corner (0, 0) lands, mapping units
 wrap: repeat|clamp|mirror = repeat  outside the image: tile, extend the edges, or tile mirrored
-filter: nearest|bilinear|mip = mip  mip: trilinear, level chosen from the ray's footprint";
+filter: nearest|bilinear|mip|tachyon(k) = mip  mip: trilinear, level chosen from the ray's footprint; tachyon(k): Tachyon's blur, k × the distance the ray travelled";
 }
 
 /// The most memory one image may use while it is decoded (see `decode.rs`): its MIP levels
@@ -119,11 +168,25 @@ impl ImageTexture {
         if p.file.is_empty() {
             return Err(invalid("parameter `file` must name an image file"));
         }
+        if let Filter::Tachyon(k) = p.filter {
+            if !(k.is_finite() && k >= 0.0) {
+                return Err(invalid(format!(
+                    "filter `tachyon({k})`: the blur per unit of distance must be a finite \
+                     number ≥ 0"
+                )));
+            }
+            if p.mapping == Kind::Uv {
+                return Err(invalid(
+                    "filter `tachyon` follows Tachyon's planar, cylindrical and spherical \
+                     image maps; use it with one of those mappings",
+                ));
+            }
+        }
         let path = ctx.resolve(&p.file);
         let header = probe(&path)?;
         let plan = Plan {
             // Only MIP filtering reads the coarser levels.
-            mip: p.filter == Filter::Mip,
+            mip: matches!(p.filter, Filter::Mip | Filter::Tachyon(_)),
             ..plan(&path.display().to_string(), &header, decode_cap(ctx))?
         };
         let image = cache.register(&path, header, p.srgb, plan);
@@ -158,6 +221,7 @@ impl Texture for ImageTexture {
         match (self.mapping.kind(), self.filter) {
             (Kind::Uv, _) => READS_UV,
             (_, Filter::Mip) => READS_POINT | READS_FOOTPRINT,
+            (_, Filter::Tachyon(_)) => READS_POINT | READS_DISTANCE,
             _ => READS_POINT,
         }
     }
@@ -186,6 +250,26 @@ impl Texture for ImageTexture {
                 let (lo, hi, f) = level_pair(mip_level(texels, n), n);
                 self.cache
                     .with_levels(img, lo, hi, |a, b| trilinear(a, b, f, l.s, l.t, wrap))
+            }
+            Filter::Tachyon(k) => {
+                let (s, t) = self.mapping.point(q);
+                let radial = match self.mapping.kind() {
+                    Kind::Cylindrical | Kind::Spherical => 1e-9 + 8.0 * self.mapping.radius(q),
+                    _ => 1.0,
+                };
+                let d = k * f64::from(q.distance) / radial;
+                let n = tachyon_levels(img.width(), img.height()).min(img.levels());
+                let (lo, hi, f) = tachyon_pair(d, n);
+                let (u, v) = (fract(s), fract(1.0 - t));
+                self.cache.with_levels(img, lo, hi, |a, b| {
+                    let ca = tachyon_bilinear(a, u, v);
+                    let cb = if f > 0.0 {
+                        tachyon_bilinear(b, u, v)
+                    } else {
+                        ca
+                    };
+                    std::array::from_fn(|c| ca[c] + f * (cb[c] - ca[c]))
+                })
             }
         };
         got.map_err(Error::new)
@@ -648,5 +732,71 @@ mod tests {
             0,
             "the last instance frees the texels"
         );
+    }
+
+    #[test]
+    fn tachyon_levels_and_blends_are_tachyons() {
+        assert_eq!(tachyon_levels(256, 256), 9);
+        assert_eq!(tachyon_levels(300, 200), 9);
+        assert_eq!(tachyon_levels(4, 2), 3);
+        assert_eq!(tachyon_levels(1, 1), 1);
+        assert_eq!(tachyon_pair(0.0, 9), (0, 1, 0.0));
+        assert_eq!(tachyon_pair(-3.0, 9), (0, 1, 0.0));
+        let (lo, hi, f) = tachyon_pair(0.8, 9);
+        assert_eq!((lo, hi), (6, 7));
+        assert!((f - 0.40).abs() < 1e-3, "{f}");
+        // From level L − 2 on: the coarsest level alone, however much it is past it.
+        assert_eq!(tachyon_pair(0.9, 9), (8, 8, 0.0));
+        assert_eq!(tachyon_pair(7.0, 9), (8, 8, 0.0));
+        assert_eq!(tachyon_pair(f64::NAN, 9), (8, 8, 0.0));
+        assert_eq!(tachyon_pair(0.5, 1), (0, 0, 0.0));
+        assert_eq!(fract(-0.25), 0.75);
+        assert_eq!(fract(3.0), 0.0);
+        assert_eq!(fract(-1e-20), 0.0);
+    }
+
+    #[test]
+    fn tachyon_filter_blurs_by_distance_and_places_texels_as_tachyon() {
+        let dir = TempDir::new("img-tachyon");
+        fixture(&dir);
+        // Planar about +y: s = x, t = -z; k = 0.1 per unit of distance.
+        let t = tex(
+            &dir,
+            r#"(file: "ramp.png", srgb: false, mapping: planar, filter: tachyon(0.1))"#,
+        );
+        assert_eq!(t.reads(), READS_POINT | READS_DISTANCE);
+        let at_d = |p: [f64; 3], distance: f32| {
+            t.eval(&TexQuery {
+                p,
+                distance,
+                ..Default::default()
+            })
+        };
+        let g = |v: f32| grey(v / 255.0);
+        // Level 0: u = 0 and v = 0 are the first texel's centre, u = 0.5 half-way between the
+        // second and third (Tachyon's x = (w − 1) u), v = 0.5 half-way between the rows.
+        assert_eq!(at_d([0.0, 0.0, 0.0], 0.0), g(0.0));
+        assert!(close(at_d([0.5, 0.0, 0.0], 0.0), g(60.0), 1e-6));
+        assert!(close(at_d([0.0, 0.0, -0.5], 0.0), g(80.0), 1e-6));
+        assert!(
+            close(at_d([2.5, 0.0, -7.0], 0.0), g(60.0), 1e-6),
+            "wraps by u's fraction"
+        );
+        // d = 0.25 on 3 levels: level 0.500025, half-way to the 2 × 1 level (100 and 173.75).
+        let c = at_d([0.0, 0.0, 0.0], 2.5);
+        assert!(close(c, g(0.500025 * 100.0), 1e-4), "{c:?}");
+        // Far away: the 1 × 1 level, the mean of all eight texels.
+        let mean = (0.0 + 40.0 + 80.0 + 120.0 + 160.0 + 200.0 + 240.0 + 255.0) / 8.0;
+        assert!(close(at_d([0.3, 0.0, -0.2], 50.0), g(mean), 1e-4));
+        // A bad blur, and uv mapping (Tachyon's maps are projections), are refused.
+        for bad in [
+            r#"(file: "ramp.png", mapping: planar, filter: tachyon(-1.0))"#,
+            r#"(file: "ramp.png", filter: tachyon(0.1))"#,
+        ] {
+            let e = make_in::<ImageTexture>(bad, &ctx_in(dir.dir()))
+                .err()
+                .unwrap();
+            assert!(e.to_string().contains("tachyon"), "{e}");
+        }
     }
 }

@@ -180,7 +180,7 @@
 //! | `rotate`  | f64 degrees | `0` | turns the image counter-clockwise |
 //! | `offset`  | `(u, v)` | `(0, 0)` | where the image's corner `(0, 0)` lands |
 //! | `wrap`    | `repeat`, `clamp`, `mirror` | `repeat` | outside [0, 1): tile, extend the edge texels, tile mirrored |
-//! | `filter`  | `nearest`, `bilinear`, `mip` | `mip` | `mip`: trilinear between MIP levels chosen from the ray's footprint |
+//! | `filter`  | `nearest`, `bilinear`, `mip`, `tachyon(k)` | `mip` | `mip`: trilinear between MIP levels chosen from the ray's footprint; `tachyon(k)`: Tachyon's image-map blur, levels chosen from k × the distance the ray travelled, texels placed as Tachyon places them (what the Tachyon importer writes) |
 //!
 //! Names of `mapping`, `wrap` and `filter` may also be capitalised (`Planar`). Image
 //! coordinates `(s, t)` have `(0, 0)` at the image's bottom-left corner and `(1, 1)` at its

@@ -177,6 +177,12 @@ impl Mapping {
         self.kind
     }
 
+    /// How far the query's point is from the projection's centre (world units).
+    pub fn radius(&self, q: &TexQuery) -> f64 {
+        let d: [f64; 3] = std::array::from_fn(|i| q.p[i] - self.center[i]);
+        dot(d, d).sqrt()
+    }
+
     /// Image coordinates `(s, t)` alone, as [`Self::lookup`] gives them (for the filters that
     /// read no footprint).
     pub fn point(&self, q: &TexQuery) -> (f64, f64) {

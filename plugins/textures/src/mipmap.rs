@@ -34,6 +34,8 @@ enum Store {
     Bytes {
         codes: Vec<[u8; 4]>,
         decode: Box<[[f32; 256]; 2]>,
+        /// `decode` is `code / 255` on every channel (an image read as linear bytes).
+        linear: bool,
     },
 }
 
@@ -51,8 +53,14 @@ impl Level {
         decode: [[f32; 256]; 2],
     ) -> Level {
         let n = codes.len();
+        let linear = (0..256).all(|i| decode.iter().all(|d| d[i] == i as f32 / 255.0));
         let decode = Box::new(decode);
-        Level::with(width, height, n, Store::Bytes { codes, decode })
+        let store = Store::Bytes {
+            codes,
+            decode,
+            linear,
+        };
+        Level::with(width, height, n, store)
     }
 
     fn with(width: usize, height: usize, n: usize, store: Store) -> Level {
@@ -70,7 +78,7 @@ impl Level {
     pub fn bytes(&self) -> usize {
         match &self.store {
             Store::Floats(t) => std::mem::size_of_val(t.as_slice()),
-            Store::Bytes { codes, decode } => {
+            Store::Bytes { codes, decode, .. } => {
                 std::mem::size_of_val(codes.as_slice()) + std::mem::size_of_val(&**decode)
             }
         }
@@ -85,7 +93,9 @@ impl Level {
     pub fn texels(&self) -> std::borrow::Cow<'_, [[f32; 4]]> {
         match &self.store {
             Store::Floats(t) => t.into(),
-            Store::Bytes { codes, decode } => codes.iter().map(|&c| decoded(decode, c)).collect(),
+            Store::Bytes { codes, decode, .. } => {
+                codes.iter().map(|&c| decoded(decode, c)).collect()
+            }
         }
     }
 
@@ -93,7 +103,7 @@ impl Level {
         let i = y * self.width + x;
         match &self.store {
             Store::Floats(t) => t[i],
-            Store::Bytes { codes, decode } => decoded(decode, codes[i]),
+            Store::Bytes { codes, decode, .. } => decoded(decode, codes[i]),
         }
     }
 }
@@ -290,7 +300,7 @@ fn bilinear_with(level: &Level, s: f64, t: f64, wrap: Wrap) -> [f32; 4] {
     // The store decided once, outside the texel reads.
     match &level.store {
         Store::Floats(texels) => bilinear_in(level, s, t, wrap, |i| texels[i]),
-        Store::Bytes { codes, decode } => {
+        Store::Bytes { codes, decode, .. } => {
             bilinear_in(level, s, t, wrap, |i| decoded(decode, codes[i]))
         }
     }
@@ -311,7 +321,19 @@ fn bilinear_in(
     let (x0, y0) = (x0 as i64, y0 as i64);
     let (xa, xb) = wrap_pair(x0, level.width, wrap);
     let (ya, yb) = wrap_pair(y0, level.height, wrap);
-    let w = level.width;
+    blend(level.width, [xa, xb, ya, yb], fx, fy, texel)
+}
+
+/// The four texels at columns `xa`, `xb` and rows `ya`, `yb` of a level `w` wide, blended by
+/// `fx` across and `fy` down.
+#[inline(always)]
+fn blend(
+    w: usize,
+    [xa, xb, ya, yb]: [usize; 4],
+    fx: f32,
+    fy: f32,
+    texel: impl Fn(usize) -> [f32; 4],
+) -> [f32; 4] {
     let (p00, p10, p01, p11) = (
         texel(ya * w + xa),
         texel(ya * w + xb),
@@ -323,6 +345,33 @@ fn bilinear_in(
         let bottom = p01[c] + (p11[c] - p01[c]) * fx;
         top + (bottom - top) * fy
     })
+}
+
+/// Bilinear between the texel centres around texel position (`x`, `y`) (centres at integers,
+/// `y` from the top row), each within [0, size − 1]: nothing wraps, a last row or column is
+/// its own neighbour.
+pub fn bilinear_inside(level: &Level, x: f64, y: f64) -> [f32; 4] {
+    match &level.store {
+        Store::Floats(texels) => inside(level, x, y, |i| texels[i]),
+        // Linear bytes: blended as their codes, divided once (not four table reads each).
+        Store::Bytes {
+            codes,
+            linear: true,
+            ..
+        } => inside(level, x, y, |i| codes[i].map(f32::from)).map(|c| c / 255.0),
+        Store::Bytes { codes, decode, .. } => inside(level, x, y, |i| decoded(decode, codes[i])),
+    }
+}
+
+#[inline(always)]
+fn inside(level: &Level, x: f64, y: f64, texel: impl Fn(usize) -> [f32; 4]) -> [f32; 4] {
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let (w, h) = (level.width, level.height);
+    // `as` saturates: NaN and negatives become 0.
+    let (xa, ya) = ((x0 as usize).min(w - 1), (y0 as usize).min(h - 1));
+    let (xb, yb) = ((xa + 1).min(w - 1), (ya + 1).min(h - 1));
+    blend(w, [xa, xb, ya, yb], fx, fy, texel)
 }
 
 /// The continuous MIP level for a footprint `texels` wide on level 0: `log2(texels)`, clamped

@@ -1,5 +1,5 @@
-//! Test plugin: the handshake of a plugin built for plugin ABI 2 with luxon-plugin 0.2.0 (the
-//! version before the current one: its `TextureObject` had no `reads`), which the host must
+//! Test plugin: the handshake of a plugin built for plugin ABI 3 with luxon-plugin 0.3.0 (the
+//! version before the current one: its `TexQuery` had no `distance`), which the host must
 //! refuse. The header's leading fields keep their layout in every ABI version, so this is what
 //! such a library really declares; the host must stop after reading `abi_version` and never
 //! touch `declaration` (null here).
@@ -14,8 +14,8 @@ unsafe impl Sync for Header {}
 
 static HEADER: Header = Header(PluginHeader {
     magic: MAGIC,
-    abi_version: 2,
-    sdk_version: Str::new("0.2.0"),
+    abi_version: 3,
+    sdk_version: Str::new("0.3.0"),
     declaration: std::ptr::null(),
 });
 
