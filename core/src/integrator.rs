@@ -430,7 +430,8 @@ impl Whitted<'_> {
         // any thread count or decomposition, different for every path.
         let seed = if self.draws { ray_seed(ray) } else { 0 };
         // Light and occlusion rays leave smooth meshes from the curved surface, not the facet.
-        let (light_p, light_error) = if side.entering && s.lift != Vec3A::ZERO {
+        let lift = !self.scene.settings.tachyon.terminator_shadows;
+        let (light_p, light_error) = if lift && side.entering && s.lift != Vec3A::ZERO {
             let q = s.p + s.lift;
             (q, s.p_error + gamma(4) * (s.lift.abs() + q.abs()))
         } else {

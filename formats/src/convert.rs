@@ -464,6 +464,7 @@ impl Checker<'_> {
                     depth_limit_background: t.depth_limit_background.unwrap_or(false),
                     centre_sample: t.centre_sample.unwrap_or(false),
                     additive_volumes: t.additive_volumes.unwrap_or(false),
+                    terminator_shadows: t.terminator_shadows.unwrap_or(false),
                 },
                 None => d.tachyon,
             },

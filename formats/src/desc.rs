@@ -740,6 +740,9 @@ pub struct TachyonDesc {
     /// counts twice (Tachyon shades its box's front face, then through it the back face from
     /// inside): C·(2 − S) + (1 − S)² × what lies behind. Shadow rays are as before.
     pub additive_volumes: bool,
+    /// Smooth meshes shadow themselves near the terminator as their flat facets do: light
+    /// and occlusion rays start at the hit point, not lifted onto the smooth surface.
+    pub terminator_shadows: bool,
 }
 
 /// A memory size as a scene (`render: (memory: ...)`) or the command line (`--memory`) gives it.

@@ -601,6 +601,7 @@ pub(crate) struct Tachyon {
     pub depth_limit_background: Option<bool>,
     pub centre_sample: Option<bool>,
     pub additive_volumes: Option<bool>,
+    pub terminator_shadows: Option<bool>,
 }
 
 #[derive(Deserialize)]

@@ -1196,6 +1196,7 @@ pub(crate) fn render_fields(
         depth_limit_background,
         centre_sample,
         additive_volumes,
+        terminator_shadows,
     } = tachyon;
     f.push(("light_scale", format!("light_scale: {}", num(*light_scale))));
     f.push((
@@ -1203,7 +1204,8 @@ pub(crate) fn render_fields(
         format!(
             "tachyon: (light_threshold: {light_threshold}, plain_highlights: \
              {plain_highlights}, depth_limit_background: {depth_limit_background}, \
-             centre_sample: {centre_sample}, additive_volumes: {additive_volumes})"
+             centre_sample: {centre_sample}, additive_volumes: {additive_volumes}, \
+             terminator_shadows: {terminator_shadows})"
         ),
     ));
     f.push(("volume_step", format!("volume_step: {}", num(*volume_step))));

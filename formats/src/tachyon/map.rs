@@ -630,6 +630,7 @@ impl Mapper {
                     depth_limit_background: true,
                     centre_sample: true,
                     additive_volumes: true,
+                    terminator_shadows: true,
                 },
                 ..RenderDesc::default()
             },

@@ -166,7 +166,7 @@
 //! | Tachyon | Luxon |
 //! |---|---|
 //! | `SPHERE` | inline sphere |
-//! | `TRI`, `STRI` | inline triangles (flat; with vertex normals); triangles without area are left out, as Tachyon does |
+//! | `TRI`, `STRI` | inline triangles (flat; with vertex normals); triangles without area are left out, as Tachyon does; smooth ones shadow themselves at the terminator as their flat facets do (`terminator_shadows`, as Tachyon's shadow rays start on the facet) |
 //! | `VCSTRI ... C0 C1 C2 surface VCST` | an inline triangle with vertex normals and vertex `colors`, in the surface's material in white: the colours interpolated barycentrically are the surface colour, lit as any other (ambient, diffuse, highlights, mirror, transparency; METAL highlights take the vertex colour), as Tachyon does (measured) |
 //! | `FCYLINDER BASE APEX RAD` | inline open cylinder (a cone with equal radii) |
 //! | `POLYCYLINDER` | a sphere at every point and an open cylinder between neighbours (as Tachyon builds it) |
