@@ -738,7 +738,8 @@ pub struct TachyonDesc {
     /// Volumes composite as Tachyon's SCALARVOL: each sample adds its opacity σ·dt and its
     /// colour times that, without attenuation, until the sum S reaches 1, and the volume
     /// counts twice (Tachyon shades its box's front face, then through it the back face from
-    /// inside): C·(2 − S) + (1 − S)² × what lies behind. Shadow rays are as before.
+    /// inside): C·(2 − S) + (1 − S)² × what lies behind. Samples take their transfer
+    /// function's colour unshaded (as Tachyon's); shadow rays are as before.
     pub additive_volumes: bool,
     /// Smooth meshes shadow themselves near the terminator as their flat facets do: light
     /// and occlusion rays start at the hit point, not lifted onto the smooth surface.

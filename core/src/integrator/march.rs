@@ -285,7 +285,7 @@ pub fn march(scene: &Scene, ray: &Ray, t_end: f32, cutoff: f32, c: &mut Counters
 
 /// Tachyon's SCALARVOL compositing along `ray` before `t_end`: (colour, summed opacity S).
 /// Each sample adds its opacity σ·dt, and its colour times that, until the sum reaches 1; no
-/// attenuation in between (Tachyon's `scalar_volume_texture`).
+/// attenuation in between and no gradient shading (Tachyon's `scalar_volume_texture`).
 pub fn march_additive(scene: &Scene, ray: &Ray, t_end: f32, c: &mut Counters) -> (Vec3A, f32) {
     let mut m = Additive {
         color: Vec3A::ZERO,
