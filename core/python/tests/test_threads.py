@@ -32,7 +32,8 @@ def test_other_python_threads_run_while_rendering():
     t.start()
     try:
         t0 = time.perf_counter()
-        scene.render(320, 240, samples=16, threads=1)
+        # Sized to last well over 0.2 s on a fast machine (320 × 240 took 0.18 s on one).
+        scene.render(640, 480, samples=16, threads=1)
         seconds = time.perf_counter() - t0
         seen = count
     finally:
