@@ -220,8 +220,10 @@ impl Whitted<'_> {
             scene.intersect(ray, f32::INFINITY, c)
         };
         if !scene.features.volumes {
-            return match hit {
-                Some(hit) => self.shade(ray, &hit, depth, weight, media, cone, c),
+            // By reference: moving the hit out of the `Option` copies it in two wide loads,
+            // which stall on `intersect`'s narrow stores (fog: 2 % of the render).
+            return match &hit {
+                Some(hit) => self.shade(ray, hit, depth, weight, media, cone, c),
                 None => self.missed(ray, depth),
             };
         }
@@ -282,8 +284,7 @@ impl Whitted<'_> {
         c: &mut Counters,
     ) -> Vec3A {
         let scene = self.scene;
-        let hit = *hit;
-        let s = scene.surface(&hit, ray);
+        let s = scene.surface(hit, ray);
         let mat = &scene.materials[s.material as usize];
         let features = scene.features;
         let cone = cone.at(hit.t, scene.pixel_spread);

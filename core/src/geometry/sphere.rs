@@ -55,16 +55,16 @@ pub fn solve_sphere(
     let d = d.as_dvec3();
     let r = r as f64;
     let b = -f.dot(d);
+    let cc = f.dot(f) - r * r;
+    // Outside (cc > 0) and moving away (b < 0): q < 0, so both roots below are negative and
+    // neither lies past t_min >= 0. Answered first, without the discriminant, the square
+    // root and the division (a shadow ray leaving the sphere it starts on).
+    if cc > 0.0 && b < 0.0 && t_min >= 0.0 {
+        return (None, 0);
+    }
     let l = f + b * d;
     let disc = r * r - l.dot(l);
     if disc < 0.0 {
-        return (None, 0);
-    }
-    let cc = f.dot(f) - r * r;
-    // Outside (cc > 0) and moving away (b < 0): q < 0, so both roots below are negative and
-    // neither lies past t_min >= 0. Answered without the square root and the division (a
-    // shadow ray leaving the sphere it starts on).
-    if cc > 0.0 && b < 0.0 && t_min >= 0.0 {
         return (None, 0);
     }
     let q = b + disc.sqrt().copysign(b);

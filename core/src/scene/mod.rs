@@ -180,7 +180,7 @@ impl Light {
                 x * x * (3.0 - 2.0 * x)
             }
             Fade::Linear { inner, outer } => {
-                ((outer - cos.acos()) / (outer - inner)).clamp(0.0, 1.0)
+                ((outer - crate::math::acos(cos)) / (outer - inner)).clamp(0.0, 1.0)
             }
         }
     }

@@ -31,6 +31,11 @@
 //! a lookup is about to use are never evicted by that lookup, so an image larger than the
 //! whole budget still renders: the cache then holds just the levels in use.
 //!
+//! **Pinning.** While the images pinned so far stay within an eighth of the budget, a newly
+//! decoded image's levels are pinned: never evicted, freed only with the image. A lookup whose levels
+//! are both pinned reads them without announcing itself (no locked instruction). The bytes
+//! pinned count toward the budget like any others; the unpinned levels are evicted to fit.
+//!
 //! **Thrashing.** When an image has to be decoded a second time (its data was evicted and is
 //! needed again), the cache logs once, with the budget and the size of all registered texture
 //! data. A decode failure is kept with the image: every lookup then fails with its message
@@ -49,6 +54,9 @@ pub const DEFAULT_BUDGET: u64 = 1 << 30;
 
 /// Reader counters per image; threads are spread over them by where their stacks lie.
 const STRIPES: usize = 16;
+
+/// Images are pinned while the pinned bytes stay within this fraction of the budget (1/8).
+const PINNED_SHARE: u64 = 8;
 
 /// Where log messages go: `(level, message)`, level 0 error, 1 warning.
 pub type Log = Box<dyn Fn(u32, &str) + Send + Sync>;
@@ -76,6 +84,10 @@ struct Slot {
     stamp: AtomicU64,
     /// Size of the level's texels.
     bytes: u64,
+    /// Never evicted: set after `data` on install, cleared only when the image is freed.
+    /// A lookup of pinned levels needs no reader counter (its two locked instructions cost
+    /// fog, whose maps are read once in every two samples, 2 % of its render).
+    pinned: AtomicBool,
 }
 
 impl Slot {
@@ -147,6 +159,17 @@ impl CachedImage {
         self.slots.iter().map(|s| s.bytes).sum()
     }
 
+    /// Bytes of the pinned levels.
+    fn pinned_bytes(&self) -> u64 {
+        let pinned = self.slots.iter().filter(|s| s.pinned.load(Relaxed));
+        pinned.map(|s| s.bytes).sum()
+    }
+
+    /// Whether level `i` is pinned (for tests).
+    pub fn is_pinned(&self, i: usize) -> bool {
+        self.slots[i].pinned.load(Relaxed)
+    }
+
     /// Whether level `i` is resident now (for tests and statistics).
     pub fn is_resident(&self, i: usize) -> bool {
         !self.slots[i].data.load(SeqCst).is_null()
@@ -174,6 +197,7 @@ impl CachedImage {
     fn free_all(&self) -> u64 {
         let mut freed = 0;
         for slot in self.slots.iter() {
+            slot.pinned.store(false, Relaxed);
             let p = slot.data.swap(ptr::null_mut(), SeqCst);
             if !p.is_null() {
                 // SAFETY: from `Arc::into_raw`; swapped out, so released exactly once; and no
@@ -197,12 +221,16 @@ struct State {
     images: Vec<Arc<CachedImage>>,
     /// Bytes of resident levels.
     resident: u64,
+    /// Bytes of the pinned ones among them.
+    pinned: u64,
 }
 
 /// Counters, for tests and messages.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Stats {
     pub resident: u64,
+    /// Bytes of pinned levels (among `resident`).
+    pub pinned: u64,
     pub decodes: u64,
     pub evictions: u64,
     pub images: usize,
@@ -238,6 +266,7 @@ impl Cache {
             state: Mutex::new(State {
                 images: Vec::new(),
                 resident: 0,
+                pinned: 0,
             }),
             budget: AtomicU64::new(if budget == 0 { DEFAULT_BUDGET } else { budget }),
             clock: AtomicU64::new(1),
@@ -268,6 +297,7 @@ impl Cache {
         let st = self.lock();
         Stats {
             resident: st.resident,
+            pinned: st.pinned,
             decodes: self.decodes.load(Relaxed),
             evictions: self.evictions.load(Relaxed),
             images: st.images.len(),
@@ -315,6 +345,7 @@ impl Cache {
                 data: AtomicPtr::new(ptr::null_mut()),
                 stamp: AtomicU64::new(0),
                 bytes: (w * h * std::mem::size_of::<[f32; 4]>()) as u64,
+                pinned: AtomicBool::new(false),
             })
             .collect();
         let img = Arc::new(CachedImage {
@@ -341,6 +372,7 @@ impl Cache {
         // caller's being the last two is a stable fact here.
         if Arc::strong_count(img) == 2 {
             st.images.retain(|i| !Arc::ptr_eq(i, img));
+            st.pinned -= img.pinned_bytes();
             let freed = img.free_all();
             st.resident -= freed;
         }
@@ -362,6 +394,14 @@ impl Cache {
         b: usize,
         f: impl FnOnce(&Level, &Level) -> R,
     ) -> Result<R, String> {
+        let (sa, sb) = (&img.slots[a], &img.slots[b]);
+        if sa.pinned.load(Acquire) && sb.pinned.load(Acquire) {
+            let (pa, pb) = (sa.data.load(Relaxed), sb.data.load(Relaxed));
+            debug_assert!(!pa.is_null() && !pb.is_null());
+            // SAFETY: a pinned slot's pointer was stored before its flag (whose release the
+            // loads above acquired) and is neither evicted nor freed while a lookup can run.
+            return Ok(f(unsafe { &*pa }, unsafe { &*pb }));
+        }
         {
             let _reading = img.enter();
             let pa = img.slots[a].data.load(SeqCst);
@@ -390,9 +430,15 @@ impl Cache {
         a: usize,
         f: impl FnOnce(&Level) -> R,
     ) -> Result<R, String> {
+        let slot = &img.slots[a];
+        if slot.pinned.load(Acquire) {
+            let pa = slot.data.load(Relaxed);
+            debug_assert!(!pa.is_null());
+            // SAFETY: as in `with_levels`.
+            return Ok(f(unsafe { &*pa }));
+        }
         {
             let _reading = img.enter();
-            let slot = &img.slots[a];
             let pa = slot.data.load(SeqCst);
             if !pa.is_null() {
                 self.touch(slot);
@@ -447,6 +493,9 @@ impl Cache {
         // Installed levels get `now`; hits from here on stamp `now + 1`, i.e. newer.
         let now = self.clock.fetch_add(2, Relaxed) + 1;
         let (mut out_a, mut out_b) = (None, None);
+        // An image is pinned whole or not at all (a lookup reads two of its levels).
+        let unpinned = img.bytes() - img.pinned_bytes();
+        let pin = st.pinned + unpinned <= self.budget() / PINNED_SHARE;
         for (i, level) in levels.into_iter().enumerate() {
             let slot = &img.slots[i];
             let wanted = i == a || i == b;
@@ -458,6 +507,11 @@ impl Cache {
                     slot.data
                         .store(Arc::into_raw(arc.clone()) as *mut Level, SeqCst);
                     st.resident += slot.bytes;
+                    if pin {
+                        st.pinned += slot.bytes;
+                        // After the pointer: a lookup that sees the flag sees the level.
+                        slot.pinned.store(true, Release);
+                    }
                     arc
                 }
             };
@@ -505,6 +559,7 @@ impl Cache {
             for (n, img) in st.images.iter().enumerate() {
                 for (i, slot) in img.slots.iter().enumerate() {
                     if slot.data.load(SeqCst).is_null()
+                        || slot.pinned.load(Relaxed)
                         || (ptr::eq(&**img, keep) && (i == a || i == b))
                     {
                         continue;
@@ -655,6 +710,39 @@ mod tests {
             .unwrap();
         assert_eq!(v, (2, 1));
         assert!(!img.is_resident(0) && img.is_resident(2) && img.is_resident(3));
+    }
+
+    #[test]
+    fn small_images_are_pinned_within_an_eighth_of_the_budget() {
+        let dir = TempDir::new("cache-pinned");
+        let (a, b) = (flat(&dir, "a.png", 255), flat(&dir, "b.png", 0));
+        let (log, _) = recorder();
+        // An eighth is 1500 bytes: room for one pyramid of 1360 bytes, not two.
+        let cache = Cache::new(12_000, log);
+        let ia = cache.register(&a, probe(&a).unwrap(), true, FULL);
+        let ib = cache.register(&b, probe(&b).unwrap(), true, FULL);
+        assert_eq!(level0(&cache, &ia), Ok(1.0));
+        assert!((0..4).all(|i| ia.is_pinned(i)));
+        assert_eq!(cache.stats().pinned, 1360);
+        assert_eq!(level0(&cache, &ib), Ok(0.0));
+        assert!((0..4).all(|i| !ib.is_pinned(i)));
+        assert_eq!(cache.stats().pinned, 1360);
+        // Pinned levels read as any other (no reader counter: not observable but by speed).
+        let v = cache.with_levels(&ia, 1, 3, |l, m| (l.texels()[0][0], m.width));
+        assert_eq!(v, Ok((1.0, 1)));
+        // A budget too small for the rest evicts unpinned levels only.
+        cache.set_budget(1500);
+        let c = flat(&dir, "c.png", 128);
+        let ic = cache.register(&c, probe(&c).unwrap(), true, FULL);
+        level0(&cache, &ic).unwrap();
+        assert!((0..4).all(|i| ia.is_resident(i)));
+        assert!((0..4).all(|i| !ib.is_resident(i)));
+        assert!(cache.stats().evictions > 0);
+        // Releasing the image unpins and frees its levels.
+        cache.release(&ia);
+        drop(ia);
+        assert_eq!(cache.stats().pinned, 0);
+        assert!(cache.stats().resident <= 1500);
     }
 
     #[test]

@@ -57,8 +57,8 @@ fn fract(x: f64) -> f64 {
 /// Bilinear as Tachyon's `ImageMap` places texels: `u` = 0 and 1 on the first and last texel
 /// centres of a row (`x = (w − 1) u`), `v` from the top row likewise.
 fn tachyon_bilinear(level: &Level, u: f64, v: f64) -> [f32; 4] {
-    let (w, h) = (level.width as f64, level.height as f64);
-    bilinear_inside(level, (w - 1.0) * u, (h - 1.0) * v)
+    let (w, h) = level.last();
+    bilinear_inside(level, w * u, h * v)
 }
 
 /// The two levels and the weight of the second that Tachyon's MIP lookup blends for blur `d`

@@ -21,6 +21,8 @@ pub struct Level {
     store: Store,
     /// `width` and `height` as f64, converted once (a lookup scales by them).
     size: (f64, f64),
+    /// The last column's and row's index as f64 (lookups clamp to them).
+    last: (f64, f64),
 }
 
 /// How a level's texels are held.
@@ -40,6 +42,11 @@ enum Store {
 }
 
 impl Level {
+    /// The last column's and row's index, as f64.
+    pub fn last(&self) -> (f64, f64) {
+        self.last
+    }
+
     pub fn new(width: usize, height: usize, texels: Vec<[f32; 4]>) -> Level {
         Level::with(width, height, texels.len(), Store::Floats(texels))
     }
@@ -71,6 +78,7 @@ impl Level {
             height,
             store,
             size: (width as f64, height as f64),
+            last: ((width - 1) as f64, (height - 1) as f64),
         }
     }
 
@@ -368,10 +376,17 @@ fn inside(level: &Level, x: f64, y: f64, texel: impl Fn(usize) -> [f32; 4]) -> [
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
     let (w, h) = (level.width, level.height);
-    // `as` saturates: NaN and negatives become 0.
-    let (xa, ya) = ((x0 as usize).min(w - 1), (y0 as usize).min(h - 1));
+    let (xa, ya) = (index(x0, level.last.0), index(y0, level.last.1));
     let (xb, yb) = ((xa + 1).min(w - 1), (ya + 1).min(h - 1));
     blend(w, [xa, xb, ya, yb], fx, fy, texel)
+}
+
+/// Whole `x` clamped to [0, `last`] as an index; NaN gives 0. (Clamped as f64 first: the
+/// cast is then to i64, a few instructions, not a saturating one to usize.)
+#[inline(always)]
+fn index(x: f64, last: f64) -> usize {
+    // `max` passes over a NaN.
+    x.max(0.0).min(last) as i64 as usize
 }
 
 /// The continuous MIP level for a footprint `texels` wide on level 0: `log2(texels)`, clamped
