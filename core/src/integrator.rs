@@ -221,7 +221,7 @@ impl Whitted<'_> {
         };
         if !scene.features.volumes {
             // By reference: moving the hit out of the `Option` copies it in two wide loads,
-            // which stall on `intersect`'s narrow stores (fog: 2 % of the render).
+            // which stall on `intersect`'s narrow stores (2 % of Tachyon's fog's samples).
             return match &hit {
                 Some(hit) => self.shade(ray, hit, depth, weight, media, cone, c),
                 None => self.missed(ray, depth),
