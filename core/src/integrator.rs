@@ -309,7 +309,13 @@ impl Whitted<'_> {
         // Post-multiplied and additive: shade as if opaque (then scale by the opacity).
         let shade_opacity = if compose.scale_shading { opacity } else { 1.0 };
         let mut color = mat.ambient * shade_opacity * base;
-        color += self.lighting(ray, &s, &side, mat, base, shade_opacity, c);
+        // Shadow rays leaving a sphere outward need not ask it (see `Casters::blocked`).
+        let own = if side.entering {
+            scene.own_caster(hit)
+        } else {
+            0
+        };
+        color += self.lighting(ray, &s, &side, mat, base, shade_opacity, own, c);
         if compose.post {
             color *= opacity;
         }
@@ -424,6 +430,7 @@ impl Whitted<'_> {
         mat: &Material,
         base: Vec3A,
         opacity: f32,
+        own: u32,
         c: &mut Counters,
     ) -> Vec3A {
         let scene = self.scene;
@@ -458,6 +465,7 @@ impl Whitted<'_> {
             } else {
                 light_p
             },
+            own,
         };
         let mut lit = Vec3A::ZERO;
         // Each light's seed is mixed only by the lights that draw (see `direct`).
@@ -682,6 +690,8 @@ struct Shade {
     /// (`offset_up`, ~40 instructions), made once for the point's lights (nearly every
     /// shading point casts one; a lazy `Cell` cost more per shadow ray than it saved).
     up: Vec3A,
+    /// What a shadow ray from `up` may pass over ([`Scene::own_caster`], or 0).
+    own: u32,
 }
 
 /// What every light's term at a shading point obeys, from the settings and the material (see
@@ -989,12 +999,14 @@ impl Whitted<'_> {
         if shadows {
             c.shadow += 1;
             let up = || sh.up;
-            let (sray, t_max) = if P {
+            let (sray, t_max, above) = if P {
                 spawn_to_or(sh.p, sh.p_error, sh.ng, target, sh.time, up)
             } else {
-                let r = spawn_or(sh.p, sh.p_error, sh.ng, to_light, sh.time, up);
-                (r, f32::INFINITY)
+                let (r, above) = spawn_or(sh.p, sh.p_error, sh.ng, to_light, sh.time, up);
+                (r, f32::INFINITY, above)
             };
+            // From `up` toward a light on `ng`'s side: the point's own sphere cannot block.
+            let skip = if above { sh.own } else { 0 };
             if colourless {
                 // Blocked is what counts, not what arrives.
                 let mut through = scene.transmittance(&sray, t_max, scene.settings.min_weight, c);
@@ -1008,7 +1020,7 @@ impl Whitted<'_> {
             } else {
                 // Blocked or not needs no product: `arriving` times one is `arriving`.
                 let min_weight = scene.settings.min_weight;
-                match scene.blocked(&sray, t_max, min_weight, c) {
+                match scene.blocked(&sray, t_max, min_weight, skip, c) {
                     Some(true) => return Vec3A::ZERO,
                     Some(false) => {}
                     None => arriving *= scene.transmittance(&sray, t_max, min_weight, c),

@@ -121,7 +121,8 @@ pub fn spawn_to(p: Vec3A, p_error: Vec3A, ng: Vec3A, target: Vec3A, time: f32) -
 }
 
 /// [`spawn_to`] bit for bit, given `up()`, the point's [`offset_up`] (made once per point
-/// by the caller): only a target behind the geometric normal pays for its own offset.
+/// by the caller): only a target behind the geometric normal pays for its own offset. The
+/// third value: the ray starts at `up()` (the target is on `ng`'s side).
 #[inline(always)]
 pub fn spawn_to_or(
     p: Vec3A,
@@ -130,17 +131,19 @@ pub fn spawn_to_or(
     target: Vec3A,
     time: f32,
     up: impl FnOnce() -> Vec3A,
-) -> (Ray, f32) {
+) -> (Ray, f32, bool) {
     let d = target - p;
-    let o = if d.dot(ng) < 0.0 {
-        offset_origin(p, p_error, ng, d)
+    let (o, above) = if d.dot(ng) < 0.0 {
+        (offset_origin(p, p_error, ng, d), false)
     } else {
-        up()
+        (up(), true)
     };
-    ray_to(o, target, time)
+    let (ray, t_max) = ray_to(o, target, time);
+    (ray, t_max, above)
 }
 
-/// [`spawn`] bit for bit, given the point's [`offset_up`] as `up()` (see [`spawn_to_or`]).
+/// [`spawn`] bit for bit, given the point's [`offset_up`] as `up()` (see [`spawn_to_or`]);
+/// with whether the ray starts at `up()`.
 #[inline(always)]
 pub fn spawn_or(
     p: Vec3A,
@@ -149,13 +152,15 @@ pub fn spawn_or(
     dir: Vec3A,
     time: f32,
     up: impl FnOnce() -> Vec3A,
-) -> Ray {
-    let o = if dir.dot(ng) < 0.0 {
-        offset_origin(p, p_error, ng, dir)
+) -> (Ray, bool) {
+    if dir.dot(ng) < 0.0 {
+        (
+            Ray::new(offset_origin(p, p_error, ng, dir), dir, time),
+            false,
+        )
     } else {
-        up()
-    };
-    Ray::new(o, dir, time)
+        (Ray::new(up(), dir, time), true)
+    }
 }
 
 /// The ray from `o` toward `target` and the distance to just short of it.
@@ -244,12 +249,14 @@ mod tests {
                 let w = if k % 5 == 0 { ng.cross(w) } else { w };
                 let target = p + 3.0 * w;
                 let (want, wt) = spawn_to(p, p_error, ng, target, 0.5);
-                let (got, gt) = spawn_to_or(p, p_error, ng, target, 0.5, || up);
+                let (got, gt, above) = spawn_to_or(p, p_error, ng, target, 0.5, || up);
                 assert_eq!((bits(&got), gt.to_bits()), (bits(&want), wt.to_bits()));
+                assert_eq!(above, (target - p).dot(ng) >= 0.0);
                 let dir = w.normalize();
                 let want = spawn(p, p_error, ng, dir, 0.5);
-                let got = spawn_or(p, p_error, ng, dir, 0.5, || up);
+                let (got, above) = spawn_or(p, p_error, ng, dir, 0.5, || up);
                 assert_eq!(bits(&got), bits(&want));
+                assert_eq!(above, dir.dot(ng) >= 0.0);
                 n += 1;
             }
         }

@@ -540,7 +540,7 @@ impl Scene {
     /// the product of the filters (`Material::shadow`) of the surfaces it crosses.
     #[inline]
     pub fn transmittance(&self, ray: &Ray, t_max: f32, min_weight: f32, c: &mut Counters) -> Vec3A {
-        match self.blocked(ray, t_max, min_weight, c) {
+        match self.blocked(ray, t_max, min_weight, 0, c) {
             Some(true) => Vec3A::ZERO,
             Some(false) => Vec3A::ONE,
             None => self.transmittance_filtered(ray, t_max, min_weight, c),
@@ -549,18 +549,34 @@ impl Scene {
 
     /// In a scene whose shadow rays are blocked or pass unchanged ([`Casters`]): whether
     /// `ray` is blocked ([`Scene::transmittance`] zero or one). `None` elsewhere, asking
-    /// nothing: the caller asks [`Scene::transmittance`].
+    /// nothing: the caller asks [`Scene::transmittance`]. `skip`: [`Scene::own_caster`] of
+    /// the sphere a ray leaves outward toward its end on the same side, else 0.
     #[inline(always)]
     pub fn blocked(
         &self,
         ray: &Ray,
         t_max: f32,
         min_weight: f32,
+        skip: u32,
         c: &mut Counters,
     ) -> Option<bool> {
         match (&self.casters, min_weight <= 1.0) {
-            (Some(casters), true) => Some(casters.blocked(self, ray, t_max, c)),
+            (Some(casters), true) => Some(casters.blocked(self, ray, t_max, skip, c)),
             _ => None,
+        }
+    }
+
+    /// For a hit on a sphere of the scene's own geometry: what [`Scene::blocked`] may pass
+    /// over for shadow rays leaving it outward (0 for any other hit or scene).
+    #[inline(always)]
+    pub fn own_caster(&self, hit: &Hit) -> u32 {
+        if hit.kind != Kind::Sphere || hit.instance != NO_INSTANCE || hit.moving || hit.object != 0
+        {
+            return 0;
+        }
+        match &self.casters {
+            Some(casters) => casters.own(hit.index),
+            None => 0,
         }
     }
 
