@@ -69,6 +69,13 @@ fn truncate(x: f32, max: f32) -> f32 {
     (linear_unit(x) * max).floor().min(max)
 }
 
+/// [`truncate`] before its `floor`: the same step once cast to an integer, which truncates
+/// (and takes NaN to 0, as `linear_unit` does).
+#[inline(always)]
+fn unfloored(x: f32, max: f32) -> f32 {
+    x.clamp(0.0, 1.0) * max
+}
+
 /// Encoded samples, RGB or RGBA, one `T` per channel; alpha is stored linearly and rounded.
 fn encode_samples<T: Copy>(
     image: &Image,
@@ -81,8 +88,11 @@ fn encode_samples<T: Copy>(
     let channels = if alpha { 4 } else { 3 };
     if encoding == Encoding::Display {
         // No curve to save here: every pixel is stepped, into a buffer of known size, without
-        // the repeated-pixel test (a pure function of the same bits: the same bytes).
-        let step = |c: f32| from_step(truncate(c, max));
+        // the repeated-pixel test (a pure function of the same bits: the same bytes). The
+        // step is `truncate`'s without its `floor` and `min` (the clamped value scaled is in
+        // [0, max], where the cast's truncation is the floor): a 1024² frame in 23 M
+        // instructions, not 26 M.
+        let step = |c: f32| from_step(unfloored(c, max));
         let pixels = image.rgba.chunks_exact(4);
         let mut out = vec![from_step(0.0); pixels.len() * channels];
         if alpha {
@@ -144,6 +154,32 @@ pub(crate) fn default_bits() -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The vector-friendly step casts to `truncate`'s sample for every kind of value: a
+    /// spread of bit patterns (signs, NaNs, infinities, subnormals), and each step's edges.
+    #[test]
+    fn unfloored_steps_cast_as_truncated_ones() {
+        let same = |x: f32| {
+            assert_eq!(unfloored(x, 255.0) as u8, truncate(x, 255.0) as u8, "{x:e}");
+            assert_eq!(
+                unfloored(x, 65535.0) as u16,
+                truncate(x, 65535.0) as u16,
+                "{x:e}"
+            );
+        };
+        for bits in (0..=u32::MAX).step_by(7919) {
+            same(f32::from_bits(bits));
+        }
+        for k in 0..=65535u32 {
+            for max in [255.0f32, 65535.0] {
+                let x = k as f32 / max;
+                [x, x.next_up(), x.next_down()].into_iter().for_each(same);
+            }
+        }
+        [0.0, -0.0, 1.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY]
+            .into_iter()
+            .for_each(same);
+    }
 
     #[test]
     fn srgb_quantization_known_values() {
