@@ -181,18 +181,8 @@ mod tests {
     use crate::geometry::sphere::intersect_sphere;
     use crate::geometry::Clips;
     use crate::math::Vec3A;
+    use crate::scene::testing::rng;
     use glam::Vec3;
-
-    /// A small deterministic generator (xorshift), numbers in [0, 1).
-    fn rng(seed: u64) -> impl FnMut() -> f32 {
-        let mut x = seed;
-        move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 40) as f32 / (1u64 << 24) as f32
-        }
-    }
 
     #[test]
     fn the_lanes_find_the_trees_nearest_sphere() {

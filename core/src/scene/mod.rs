@@ -14,6 +14,19 @@ mod instances;
 mod place;
 mod series;
 mod shadows;
+#[cfg(test)]
+mod testing {
+    /// A small deterministic generator (xorshift), numbers in [0, 1).
+    pub fn rng(seed: u64) -> impl FnMut() -> f32 {
+        let mut x = seed;
+        move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+}
 mod sky;
 mod sweep;
 pub(crate) mod update;

@@ -292,6 +292,7 @@ impl Casters {
 mod tests {
     use super::*;
     use crate::geometry::triangle::{intersect_triangle, TriRay};
+    use crate::scene::testing::rng;
     use glam::Vec3;
 
     /// The lanes' sphere query gives `any_few`'s answer and test count: rays from the
@@ -299,13 +300,7 @@ mod tests {
     /// copies and spheres inside one another.
     #[test]
     fn lanes_answer_as_any_few() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut r = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = rng(0x2545_f491_4f6c_dd1d);
         let (mut blocked, mut open) = (0, 0);
         for n in 0..=4 {
             let mut set = Spheres::default();
@@ -367,13 +362,7 @@ mod tests {
     fn a_ray_leaving_a_sphere_outward_never_meets_it() {
         use crate::geometry::sphere::surface;
         use crate::ray::{offset_up, spawn_to_or};
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut r = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = rng(0x9e37_79b9_7f4a_7c15);
         fn unit(r: &mut impl FnMut() -> f32) -> Vec3A {
             Vec3A::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize()
         }
