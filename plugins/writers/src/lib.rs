@@ -90,6 +90,7 @@ mod jpeg;
 mod openexr;
 mod png;
 mod ppm;
+mod srgb8;
 #[cfg(test)]
 mod testing;
 mod tga;
