@@ -231,12 +231,8 @@ pub fn rgba8(px: [f32; 4]) -> [u8; 4] {
     } else {
         px[3].clamp(0.0, 1.0)
     };
-    [
-        q(luxon_plugin::linear_to_srgb(px[0])),
-        q(luxon_plugin::linear_to_srgb(px[1])),
-        q(luxon_plugin::linear_to_srgb(px[2])),
-        q(alpha),
-    ]
+    let t = luxon_plugin::srgb8::tables();
+    [t.sample(px[0]), t.sample(px[1]), t.sample(px[2]), q(alpha)]
 }
 
 #[cfg(test)]

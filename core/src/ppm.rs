@@ -2,10 +2,14 @@
 //! collectively over MPI-IO): the header and the pixel bytes, exactly as the `ppm` writer plugin
 //! makes them.
 
-/// Appends the 8-bit sRGB RGB bytes of linear RGBA pixels, exactly as the `ppm` writer does.
+/// Appends the 8-bit sRGB RGB bytes of linear RGBA pixels, exactly as the `ppm` writer does
+/// (the SDK's exact tables, [`luxon_plugin::srgb8`]).
 pub fn srgb8(rgba: &[f32], out: &mut Vec<u8>) {
-    let encode = |c: f32| (luxon_plugin::linear_to_srgb(c) * 255.0).round() as u8;
-    luxon_plugin::encode_rgb(rgba, encode, |rgb, _| out.extend_from_slice(&rgb));
+    let t = luxon_plugin::srgb8::tables();
+    out.reserve(rgba.len() / 4 * 3);
+    for px in rgba.chunks_exact(4) {
+        out.extend_from_slice(&[t.sample(px[0]), t.sample(px[1]), t.sample(px[2])]);
+    }
 }
 
 pub fn ppm_header(width: u32, height: u32) -> Vec<u8> {
@@ -16,9 +20,10 @@ pub fn ppm_header(width: u32, height: u32) -> Vec<u8> {
 mod tests {
     use super::*;
 
-    /// Runs of equal pixels (copied bytes) encode as every pixel computed on its own.
+    /// Pixels encode as each alone, and as the curve itself rounds (NaN, negative and over-one
+    /// values, runs of equal pixels).
     #[test]
-    fn repeated_pixels_encode_as_computed_alone() {
+    fn pixels_encode_alone_and_as_the_curve_gives() {
         let values = [
             0.0,
             -0.0,
@@ -44,5 +49,11 @@ mod tests {
         }
         assert_eq!(all, alone);
         assert_eq!(&all[..3], &[0, 124, 0]);
+        let curve: Vec<u8> = rgba
+            .chunks_exact(4)
+            .flat_map(|p| p[..3].to_vec())
+            .map(luxon_plugin::srgb8::direct)
+            .collect();
+        assert_eq!(all, curve);
     }
 }

@@ -43,6 +43,7 @@ pub mod abi;
 pub mod files;
 pub mod names;
 mod params;
+pub mod srgb8;
 
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};

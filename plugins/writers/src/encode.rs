@@ -1,8 +1,7 @@
 //! What every integer format shares: the image checks, the encoding and quantisation of the
 //! samples (`encoding`), and the error of a failed encoder.
 
-use crate::srgb8;
-use luxon_plugin::{encode_rgb, invalid, linear_to_srgb, Error, Image};
+use luxon_plugin::{encode_rgb, invalid, linear_to_srgb, srgb8, Error, Image};
 use serde::Deserialize;
 
 /// How colour values become integer samples (parameter `encoding`).

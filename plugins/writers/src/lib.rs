@@ -90,7 +90,6 @@ mod jpeg;
 mod openexr;
 mod png;
 mod ppm;
-mod srgb8;
 #[cfg(test)]
 mod testing;
 mod tga;

@@ -11,10 +11,11 @@
 //! step (the only place `powf`'s rounding could break it). Checked once over every float
 //! from 0 to 1 too (1,065,353,217, all equal; 3 s in a release build, so not a test).
 //!
-//! A 1024² frame: the curve took 151 M instructions through `powf`, a lookup a few.
+//! A 1024² frame: the curve took 151 M instructions through `powf` (skipping repeated
+//! pixels), the tables 60 M. For a whole image take [`tables`] once and call
+//! [`Tables::sample`]; [`srgb8`] is the same for one value.
 
-use crate::encode::quantize8;
-use luxon_plugin::linear_to_srgb;
+use crate::linear_to_srgb;
 use std::sync::OnceLock;
 
 /// Bits of 1.0: every float from 0 to 1 has bits at or below it.
@@ -25,7 +26,7 @@ const RUN_BITS: u32 = 16;
 /// Runs of 2^16 floats from 0 to 1 (1.0 starts the last).
 const RUNS: usize = (ONE >> RUN_BITS) as usize + 1;
 
-pub(crate) struct Tables {
+pub struct Tables {
     /// `first[k]`: the bits of the first float in [0, 1] whose sample is at least `k`
     /// (`first[0]` = 0).
     first: [u32; 256],
@@ -34,12 +35,12 @@ pub(crate) struct Tables {
 }
 
 /// The sample `linear_to_srgb` and rounding give: the function the tables stand for.
-pub(crate) fn direct(x: f32) -> u8 {
-    quantize8(linear_to_srgb(x))
+pub fn direct(x: f32) -> u8 {
+    (linear_to_srgb(x) * 255.0).round() as u8
 }
 
 /// The tables, made on first use (about 24 000 evaluations of the curve).
-pub(crate) fn tables() -> &'static Tables {
+pub fn tables() -> &'static Tables {
     static TABLES: OnceLock<Tables> = OnceLock::new();
     TABLES.get_or_init(|| {
         let mut first = [0u32; 256];
@@ -64,10 +65,16 @@ pub(crate) fn tables() -> &'static Tables {
     })
 }
 
+/// `round(255 · linear_to_srgb(x))`, from the tables.
+#[inline]
+pub fn srgb8(x: f32) -> u8 {
+    tables().sample(x)
+}
+
 impl Tables {
     /// `direct(x)`, from the tables.
     #[inline]
-    pub(crate) fn sample(&self, x: f32) -> u8 {
+    pub fn sample(&self, x: f32) -> u8 {
         let bits = x.to_bits();
         // Negative values (and -0.0) clamp to 0, above 1 (and +inf) to 255; NaN (either
         // sign) is 0.
