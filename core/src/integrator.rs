@@ -310,11 +310,7 @@ impl Whitted<'_> {
         let shade_opacity = if compose.scale_shading { opacity } else { 1.0 };
         let mut color = mat.ambient * shade_opacity * base;
         // Shadow rays leaving a sphere outward need not ask it (see `Casters::blocked`).
-        let own = if side.entering {
-            scene.own_caster(hit)
-        } else {
-            0
-        };
+        let own = scene.own_caster(hit, side.entering);
         color += self.lighting(ray, &s, &side, mat, base, shade_opacity, own, c);
         if compose.post {
             color *= opacity;

@@ -579,12 +579,13 @@ impl Scene {
         }
     }
 
-    /// For a hit on a sphere of the scene's own geometry: what [`Scene::blocked`] may pass
-    /// over for shadow rays leaving it outward (0 for any other hit or scene).
+    /// For a hit from outside (`entering`) on a sphere of the scene's own geometry: what
+    /// [`Scene::blocked`] may pass over for shadow rays leaving it outward (0 for any other
+    /// hit or scene).
     #[inline(always)]
-    pub fn own_caster(&self, hit: &Hit) -> u32 {
-        if hit.kind != Kind::Sphere || hit.instance != NO_INSTANCE || hit.moving || hit.object != 0
-        {
+    pub fn own_caster(&self, hit: &Hit, entering: bool) -> u32 {
+        let own = hit.kind == Kind::Sphere && hit.instance == NO_INSTANCE && !hit.moving;
+        if !entering || !own || hit.object != 0 {
             return 0;
         }
         match &self.casters {

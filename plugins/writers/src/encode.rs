@@ -56,7 +56,7 @@ fn linear_unit(x: f32) -> f32 {
     }
 }
 
-pub(crate) fn quantize8(x: f32) -> u8 {
+fn quantize8(x: f32) -> u8 {
     (x * 255.0).round() as u8
 }
 
@@ -108,8 +108,7 @@ pub(crate) fn samples8(image: &Image, alpha: bool, encoding: Encoding) -> Vec<u8
             let t = srgb8::tables();
             each_sample(image, alpha, |c| t.sample(c), quantize8, 0)
         }
-        // `truncate`'s step without its `floor` and `min` (the clamped value scaled is in
-        // [0, 255], where the cast's truncation is the floor): 23 M instructions, not 26 M.
+        // Stepped without a `floor` (see `unfloored`): 23 M instructions, not 26 M.
         Encoding::Display => each_sample(image, alpha, |c| unfloored(c, 255.0) as u8, quantize8, 0),
     }
 }
