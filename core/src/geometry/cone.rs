@@ -219,6 +219,7 @@ pub fn surface(c: &Cone, t: f32, ray: &Ray, uv: bool, material: u32) -> Surface 
 
 #[cfg(test)]
 mod tests {
+    use super::super::testing::Lcg;
     use super::*;
 
     const CYL: Cone = Cone {
@@ -294,39 +295,6 @@ mod tests {
             f32::INFINITY,
         );
         assert_eq!(n, 0);
-    }
-
-    /// Deterministic numbers for the random cases.
-    struct Lcg(u64);
-
-    impl Lcg {
-        /// Uniform in [0, 1).
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next()
-        }
-        /// 10^x for x uniform in [lo, hi).
-        fn log(&mut self, lo: f64, hi: f64) -> f64 {
-            10f64.powf(self.range(lo, hi))
-        }
-        fn unit(&mut self) -> DVec3 {
-            loop {
-                let v = DVec3::new(
-                    self.range(-1.0, 1.0),
-                    self.range(-1.0, 1.0),
-                    self.range(-1.0, 1.0),
-                );
-                if v.length() > 0.1 && v.length() <= 1.0 {
-                    return v.normalize();
-                }
-            }
-        }
     }
 
     /// The f32 rejection never turns away a line on which the exact test finds a root, over

@@ -22,6 +22,44 @@ pub mod triangle;
 mod props;
 
 #[cfg(test)]
+mod testing {
+    use crate::math::DVec3;
+
+    /// Deterministic numbers for the random cases.
+    pub struct Lcg(pub u64);
+
+    impl Lcg {
+        /// Uniform in [0, 1).
+        pub fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.next()
+        }
+        /// 10^x for x uniform in [lo, hi).
+        pub fn log(&mut self, lo: f64, hi: f64) -> f64 {
+            10f64.powf(self.range(lo, hi))
+        }
+        pub fn unit(&mut self) -> DVec3 {
+            loop {
+                let v = DVec3::new(
+                    self.range(-1.0, 1.0),
+                    self.range(-1.0, 1.0),
+                    self.range(-1.0, 1.0),
+                );
+                if v.length() > 0.1 && v.length() <= 1.0 {
+                    return v.normalize();
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     /// A hit is copied on every closer find: the array objects' and the instances' numbers
     /// took padding and the room of the plugin objects' uv (kept in `b1`, `b2`).

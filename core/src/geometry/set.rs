@@ -14,12 +14,23 @@ pub trait Shape: Copy + Send + Sync {
     /// What a ray precomputes once per traversal (e.g. the triangle test's shear).
     type Prep: Copy;
     fn prep(ray: &Ray) -> Self::Prep;
+    /// The kind has tests that pay only among [`Shape::dense`] primitives
+    /// ([`Shape::hit_after_in`], [`Shape::crossings_in`]); sets of other kinds compile one
+    /// traversal, not two.
+    const DENSE_TESTS: bool = false;
+    /// Whether these primitives (in leaf order) overlap so much that tests which pay only then
+    /// should run (see `Set::dense`).
+    fn dense(data: &[Self]) -> bool {
+        let _ = data;
+        false
+    }
     fn bounds(&self) -> Aabb;
     /// The SAH prices a leaf by blocks of this many primitives (see `Bvh::build_blocks`): more
     /// than 1 for a kind whose leaf test takes a block at a time. Triangles stay at 1 until
     /// such a test pays and ties are canonical (examples/BENCHMARKS.md, h9-tri).
     const LEAF_BLOCK: usize = 1;
     /// The nearest hit in (0, t_max): t and two kind-specific values (triangle barycentrics).
+    #[inline(always)]
     fn hit(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> Option<(f32, f32, f32)> {
         self.hit_after(ray, prep, 0.0, t_max)
     }
@@ -35,6 +46,23 @@ pub trait Shape: Copy + Send + Sync {
     #[inline(always)]
     fn crossings(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> u32 {
         u32::from(self.hit(ray, prep, t_max).is_some())
+    }
+    /// [`Shape::hit_after`] in a set that is [`Shape::dense`] (`DENSE`) or not: the same
+    /// answer, by the tests that pay there.
+    #[inline(always)]
+    fn hit_after_in<const DENSE: bool>(
+        &self,
+        ray: &Ray,
+        prep: &Self::Prep,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32)> {
+        self.hit_after(ray, prep, t_min, t_max)
+    }
+    /// [`Shape::crossings`] in a set that is [`Shape::dense`] (`DENSE`) or not.
+    #[inline(always)]
+    fn crossings_in<const DENSE: bool>(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> u32 {
+        self.crossings(ray, prep, t_max)
     }
 }
 
@@ -58,6 +86,9 @@ pub struct Set<S> {
     /// Some primitive belongs to a clip group (set when built): without, tests skip the
     /// packed-material load.
     clipped: bool,
+    /// The primitives overlap much ([`Shape::dense`], set when built): a hint that only
+    /// chooses which of a kind's equivalent tests run, never what they find.
+    dense: bool,
 }
 
 impl<S> Default for Set<S> {
@@ -67,6 +98,7 @@ impl<S> Default for Set<S> {
             material: Vec::new(),
             bvh: Bvh::default(),
             clipped: false,
+            dense: false,
         }
     }
 }
@@ -88,11 +120,13 @@ impl<S: Shape> Set<S> {
     /// A set already built (read back from the geometry cache).
     pub(crate) fn from_parts(data: Vec<S>, material: Vec<u32>, bvh: Bvh) -> Set<S> {
         let clipped = material.iter().any(|&m| clip_of(m) != 0);
+        let dense = S::dense(&data);
         Set {
             data,
             material,
             bvh,
             clipped,
+            dense,
         }
     }
 
@@ -145,6 +179,7 @@ impl<S: Shape> Set<S> {
         }
         self.bvh = bvh;
         self.clipped = self.material.iter().any(|&m| clip_of(m) != 0);
+        self.dense = S::dense(&self.data);
     }
 
     /// A copy holding only the primitives whose packed material `keep` accepts, with its own
@@ -162,7 +197,7 @@ impl<S: Shape> Set<S> {
 
     /// The nearest hit of primitive `i` in (0, t_max) that its clip group keeps.
     #[inline(always)]
-    fn kept_hit(
+    fn kept_hit<const DENSE: bool>(
         &self,
         i: usize,
         ray: &Ray,
@@ -171,16 +206,20 @@ impl<S: Shape> Set<S> {
         clips: &Clips,
     ) -> Option<(f32, f32, f32)> {
         let shape = &self.data[i];
+        let hit = |t_max| match DENSE {
+            true => shape.hit_after_in::<true>(ray, prep, 0.0, t_max),
+            false => shape.hit(ray, prep, t_max),
+        };
         if !self.clipped {
-            return shape.hit(ray, prep, t_max);
+            return hit(t_max);
         }
         let clip = clip_of(self.material[i]);
         if clip == 0 {
-            return shape.hit(ray, prep, t_max);
+            return hit(t_max);
         }
         let mut lo = 0.0;
         loop {
-            let h = shape.hit_after(ray, prep, lo, t_max)?;
+            let h = shape.hit_after_in::<DENSE>(ray, prep, lo, t_max)?;
             if !clips.cut(clip, ray.at(h.0)) {
                 return Some(h);
             }
@@ -222,6 +261,27 @@ impl<S: Shape> Set<S> {
         if self.data.is_empty() {
             return;
         }
+        if S::DENSE_TESTS && self.dense {
+            self.closest_with::<true>(ray, boxes, t_max, hit, clips, c, noted);
+        } else {
+            self.closest_with::<false>(ray, boxes, t_max, hit, clips, c, noted);
+        }
+    }
+
+    /// [`Set::intersect_noting`] with the tests for `DENSE` primitives or the others (a
+    /// constant, so the choice is made once per ray, not per test).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn closest_with<const DENSE: bool>(
+        &self,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: &mut f32,
+        hit: &mut Option<Hit>,
+        clips: &Clips,
+        c: &mut Counters,
+        noted: impl Fn(usize),
+    ) {
         let prep = S::prep(ray);
         *t_max = self.bvh.intersect_ray(
             boxes,
@@ -229,7 +289,7 @@ impl<S: Shape> Set<S> {
             #[inline(always)]
             |i, tm| {
                 c.tests += 1;
-                let (t, b1, b2) = self.kept_hit(i, ray, &prep, tm, clips)?;
+                let (t, b1, b2) = self.kept_hit::<DENSE>(i, ray, &prep, tm, clips)?;
                 let mut h = Hit::new(t, S::KIND, i);
                 h.b1 = b1;
                 h.b2 = b2;
@@ -346,11 +406,31 @@ impl<S: Shape> Set<S> {
         clips: &Clips,
         c: &mut Counters,
         skip: impl Fn(u32) -> bool,
-        mut on_hit: impl FnMut(u32, u32) -> bool,
+        on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
         if self.data.is_empty() {
             return false;
         }
+        if S::DENSE_TESTS && self.dense {
+            self.first_with::<SKIP, true>(ray, boxes, t_max, clips, c, skip, on_hit)
+        } else {
+            self.first_with::<SKIP, false>(ray, boxes, t_max, clips, c, skip, on_hit)
+        }
+    }
+
+    /// [`Set::any_with`] with the tests for `DENSE` primitives or the others.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn first_with<const SKIP: bool, const DENSE: bool>(
+        &self,
+        ray: &Ray,
+        boxes: &BoxRay,
+        t_max: f32,
+        clips: &Clips,
+        c: &mut Counters,
+        skip: impl Fn(u32) -> bool,
+        mut on_hit: impl FnMut(u32, u32) -> bool,
+    ) -> bool {
         let prep = S::prep(ray);
         self.bvh.any_ray(
             boxes,
@@ -362,16 +442,16 @@ impl<S: Shape> Set<S> {
                 }
                 c.tests += 1;
                 if !self.clipped {
-                    let n = self.data[i].crossings(ray, &prep, t_max);
+                    let n = self.data[i].crossings_in::<DENSE>(ray, &prep, t_max);
                     return n > 0 && on_hit(material_of(self.material[i]), n);
                 }
                 let packed = self.material[i];
                 let n = if clip_of(packed) == 0 {
-                    self.data[i].crossings(ray, &prep, t_max)
+                    self.data[i].crossings_in::<DENSE>(ray, &prep, t_max)
                 } else {
                     // Count only the crossings the clip group keeps.
                     let (mut n, mut lo) = (0, 0.0);
-                    while let Some(h) = self.data[i].hit_after(ray, &prep, lo, t_max) {
+                    while let Some(h) = self.data[i].hit_after_in::<DENSE>(ray, &prep, lo, t_max) {
                         n += u32::from(!clips.cut(clip_of(packed), ray.at(h.0)));
                         lo = h.0;
                     }
@@ -430,6 +510,86 @@ mod tests {
             blocked += usize::from(tree);
         }
         blocked
+    }
+
+    /// A seashell's spheres (each overlapping the next) are dense, spaced or touching ones
+    /// are not; and a dense set answers every query as the same set without the dense tests.
+    #[test]
+    fn dense_sets_answer_as_the_others() {
+        let shell = |step: f32| {
+            let mut set = Set::default();
+            for k in 0..300 {
+                let a = k as f32 * step;
+                let r = 0.05 + 0.002 * k as f32;
+                let center = Vec3::new(
+                    a.cos() * (1.0 + 0.3 * a),
+                    a.sin() * (1.0 + 0.3 * a),
+                    2.0 + 0.05 * a,
+                );
+                set.push(Sphere { center, radius: r }, k);
+            }
+            set.build();
+            set
+        };
+        let dense = shell(0.02);
+        assert!(dense.dense);
+        assert!(!shell(2.0).dense);
+        let mut touching = Set::default();
+        for k in 0..100 {
+            let center = Vec3::new(2.0 * k as f32, 0.0, 0.0);
+            touching.push(
+                Sphere {
+                    center,
+                    radius: 1.0,
+                },
+                0,
+            );
+        }
+        touching.build();
+        assert!(!touching.dense);
+
+        let mut plain = shell(0.02);
+        plain.dense = false;
+        let (clips, mut c) = (Clips::default(), Counters::default());
+        // The test rays, and rays leaving points on the spheres' surfaces (shadow and
+        // reflection rays, which start inside many boxes).
+        let mut all = rays();
+        for (k, s) in dense.data.iter().enumerate().step_by(7) {
+            let n = Vec3A::new((k as f32).sin(), (k as f32).cos(), 0.3).normalize();
+            let p = Vec3A::from(s.center) + n * s.radius * 1.0001;
+            for d in [n, -n, Vec3A::Z, (n + Vec3A::X).normalize()] {
+                all.push((Ray::new(p, d, 0.0), f32::INFINITY));
+                all.push((Ray::new(p, d, 0.0), 0.5));
+            }
+        }
+        let (mut hits, mut blocked) = (0, 0);
+        for (ray, t_max) in &all {
+            let b = BoxRay::new(ray.origin, ray.dir);
+            let closest = |set: &Set<Sphere>, c: &mut Counters| {
+                let (mut t, mut hit) = (*t_max, None);
+                set.intersect_noting(ray, &b, &mut t, &mut hit, &clips, c, |_| {});
+                (t.to_bits(), hit.map(|h| h.index))
+            };
+            let got = closest(&dense, &mut c);
+            assert_eq!(got, closest(&plain, &mut c), "{ray:?} {t_max}");
+            hits += usize::from(got.1.is_some());
+            let any = |set: &Set<Sphere>, c: &mut Counters| {
+                let mut n = 0;
+                let a = set.any_prepared(ray, &b, *t_max, &clips, c, |_, k| {
+                    n += k;
+                    false
+                });
+                (a, n)
+            };
+            let got = any(&dense, &mut c);
+            assert_eq!(got, any(&plain, &mut c), "{ray:?} {t_max}");
+            blocked += usize::from(got.1 > 0);
+        }
+        let n = all.len();
+        assert!(
+            hits > n / 10 && blocked > n / 10,
+            "{hits} hits, {blocked} blocked of {n}"
+        );
     }
 
     #[test]
