@@ -64,6 +64,45 @@ pub trait Shape: Copy + Send + Sync {
     fn crossings_in<const DENSE: bool>(&self, ray: &Ray, prep: &Self::Prep, t_max: f32) -> u32 {
         self.crossings(ray, prep, t_max)
     }
+    /// In a [`Shape::dense`] set: which of the up to [`BLOCK`] primitives from `start` may
+    /// meet the ray in (t_min, t_max) (bit k for `start + k`), tested together; a cleared bit
+    /// promises that [`Shape::hit_after_in`] and [`Shape::crossings_in`] would find nothing
+    /// there for this ray in any (t_min', t_max') inside (t_min, t_max).
+    #[inline(always)]
+    fn block_may_hit(data: &[Self], start: usize, ray: &Ray, t_min: f32, t_max: f32) -> u32 {
+        let _ = (data, start, ray, t_min, t_max);
+        u32::MAX
+    }
+}
+
+/// Primitives a dense set's traversal tests together ([`Shape::block_may_hit`]): a leaf or
+/// more, in leaf order.
+pub const BLOCK: usize = 8;
+
+/// The last block a dense set's traversal tested: its first primitive and its mask. Leaves
+/// are visited in any order, but a block tested with a larger t_max than now only lets more
+/// through, so a mask stays valid for the rest of the ray.
+struct Block {
+    start: usize,
+    mask: u32,
+}
+
+impl Block {
+    /// No block yet: every index lies outside it (`i - start` wraps to `i + BLOCK + 1`).
+    const NONE: Block = Block {
+        start: usize::MAX - BLOCK,
+        mask: 0,
+    };
+
+    /// Whether primitive `i` may meet the ray, testing its block when `i` is outside the last.
+    #[inline(always)]
+    fn may_hit(&mut self, i: usize, test: impl FnOnce() -> u32) -> bool {
+        let mut k = i.wrapping_sub(self.start);
+        if k >= BLOCK {
+            (self.start, self.mask, k) = (i, test(), 0);
+        }
+        self.mask >> k & 1 != 0
+    }
 }
 
 /// Up to this many primitives of a kind, an opaque any-hit query tests them one by one,
@@ -269,7 +308,8 @@ impl<S: Shape> Set<S> {
     }
 
     /// [`Set::intersect_noting`] with the tests for `DENSE` primitives or the others (a
-    /// constant, so the choice is made once per ray, not per test).
+    /// constant, so the choice is made once per ray, not per test). Dense sets skip the
+    /// primitives their [`Block`] rules out.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn closest_with<const DENSE: bool>(
@@ -283,12 +323,17 @@ impl<S: Shape> Set<S> {
         noted: impl Fn(usize),
     ) {
         let prep = S::prep(ray);
+        // Unused (and optimised away) in the other sets.
+        let mut block = Block::NONE;
         *t_max = self.bvh.intersect_ray(
             boxes,
             *t_max,
             #[inline(always)]
             |i, tm| {
                 c.tests += 1;
+                if DENSE && !block.may_hit(i, || S::block_may_hit(&self.data, i, ray, 0.0, tm)) {
+                    return None;
+                }
                 let (t, b1, b2) = self.kept_hit::<DENSE>(i, ray, &prep, tm, clips)?;
                 let mut h = Hit::new(t, S::KIND, i);
                 h.b1 = b1;
@@ -432,6 +477,7 @@ impl<S: Shape> Set<S> {
         mut on_hit: impl FnMut(u32, u32) -> bool,
     ) -> bool {
         let prep = S::prep(ray);
+        let mut block = Block::NONE;
         self.bvh.any_ray(
             boxes,
             t_max,
@@ -441,6 +487,9 @@ impl<S: Shape> Set<S> {
                     return false;
                 }
                 c.tests += 1;
+                if DENSE && !block.may_hit(i, || S::block_may_hit(&self.data, i, ray, 0.0, t_max)) {
+                    return false;
+                }
                 if !self.clipped {
                     let n = self.data[i].crossings_in::<DENSE>(ray, &prep, t_max);
                     return n > 0 && on_hit(material_of(self.material[i]), n);
