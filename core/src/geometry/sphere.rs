@@ -167,10 +167,10 @@ impl Shape for Sphere {
 
     /// Spheres that overlap deeply and many at a time (one's centre inside the other): in leaf
     /// order (spatial neighbours), each overlaps at least three of the next seven on average,
-    /// in a sample of every 16th. A seashell's spiral (6.9 of 7) or a grid of overlapping balls
-    /// is dense; a space-filling DNA (Tachyon's dna.dat: 0.7) is not, nor are spheres that only
-    /// touch (the sphereflake: 0). Dense sets' rays meet many spheres' boxes before their
-    /// closest hit, and leave surfaces inside many boxes.
+    /// in a sample of every 16th. A seashell's spiral (6.9 of 7) or spheres stacked at the same
+    /// points (Tachyon's gridtest.dat: 7.0) are dense; a space-filling DNA (dna.dat: 0.7) is not,
+    /// nor are spheres that only touch (the sphereflake: 0). Dense sets' rays meet many spheres'
+    /// boxes before their closest hit, and leave surfaces inside many boxes.
     fn dense(data: &[Sphere]) -> bool {
         let deep = |a: &Sphere, b: &Sphere| {
             let reach = a.radius.max(b.radius);
